@@ -1,0 +1,24 @@
+"""The project's error types.
+
+Every error roots at :class:`VestError` and also inherits the matching builtin, so callers
+can catch either ``VestError`` or, say, ``ValueError``. Messages name the thing, the value
+and the place.
+"""
+
+from __future__ import annotations
+
+
+class VestError(Exception):
+    """Root of every error raised by vest."""
+
+
+class ConfigError(VestError, ValueError):
+    """A person's input (a YAML file, a CLI argument, a config) is wrong."""
+
+
+class DeviceError(VestError, OSError):
+    """A device could not be reached or answered something it should not."""
+
+
+class ServiceError(VestError, RuntimeError):
+    """A service (speech, LEDs, servos, sensors, IoT) could not do what was asked."""
