@@ -1,0 +1,101 @@
+"""The engine's view of py_trees' blackboard: staged writes committed between ticks.
+
+py_trees keeps one process-wide blackboard; :class:`Blackboard` owns how the engine writes
+to it. Threads that produce data (pollers, the speech recognizer, the IoT client) call
+:meth:`Blackboard.stage` or :meth:`Blackboard.stage_event`; the scheduler calls
+:meth:`Blackboard.commit` between ticks, so a tick never sees half an update. Tree nodes
+read through py_trees blackboard clients and write during their tick with :meth:`set`.
+"""
+
+from __future__ import annotations
+
+import threading
+from typing import Any
+
+import py_trees
+
+from engine.blackboard.catalogue import KeyCatalogue
+from engine.blackboard.events import EventLog
+from engine.clock import Clock
+
+_STORAGE = py_trees.blackboard.Blackboard.storage
+
+
+class Blackboard:
+    """Staging and committing writes, event logs, and when each key last changed.
+
+    Times are the injected clock's seconds.
+    """
+
+    def __init__(self, catalogue: KeyCatalogue, clock: Clock) -> None:
+        self.catalogue = catalogue
+        self.clock = clock
+        self._pending: list[tuple[str, Any, bool]] = []
+        self._lock = threading.Lock()
+        self._updated_s: dict[str, float] = {}
+
+    # -- producers (any thread) ---------------------------------------------------------
+    def stage(self, key: str, value: Any) -> None:
+        """Queue ``key = value`` for the next commit."""
+        with self._lock:
+            self._pending.append((key, value, False))
+
+    def stage_event(self, key: str, value: Any) -> None:
+        """Queue one event on ``key`` for the next commit."""
+        with self._lock:
+            self._pending.append((key, value, True))
+
+    # -- the scheduler's thread ---------------------------------------------------------
+    def commit(self) -> int:
+        """Apply every staged write, in order; returns how many there were."""
+        with self._lock:
+            pending, self._pending = self._pending, []
+        for key, value, is_event in pending:
+            if is_event:
+                self._append_event(key, value)
+            else:
+                self._write(key, value)
+        return len(pending)
+
+    def set(self, key: str, value: Any) -> None:
+        """Write now (a tree node during its tick, or a test). Event keys get an event."""
+        spec = self.catalogue.lookup(key)
+        if spec is not None and spec.kind == "event":
+            self._append_event(key, value)
+        else:
+            self._write(key, value)
+
+    def emit(self, key: str, value: Any) -> None:
+        """Add an event to ``key`` now."""
+        self._append_event(key, value)
+
+    def get(self, key: str, default: Any = None) -> Any:
+        return _STORAGE.get(key, default)
+
+    def event_log(self, key: str) -> EventLog:
+        log = _STORAGE.get(key)
+        return log if isinstance(log, EventLog) else EventLog()
+
+    def updated_s(self, key: str) -> float | None:
+        """Clock time of the last write to ``key``, or None if never written."""
+        return self._updated_s.get(key)
+
+    def snapshot(self) -> dict[str, Any]:
+        """A copy of every key and value, for debug views and recordings."""
+        return dict(_STORAGE)
+
+    def reset(self) -> None:
+        """Forget every key, pending write and blackboard client (a fresh robot)."""
+        with self._lock:
+            self._pending.clear()
+        self._updated_s.clear()
+        py_trees.blackboard.Blackboard.clear()
+
+    def _write(self, key: str, value: Any) -> None:
+        _STORAGE[key] = value
+        self._updated_s[key] = self.clock.now()
+
+    def _append_event(self, key: str, value: Any) -> None:
+        now = self.clock.now()
+        _STORAGE[key] = self.event_log(key).appended(value, now)
+        self._updated_s[key] = now

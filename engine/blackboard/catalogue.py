@@ -1,0 +1,146 @@
+"""The catalogue of blackboard keys: name, type, unit, writer and meaning.
+
+The YAML loader checks every key a tree names against it (with "did you mean"), the docs
+list it, and the catalogue says which keys are *events* (reacted to once per event) rather
+than *state* (read every tick). Keys under ``/vars/`` are free for trees to use as their
+own variables; ``/devices/<name>/ok`` exists for every configured device.
+"""
+
+from __future__ import annotations
+
+import difflib
+import fnmatch
+from collections.abc import Iterable, Iterator
+from dataclasses import dataclass
+from typing import Any, Literal
+
+Kind = Literal["state", "event"]
+
+VARIABLES_PREFIX = "/vars/"
+
+
+@dataclass(frozen=True)
+class KeySpec:
+    """What one blackboard key holds.
+
+    ``name`` may contain one ``*`` segment for families of keys (``/devices/*/ok``).
+    ``value_type`` is what a comparison against it must be: bool, float (int accepted),
+    str, list (of the item type) or object. ``alias`` is a short name for text templates
+    (``{temperature_f:.0f}``).
+    """
+
+    name: str
+    value_type: type
+    unit: str
+    writer: str
+    description: str
+    kind: Kind = "state"
+    alias: str | None = None
+
+    @property
+    def is_pattern(self) -> bool:
+        return "*" in self.name
+
+    def matches(self, key: str) -> bool:
+        if not self.is_pattern:
+            return key == self.name
+        return fnmatch.fnmatchcase(key, self.name) and key.count("/") == self.name.count("/")
+
+    @property
+    def type_name(self) -> str:
+        return {bool: "bool", float: "number", int: "integer", str: "text", list: "list"}.get(
+            self.value_type, "object"
+        )
+
+
+VARIABLE_SPEC = KeySpec(
+    VARIABLES_PREFIX + "*", object, "", "trees", "a tree's own variable (any value)"
+)
+
+
+class KeyCatalogue:
+    """A set of :class:`KeySpec`; look up a key, list them, suggest the nearest."""
+
+    def __init__(self, specs: Iterable[KeySpec]) -> None:
+        self._exact: dict[str, KeySpec] = {}
+        self._patterns: list[KeySpec] = []
+        for spec in specs:
+            self.add(spec)
+
+    def add(self, spec: KeySpec) -> None:
+        if not spec.name.startswith("/"):
+            raise ValueError(f"blackboard keys are absolute: {spec.name!r} must start with '/'")
+        if spec.is_pattern:
+            self._patterns.append(spec)
+        else:
+            self._exact[spec.name] = spec
+
+    def lookup(self, key: str) -> KeySpec | None:
+        """The spec of ``key``; tree variables (``/vars/...``) always exist."""
+        spec = self._exact.get(key)
+        if spec is not None:
+            return spec
+        if key.startswith(VARIABLES_PREFIX) and len(key) > len(VARIABLES_PREFIX):
+            return VARIABLE_SPEC
+        for pattern in self._patterns:
+            if pattern.matches(key):
+                return pattern
+        return None
+
+    def by_alias(self, alias: str) -> KeySpec | None:
+        for spec in self._exact.values():
+            if spec.alias == alias:
+                return spec
+        return None
+
+    def suggest(self, key: str) -> str | None:
+        """The known key nearest to ``key``, or None when nothing is close."""
+        names = [*self._exact, *(p.name for p in self._patterns)]
+        close = difflib.get_close_matches(key, names, n=1, cutoff=0.6)
+        return close[0] if close else None
+
+    def __iter__(self) -> Iterator[KeySpec]:
+        yield from sorted(self._exact.values(), key=lambda s: s.name)
+        yield from self._patterns
+        yield VARIABLE_SPEC
+
+    def __contains__(self, key: Any) -> bool:
+        return isinstance(key, str) and self.lookup(key) is not None
+
+
+def default_catalogue() -> KeyCatalogue:
+    """The keys every vest robot has."""
+    return KeyCatalogue(
+        [
+            KeySpec("/sensors/touch/pads", list, "", "touch poller (MPR121)",
+                    "12 booleans, True while that pad is touched"),
+            KeySpec("/sensors/touch/any", bool, "", "touch poller (MPR121)",
+                    "True while any pad is touched"),
+            KeySpec("/sensors/force/left_n", float, "N", "force poller (ADS1115 + FSR 406)",
+                    "force on the left side pad", alias="force_left_n"),
+            KeySpec("/sensors/force/right_n", float, "N", "force poller (ADS1115 + FSR 406)",
+                    "force on the right side pad", alias="force_right_n"),
+            KeySpec("/sensors/range/left_mm", float, "mm", "range poller (VL53L0X)",
+                    "distance seen by the left time-of-flight sensor; absent when nothing "
+                    "is in range", alias="range_left_mm"),
+            KeySpec("/sensors/range/center_mm", float, "mm", "range poller (VL53L0X)",
+                    "distance seen by the center time-of-flight sensor", alias="range_center_mm"),
+            KeySpec("/sensors/range/right_mm", float, "mm", "range poller (VL53L0X)",
+                    "distance seen by the right time-of-flight sensor", alias="range_right_mm"),
+            KeySpec("/sensors/gesture/last", str, "", "gesture poller (ZX sensor)",
+                    "a hand gesture: wave, swipe_left, swipe_right, swipe_up, hover, ...",
+                    kind="event"),
+            KeySpec("/sensors/temperature/c", float, "degC", "temperature service (MCP9808)",
+                    "room temperature, read on request", alias="temperature_c"),
+            KeySpec("/sensors/temperature/f", float, "degF", "temperature service (MCP9808)",
+                    "room temperature, read on request", alias="temperature_f"),
+            KeySpec("/sensors/ultrasound/cm", float, "cm", "ultrasound service (SRF02)",
+                    "distance in front of the robot, read on request", alias="ultrasound_cm"),
+            KeySpec("/speech/heard", str, "", "speech recognizer",
+                    "an utterance the robot heard, as text", kind="event"),
+            KeySpec("/iot/inbox", dict, "", "IoT client",
+                    "a remote command: {id, type, args}", kind="event"),
+            KeySpec("/devices/*/ok", bool, "", "bus managers",
+                    "False while that device is offline (unplugged or failing)"),
+        ]
+    )

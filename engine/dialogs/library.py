@@ -1,0 +1,212 @@
+"""Loading dialog files from a folder, with file:line:column problems.
+
+A dialog file::
+
+    dialog: default
+    concepts:                       # named lists of synonyms, used as ~name in phrases
+      greeting: [hello, hi, hey]
+    rules:
+      - hear: ["what is your name", "who are you"]
+        say: "My name is H B S 2"
+      - hear: ["what is the temperature"]
+        read: temperature           # read this sensor before answering
+        say: "The temperature is {temperature_f:.0f} degrees"
+      - hear: ["~greeting robot"]
+        say: "Hello!"
+    fallback: "Sorry, I did not catch that."
+"""
+
+from __future__ import annotations
+
+import itertools
+from pathlib import Path
+
+from engine.blackboard.catalogue import KeyCatalogue
+from engine.dialogs.model import Dialog, DialogRule, normalize
+from engine.loader.problems import LoadError, Problems
+from engine.loader.yaml_source import YList, YMap, YScalar, YValue, describe, load_yaml
+from engine.nodes.params import CheckContext, ParamProblem, did_you_mean
+from engine.nodes.templates import CompiledTemplate, compile_template
+
+ON_REQUEST_SENSORS = ("temperature", "ultrasound")
+_TOP_KEYS = ("dialog", "description", "concepts", "rules", "fallback", "min_score")
+_RULE_KEYS = ("hear", "say", "read")
+
+
+class DialogLibrary:
+    """Dialogs by name, loaded from ``*.yaml`` files in a folder."""
+
+    def __init__(self, dialogs: dict[str, Dialog] | None = None) -> None:
+        self.dialogs = dialogs or {}
+
+    @classmethod
+    def from_folder(cls, folder: Path, catalogue: KeyCatalogue) -> DialogLibrary:
+        """Every dialog in ``folder``; LoadError listing all problems of all files."""
+        problems = Problems()
+        dialogs: dict[str, Dialog] = {}
+        for path in sorted(folder.glob("*.yaml")):
+            try:
+                dialog = load_dialog(path, catalogue)
+            except LoadError as error:
+                problems.extend(error.problems)
+                continue
+            dialogs[dialog.name] = dialog
+        problems.raise_if_any()
+        return cls(dialogs)
+
+    def get(self, name: str) -> Dialog | None:
+        return self.dialogs.get(name)
+
+    @property
+    def names(self) -> list[str]:
+        return sorted(self.dialogs)
+
+    def phrases(self) -> list[str]:
+        return sorted({p for dialog in self.dialogs.values() for p in dialog.phrases})
+
+
+def load_dialog(path: Path, catalogue: KeyCatalogue, shown: str | None = None) -> Dialog:
+    name = shown or str(path)
+    document = load_yaml(path, name)
+    return check_dialog(document, name, catalogue, default_name=path.stem)
+
+
+def check_dialog(
+    document: YValue | None, file: str, catalogue: KeyCatalogue, *, default_name: str
+) -> Dialog:
+    """Validate a parsed dialog file whole; LoadError with every problem."""
+    from engine.loader.problems import Mark
+
+    problems = Problems()
+    if not isinstance(document, YMap):
+        where = document.mark if document is not None else Mark(file, 1, 1)
+        problems.add(where, "a dialog file is a mapping with 'dialog:' and 'rules:'")
+        problems.raise_if_any()
+    assert isinstance(document, YMap)
+    for key, mark in document.key_marks.items():
+        if key not in _TOP_KEYS:
+            problems.add(mark, f"unknown dialog field {key!r}",
+                         did_you_mean(key, _TOP_KEYS) or "fields: " + ", ".join(_TOP_KEYS))
+    ctx = CheckContext(catalogue)
+    dialog_name = _text(document.get("dialog"), problems, "dialog") or default_name
+    concepts = _concepts(document.get("concepts"), problems)
+    rules: list[DialogRule] = []
+    raw_rules = document.get("rules")
+    if raw_rules is None:
+        problems.add(document.mark, "a dialog needs 'rules:'", "add a list of hear/say rules")
+    elif not isinstance(raw_rules, YList):
+        problems.add(raw_rules.mark, f"'rules' must be a list, got {describe(raw_rules)}")
+    else:
+        for raw in raw_rules:
+            rule = _rule(raw, concepts, ctx, problems)
+            if rule is not None:
+                rules.append(rule)
+    fallback = None
+    raw_fallback = document.get("fallback")
+    if raw_fallback is not None:
+        fallback = _template(raw_fallback, ctx, problems)
+    min_score = 0.8
+    raw_score = document.get("min_score")
+    if raw_score is not None:
+        value = raw_score.value if isinstance(raw_score, YScalar) else None
+        if isinstance(value, bool) or not isinstance(value, int | float) or not 0 < value <= 1:
+            problems.add(raw_score.mark, f"'min_score' must be a number in 0..1, got "
+                         f"{describe(raw_score)}")
+        else:
+            min_score = float(value)
+    problems.raise_if_any()
+    return Dialog(dialog_name, tuple(rules), fallback, min_score, file)
+
+
+def _text(value: YValue | None, problems: Problems, what: str) -> str | None:
+    if value is None:
+        return None
+    if not isinstance(value, YScalar) or not isinstance(value.value, str | int | float):
+        problems.add(value.mark, f"{what!r} must be text, got {describe(value)}")
+        return None
+    return str(value.value)
+
+
+def _concepts(value: YValue | None, problems: Problems) -> dict[str, list[str]]:
+    concepts: dict[str, list[str]] = {}
+    if value is None:
+        return concepts
+    if not isinstance(value, YMap):
+        problems.add(value.mark, "'concepts' must map names to lists of words")
+        return concepts
+    for name, words in value.items():
+        if not isinstance(words, YList) or not all(isinstance(w, YScalar) for w in words):
+            problems.add(words.mark, f"concept {name!r} must be a list of words or phrases")
+            continue
+        concepts[name] = [normalize(str(w.value)) for w in words if isinstance(w, YScalar)]
+    return concepts
+
+
+def _expand(phrase: str, concepts: dict[str, list[str]]) -> list[str] | str:
+    """Every phrase ``~concept`` words expand to, or an error message."""
+    options: list[list[str]] = []
+    for word in phrase.split():
+        if word.startswith("~"):
+            synonyms = concepts.get(word[1:])
+            if synonyms is None:
+                hint = did_you_mean(word[1:], list(concepts))
+                return f"unknown concept {word!r}" + (f"; {hint}" if hint else "")
+            options.append(synonyms)
+        else:
+            options.append([normalize(word)])
+    return [" ".join(filter(None, combo)) for combo in itertools.product(*options)]
+
+
+def _rule(raw: YValue, concepts: dict[str, list[str]], ctx: CheckContext,
+          problems: Problems) -> DialogRule | None:
+    if not isinstance(raw, YMap):
+        problems.add(raw.mark, "each rule is a mapping with 'hear:' and 'say:'")
+        return None
+    for key, mark in raw.key_marks.items():
+        if key not in _RULE_KEYS:
+            problems.add(mark, f"unknown rule field {key!r}",
+                         did_you_mean(key, _RULE_KEYS) or "fields: hear, say, read")
+    hear = raw.get("hear")
+    phrases: list[str] = []
+    if hear is None:
+        problems.add(raw.mark, "rule has no 'hear:'", "list the phrases that trigger it")
+    else:
+        items = hear.items if isinstance(hear, YList) else [hear]
+        for item in items:
+            if not isinstance(item, YScalar) or not isinstance(item.value, str) or not item.value:
+                problems.add(item.mark, f"a phrase must be text, got {describe(item)}")
+                continue
+            expanded = _expand(item.value, concepts)
+            if isinstance(expanded, str):
+                problems.add(item.mark, expanded)
+            else:
+                phrases.extend(p for p in expanded if p)
+    say = raw.get("say")
+    answer = None
+    if say is None:
+        problems.add(raw.mark, "rule has no 'say:'", "write what the robot answers")
+    else:
+        answer = _template(say, ctx, problems)
+    read = None
+    raw_read = raw.get("read")
+    if raw_read is not None:
+        read = _text(raw_read, problems, "read")
+        if read is not None and read not in ON_REQUEST_SENSORS:
+            problems.add(raw_read.mark, f"cannot read {read!r} on request",
+                         did_you_mean(read, ON_REQUEST_SENSORS)
+                         or "use " + " or ".join(ON_REQUEST_SENSORS))
+            read = None
+    if answer is None or not phrases:
+        return None
+    return DialogRule(tuple(dict.fromkeys(phrases)), answer, read, raw.mark.line)
+
+
+def _template(value: YValue, ctx: CheckContext, problems: Problems) -> CompiledTemplate | None:
+    if not isinstance(value, YScalar) or not isinstance(value.value, str):
+        problems.add(value.mark, f"an answer must be text, got {describe(value)}")
+        return None
+    try:
+        return compile_template(value.value, ctx)
+    except ParamProblem as problem:
+        problems.add(value.mark, problem.message, problem.hint)
+        return None

@@ -1,0 +1,412 @@
+"""Pololu Maestro servo controller (Mini Maestro 12) over its serial command port.
+
+Over USB the Maestro shows up as two serial ports; commands go to the first one, the
+"Command Port" (usually ``/dev/ttyACM0``), where the baud rate does not matter. The same
+commands work on the TTL serial line.
+
+The protocol (Maestro user's guide, sections 5.c and 5.e) is a command byte with its most
+significant bit set followed by data bytes with it cleared, so every 14-bit value travels
+as two 7-bit bytes, low bits first. The *compact* protocol sends the command byte itself;
+the *Pololu* protocol sends ``0xAA``, the device number and the command byte with its MSB
+cleared, so several Pololu controllers can share one line. Replies are plain bytes, 16-bit
+values little-endian.
+
+Pulse widths travel in quarter-microseconds (a target of 6000 is 1500 us; 0 stops the
+pulses). Speed is in (0.25 us)/(10 ms), acceleration in (0.25 us)/(10 ms)/(80 ms), for the
+default 20 ms servo period; 0 means unlimited for both.
+
+The encoding is kept in pure functions (``encode_*``, ``decode_*``) testable without a
+port; :class:`Maestro` only moves bytes.
+"""
+
+from __future__ import annotations
+
+import errno
+import os
+import threading
+from types import TracebackType
+from typing import Literal, Protocol, Self
+
+import serial
+
+from engine.clock import Clock, RealClock
+from engine.errors import DeviceError
+
+# Command bytes (compact protocol).
+CMD_SET_TARGET = 0x84
+CMD_SET_SPEED = 0x87
+CMD_SET_ACCELERATION = 0x89
+CMD_GET_POSITION = 0x90
+CMD_GET_MOVING_STATE = 0x93
+CMD_GET_ERRORS = 0xA1
+CMD_GO_HOME = 0xA2
+POLOLU_PROTOCOL_START = 0xAA
+"""First byte of a Pololu-protocol packet (also the baud-rate indication byte)."""
+
+DEFAULT_DEVICE_NUMBER = 12
+MAX_DEVICE_NUMBER = 127
+MAX_14_BIT = 0x3FFF
+MAX_ACCELERATION = 255
+QUARTER_US_PER_US = 4
+
+# Error register (user's guide section 4.e): read and cleared by Get Errors.
+ERROR_SERIAL_SIGNAL = 1 << 0
+ERROR_SERIAL_OVERRUN = 1 << 1
+ERROR_SERIAL_BUFFER_FULL = 1 << 2
+ERROR_SERIAL_CRC = 1 << 3
+ERROR_SERIAL_PROTOCOL = 1 << 4
+ERROR_SERIAL_TIMEOUT = 1 << 5
+ERROR_SCRIPT_STACK = 1 << 6
+ERROR_SCRIPT_CALL_STACK = 1 << 7
+ERROR_SCRIPT_PROGRAM_COUNTER = 1 << 8
+
+ERROR_NAMES: dict[int, str] = {
+    ERROR_SERIAL_SIGNAL: "serial signal error",
+    ERROR_SERIAL_OVERRUN: "serial overrun error",
+    ERROR_SERIAL_BUFFER_FULL: "serial buffer full",
+    ERROR_SERIAL_CRC: "serial CRC error",
+    ERROR_SERIAL_PROTOCOL: "serial protocol error",
+    ERROR_SERIAL_TIMEOUT: "serial timeout",
+    ERROR_SCRIPT_STACK: "script stack error",
+    ERROR_SCRIPT_CALL_STACK: "script call stack error",
+    ERROR_SCRIPT_PROGRAM_COUNTER: "script program counter error",
+}
+"""Bit mask -> name of each error the Maestro reports, in bit order."""
+
+
+class SerialPort(Protocol):
+    """The part of ``serial.Serial`` the driver uses; ``timeout`` is in seconds."""
+
+    timeout: float | None
+
+    def write(self, data: bytes, /) -> int | None: ...
+
+    def read(self, size: int = 1, /) -> bytes: ...
+
+    def flush(self) -> None: ...
+
+    def reset_input_buffer(self) -> None: ...
+
+    def close(self) -> None: ...
+
+
+# --- pure encoding -------------------------------------------------------------------------
+
+
+def _check_data_byte(what: str, value: int) -> None:
+    if not 0 <= value <= 0x7F:
+        raise ValueError(f"{what} {value} does not fit a 7-bit data byte (0..127)")
+
+
+def _encode_14_bit(what: str, value: int) -> bytes:
+    if not 0 <= value <= MAX_14_BIT:
+        raise ValueError(f"{what} {value} is outside 0..{MAX_14_BIT} (14 bits)")
+    return bytes((value & 0x7F, (value >> 7) & 0x7F))
+
+
+def us_to_quarter_us(pulse_us: float) -> int:
+    """A pulse width in microseconds as the Maestro's integer quarter-microseconds."""
+    quarter_us = round(pulse_us * QUARTER_US_PER_US)
+    if not 0 <= quarter_us <= MAX_14_BIT:
+        raise ValueError(
+            f"pulse width {pulse_us} us is outside 0..{MAX_14_BIT / QUARTER_US_PER_US} us"
+        )
+    return quarter_us
+
+
+def encode_set_target(channel: int, quarter_us: int) -> bytes:
+    """Set Target: ``channel`` moves to ``quarter_us`` (0.25 us units; 0 stops its pulses)."""
+    _check_data_byte("channel", channel)
+    return bytes((CMD_SET_TARGET, channel)) + _encode_14_bit("target", quarter_us)
+
+
+def encode_set_speed(channel: int, speed: int) -> bytes:
+    """Set Speed: limit in (0.25 us)/(10 ms); 0 is unlimited."""
+    _check_data_byte("channel", channel)
+    return bytes((CMD_SET_SPEED, channel)) + _encode_14_bit("speed", speed)
+
+
+def encode_set_acceleration(channel: int, acceleration: int) -> bytes:
+    """Set Acceleration: limit in (0.25 us)/(10 ms)/(80 ms), 0..255; 0 is unlimited."""
+    _check_data_byte("channel", channel)
+    if not 0 <= acceleration <= MAX_ACCELERATION:
+        raise ValueError(f"acceleration {acceleration} is outside 0..{MAX_ACCELERATION}")
+    return bytes((CMD_SET_ACCELERATION, channel)) + _encode_14_bit("acceleration", acceleration)
+
+
+def encode_get_position(channel: int) -> bytes:
+    """Get Position: the reply is the pulse width being sent, 2 bytes little-endian (0.25 us)."""
+    _check_data_byte("channel", channel)
+    return bytes((CMD_GET_POSITION, channel))
+
+
+def encode_get_moving_state() -> bytes:
+    """Get Moving State: the reply is 0x01 while a speed- or acceleration-limited servo moves."""
+    return bytes((CMD_GET_MOVING_STATE,))
+
+
+def encode_get_errors() -> bytes:
+    """Get Errors: the reply is the error register, 2 bytes little-endian; reading clears it."""
+    return bytes((CMD_GET_ERRORS,))
+
+
+def encode_go_home() -> bytes:
+    """Go Home: every channel goes to its configured home (off, unchanged, or a position)."""
+    return bytes((CMD_GO_HOME,))
+
+
+def encode_pololu(device: int, packet: bytes) -> bytes:
+    """A compact-protocol ``packet`` rewritten for the Pololu protocol and ``device``."""
+    _check_data_byte("device number", device)
+    if not packet or not packet[0] & 0x80:
+        raise ValueError(f"packet {packet.hex(' ')} does not start with a command byte")
+    return bytes((POLOLU_PROTOCOL_START, device, packet[0] & 0x7F)) + packet[1:]
+
+
+def decode_u16(reply: bytes) -> int:
+    """A 2-byte little-endian reply as an integer."""
+    if len(reply) != 2:
+        raise ValueError(f"expected a 2-byte reply, got {reply.hex(' ') or 'nothing'}")
+    return reply[0] | (reply[1] << 8)
+
+
+def decode_errors(register: int) -> list[str]:
+    """The error register as names, lowest bit first; unknown bits are named by number."""
+    names = []
+    for bit in range(16):
+        mask = 1 << bit
+        if register & mask:
+            names.append(ERROR_NAMES.get(mask, f"unknown error bit {bit}"))
+    return names
+
+
+def describe_port_error(code: int | None) -> str:
+    """Words for an errno from opening or using a serial port, with what to do about it."""
+    if code == errno.ENOENT:
+        return "no such file: is the Maestro plugged in? (its command port is often /dev/ttyACM0)"
+    if code in (errno.EACCES, errno.EPERM):
+        return "permission denied: add yourself to the dialout group"
+    if code in (errno.EBUSY, errno.EAGAIN, errno.EWOULDBLOCK):
+        return "busy: another program has it open"
+    if code in (errno.ENXIO, errno.ENODEV):
+        return "no such device: was the Maestro unplugged?"
+    if code is None:
+        return "unknown error"
+    return os.strerror(code).lower()
+
+
+# --- the device ----------------------------------------------------------------------------
+
+
+class Maestro:
+    """A Pololu Maestro on a serial port.
+
+    ``port`` is an open pyserial-compatible port (the caller keeps ownership) or a port name
+    that this class opens and, on :meth:`close`, closes. ``device`` is the Pololu-protocol
+    device number (0..127), used when ``protocol="pololu"``; ``channels`` is 12 for a Mini
+    Maestro 12. ``clock`` is only needed by :meth:`wait_until_stopped`. ``baudrate`` and
+    ``timeout_s`` apply only when the port is opened here; a borrowed port must have a
+    timeout so that a silent Maestro cannot hang a read.
+
+    Thread-safe: each command and its reply form one transaction.
+    """
+
+    def __init__(
+        self,
+        port: SerialPort | str,
+        *,
+        device: int = DEFAULT_DEVICE_NUMBER,
+        protocol: Literal["compact", "pololu"] = "compact",
+        channels: int = 12,
+        clock: Clock | None = None,
+        baudrate: int = 115200,
+        timeout_s: float = 0.5,
+    ) -> None:
+        if not 0 <= device <= MAX_DEVICE_NUMBER:
+            raise ValueError(f"Maestro device number {device} is outside 0..{MAX_DEVICE_NUMBER}")
+        if protocol not in ("compact", "pololu"):
+            raise ValueError(f"Maestro protocol {protocol!r} is neither 'compact' nor 'pololu'")
+        if channels not in (6, 12, 18, 24):
+            raise ValueError(f"a Maestro has 6, 12, 18 or 24 channels, not {channels}")
+        self.device = device
+        self.protocol = protocol
+        self.channels = channels
+        self._clock = clock if clock is not None else RealClock()
+        self._lock = threading.Lock()
+        self._closed = False
+        if isinstance(port, str):
+            self._port: SerialPort = _open_port(port, baudrate=baudrate, timeout_s=timeout_s)
+            self._owns_port = True
+            self._port_name = port
+        else:
+            if getattr(port, "timeout", None) is None:
+                raise ValueError(
+                    "the Maestro's serial port needs a read timeout (port.timeout is None), "
+                    "or a silent Maestro would hang every read"
+                )
+            self._port = port
+            self._owns_port = False
+            self._port_name = str(getattr(port, "port", None) or getattr(port, "name", port))
+
+    @property
+    def port(self) -> SerialPort:
+        """The serial port in use (owned by this object only if it was opened by name)."""
+        return self._port
+
+    @property
+    def port_name(self) -> str:
+        """The port's path, for messages."""
+        return self._port_name
+
+    # -- commands ---------------------------------------------------------------------------
+
+    def set_target_us(self, channel: int, pulse_us: float) -> None:
+        """Move ``channel`` to a pulse width of ``pulse_us`` microseconds (0 turns it off).
+
+        The Maestro clamps targets to the channel's Min/Max configured on the device and
+        honours its speed and acceleration limits.
+        """
+        self._check_channel(channel)
+        self._send(encode_set_target(channel, us_to_quarter_us(pulse_us)))
+
+    def set_speed(self, channel: int, speed: int) -> None:
+        """Limit ``channel``'s speed, in (0.25 us)/(10 ms) (0 = unlimited)."""
+        self._check_channel(channel)
+        self._send(encode_set_speed(channel, speed))
+
+    def set_acceleration(self, channel: int, acceleration: int) -> None:
+        """Limit ``channel``'s acceleration, in (0.25 us)/(10 ms)/(80 ms), 0..255 (0 = off)."""
+        self._check_channel(channel)
+        self._send(encode_set_acceleration(channel, acceleration))
+
+    def get_position_us(self, channel: int) -> float:
+        """The pulse width the Maestro sends on ``channel`` now, in us (0.0 when it is off).
+
+        This is the commanded position after speed/acceleration limits, not a measurement:
+        hobby servos report nothing back.
+        """
+        self._check_channel(channel)
+        reply = self._query(encode_get_position(channel), 2, "Get Position")
+        return decode_u16(reply) / QUARTER_US_PER_US
+
+    def is_moving(self) -> bool:
+        """Whether any speed- or acceleration-limited servo has not reached its target yet."""
+        reply = self._query(encode_get_moving_state(), 1, "Get Moving State")
+        return reply[0] != 0
+
+    def get_errors(self) -> list[str]:
+        """Names of the errors the Maestro has seen since the last call (reading clears them)."""
+        reply = self._query(encode_get_errors(), 2, "Get Errors")
+        return decode_errors(decode_u16(reply))
+
+    def go_home(self) -> None:
+        """Send every channel to the home the Maestro is configured with (default: off)."""
+        self._send(encode_go_home())
+
+    def wait_until_stopped(self, timeout_s: float, *, poll_s: float = 0.02) -> None:
+        """Wait on the clock until no servo moves; DeviceError after ``timeout_s`` seconds."""
+        if timeout_s < 0 or poll_s <= 0:
+            raise ValueError(f"timeout_s {timeout_s} and poll_s {poll_s} must be positive")
+        deadline_s = self._clock.now() + timeout_s
+        while self.is_moving():
+            if self._clock.now() >= deadline_s:
+                raise DeviceError(
+                    errno.ETIMEDOUT,
+                    f"Maestro on {self._port_name}: servos still moving after {timeout_s} s",
+                )
+            self._clock.sleep(poll_s)
+
+    def close(self) -> None:
+        """Stop using the port; close it only if this object opened it."""
+        with self._lock:
+            if self._closed:
+                return
+            self._closed = True
+            if self._owns_port:
+                self._port.close()
+
+    def __enter__(self) -> Self:
+        return self
+
+    def __exit__(
+        self,
+        exc_type: type[BaseException] | None,
+        exc: BaseException | None,
+        tb: TracebackType | None,
+    ) -> None:
+        self.close()
+
+    # -- transport --------------------------------------------------------------------------
+
+    def _check_channel(self, channel: int) -> None:
+        if not 0 <= channel < self.channels:
+            raise ValueError(
+                f"channel {channel} is outside 0..{self.channels - 1} "
+                f"(Maestro on {self._port_name})"
+            )
+
+    def _frame(self, packet: bytes) -> bytes:
+        return encode_pololu(self.device, packet) if self.protocol == "pololu" else packet
+
+    def _send(self, packet: bytes) -> None:
+        with self._lock:
+            self._write(packet)
+
+    def _query(self, packet: bytes, reply_length: int, what: str) -> bytes:
+        with self._lock:
+            self._check_open()
+            try:
+                # A reply that came too late for an earlier query must not answer this one.
+                self._port.reset_input_buffer()
+            except OSError as error:
+                raise self._io_error(error) from error
+            self._write(packet)
+            try:
+                reply = self._port.read(reply_length)
+            except OSError as error:
+                raise self._io_error(error) from error
+        if len(reply) < reply_length:
+            raise DeviceError(
+                errno.ETIMEDOUT,
+                f"Maestro on {self._port_name}: no reply to {what} within "
+                f"{self._port.timeout} s (got {len(reply)} of {reply_length} bytes; "
+                f"protocol {self.protocol}, device number {self.device})",
+            )
+        return reply
+
+    def _check_open(self) -> None:
+        if self._closed:
+            raise DeviceError(errno.EBADF, f"Maestro on {self._port_name} is closed")
+
+    def _write(self, packet: bytes) -> None:
+        self._check_open()
+        try:
+            self._port.write(self._frame(packet))
+            self._port.flush()
+        except OSError as error:
+            raise self._io_error(error) from error
+
+    def _io_error(self, error: OSError) -> DeviceError:
+        if isinstance(error, DeviceError):
+            return error
+        words = describe_port_error(error.errno) if error.errno else str(error)
+        return DeviceError(error.errno or errno.EIO, f"Maestro on {self._port_name}: {words}")
+
+
+def _open_port(name: str, *, baudrate: int, timeout_s: float) -> serial.Serial:
+    """Open ``name`` exclusively, turning pyserial's errors into a DeviceError in words."""
+    try:
+        return serial.Serial(
+            port=name,
+            baudrate=baudrate,
+            timeout=timeout_s,
+            write_timeout=timeout_s,
+            exclusive=True,
+        )
+    except serial.SerialException as error:
+        raise DeviceError(
+            error.errno or errno.EIO,
+            f"cannot open Maestro port {name}: {describe_port_error(error.errno)}",
+        ) from error
+    except ValueError as error:  # pyserial's answer to a bad baud rate or timeout
+        raise DeviceError(errno.EINVAL, f"cannot open Maestro port {name}: {error}") from error

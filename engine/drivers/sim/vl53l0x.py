@@ -1,0 +1,260 @@
+"""A register-level model of the ST VL53L0X time-of-flight sensor.
+
+What it models, as the chip behaves on the wire:
+
+* identity registers 0xC0..0xC2 = 0xEE 0xAA 0x10; an 8-bit register pointer that
+  auto-increments, so 16-bit registers read big-endian in one transfer;
+* the private register page (0xFF = 0x01) with the stop variable at 0x91;
+* single-shot ranging: writing bit 0 of SYSRANGE_START starts it (the bit reads back 0
+  once ranging has begun, here at once); RESULT_INTERRUPT_STATUS reads 0 for the timing
+  budget (~33 ms by default) and then "new sample ready" (0x04) until SYSTEM_INTERRUPT_CLEAR
+  is written; RESULT_RANGE_STATUS holds device status 11 (valid) and the range in mm at
+  +10, or 8190 and a failure status when nothing is within ``max_range_mm``;
+* reference calibrations (SYSRANGE_START with SYSTEM_SEQUENCE_CONFIG 0x01 or 0x02): they
+  raise the same interrupt after ``CALIBRATION_TIME_S``;
+* I2C_SLAVE_DEVICE_ADDRESS (0x8A): the chip moves to the new address on its bus;
+* XSHUT: low puts the chip in hardware standby: it leaves the bus (no answer at all) and
+  forgets its address and every register; high boots it at 0x29, NACKing for tBOOT.
+
+Simplified: the distance is sampled when ranging starts; there is no noise, no signal rate,
+no SPAD or tuning effect (the chip ranges the same with or without the full ST init);
+back-to-back and timed continuous modes are not modelled; a calibration's duration is a
+stand-in (ST does not publish it). The "no target" status is MSRC no-target (4); a real
+chip may report another failure code, which the driver treats alike.
+
+Two chips cannot share an address on a :class:`SimI2CBus`, so a collision that real
+hardware would turn into garbled answers raises ``ValueError`` here (a wiring mistake in
+the simulated world, said loudly).
+"""
+
+from __future__ import annotations
+
+import errno
+
+from engine.clock import Clock
+from engine.drivers.sim.i2c_bus import SimI2CBus, SimI2CDevice, bus_error
+
+POWER_ON_ADDRESS = 0x29
+
+SYSRANGE_START = 0x00
+SYSTEM_SEQUENCE_CONFIG = 0x01
+SYSTEM_INTERRUPT_CLEAR = 0x0B
+RESULT_INTERRUPT_STATUS = 0x13
+RESULT_RANGE_STATUS = 0x14
+RESULT_RANGE_MM = RESULT_RANGE_STATUS + 10  # 0x1E..0x1F, big-endian
+I2C_SLAVE_DEVICE_ADDRESS = 0x8A
+PAGE_SELECT = 0xFF
+STOP_VARIABLE = 0x91  # on the private page
+
+INTERRUPT_NEW_SAMPLE_READY = 0x04
+DEVICE_STATUS_RANGE_VALID = 11
+DEVICE_STATUS_MSRC_NO_TARGET = 4
+OUT_OF_RANGE_MM = 8190
+
+CALIBRATION_SEQUENCES = {0x01, 0x02}  # VHV and phase reference calibration
+CALIBRATION_TIME_S = 0.001
+BOOT_TIME_S = 0.0012  # tBOOT, datasheet maximum
+
+_POWER_ON_REGISTERS = {
+    0xC0: 0xEE,
+    0xC1: 0xAA,
+    0xC2: 0x10,
+    SYSTEM_SEQUENCE_CONFIG: 0xFF,
+    0x44: 0x00,  # FINAL_RANGE_CONFIG_MIN_COUNT_RATE_RTN_LIMIT, high byte
+    0x45: 0x20,  # ... low byte: 0.25 MCPS in Q9.7
+    0x84: 0x11,  # GPIO_HV_MUX_ACTIVE_HIGH
+    I2C_SLAVE_DEVICE_ADDRESS: POWER_ON_ADDRESS,
+}
+_POWER_ON_PRIVATE = {STOP_VARIABLE: 0x3C}  # a plausible stop variable; any value works
+_READ_ONLY = {0xC0, 0xC1, 0xC2, RESULT_INTERRUPT_STATUS, *range(0x14, 0x20)}
+
+
+class SimVL53L0X(SimI2CDevice):
+    """A VL53L0X soldered onto ``bus``, looking at whatever is ``distance_mm`` away.
+
+    With ``xshut_high`` (the board's pull-up) it is powered and on the bus at once;
+    otherwise it waits in hardware standby for :meth:`set_xshut`.
+    """
+
+    def __init__(
+        self,
+        clock: Clock,
+        bus: SimI2CBus,
+        address: int = POWER_ON_ADDRESS,
+        *,
+        timing_budget_s: float = 0.033,
+        max_range_mm: float = 1200.0,
+        xshut_high: bool = True,
+    ) -> None:
+        super().__init__(address)
+        self._clock = clock
+        self._bus = bus
+        self.timing_budget_s = timing_budget_s
+        self.max_range_mm = max_range_mm
+        self._distance_mm: float | None = None
+        self._attached = False
+        self._xshut_high = False
+        self._power_on_reset()
+        self.measurements = 0
+        if xshut_high:
+            # Powered long before the simulation began, possibly already moved.
+            self._xshut_high = True
+            self.address = address
+            self._registers[I2C_SLAVE_DEVICE_ADDRESS] = address
+            self._attach()
+        elif address != POWER_ON_ADDRESS:
+            raise ValueError(
+                f"a VL53L0X held in standby boots at 0x{POWER_ON_ADDRESS:02X}, "
+                f"not 0x{address:02X}"
+            )
+
+    # -- the world ---------------------------------------------------------------------------
+    @property
+    def distance_mm(self) -> float | None:
+        """What the sensor looks at, in mm; ``None`` when nothing is there."""
+        return self._distance_mm
+
+    @distance_mm.setter
+    def distance_mm(self, value: float | None) -> None:
+        if value is not None and value < 0:
+            raise ValueError(f"a distance cannot be negative, got {value} mm")
+        self._distance_mm = value
+
+    def set_xshut(self, high: bool) -> None:
+        """Drive the XSHUT pin: low = hardware standby and off the bus, high = boot at 0x29."""
+        if high == self._xshut_high:
+            return
+        self._xshut_high = high
+        if not high:
+            self._detach()
+            self._power_on_reset()
+            return
+        self._boot_done_s = self._clock.now() + BOOT_TIME_S
+        self._attach()
+
+    @property
+    def powered(self) -> bool:
+        """Whether XSHUT is high (the chip is out of hardware standby)."""
+        return self._xshut_high
+
+    def peek(self, register: int, *, private_page: bool = False) -> int:
+        """A register's content as the chip holds it (for tests; no side effects)."""
+        self._update()
+        if register == RESULT_INTERRUPT_STATUS and not private_page:
+            return self._interrupt_status
+        return (self._private if private_page else self._registers)[register]
+
+    # -- power and wiring ---------------------------------------------------------------------
+    def _power_on_reset(self) -> None:
+        self._registers = bytearray(256)
+        for register, value in _POWER_ON_REGISTERS.items():
+            self._registers[register] = value
+        self._private = bytearray(256)
+        for register, value in _POWER_ON_PRIVATE.items():
+            self._private[register] = value
+        self._page = 0
+        self._pointer = 0
+        self._interrupt_status = 0
+        self._busy_until_s: float | None = None
+        self._calibrating = False
+        self._sampled_mm: float | None = None
+        self.address = POWER_ON_ADDRESS
+        self._boot_done_s = 0.0
+
+    def _attach(self) -> None:
+        self._bus.attach(self)
+        self._attached = True
+
+    def _detach(self) -> None:
+        if self._attached and self._bus.device_at(self.address) is self:
+            self._bus.detach(self.address)
+        self._attached = False
+
+    def _check_booted(self) -> None:
+        if self._clock.now() < self._boot_done_s:
+            raise bus_error(errno.EREMOTEIO, self.address)  # still booting: no ACK
+
+    # -- ranging -------------------------------------------------------------------------------
+    def _start(self) -> None:
+        self._calibrating = self._registers[SYSTEM_SEQUENCE_CONFIG] in CALIBRATION_SEQUENCES
+        duration = CALIBRATION_TIME_S if self._calibrating else self.timing_budget_s
+        self._busy_until_s = self._clock.now() + duration
+        self._sampled_mm = self._distance_mm
+
+    def _update(self) -> None:
+        if self._busy_until_s is None or self._clock.now() < self._busy_until_s:
+            return
+        self._busy_until_s = None
+        self._interrupt_status = INTERRUPT_NEW_SAMPLE_READY
+        if self._calibrating:
+            return
+        self.measurements += 1
+        distance = self._sampled_mm
+        if distance is None or distance > self.max_range_mm:
+            status, range_mm = DEVICE_STATUS_MSRC_NO_TARGET, OUT_OF_RANGE_MM
+        else:
+            status, range_mm = DEVICE_STATUS_RANGE_VALID, min(round(distance), OUT_OF_RANGE_MM - 1)
+        self._registers[RESULT_RANGE_STATUS] = status << 3
+        self._registers[RESULT_RANGE_MM] = range_mm >> 8
+        self._registers[RESULT_RANGE_MM + 1] = range_mm & 0xFF
+
+    # -- the wire ------------------------------------------------------------------------------
+    def write(self, data: bytes) -> None:
+        self._check_booted()
+        self._update()
+        if not data:
+            return
+        self._pointer = data[0]
+        for value in data[1:]:
+            self._write_register(self._pointer, value)
+            self._pointer = (self._pointer + 1) & 0xFF
+
+    def _write_register(self, register: int, value: int) -> None:
+        if register == PAGE_SELECT:
+            self._page = value & 0x01
+            return
+        if self._page:
+            self._private[register] = value
+            return
+        if register in _READ_ONLY:
+            return
+        if register == SYSRANGE_START:
+            if value & 0x01:
+                self._start()
+            self._registers[register] = value & ~0x01  # the start bit clears once begun
+        elif register == SYSTEM_INTERRUPT_CLEAR:
+            if value & 0x01:
+                self._interrupt_status = 0
+            self._registers[register] = value
+        elif register == I2C_SLAVE_DEVICE_ADDRESS:
+            self._move_to(value & 0x7F)
+        else:
+            self._registers[register] = value
+
+    def _move_to(self, new_address: int) -> None:
+        if not 0x03 <= new_address <= 0x77:
+            raise ValueError(f"simulated VL53L0X: 0x{new_address:02X} is not a usable address")
+        if new_address == self.address:
+            return
+        holder = self._bus.device_at(new_address)
+        if holder is not None:
+            raise ValueError(
+                f"simulated VL53L0X moving to 0x{new_address:02X}, already used by "
+                f"{type(holder).__name__}: two chips would answer there"
+            )
+        self._bus.readdress(self.address, new_address)
+        self._registers[I2C_SLAVE_DEVICE_ADDRESS] = new_address
+
+    def read(self, length: int) -> bytes:
+        self._check_booted()
+        self._update()
+        out = bytearray()
+        for _ in range(length):
+            if self._page:
+                out.append(self._private[self._pointer])
+            elif self._pointer == RESULT_INTERRUPT_STATUS:
+                out.append(self._interrupt_status)
+            else:
+                out.append(self._registers[self._pointer])
+            self._pointer = (self._pointer + 1) & 0xFF
+        return bytes(out)

@@ -1,0 +1,135 @@
+"""XYZ Interactive ZX Sensor (SparkFun ZX Distance and Gesture Sensor), I2C register map v1.
+
+Address 0x10 (0x11 with the address jumper closed). The chip reports swipes and hovers
+through GESTURE (0x04) and flags them in STATUS (0x00); it reports the hand's position as
+X (0x08, across the sensor, 0..240) and Z (0x0A, away from it, 0..240) and flags each new
+coordinate with STATUS.DAV. Every flag in STATUS clears when STATUS is read, so this driver
+keeps the flags it has seen but not yet consumed: reading the position never loses a
+gesture, and each gesture is reported once.
+
+The engine calls a left or right swipe a "wave": that mapping belongs to the behaviour
+tree; this driver reports what the chip reports.
+"""
+
+from __future__ import annotations
+
+import threading
+from typing import Protocol
+
+from engine.errors import DeviceError
+
+CHIP = "ZX gesture sensor"
+ADDRESSES = (0x10, 0x11)
+
+# -- register map -----------------------------------------------------------------------------
+STATUS = 0x00
+STATUS_DAV = 1 << 0  # new position data
+STATUS_OVF = 1 << 1  # brightness overflow (unused, reads 0)
+STATUS_SWP = 1 << 2  # swipe gesture available
+STATUS_HOVER = 1 << 3  # hover gesture available
+STATUS_HVG = 1 << 4  # hover-move gesture available
+STATUS_EDGE = 1 << 5  # edge detection (unused, reads 0)
+STATUS_HB = 1 << 7  # heartbeat: toggles on every STATUS read
+STATUS_GESTURES = STATUS_SWP | STATUS_HOVER | STATUS_HVG
+DRE = 0x01  # data-ready (DR pin) enables
+DRCFG = 0x02  # DR pin configuration
+GESTURE = 0x04
+GSPEED = 0x05
+DCM = 0x06
+XPOS = 0x08
+ZPOS = 0x0A
+LRNG = 0x0C
+RRNG = 0x0E
+REGVER = 0xFE
+MODEL = 0xFF
+
+MODEL_ID = 0x01  # XZ01
+REGISTER_MAP_VERSION = 0x01
+MAX_POSITION = 240
+
+GESTURE_NAMES = {
+    0x01: "swipe_right",
+    0x02: "swipe_left",
+    0x03: "swipe_up",
+    0x05: "hover",
+    0x06: "hover_left",
+    0x07: "hover_right",
+    0x08: "hover_up",
+}
+
+
+class SMBusLike(Protocol):
+    def read_byte_data(self, i2c_addr: int, register: int) -> int: ...
+
+    def write_byte_data(self, i2c_addr: int, register: int, value: int) -> None: ...
+
+
+def gesture_name(code: int) -> str | None:
+    """The engine's name for a GESTURE register value, or ``None`` for no/unknown gesture."""
+    return GESTURE_NAMES.get(code)
+
+
+def decode_position(x: int, z: int) -> tuple[int, int] | None:
+    """X and Z in sensor units (0..240), or ``None`` when either is out of the chip's range."""
+    if x > MAX_POSITION or z > MAX_POSITION:
+        return None
+    return (x, z)
+
+
+class ZXGesture:
+    """A ZX sensor, polled (its DR pin is not used). Thread-safe."""
+
+    def __init__(self, bus: SMBusLike, *, address: int = 0x10) -> None:
+        if address not in ADDRESSES:
+            raise ValueError(f"{CHIP} address must be 0x10 or 0x11, got 0x{address:02X}")
+        self._bus = bus
+        self.address = address
+        self._lock = threading.Lock()
+        self._pending = 0
+        where = f"{CHIP} at 0x{address:02X}"
+        try:
+            model = bus.read_byte_data(address, MODEL)
+            version = bus.read_byte_data(address, REGVER)
+        except OSError as err:
+            raise DeviceError(f"{where} did not answer: {err}") from err
+        if model != MODEL_ID or version != REGISTER_MAP_VERSION:
+            raise DeviceError(
+                f"{where}: model 0x{model:02X}, register map 0x{version:02X}; expected "
+                f"model 0x{MODEL_ID:02X} with register map 0x{REGISTER_MAP_VERSION:02X}"
+            )
+        bus.write_byte_data(address, DRE, 0x00)  # polled: the DR pin stays quiet
+
+    def __repr__(self) -> str:
+        return f"ZXGesture(address=0x{self.address:02X})"
+
+    def _poll_status(self) -> None:
+        status = self._bus.read_byte_data(self.address, STATUS)
+        self._pending |= status & (STATUS_DAV | STATUS_GESTURES)
+
+    def read_gesture(self) -> str | None:
+        """The gesture detected since the last call (each is reported once), or ``None``.
+
+        One of ``swipe_right``, ``swipe_left``, ``swipe_up``, ``hover``, ``hover_left``,
+        ``hover_right``, ``hover_up``.
+        """
+        with self._lock:
+            self._poll_status()
+            if not self._pending & STATUS_GESTURES:
+                return None
+            self._pending &= ~STATUS_GESTURES
+            code = self._bus.read_byte_data(self.address, GESTURE)
+        return gesture_name(code)
+
+    def read_position(self) -> tuple[int, int] | None:
+        """The hand's (x, z) in sensor units 0..240 when the chip has a new coordinate.
+
+        ``None`` when no new coordinate arrived since the last call (no hand in view).
+        """
+        with self._lock:
+            self._poll_status()
+            if not self._pending & STATUS_DAV:
+                return None
+            self._pending &= ~STATUS_DAV
+            x = self._bus.read_byte_data(self.address, XPOS)
+            z = self._bus.read_byte_data(self.address, ZPOS)
+        return decode_position(x, z)

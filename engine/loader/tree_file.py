@@ -1,0 +1,341 @@
+"""Tree files: validated whole into a :class:`TreeDefinition`, then built into py_trees.
+
+A tree file::
+
+    name: hug
+    rate_hz: 20
+    description: Hug back when both side pads are squeezed.
+    params:
+      threshold_n: 3.0
+    root:
+      Sequence:
+        - Check: {key: /sensors/force/left_n, above: "${threshold_n}"}
+        - ...
+
+A node is a mapping with one key, its type. Composites take a list of children (or a
+mapping with their options and ``children:``); decorators a mapping with their options and
+``child:``; leaves a mapping of parameters. Every node accepts ``name:`` for display.
+``Subtree: {file: parts/x.yaml, params: {...}}`` includes another tree file's root.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from types import SimpleNamespace
+from typing import Any
+
+import py_trees
+
+from engine.blackboard.catalogue import KeyCatalogue
+from engine.dialogs.library import DialogLibrary
+from engine.loader.problems import LoadError, Mark, Problems
+from engine.loader.substitution import (
+    ParamValue,
+    Profile,
+    check_override,
+    read_params,
+    substitute,
+)
+from engine.loader.yaml_source import YList, YMap, YScalar, YValue, describe, load_yaml, plain
+from engine.nodes.context import TreeContext
+from engine.nodes.params import CheckContext, ParamProblem, did_you_mean
+from engine.nodes.registry import NodeRegistry
+from engine.nodes.spec import NodeType
+
+TOP_KEYS = ("name", "description", "rate_hz", "params", "root")
+SUBTREE = "Subtree"
+DEFAULT_RATE_HZ = 10.0
+MAX_RATE_HZ = 1000.0
+
+
+@dataclass
+class NodeDefinition:
+    """One validated node: its type, display name, converted arguments and children."""
+
+    type: NodeType
+    name: str
+    args: dict[str, Any]
+    children: list[NodeDefinition]
+    mark: Mark
+
+
+@dataclass
+class TreeDefinition:
+    """A validated tree file, ready to build as often as needed."""
+
+    name: str
+    rate_hz: float
+    description: str
+    root: NodeDefinition
+    path: Path
+    files: list[Path] = field(default_factory=list)
+
+    def build(self, ctx: TreeContext) -> py_trees.trees.BehaviourTree:
+        """A fresh py_trees tree whose nodes use ``ctx``."""
+        return py_trees.trees.BehaviourTree(_build(self.root, ctx))
+
+
+def _build(node: NodeDefinition, ctx: TreeContext) -> py_trees.behaviour.Behaviour:
+    children = [_build(child, ctx) for child in node.children]
+    return node.type.build(node.name, SimpleNamespace(**node.args), children, ctx)
+
+
+class TreeLoader:
+    """Validates tree files against a registry, a key catalogue, dialogs and a profile."""
+
+    def __init__(
+        self,
+        registry: NodeRegistry,
+        catalogue: KeyCatalogue,
+        *,
+        dialogs: DialogLibrary | None = None,
+        profile: Profile | None = None,
+        root_dir: Path | None = None,
+    ) -> None:
+        self.registry = registry
+        self.catalogue = catalogue
+        self.dialogs = dialogs
+        self.profile = profile
+        self.root_dir = root_dir
+        self.check_context = CheckContext(catalogue, dialogs)
+
+    def shown(self, path: Path) -> str:
+        """How messages name ``path``: relative to the working folder when inside it."""
+        base = self.root_dir or Path.cwd()
+        try:
+            return str(path.resolve().relative_to(base.resolve()))
+        except ValueError:
+            return str(path)
+
+    def load(self, path: Path) -> TreeDefinition:
+        """Validate the tree file at ``path``; LoadError listing every problem."""
+        problems = Problems()
+        files: list[Path] = []
+        document = self._read(path, problems, files)
+        if document is None:
+            problems.raise_if_any()
+            raise LoadError([])  # pragma: no cover - _read always reports why
+        name = path.stem
+        raw_name = document.get("name")
+        if raw_name is not None:
+            if isinstance(raw_name, YScalar) and isinstance(raw_name.value, str) \
+                    and raw_name.value.strip():
+                name = raw_name.value.strip()
+            else:
+                problems.add(raw_name.mark, f"'name' must be text, got {describe(raw_name)}")
+        params = self._params(document, problems, overrides=None, where="")
+        rate_hz = self._rate(document, params, problems)
+        description = document.get("description")
+        root = self._root(document, path, params, problems, [path.resolve()], files)
+        problems.raise_if_any()
+        assert root is not None
+        text = plain(description) if description is not None else ""
+        return TreeDefinition(name, rate_hz, str(text or ""), root, path, files)
+
+    # -- file level -----------------------------------------------------------------------
+    def _read(self, path: Path, problems: Problems, files: list[Path]) -> YMap | None:
+        shown = self.shown(path)
+        try:
+            document = load_yaml(path, shown)
+        except LoadError as error:
+            problems.extend(error.problems)
+            return None
+        files.append(path)
+        if not isinstance(document, YMap):
+            where = document.mark if document is not None else Mark(shown, 1, 1)
+            problems.add(where, "a tree file is a mapping with 'name:', 'rate_hz:' and 'root:'",
+                         "see docs/therapist-guide.md")
+            return None
+        for key, mark in document.key_marks.items():
+            if key not in TOP_KEYS:
+                problems.add(mark, f"unknown field {key!r}",
+                             did_you_mean(key, TOP_KEYS) or "fields: " + ", ".join(TOP_KEYS))
+        return document
+
+    def _params(self, document: YMap, problems: Problems,
+                overrides: dict[str, ParamValue] | None, where: str) -> dict[str, ParamValue]:
+        params = read_params(document.get("params"), problems)
+        if self.profile is not None:
+            for name, given in self.profile.params.items():
+                if name in params and check_override(
+                        name, params[name], given, problems, f"profile {self.profile.name!r}"):
+                    params[name] = given
+        for name, given in (overrides or {}).items():
+            if name not in params:
+                problems.add(given.source, f"{where} passes unknown parameter {name!r}",
+                             did_you_mean(name, list(params)) or
+                             "parameters: " + (", ".join(params) or "none"))
+            elif check_override(name, params[name], given, problems, where):
+                params[name] = given
+        return params
+
+    def _rate(self, document: YMap, params: dict[str, ParamValue], problems: Problems) -> float:
+        raw = document.get("rate_hz")
+        if raw is None:
+            return DEFAULT_RATE_HZ
+        raw = substitute(raw, params, problems)
+        value = raw.value if isinstance(raw, YScalar) else None
+        if isinstance(value, bool) or not isinstance(value, int | float):
+            problems.add(raw.mark, f"'rate_hz' must be a number, got {describe(raw)}",
+                         "ticks per second, e.g. 10")
+            return DEFAULT_RATE_HZ
+        if not 0 < value <= MAX_RATE_HZ:
+            problems.add(raw.mark, f"'rate_hz' must be above 0 and at most {MAX_RATE_HZ:g}, "
+                         f"got {value:g}")
+            return DEFAULT_RATE_HZ
+        return float(value)
+
+    def _root(self, document: YMap, path: Path, params: dict[str, ParamValue],
+              problems: Problems, stack: list[Path], files: list[Path]) -> NodeDefinition | None:
+        raw = document.get("root")
+        if raw is None:
+            problems.add(document.mark, "the tree has no 'root:'", "add root: with one node")
+            return None
+        return self._node(substitute(raw, params, problems), path, problems, stack, files)
+
+    # -- nodes ----------------------------------------------------------------------------
+    def _node(self, raw: YValue, path: Path, problems: Problems, stack: list[Path],
+              files: list[Path]) -> NodeDefinition | None:
+        if not isinstance(raw, YMap) or len(raw) != 1:
+            got = describe(raw) if not isinstance(raw, YMap) else (
+                f"{len(raw)} keys ({', '.join(k for k, _ in raw.items()) or 'none'})")
+            problems.add(raw.mark, f"a node is a mapping with one key, its type; got {got}",
+                         "e.g. - Say: {text: hello}")
+            return None
+        type_name, body = next(iter(raw.items()))
+        mark = raw.key_marks[type_name]
+        if type_name == SUBTREE:
+            return self._subtree(body, mark, path, problems, stack, files)
+        node_type = self.registry.get(type_name)
+        if node_type is None:
+            suggestion = self.registry.suggest(type_name)
+            hint = f"did you mean {suggestion!r}?" if suggestion else "see `vest nodes`"
+            problems.add(mark, f"unknown node type {type_name!r}", hint)
+            return None
+        children_raw: YValue | None = None
+        params_raw: YMap | None = None
+        if node_type.children == "many" and isinstance(body, YList):
+            children_raw = body
+        elif isinstance(body, YMap):
+            params_raw = body
+        elif not (isinstance(body, YScalar) and body.value is None):
+            expected = {"many": "a list of children or a mapping with 'children:'",
+                        "one": "a mapping with 'child:'", "none": "a mapping of parameters"}
+            problems.add(body.mark, f"{type_name} takes {expected[node_type.children]}, "
+                         f"got {describe(body)}")
+            return None
+        args, name, children_raw = self._arguments(node_type, params_raw, children_raw, mark,
+                                                   problems)
+        children = self._children(node_type, children_raw, mark, path, problems, stack, files)
+        if args is None or children is None:
+            return None
+        return NodeDefinition(node_type, name, args, children, mark)
+
+    def _arguments(self, node_type: NodeType, body: YMap | None, children_raw: YValue | None,
+                   mark: Mark, problems: Problems
+                   ) -> tuple[dict[str, Any] | None, str, YValue | None]:
+        structural = {"many": "children", "one": "child"}.get(node_type.children)
+        args: dict[str, Any] = {}
+        name = node_type.name
+        ok = True
+        given = dict(body.items()) if body is not None else {}
+        key_marks = body.key_marks if body is not None else {}
+        if structural and structural in given:
+            children_raw = given.pop(structural)
+        raw_name = given.pop("name", None)
+        if raw_name is not None:
+            if isinstance(raw_name, YScalar) and isinstance(raw_name.value, str | int):
+                name = str(raw_name.value)
+            else:
+                problems.add(raw_name.mark, f"'name' must be text, got {describe(raw_name)}")
+        known = [p.name for p in node_type.params]
+        for key, value in given.items():
+            param = node_type.param(key)
+            if param is None:
+                options = [*known, "name", *([structural] if structural else [])]
+                hint = did_you_mean(key, options) or (
+                    f"{node_type.name} takes " + (", ".join(options)))
+                problems.add(key_marks[key], f"unknown parameter {key!r} for {node_type.name}",
+                             hint)
+                ok = False
+                continue
+            try:
+                args[key] = param.type.convert(plain(value), self.check_context)
+            except ParamProblem as problem:
+                message = problem.message
+                if message.startswith(("must", "needs", "takes", "item")):
+                    message = f"{key!r} {message}"
+                problems.add(value.mark, message, problem.hint)
+                ok = False
+        for param in node_type.params:
+            if param.name in args or param.name in given:
+                continue
+            if param.required:
+                problems.add(mark, f"{node_type.name} needs {param.name!r}",
+                             param.doc or None)
+                ok = False
+            else:
+                args[param.name] = param.default
+        if ok and node_type.check is not None:
+            for param_name, message, hint in node_type.check(args, self.check_context):
+                where = given[param_name].mark if param_name in given else mark
+                problems.add(where, message, hint)
+                ok = False
+        return (args if ok else None), name, children_raw
+
+    def _children(self, node_type: NodeType, raw: YValue | None, mark: Mark, path: Path,
+                  problems: Problems, stack: list[Path],
+                  files: list[Path]) -> list[NodeDefinition] | None:
+        if node_type.children == "none":
+            return []
+        if node_type.children == "one":
+            if raw is None:
+                problems.add(mark, f"{node_type.name} needs 'child:' with one node")
+                return None
+            if isinstance(raw, YList):
+                problems.add(raw.mark, f"{node_type.name} takes one child, got a list of "
+                             f"{len(raw)}", "wrap them in a Sequence")
+                return None
+            child = self._node(raw, path, problems, stack, files)
+            return [child] if child is not None else None
+        if raw is None or not isinstance(raw, YList) or len(raw) == 0:
+            problems.add(raw.mark if raw is not None else mark,
+                         f"{node_type.name} needs a list of at least one child")
+            return None
+        children = [self._node(item, path, problems, stack, files) for item in raw]
+        if any(child is None for child in children):
+            return None
+        return [child for child in children if child is not None]
+
+    def _subtree(self, body: YValue, mark: Mark, path: Path, problems: Problems,
+                 stack: list[Path], files: list[Path]) -> NodeDefinition | None:
+        if not isinstance(body, YMap) or not isinstance(body.get("file"), YScalar):
+            problems.add(body.mark, "Subtree takes {file: path.yaml, params: {...}}")
+            return None
+        for key, key_mark in body.key_marks.items():
+            if key not in ("file", "params", "name"):
+                problems.add(key_mark, f"unknown parameter {key!r} for Subtree",
+                             did_you_mean(key, ["file", "params", "name"]))
+        file_value = body.get("file")
+        assert isinstance(file_value, YScalar)
+        target = (path.parent / str(file_value.value)).resolve()
+        if target in stack:
+            chain = " -> ".join(self.shown(p) for p in [*stack, target])
+            problems.add(file_value.mark, f"subtree include cycle: {chain}",
+                         "a tree cannot include itself")
+            return None
+        before = len(problems)
+        document = self._read(target, problems, files)
+        if document is None:
+            if len(problems) > before:
+                # the included file's own problem names it; say where it was included from
+                problems.add(file_value.mark, f"cannot include {file_value.value!r}")
+            return None
+        overrides = read_params(body.get("params"), problems)
+        params = self._params(document, problems, overrides, "Subtree")
+        root = self._root(document, target, params, problems, [*stack, target], files)
+        raw_name = body.get("name")
+        if root is not None and isinstance(raw_name, YScalar) and raw_name.value:
+            root.name = str(raw_name.value)
+        return root

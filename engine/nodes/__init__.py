@@ -1,0 +1,42 @@
+"""Node types: the registry, the base classes for new leaves, and the built-in nodes."""
+
+from py_trees.common import Status
+
+from engine.nodes.base import Condition, Leaf, ServiceAction
+from engine.nodes.params import (
+    AnyValue,
+    Boolean,
+    Choice,
+    Integer,
+    Key,
+    ListOf,
+    Number,
+    Param,
+    Scalar,
+    Text,
+)
+from engine.nodes.registry import NodeRegistry, builtin_registry, default_registry
+from engine.nodes.spec import NodeType
+from engine.nodes.templates import Template
+
+__all__ = [
+    "AnyValue",
+    "Boolean",
+    "Choice",
+    "Condition",
+    "Integer",
+    "Key",
+    "Leaf",
+    "ListOf",
+    "NodeRegistry",
+    "NodeType",
+    "Number",
+    "Param",
+    "Scalar",
+    "ServiceAction",
+    "Status",
+    "Template",
+    "Text",
+    "builtin_registry",
+    "default_registry",
+]

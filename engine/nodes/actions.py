@@ -1,0 +1,258 @@
+"""Actions: the robot does something. Service actions never block a tick.
+
+Each action is RUNNING while its service works, SUCCESS when done, and FAILURE only
+when it could not act (the service failed or refused); ``feedback_message`` says why.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any, ClassVar
+
+from py_trees.common import Status
+
+from engine.colors import NAMED_COLORS, parse_color
+from engine.errors import ServiceError
+from engine.nodes.base import Leaf, ServiceAction
+from engine.nodes.params import (
+    AnyValue,
+    CheckContext,
+    Choice,
+    Key,
+    Number,
+    Param,
+    ParamProblem,
+    ParamType,
+    Text,
+    did_you_mean,
+)
+from engine.nodes.templates import Template
+from engine.services.jobs import ImmediateJob, Job
+
+ON_REQUEST_SENSORS = ("temperature", "ultrasound")
+
+
+class Color(ParamType):
+    """A color name (pink, blue, ...) or #RRGGBB."""
+
+    name = "color"
+
+    def convert(self, value: Any, ctx: CheckContext) -> str:
+        try:
+            parse_color(str(value))
+        except ValueError:
+            hint = did_you_mean(str(value), list(NAMED_COLORS)) or "or write #RRGGBB"
+            raise ParamProblem(f"unknown color {value!r}", hint) from None
+        return str(value)
+
+
+class Say(ServiceAction):
+    """Say a phrase through the speaker.
+
+    ``{fields}`` in the text are filled from the blackboard (``{temperature_f:.0f}``).
+    RUNNING while speaking; SUCCESS when said; FAILURE when the speech service failed or
+    a field has no value yet.
+    """
+
+    params: ClassVar = (
+        Param("text", Template(), doc="what to say; {key} fields are filled from the blackboard"),
+        Param("volume", Number(0.0, 1.0), None, "0..1; empty: the robot's default volume"),
+    )
+
+    def start(self) -> Job:
+        try:
+            text = self.args.text.fill(self.read)
+        except (KeyError, ValueError) as error:
+            return ImmediateJob(error=ServiceError(str(error).strip("'\"")))
+        return self.ctx.actions.say(text, volume=self.args.volume)
+
+
+class SetLed(ServiceAction):
+    """Light the face LEDs in a color, for a while or until changed.
+
+    RUNNING for ``seconds`` (the LEDs go off afterwards); SUCCESS then (at once when no
+    ``seconds``); FAILURE when the LED service failed.
+    """
+
+    params: ClassVar = (
+        Param("color", Color(), doc="a color name (pink, blue, off, ...) or #RRGGBB"),
+        Param("seconds", Number(minimum=0.0, unit="s"), None,
+              "how long to keep it lit; empty: until another SetLed"),
+    )
+
+    def start(self) -> Job:
+        return self.ctx.actions.set_led(self.args.color, seconds=self.args.seconds)
+
+
+class MoveServo(ServiceAction):
+    """Move a joint (neck, left_arm, ...) to an angle.
+
+    RUNNING while it moves; SUCCESS when there; FAILURE when the servo service refused
+    (unknown joint, beyond the joint's limits) or failed.
+    """
+
+    params: ClassVar = (
+        Param("joint", Text(), doc="joint name from the robot config, e.g. neck"),
+        Param("angle_deg", Number(-180.0, 180.0, "deg"), doc="target angle in degrees"),
+        Param("speed_dps", Number(minimum=0.0, unit="deg/s"), None,
+              "degrees per second; empty: the joint's own maximum"),
+    )
+
+    def start(self) -> Job:
+        return self.ctx.actions.move_servo(
+            self.args.joint, self.args.angle_deg, speed_dps=self.args.speed_dps
+        )
+
+
+class LookToward(Leaf):
+    """Turn a joint toward the nearest thing the three range sensors see (tracking).
+
+    When the nearest reading is the left or right one, turns to +turn_deg (left) or
+    -turn_deg (right); when it is the center one, or the joint already points there, or
+    nothing is within max_mm, nothing moves. RUNNING while turning; SUCCESS when turned or
+    when there was nothing to do; FAILURE when the servo service failed.
+    """
+
+    params: ClassVar = (
+        Param("joint", Text(), "neck", "the joint to turn"),
+        Param("turn_deg", Number(0.0, 90.0, "deg"), 30.0, "how far to turn; left is positive"),
+        Param("max_mm", Number(minimum=0.0, unit="mm"), 1200.0, "ignore anything farther"),
+        Param("speed_dps", Number(minimum=0.0, unit="deg/s"), None, "turn speed"),
+        Param("left", Key(), "/sensors/range/left_mm", "left distance key"),
+        Param("center", Key(), "/sensors/range/center_mm", "center distance key"),
+        Param("right", Key(), "/sensors/range/right_mm", "right distance key"),
+    )
+
+    def __init__(self, *a: Any) -> None:
+        super().__init__(*a)
+        self.angle_deg = 0.0
+        self.job: Job | None = None
+
+    def nearest_side(self) -> str | None:
+        """left, center or right: whichever sees the nearest thing within max_mm."""
+        readings = []
+        for side in ("left", "center", "right"):
+            distance = self.read(getattr(self.args, side))
+            if distance is not None and distance <= self.args.max_mm:
+                readings.append((distance, side))
+        return min(readings)[1] if readings else None
+
+    def initialise(self) -> None:
+        self.job = None
+        side = self.nearest_side()
+        target = {"left": self.args.turn_deg, "right": -self.args.turn_deg}.get(side or "center")
+        if target is None or target == self.angle_deg:
+            self.feedback_message = f"nearest: {side or 'nothing'}; no turn needed"
+            return
+        self.angle_deg = target
+        self.feedback_message = f"nearest: {side}; turning to {target:g} deg"
+        self.job = self.ctx.actions.move_servo(
+            self.args.joint, target, speed_dps=self.args.speed_dps
+        )
+
+    def update(self) -> Status:
+        if self.job is None:
+            return Status.SUCCESS
+        if not self.job.done():
+            return Status.RUNNING
+        error = self.job.error()
+        if error is not None:
+            self.feedback_message = f"could not turn: {error}"
+            return Status.FAILURE
+        return Status.SUCCESS
+
+    def terminate(self, new_status: Status) -> None:
+        if new_status == Status.INVALID and self.job is not None and not self.job.done():
+            self.job.cancel()
+
+
+class Wait(Leaf):
+    """Wait a while (engine clock).
+
+    RUNNING until ``seconds`` have passed since it started; then SUCCESS.
+    """
+
+    params: ClassVar = (Param("seconds", Number(minimum=0.0, unit="s"), doc="how long"),)
+
+    def initialise(self) -> None:
+        self.until_s = self.now() + self.args.seconds
+
+    def update(self) -> Status:
+        return Status.SUCCESS if self.now() >= self.until_s else Status.RUNNING
+
+
+class SetValue(Leaf):
+    """Set one of the tree's variables (``/vars/...``).
+
+    SUCCESS always.
+    """
+
+    params: ClassVar = (
+        Param("key", Key(access="write"), doc="a /vars/ key"),
+        Param("value", AnyValue(), doc="the value to store"),
+    )
+
+    def update(self) -> Status:
+        self.write(self.args.key, self.args.value)
+        return Status.SUCCESS
+
+
+class ReadSensor(ServiceAction):
+    """Read an on-request sensor (temperature, ultrasound) onto the blackboard.
+
+    RUNNING while the read is under way; SUCCESS when the new values are on the
+    blackboard (/sensors/temperature/c and /f, or /sensors/ultrasound/cm); FAILURE when
+    the sensor could not be read.
+    """
+
+    params: ClassVar = (
+        Param("sensor", Choice(ON_REQUEST_SENSORS), doc="which sensor to read"),
+    )
+    writes: ClassVar = (
+        "/sensors/temperature/c",
+        "/sensors/temperature/f",
+        "/sensors/ultrasound/cm",
+    )
+
+    def start(self) -> Job:
+        return self.ctx.actions.read_sensor(self.args.sensor)
+
+    def finished(self, job: Job) -> Status:
+        for key, value in (job.result() or {}).items():
+            self.ctx.blackboard.set(key, value)
+        return Status.SUCCESS
+
+
+class ReportResult(ServiceAction):
+    """Tell the cloud how a remote command ended.
+
+    SUCCESS when the report was handed to the IoT service; FAILURE when the command has
+    no id or the report could not be sent.
+    """
+
+    params: ClassVar = (
+        Param("command", Key(), doc="the /vars/ key holding the command"),
+        Param("status", Choice(("succeeded", "failed")), doc="how it ended"),
+        Param("result", Key(), None, "a /vars/ key holding the result to send"),
+    )
+
+    @classmethod
+    def check_params(
+        cls, args: Mapping[str, Any], ctx: CheckContext
+    ) -> list[tuple[str | None, str, str | None]]:
+        problems: list[tuple[str | None, str, str | None]] = []
+        for name in ("command", "result"):
+            key = args.get(name)
+            if key is not None and not key.startswith("/vars/"):
+                problems.append((name, f"{key!r} is not a tree variable", "use a /vars/ key"))
+        return problems
+
+    def start(self) -> Job:
+        command = self.read(self.args.command)
+        if not isinstance(command, Mapping) or "id" not in command:
+            return ImmediateJob(error=ServiceError(f"{self.args.command} holds no command"))
+        result = self.read(self.args.result) if self.args.result else None
+        return self.ctx.actions.report_result(str(command["id"]), self.args.status, result)
+
+
+ACTIONS = (Say, SetLed, MoveServo, LookToward, Wait, SetValue, ReadSensor, ReportResult)

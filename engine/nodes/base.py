@@ -1,0 +1,177 @@
+"""Base classes for leaf nodes: conditions and actions.
+
+A developer writes a leaf in a few lines::
+
+    class IsWarm(Condition):
+        \"\"\"True when the room is warmer than a threshold.
+
+        SUCCESS when the last temperature reading is above ``above_c``; FAILURE otherwise
+        or when no reading exists yet.
+        \"\"\"
+
+        params = (Param("above_c", Number(unit="degC"), 25.0, "threshold in degC"),)
+        reads = ("/sensors/temperature/c",)
+
+        def check(self) -> bool:
+            return (self.read("/sensors/temperature/c") or -273.0) > self.args.above_c
+
+and registers it: ``registry.add(IsWarm)``. Parameters are declared with types, defaults
+and docs; the loader validates YAML against them and ``vest nodes`` lists them.
+
+An exception inside any leaf makes that node FAILURE, is reported with the node's path,
+and the tree keeps ticking.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from types import SimpleNamespace
+from typing import Any, ClassVar
+
+import py_trees
+from py_trees.common import Access, Status
+
+from engine.nodes.context import TreeContext
+from engine.nodes.params import CheckContext, Param
+from engine.services.jobs import Job
+
+
+def node_path(node: py_trees.behaviour.Behaviour) -> str:
+    """``root/…/node`` names from the tree's root to ``node``."""
+    names = []
+    current: py_trees.behaviour.Behaviour | None = node
+    while current is not None:
+        names.append(current.name)
+        current = current.parent
+    return "/".join(reversed(names))
+
+
+class Leaf(py_trees.behaviour.Behaviour):
+    """Base of vest leaf nodes. Subclasses set the class attributes and lifecycle methods.
+
+    Class attributes: ``kind`` ("condition" or "action"), ``params`` (a tuple of
+    :class:`Param`), ``reads`` / ``writes`` (fixed blackboard keys; keys given as ``Key``
+    parameters are added automatically), ``type_name`` (defaults to the class name).
+    ``self.args`` holds the converted parameters, ``self.ctx`` the tree's context.
+    """
+
+    kind: ClassVar[str] = "action"
+    type_name: ClassVar[str | None] = None
+    params: ClassVar[tuple[Param, ...]] = ()
+    reads: ClassVar[tuple[str, ...]] = ()
+    writes: ClassVar[tuple[str, ...]] = ()
+
+    def __init__(self, name: str, args: SimpleNamespace, ctx: TreeContext) -> None:
+        super().__init__(name)
+        self.args = args
+        self.ctx = ctx
+        from engine.nodes.spec import leaf_type  # a leaf knows its own declaration
+
+        read_keys, write_keys = leaf_type(type(self)).keys(vars(args))
+        self.blackboard = self.attach_blackboard_client(name=name)
+        for key in dict.fromkeys(read_keys):
+            self.blackboard.register_key(key, access=Access.READ)
+        for key in dict.fromkeys(write_keys):
+            self.blackboard.register_key(key, access=Access.WRITE)
+
+    @classmethod
+    def check_params(
+        cls, args: Mapping[str, Any], ctx: CheckContext
+    ) -> list[tuple[str | None, str, str | None]]:
+        """Checks across parameters at load time: (parameter, message, hint) per problem."""
+        return []
+
+    # -- helpers for subclasses ---------------------------------------------------------
+    def read(self, key: str, default: Any = None) -> Any:
+        """The committed value of ``key``, or ``default`` when it has none yet."""
+        try:
+            return self.blackboard.get(key)
+        except KeyError:
+            return default
+
+    def write(self, key: str, value: Any) -> None:
+        """Write one of this tree's variables (``/vars/...``) now."""
+        self.ctx.blackboard.set(key, value)
+
+    def now(self) -> float:
+        """The engine clock, in seconds."""
+        return self.ctx.clock.now()
+
+    # -- the safety net -----------------------------------------------------------------
+    def tick(self) -> Any:
+        """py_trees' leaf tick, but an exception makes this node FAILURE, not the tree crash."""
+        try:
+            if self.status != Status.RUNNING:
+                self.initialise()
+            new_status = self.update()
+            if new_status != Status.RUNNING:
+                self.stop(new_status)
+        except Exception as error:
+            new_status = self._failed(error)
+        self.status = new_status
+        yield self
+
+    def _failed(self, error: Exception) -> Status:
+        self.feedback_message = f"{type(error).__name__}: {error}"
+        self.ctx.on_node_error(self.ctx.tree, node_path(self), error)
+        try:
+            self.stop(Status.FAILURE)
+        except Exception as stop_error:  # terminate() failing must not stop the tick either
+            self.ctx.on_node_error(self.ctx.tree, node_path(self), stop_error)
+        return Status.FAILURE
+
+
+class Condition(Leaf):
+    """A yes/no question about the blackboard: implement :meth:`check`.
+
+    SUCCESS when the answer is yes, FAILURE when no. Never RUNNING.
+    """
+
+    kind: ClassVar[str] = "condition"
+
+    def check(self) -> bool:
+        raise NotImplementedError(f"{type(self).__name__} must implement check()")
+
+    def update(self) -> Status:
+        return Status.SUCCESS if self.check() else Status.FAILURE
+
+
+class ServiceAction(Leaf):
+    """An action done by a service: implement :meth:`start` returning a Job.
+
+    RUNNING while the job runs; SUCCESS when it finished; FAILURE when the service could
+    not do it (``feedback_message`` says why). Pre-empted, it cancels the job.
+    """
+
+    kind: ClassVar[str] = "action"
+
+    def __init__(self, name: str, args: SimpleNamespace, ctx: TreeContext) -> None:
+        super().__init__(name, args, ctx)
+        self.job: Job | None = None
+
+    def start(self) -> Job:
+        raise NotImplementedError(f"{type(self).__name__} must implement start()")
+
+    def finished(self, job: Job) -> Status:
+        """Called once the job succeeded; may use its result. Returns SUCCESS by default."""
+        return Status.SUCCESS
+
+    def initialise(self) -> None:
+        self.job = None
+        self.job = self.start()
+
+    def update(self) -> Status:
+        job = self.job
+        if job is None:
+            return Status.FAILURE
+        if not job.done():
+            return Status.RUNNING
+        error = job.error()
+        if error is not None:
+            self.feedback_message = f"could not act: {error}"
+            return Status.FAILURE
+        return self.finished(job)
+
+    def terminate(self, new_status: Status) -> None:
+        if new_status == Status.INVALID and self.job is not None and not self.job.done():
+            self.job.cancel()

@@ -1,0 +1,173 @@
+"""Decorators: one child, changing what its status means or when it runs.
+
+Timeout and Cooldown measure time on the engine clock, never the wall clock.
+"""
+
+from __future__ import annotations
+
+from types import SimpleNamespace
+from typing import Any
+
+import py_trees
+from py_trees.common import OneShotPolicy, Status
+
+from engine.clock import Clock
+from engine.nodes.context import TreeContext
+from engine.nodes.params import REQUIRED, Choice, Integer, Number, Param
+from engine.nodes.spec import NodeType
+
+
+class EngineTimeout(py_trees.decorators.Decorator):
+    """FAILURE when the child is still RUNNING ``seconds`` after it started."""
+
+    def __init__(self, name: str, child: Any, seconds: float, clock: Clock) -> None:
+        super().__init__(name=name, child=child)
+        self.seconds = seconds
+        self.clock = clock
+        self.deadline_s = 0.0
+
+    def initialise(self) -> None:
+        self.deadline_s = self.clock.now() + self.seconds
+
+    def update(self) -> Status:
+        status = self.decorated.status
+        if status == Status.RUNNING and self.clock.now() >= self.deadline_s:
+            self.feedback_message = f"timed out after {self.seconds:g} s"
+            return Status.FAILURE
+        return status
+
+
+class Cooldown(py_trees.decorators.Decorator):
+    """After the child succeeds, FAILURE for ``seconds`` without ticking the child."""
+
+    def __init__(self, name: str, child: Any, seconds: float, clock: Clock) -> None:
+        super().__init__(name=name, child=child)
+        self.seconds = seconds
+        self.clock = clock
+        self.ready_at_s = float("-inf")
+
+    def tick(self) -> Any:
+        remaining = self.ready_at_s - self.clock.now()
+        if self.status != Status.RUNNING and remaining > 0:
+            self.feedback_message = f"cooling down, {remaining:.1f} s left"
+            self.stop(Status.FAILURE)
+            yield self
+            return
+        yield from super().tick()
+
+    def update(self) -> Status:
+        status = self.decorated.status
+        if status == Status.SUCCESS:
+            self.ready_at_s = self.clock.now() + self.seconds
+        self.feedback_message = ""
+        return status
+
+
+def _child(children: list[Any]) -> Any:
+    return children[0]
+
+
+def _inverter(name: str, args: SimpleNamespace, children: list[Any], ctx: TreeContext) -> Any:
+    return py_trees.decorators.Inverter(name=name, child=_child(children))
+
+
+def _force_success(name: str, args: SimpleNamespace, children: list[Any], ctx: TreeContext) -> Any:
+    return py_trees.decorators.FailureIsSuccess(name=name, child=_child(children))
+
+
+def _repeat(name: str, args: SimpleNamespace, children: list[Any], ctx: TreeContext) -> Any:
+    return py_trees.decorators.Repeat(name=name, child=_child(children), num_success=args.times)
+
+
+def _retry(name: str, args: SimpleNamespace, children: list[Any], ctx: TreeContext) -> Any:
+    return py_trees.decorators.Retry(name=name, child=_child(children), num_failures=args.times)
+
+
+def _timeout(name: str, args: SimpleNamespace, children: list[Any], ctx: TreeContext) -> Any:
+    return EngineTimeout(name, _child(children), args.seconds, ctx.clock)
+
+
+def _cooldown(name: str, args: SimpleNamespace, children: list[Any], ctx: TreeContext) -> Any:
+    return Cooldown(name, _child(children), args.seconds, ctx.clock)
+
+
+def _one_shot(name: str, args: SimpleNamespace, children: list[Any], ctx: TreeContext) -> Any:
+    policy = (
+        OneShotPolicy.ON_SUCCESSFUL_COMPLETION
+        if args.after == "success"
+        else OneShotPolicy.ON_COMPLETION
+    )
+    return py_trees.decorators.OneShot(name=name, child=_child(children), policy=policy)
+
+
+_SECONDS = Number(minimum=0.0, unit="s")
+
+DECORATORS = (
+    NodeType(
+        "Inverter",
+        "decorator",
+        """Swap the child's SUCCESS and FAILURE ("not").
+
+        SUCCESS when the child failed; FAILURE when it succeeded; RUNNING while it runs.""",
+        (),
+        _inverter,
+    ),
+    NodeType(
+        "ForceSuccess",
+        "decorator",
+        """Run the child; its failure does not count.
+
+        SUCCESS when the child finished either way; RUNNING while it runs.""",
+        (),
+        _force_success,
+    ),
+    NodeType(
+        "Repeat",
+        "decorator",
+        """Run the child again each time it succeeds, ``times`` times in all.
+
+        SUCCESS after ``times`` successes; FAILURE as soon as the child fails; RUNNING
+        in between.""",
+        (Param("times", Integer(minimum=1), REQUIRED, "how many successes"),),
+        _repeat,
+    ),
+    NodeType(
+        "Retry",
+        "decorator",
+        """Try the child again when it fails, up to ``times`` failures.
+
+        SUCCESS as soon as the child succeeds; FAILURE after ``times`` failures; RUNNING
+        in between.""",
+        (Param("times", Integer(minimum=1), REQUIRED, "how many failures to tolerate"),),
+        _retry,
+    ),
+    NodeType(
+        "Timeout",
+        "decorator",
+        """Give the child at most ``seconds`` to finish (engine clock).
+
+        The child's status while it is in time; FAILURE (and the child stopped) when it is
+        still RUNNING after ``seconds``.""",
+        (Param("seconds", _SECONDS, REQUIRED, "time allowed, in seconds"),),
+        _timeout,
+    ),
+    NodeType(
+        "Cooldown",
+        "decorator",
+        """After the child succeeds, rest for ``seconds`` so a behavior does not repeat itself.
+
+        The child's status; FAILURE without ticking the child while cooling down.""",
+        (Param("seconds", _SECONDS, REQUIRED, "rest time after a success, in seconds"),),
+        _cooldown,
+    ),
+    NodeType(
+        "OneShot",
+        "decorator",
+        """Run the child until it has finished once, then never again.
+
+        The child's status until then; afterwards the status it finished with, forever.""",
+        (Param("after", Choice(("success", "completion")), "success",
+               "success: only a success counts as done; completion: any finish does"),),
+        _one_shot,
+    ),
+)

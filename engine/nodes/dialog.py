@@ -1,0 +1,101 @@
+"""Reply: answer what was heard from a dialog file."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any, ClassVar
+
+from py_trees.common import Status
+
+from engine.dialogs.model import Dialog
+from engine.nodes.base import Leaf
+from engine.nodes.params import CheckContext, Key, Param, Text, did_you_mean
+from engine.nodes.templates import CompiledTemplate
+from engine.services.jobs import Job
+
+
+class Reply(Leaf):
+    """Answer an utterance with the best-matching rule of a dialog (dialogs/NAME.yaml).
+
+    When the rule says ``read: temperature`` (or ultrasound), the sensor is read first and
+    the answer is filled with the new value. RUNNING while reading and speaking; SUCCESS
+    when the answer was said; FAILURE when no rule matched and the dialog has no fallback,
+    or a sensor or the speech service failed.
+    """
+
+    params: ClassVar = (
+        Param("heard", Key(), doc="the /vars/ key holding the utterance"),
+        Param("dialog", Text(), "default", "which dialog (file in dialogs/, without .yaml)"),
+    )
+    writes: ClassVar = ("/sensors/temperature/c", "/sensors/temperature/f",
+                        "/sensors/ultrasound/cm")
+
+    @classmethod
+    def check_params(
+        cls, args: Mapping[str, Any], ctx: CheckContext
+    ) -> list[tuple[str | None, str, str | None]]:
+        dialog = args.get("dialog")
+        if ctx.dialogs is not None and dialog is not None and ctx.dialogs.get(dialog) is None:
+            known = ctx.dialogs.names
+            hint = did_you_mean(dialog, known) or ("dialogs: " + ", ".join(known) if known
+                                                   else "add dialogs/NAME.yaml")
+            return [("dialog", f"no dialog named {dialog!r}", hint)]
+        return []
+
+    def __init__(self, *a: Any) -> None:
+        super().__init__(*a)
+        self.job: Job | None = None
+        self.answer: CompiledTemplate | None = None
+        self.phase = "idle"
+
+    def dialog(self) -> Dialog:
+        dialogs = self.ctx.dialogs
+        dialog = dialogs.get(self.args.dialog) if dialogs is not None else None
+        if dialog is None:
+            raise LookupError(f"dialog {self.args.dialog!r} is not loaded")
+        return dialog
+
+    def initialise(self) -> None:
+        self.job, self.answer, self.phase = None, None, "idle"
+        heard = self.read(self.args.heard)
+        dialog = self.dialog()
+        match = dialog.match(str(heard)) if heard else None
+        if match is None:
+            self.feedback_message = f"no rule matches {heard!r}"
+            if dialog.fallback is not None:
+                self._speak(dialog.fallback)
+            return
+        self.feedback_message = f"matched rule at line {match.rule.line} ({match.score:.2f})"
+        self.answer = match.rule.answer
+        if match.rule.read:
+            self.phase = "reading"
+            self.job = self.ctx.actions.read_sensor(match.rule.read)
+        else:
+            self._speak(self.answer)
+
+    def _speak(self, template: CompiledTemplate) -> None:
+        self.phase = "speaking"
+        self.job = self.ctx.actions.say(template.fill(self.read))
+
+    def update(self) -> Status:
+        if self.job is None:
+            return Status.FAILURE
+        if not self.job.done():
+            return Status.RUNNING
+        error = self.job.error()
+        if error is not None:
+            self.feedback_message = f"could not answer: {error}"
+            return Status.FAILURE
+        if self.phase == "reading" and self.answer is not None:
+            for key, value in (self.job.result() or {}).items():
+                self.ctx.blackboard.set(key, value)
+            self._speak(self.answer)
+            return self.update()
+        return Status.SUCCESS
+
+    def terminate(self, new_status: Status) -> None:
+        if new_status == Status.INVALID and self.job is not None and not self.job.done():
+            self.job.cancel()
+
+
+DIALOG_NODES = (Reply,)

@@ -1,0 +1,266 @@
+"""Parameter types of node declarations: each converts a YAML value or says what is wrong.
+
+A conversion problem raises :class:`ParamProblem` with a message that names the expected
+type and the value found, and a hint where one helps. The loader adds the place.
+"""
+
+from __future__ import annotations
+
+import difflib
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any, Literal
+
+if TYPE_CHECKING:
+    from engine.blackboard.catalogue import KeyCatalogue
+    from engine.dialogs.library import DialogLibrary
+
+
+class ParamProblem(Exception):  # noqa: N818 - a problem report, not a failure
+    """A parameter value is wrong: ``message`` says what, ``hint`` how to fix it."""
+
+    def __init__(self, message: str, hint: str | None = None) -> None:
+        super().__init__(message)
+        self.message = message
+        self.hint = hint
+
+
+@dataclass(frozen=True)
+class CheckContext:
+    """What parameter checks may consult at load time (never hardware)."""
+
+    catalogue: KeyCatalogue
+    dialogs: DialogLibrary | None = None
+
+
+def _shown(value: Any) -> str:
+    if isinstance(value, str):
+        return repr(value)
+    if value is None:
+        return "nothing"
+    if isinstance(value, dict):
+        return "a mapping"
+    if isinstance(value, list):
+        return "a list"
+    return repr(value)
+
+
+def did_you_mean(word: str, choices: Sequence[str]) -> str | None:
+    """``"did you mean 'x'?"`` for the choice closest to ``word``, or None."""
+    close = difflib.get_close_matches(word, list(choices), n=1, cutoff=0.6)
+    if not close:
+        lowered = {c.lower(): c for c in choices}
+        if word.lower() in lowered:
+            close = [lowered[word.lower()]]
+    return f"did you mean {close[0]!r}?" if close else None
+
+
+class ParamType:
+    """Base of parameter types. ``name`` is what docs and messages call the type."""
+
+    name = "value"
+
+    def convert(self, value: Any, ctx: CheckContext) -> Any:
+        return value
+
+    def describe(self) -> str:
+        return self.name
+
+
+class Text(ParamType):
+    name = "text"
+
+    def convert(self, value: Any, ctx: CheckContext) -> str:
+        if isinstance(value, bool) or value is None or isinstance(value, dict | list):
+            raise ParamProblem(f"must be text, got {_shown(value)}", "put the text in quotes")
+        return str(value)
+
+
+@dataclass(frozen=True)
+class Number(ParamType):
+    """A real number, optionally bounded (inclusive), with a unit for docs."""
+
+    minimum: float | None = None
+    maximum: float | None = None
+    unit: str = ""
+    name = "number"
+
+    def convert(self, value: Any, ctx: CheckContext) -> float:
+        if isinstance(value, bool) or not isinstance(value, int | float):
+            raise ParamProblem(f"must be a number, got {_shown(value)}", self._example())
+        number = float(value)
+        if self.minimum is not None and number < self.minimum:
+            raise ParamProblem(f"must be at least {self.minimum:g}, got {number:g}")
+        if self.maximum is not None and number > self.maximum:
+            raise ParamProblem(f"must be at most {self.maximum:g}, got {number:g}")
+        return number
+
+    def _example(self) -> str:
+        return "write digits, e.g. 3.0" + (f" ({self.unit})" if self.unit else "")
+
+    def describe(self) -> str:
+        bounds = ""
+        if self.minimum is not None or self.maximum is not None:
+            low = "" if self.minimum is None else f"{self.minimum:g}"
+            high = "" if self.maximum is None else f"{self.maximum:g}"
+            bounds = f" {low}..{high}"
+        return f"number{bounds}" + (f" {self.unit}" if self.unit else "")
+
+
+@dataclass(frozen=True)
+class Integer(ParamType):
+    minimum: int | None = None
+    maximum: int | None = None
+    name = "integer"
+
+    def convert(self, value: Any, ctx: CheckContext) -> int:
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise ParamProblem(f"must be a whole number, got {_shown(value)}")
+        if self.minimum is not None and value < self.minimum:
+            raise ParamProblem(f"must be at least {self.minimum}, got {value}")
+        if self.maximum is not None and value > self.maximum:
+            raise ParamProblem(f"must be at most {self.maximum}, got {value}")
+        return value
+
+    def describe(self) -> str:
+        if self.minimum is None and self.maximum is None:
+            return "integer"
+        low = "" if self.minimum is None else str(self.minimum)
+        high = "" if self.maximum is None else str(self.maximum)
+        return f"integer {low}..{high}"
+
+
+class Boolean(ParamType):
+    name = "true/false"
+
+    def convert(self, value: Any, ctx: CheckContext) -> bool:
+        if not isinstance(value, bool):
+            raise ParamProblem(f"must be true or false, got {_shown(value)}")
+        return value
+
+
+@dataclass(frozen=True)
+class Choice(ParamType):
+    options: tuple[str, ...]
+    name = "choice"
+
+    def convert(self, value: Any, ctx: CheckContext) -> str:
+        if not isinstance(value, str) or value not in self.options:
+            hint = did_you_mean(str(value), self.options) if isinstance(value, str) else None
+            options = ", ".join(self.options)
+            raise ParamProblem(f"must be one of {options}; got {_shown(value)}", hint)
+        return value
+
+    def describe(self) -> str:
+        return " | ".join(self.options)
+
+
+@dataclass(frozen=True)
+class Key(ParamType):
+    """A blackboard key from the catalogue.
+
+    ``access`` says whether the node reads or writes it (the loader lists it so), ``kinds``
+    which kinds of key are allowed: a state key is read every tick, an event key is
+    reacted to once per event.
+    """
+
+    access: Literal["read", "write"] = "read"
+    kinds: tuple[str, ...] = ("state",)
+    name = "blackboard key"
+
+    def convert(self, value: Any, ctx: CheckContext) -> str:
+        if not isinstance(value, str):
+            raise ParamProblem(
+                f"must be a blackboard key like /sensors/touch/any, got {_shown(value)}"
+            )
+        if not value.startswith("/"):
+            raise ParamProblem(
+                f"blackboard keys start with '/', got {value!r}",
+                f"did you mean {'/' + value!r}?",
+            )
+        spec = ctx.catalogue.lookup(value)
+        if spec is None:
+            suggestion = ctx.catalogue.suggest(value)
+            hint = (f"did you mean {suggestion!r}?" if suggestion
+                    else "see `vest keys`; use /vars/NAME for a tree's own variable")
+            raise ParamProblem(f"unknown blackboard key {value!r}", hint)
+        if spec.kind == "event" and "event" not in self.kinds:
+            raise ParamProblem(
+                f"{value!r} is an event key: its value stays after the event",
+                "use OnEvent to react once per event",
+            )
+        if spec.kind == "state" and "state" not in self.kinds and not value.startswith("/vars/"):
+            raise ParamProblem(
+                f"{value!r} is not an event key", "use Check to compare a value each tick"
+            )
+        if self.access == "write" and not value.startswith("/vars/"):
+            raise ParamProblem(
+                f"trees may only write their own variables, not {value!r}",
+                "write to /vars/NAME",
+            )
+        return value
+
+    def describe(self) -> str:
+        kind = "event key" if self.kinds == ("event",) else "blackboard key"
+        return f"{kind} ({self.access})"
+
+
+@dataclass(frozen=True)
+class ListOf(ParamType):
+    item: ParamType
+    min_items: int = 0
+    max_items: int | None = None
+    name = "list"
+
+    def convert(self, value: Any, ctx: CheckContext) -> list[Any]:
+        if not isinstance(value, list):
+            raise ParamProblem(f"must be a list like [a, b], got {_shown(value)}")
+        if len(value) < self.min_items:
+            raise ParamProblem(f"needs at least {self.min_items} items, got {len(value)}")
+        if self.max_items is not None and len(value) > self.max_items:
+            raise ParamProblem(f"takes at most {self.max_items} items, got {len(value)}")
+        converted = []
+        for index, item in enumerate(value):
+            try:
+                converted.append(self.item.convert(item, ctx))
+            except ParamProblem as problem:
+                raise ParamProblem(f"item {index + 1} {problem.message}", problem.hint) from None
+        return converted
+
+    def describe(self) -> str:
+        return f"list of {self.item.describe()}"
+
+
+class Scalar(ParamType):
+    """A number, text, or true/false (what a key is compared with)."""
+
+    name = "number, text or true/false"
+
+    def convert(self, value: Any, ctx: CheckContext) -> Any:
+        if isinstance(value, dict | list) or value is None:
+            raise ParamProblem(f"must be a number, text or true/false, got {_shown(value)}")
+        return value
+
+
+class AnyValue(ParamType):
+    """Any YAML value (number, text, list, mapping)."""
+
+    name = "any value"
+
+
+REQUIRED: Any = object()
+
+
+@dataclass(frozen=True)
+class Param:
+    """One declared parameter: its name, type, default (or :data:`REQUIRED`) and meaning."""
+
+    name: str
+    type: ParamType
+    default: Any = REQUIRED
+    doc: str = ""
+    choices_doc: list[str] = field(default_factory=list)
+
+    @property
+    def required(self) -> bool:
+        return self.default is REQUIRED

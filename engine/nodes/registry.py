@@ -1,0 +1,116 @@
+"""The node registry: every node type the YAML may name, built-in or from plugins.
+
+A registry is an object handed to the loader (no import-time globals). Other installed
+packages add node types through the ``vest.nodes`` entry point group: the entry point
+names either a Leaf subclass or a function ``register(registry)``.
+"""
+
+from __future__ import annotations
+
+import difflib
+import inspect
+from collections.abc import Callable, Iterator
+from importlib.metadata import EntryPoint, entry_points
+
+from engine.nodes.base import Leaf
+from engine.nodes.spec import NodeType, leaf_type
+
+ENTRY_POINT_GROUP = "vest.nodes"
+
+
+class NodeRegistry:
+    """Node types by name."""
+
+    def __init__(self) -> None:
+        self._types: dict[str, NodeType] = {}
+        self.plugin_errors: list[str] = []
+
+    def add(self, node: type[Leaf] | NodeType, *, source: str = "vest") -> NodeType:
+        """Register a leaf class or a NodeType; a name already taken is an error naming both."""
+        node_type = node if isinstance(node, NodeType) else leaf_type(node, source=source)
+        holder = self._types.get(node_type.name)
+        if holder is not None:
+            raise ValueError(
+                f"node type {node_type.name!r} from {node_type.source} is already "
+                f"registered by {holder.source}"
+            )
+        self._types[node_type.name] = node_type
+        return node_type
+
+    def get(self, name: str) -> NodeType | None:
+        return self._types.get(name)
+
+    def suggest(self, name: str) -> str | None:
+        close = difflib.get_close_matches(name, list(self._types), n=1, cutoff=0.5)
+        if not close:
+            lowered = {n.lower(): n for n in self._types}
+            close = [lowered[name.lower()]] if name.lower() in lowered else []
+        return close[0] if close else None
+
+    @property
+    def names(self) -> list[str]:
+        return sorted(self._types)
+
+    def __iter__(self) -> Iterator[NodeType]:
+        return iter(sorted(self._types.values(), key=lambda t: (t.kind, t.name)))
+
+    def __contains__(self, name: object) -> bool:
+        return name in self._types
+
+    def load_plugins(self, entries: list[EntryPoint] | None = None) -> None:
+        """Add node types from installed packages; a broken plugin is noted, not fatal."""
+        for entry in entries if entries is not None else entry_points(group=ENTRY_POINT_GROUP):
+            source = entry.dist.name if entry.dist is not None else entry.value
+            try:
+                target = entry.load()
+                if inspect.isclass(target) and issubclass(target, Leaf):
+                    self.add(target, source=source)
+                elif callable(target):
+                    _call_register(target, self, source)
+                else:
+                    raise TypeError("is neither a Leaf subclass nor a register(registry) function")
+            except Exception as error:  # one bad plugin must not stop the robot
+                self.plugin_errors.append(f"plugin {entry.name} ({entry.value}): {error}")
+
+
+def _call_register(register: Callable[..., object], registry: NodeRegistry, source: str) -> None:
+    before = set(registry.names)
+    register(_SourcedRegistry(registry, source))
+    if set(registry.names) == before:
+        raise ValueError("registered no node type")
+
+
+class _SourcedRegistry:
+    """What a plugin's register() receives: add() records the plugin as the source."""
+
+    def __init__(self, registry: NodeRegistry, source: str) -> None:
+        self._registry = registry
+        self._source = source
+
+    def add(self, node: type[Leaf] | NodeType, *, source: str | None = None) -> NodeType:
+        return self._registry.add(node, source=source or self._source)
+
+
+def builtin_registry() -> NodeRegistry:
+    """The node types vest ships with."""
+    from engine.nodes.actions import ACTIONS
+    from engine.nodes.composites import COMPOSITES
+    from engine.nodes.conditions import CONDITIONS
+    from engine.nodes.decorators import DECORATORS
+    from engine.nodes.dialog import DIALOG_NODES
+    from engine.nodes.remote import REMOTE_NODES
+
+    registry = NodeRegistry()
+    for node_type in (*COMPOSITES, *DECORATORS):
+        registry.add(node_type)
+    for leaf in (*CONDITIONS, *ACTIONS, *DIALOG_NODES, *REMOTE_NODES):
+        registry.add(leaf)
+    return registry
+
+
+def default_registry(*, plugins: bool = True) -> NodeRegistry:
+    """Built-in node types plus those of installed plugins."""
+    registry = builtin_registry()
+    if plugins:
+        registry.load_plugins()
+    return registry

@@ -1,0 +1,105 @@
+"""Node type declarations: what the loader, ``vest nodes`` and the docs are made from.
+
+A :class:`NodeType` names a node, its kind, its parameters and the blackboard keys it
+reads and writes, and knows how to build the py_trees behaviour. Leaf nodes written as
+classes (subclasses of :class:`~engine.nodes.base.Leaf`) are turned into a NodeType by
+:func:`leaf_type`.
+"""
+
+from __future__ import annotations
+
+import inspect
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from types import SimpleNamespace
+from typing import TYPE_CHECKING, Any, Literal
+
+import py_trees
+
+from engine.nodes.context import TreeContext
+from engine.nodes.params import CheckContext, Key, ListOf, Param
+
+if TYPE_CHECKING:
+    from engine.nodes.base import Leaf
+
+Kind = Literal["composite", "decorator", "condition", "action"]
+KINDS: tuple[Kind, ...] = ("composite", "decorator", "condition", "action")
+
+Builder = Callable[[str, SimpleNamespace, list[py_trees.behaviour.Behaviour], TreeContext],
+                   py_trees.behaviour.Behaviour]
+ExtraCheck = Callable[[Mapping[str, Any], CheckContext], list[tuple[str | None, str, str | None]]]
+"""Cross-parameter checks: returns (parameter or None, message, hint) per problem."""
+
+@dataclass(frozen=True)
+class NodeType:
+    """A node type the YAML can name."""
+
+    name: str
+    kind: Kind
+    doc: str
+    params: tuple[Param, ...]
+    build: Builder
+    check: ExtraCheck | None = None
+    fixed_reads: tuple[str, ...] = ()
+    fixed_writes: tuple[str, ...] = ()
+    source: str = "vest"
+
+    @property
+    def children(self) -> Literal["none", "one", "many"]:
+        return {"composite": "many", "decorator": "one"}.get(self.kind, "none")  # type: ignore[return-value]
+
+    @property
+    def summary(self) -> str:
+        return self.doc.strip().splitlines()[0] if self.doc.strip() else ""
+
+    def param(self, name: str) -> Param | None:
+        for param in self.params:
+            if param.name == name:
+                return param
+        return None
+
+    def keys(self, args: Mapping[str, Any]) -> tuple[list[str], list[str]]:
+        """The blackboard keys a node with these (converted) arguments reads and writes."""
+        reads, writes = list(self.fixed_reads), list(self.fixed_writes)
+        for param in self.params:
+            value = args.get(param.name)
+            if value is None:
+                continue
+            key_type = param.type.item if isinstance(param.type, ListOf) else param.type
+            if not isinstance(key_type, Key):
+                continue
+            values = value if isinstance(value, list) else [value]
+            (writes if key_type.access == "write" else reads).extend(values)
+        return reads, writes
+
+
+def leaf_type(cls: type[Leaf], *, source: str = "vest") -> NodeType:
+    """The :class:`NodeType` of a leaf class (its name is ``cls.type_name`` or the class name)."""
+    if cls.kind not in ("condition", "action"):
+        raise TypeError(f"{cls.__name__}.kind must be 'condition' or 'action', not {cls.kind!r}")
+    names = [p.name for p in cls.params]
+    if len(set(names)) != len(names) or "name" in names:
+        raise TypeError(f"{cls.__name__}.params: names must be unique and not 'name'")
+
+    def build(
+        name: str, args: SimpleNamespace, children: list[Any], ctx: TreeContext
+    ) -> py_trees.behaviour.Behaviour:
+        return cls(name, args, ctx)
+
+    return NodeType(
+        name=cls.type_name or cls.__name__,
+        kind=cls.kind,
+        doc=inspect.cleandoc(cls.__doc__ or ""),
+        params=tuple(cls.params),
+        build=build,
+        check=cls.check_params if _overrides(cls, "check_params") else None,
+        fixed_reads=tuple(cls.reads),
+        fixed_writes=tuple(cls.writes),
+        source=source,
+    )
+
+
+def _overrides(cls: type, method: str) -> bool:
+    from engine.nodes.base import Leaf
+
+    return getattr(cls, method) is not getattr(Leaf, method)

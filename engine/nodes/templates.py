@@ -1,0 +1,103 @@
+"""Text templates filled from the blackboard: ``"It is {temperature_f:.0f} degrees"``.
+
+A field names a blackboard key (``{/sensors/temperature/f}``) or a key's short alias
+(``{temperature_f}``), optionally with a Python format spec after a colon. Templates are
+checked when the tree loads and never evaluate code.
+"""
+
+from __future__ import annotations
+
+import string
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+from engine.nodes.params import CheckContext, ParamProblem, ParamType, did_you_mean
+
+_FORMATTER = string.Formatter()
+
+
+@dataclass(frozen=True)
+class CompiledTemplate:
+    """Literal text and the fields to fill: (literal, key or None, format spec)."""
+
+    source: str
+    parts: tuple[tuple[str, str | None, str], ...]
+
+    @property
+    def keys(self) -> tuple[str, ...]:
+        return tuple(key for _, key, _ in self.parts if key is not None)
+
+    def fill(self, read: Callable[[str], Any]) -> str:
+        """The text with every field filled by ``read(key)``.
+
+        Raises KeyError naming the key when it has no value yet, ValueError when the value
+        does not suit the format spec.
+        """
+        if not self.keys:
+            return self.source
+        pieces = []
+        for literal, key, spec in self.parts:
+            pieces.append(literal)
+            if key is None:
+                continue
+            value = read(key)
+            if value is None:
+                raise KeyError(f"{key} has no value yet")
+            try:
+                pieces.append(format(value, spec))
+            except (TypeError, ValueError) as error:
+                raise ValueError(f"cannot format {key}={value!r} as {spec!r}: {error}") from None
+        return "".join(pieces)
+
+    def __str__(self) -> str:
+        return self.source
+
+
+def compile_template(text: str, ctx: CheckContext) -> CompiledTemplate:
+    """Parse ``text``; raises :class:`ParamProblem` for a bad field or unknown key."""
+    try:
+        parsed = list(_FORMATTER.parse(text))
+    except ValueError as error:
+        raise ParamProblem(
+            f"bad template {text!r}: {error}", "write {{ and }} for literal braces"
+        ) from None
+    parts: list[tuple[str, str | None, str]] = []
+    for literal, field, spec, conversion in parsed:
+        if field is None:
+            parts.append((literal, None, ""))
+            continue
+        if conversion or (spec and ("{" in spec)):
+            raise ParamProblem(f"template field {{{field}}} is too complex", "use {key:.1f}")
+        parts.append((literal, _resolve(field, ctx), spec or ""))
+    return CompiledTemplate(text, tuple(parts))
+
+
+def _resolve(field: str, ctx: CheckContext) -> str:
+    if not field:
+        raise ParamProblem("empty template field {}", "name a key, e.g. {temperature_f}")
+    if field.startswith("/"):
+        if ctx.catalogue.lookup(field) is None:
+            suggestion = ctx.catalogue.suggest(field)
+            hint = f"did you mean {suggestion!r}?" if suggestion else None
+            raise ParamProblem(f"unknown blackboard key {field!r} in template", hint)
+        return field
+    spec = ctx.catalogue.by_alias(field)
+    if spec is None:
+        aliases = [s.alias for s in ctx.catalogue if s.alias]
+        raise ParamProblem(
+            f"unknown template field {{{field}}}",
+            did_you_mean(field, aliases) or "name a blackboard key, e.g. {/vars/name}",
+        )
+    return spec.name
+
+
+class Template(ParamType):
+    """Text that may contain ``{key}`` fields filled from the blackboard when used."""
+
+    name = "text with {fields}"
+
+    def convert(self, value: Any, ctx: CheckContext) -> CompiledTemplate:
+        if isinstance(value, bool) or value is None or isinstance(value, dict | list):
+            raise ParamProblem("must be text", "put the text in quotes")
+        return compile_template(str(value), ctx)
