@@ -33,6 +33,15 @@ _TOP_KEYS = ("dialog", "description", "concepts", "rules", "fallback", "min_scor
 _RULE_KEYS = ("hear", "say", "read")
 
 
+def find_dialogs_folder(path: Path) -> Path | None:
+    """The nearest ``dialogs/`` folder beside ``path`` or above it."""
+    for folder in [path.parent, *path.resolve().parents]:
+        candidate = folder / "dialogs"
+        if candidate.is_dir():
+            return candidate
+    return None
+
+
 class DialogLibrary:
     """Dialogs by name, loaded from ``*.yaml`` files in a folder."""
 

@@ -93,6 +93,12 @@ def data_rate_code(data_rate_sps: int) -> int:
     return DATA_RATES_SPS.index(data_rate_sps)
 
 
+def _not_found(address: int, error: OSError) -> DeviceError:
+    """The bus error of a first contact, as a DeviceError that keeps its errno."""
+    message = f"ADS1115 not found at I2C 0x{address:02X}: {error.strerror or error}"
+    return DeviceError(error.errno, message) if error.errno is not None else DeviceError(message)
+
+
 class ADS1115:
     """An ADS1115 on an ``smbus2.SMBus``-compatible ``bus``, waiting on ``clock``.
 
@@ -187,9 +193,7 @@ class ADS1115:
         except DeviceError:
             raise
         except OSError as error:
-            raise DeviceError(
-                f"ADS1115 not found at I2C 0x{self.address:02X}: {error.strerror or error}"
-            ) from error
+            raise _not_found(self.address, error) from error
         if echoed & ~OS_START != expected:
             raise DeviceError(
                 f"ADS1115 at I2C 0x{self.address:02X} failed its identity check: config "

@@ -71,7 +71,9 @@ GPIO_V2_LINE_GET_VALUES_IOCTL = ioctl_readwrite(_GPIO_IOCTL_TYPE, 0x0E, LINE_VAL
 GPIO_V2_LINE_SET_VALUES_IOCTL = ioctl_readwrite(_GPIO_IOCTL_TYPE, 0x0F, LINE_VALUES_SIZE)
 
 
-def pack_output_request(offset: int, *, consumer: str, initial_high: bool, active_low: bool) -> bytearray:
+def pack_output_request(
+    offset: int, *, consumer: str, initial_high: bool, active_low: bool
+) -> bytearray:
     """A ``gpio_v2_line_request`` asking for one output line driven to ``initial_high``."""
     if not 0 <= offset < 2**32:
         raise ValueError(f"GPIO line offset must be a non-negative 32-bit number, got {offset}")

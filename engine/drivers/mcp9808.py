@@ -87,7 +87,9 @@ class AlertFlags:
 def word_to_flags(word: int) -> AlertFlags:
     """The three alert flags of an ambient register word."""
     return AlertFlags(
-        critical=bool(word & FLAG_CRIT), upper=bool(word & FLAG_UPPER), lower=bool(word & FLAG_LOWER)
+        critical=bool(word & FLAG_CRIT),
+        upper=bool(word & FLAG_UPPER),
+        lower=bool(word & FLAG_LOWER),
     )
 
 
@@ -98,6 +100,12 @@ def _resolution_entry(resolution_c: float) -> tuple[int, float]:
             f"MCP9808 resolution {resolution_c!r} degC is not one of 0.5, 0.25, 0.125, 0.0625"
         )
     return entry
+
+
+def _not_found(address: int, error: OSError) -> DeviceError:
+    """The bus error of a first contact, as a DeviceError that keeps its errno."""
+    message = f"MCP9808 not found at I2C 0x{address:02X}: {error.strerror or error}"
+    return DeviceError(error.errno, message) if error.errno is not None else DeviceError(message)
 
 
 class MCP9808:
@@ -165,9 +173,7 @@ class MCP9808:
         except DeviceError:
             raise
         except OSError as error:
-            raise DeviceError(
-                f"MCP9808 not found at I2C 0x{self.address:02X}: {error.strerror or error}"
-            ) from error
+            raise _not_found(self.address, error) from error
         if manufacturer != MANUFACTURER_ID_VALUE or device >> 8 != DEVICE_ID_VALUE:
             raise DeviceError(
                 f"MCP9808 at I2C 0x{self.address:02X} failed its identity check: "

@@ -72,6 +72,12 @@ def status_to_pads(status: int) -> list[bool]:
     return [bool(status >> pad & 1) for pad in range(PADS)]
 
 
+def _not_found(address: int, error: OSError) -> DeviceError:
+    """The bus error of a first contact, as a DeviceError that keeps its errno."""
+    message = f"MPR121 not found at I2C 0x{address:02X}: {error.strerror or error}"
+    return DeviceError(error.errno, message) if error.errno is not None else DeviceError(message)
+
+
 class MPR121:
     """An MPR121 on an ``smbus2.SMBus``-compatible ``bus``.
 
@@ -112,9 +118,7 @@ class MPR121:
         except DeviceError:
             raise
         except OSError as error:
-            raise DeviceError(
-                f"MPR121 not found at I2C 0x{self.address:02X}: {error.strerror or error}"
-            ) from error
+            raise _not_found(self.address, error) from error
         if config2 != CONFIG2_AFTER_RESET:
             raise DeviceError(
                 f"MPR121 at I2C 0x{self.address:02X} failed its identity check: CONFIG2 "

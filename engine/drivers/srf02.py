@@ -39,6 +39,12 @@ MAX_POLLS = 10
 MIN_RANGE_CM = 16  # the tuned minimum; a fresh chip starts at 28 cm
 
 
+def _not_found(address: int, error: OSError) -> DeviceError:
+    """The bus error of a first contact, as a DeviceError that keeps its errno."""
+    message = f"SRF02 not found at I2C 0x{address:02X}: {error.strerror or error}"
+    return DeviceError(error.errno, message) if error.errno is not None else DeviceError(message)
+
+
 class SRF02:
     """An SRF02 on an ``smbus2.SMBus``-compatible ``bus``, timed by ``clock``.
 
@@ -74,13 +80,28 @@ class SRF02:
         self._started_s = self._clock.now()
 
     def result_ready(self) -> bool:
-        """True once the last ranging finished (no bus traffic before 66 ms have passed)."""
-        if self._started_s is not None:
-            if self._clock.now() < self._started_s + RANGING_TIME_S:
+        """True once the last ranging finished (no bus traffic before 66 ms have passed).
+
+        The chip does not listen while ranging: the revision register reads 0xFF, or on
+        a bus that checks acknowledges the read fails. A failed read counts as "not yet"
+        until the polling allowance (``max_polls`` x ``poll_interval_s`` after the
+        ranging time) has passed, and is raised after that.
+        """
+        if self._started_s is None:
+            return True
+        now = self._clock.now()
+        if now < self._started_s + RANGING_TIME_S:
+            return False
+        try:
+            busy = self._read(COMMAND, 1)[0] == BUSY
+        except OSError:
+            allowance_s = RANGING_TIME_S + self._max_polls * self._poll_interval_s
+            if now < self._started_s + allowance_s:
                 return False
-            if self._read(COMMAND, 1)[0] == BUSY:
-                return False
-            self._started_s = None
+            raise
+        if busy:
+            return False
+        self._started_s = None
         return True
 
     def read_result_cm(self) -> int:
@@ -123,9 +144,7 @@ class SRF02:
         except DeviceError:
             raise
         except OSError as error:
-            raise DeviceError(
-                f"SRF02 not found at I2C 0x{self.address:02X}: {error.strerror or error}"
-            ) from error
+            raise _not_found(self.address, error) from error
         if revision == BUSY or unused != UNUSED_VALUE:
             raise DeviceError(
                 f"SRF02 at I2C 0x{self.address:02X} failed its identity check: software "

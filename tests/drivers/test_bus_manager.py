@@ -294,6 +294,45 @@ def test_a_cancelled_transaction_never_reaches_the_bus(threaded_vest: Vest) -> N
         cancelled.result(0)
 
 
+def test_transactions_from_many_threads_never_share_the_bus(threaded_vest: Vest) -> None:
+    handles = [threaded_vest.claim_left(), threaded_vest.claim_right()]
+    threaded_vest.left_chip.level, threaded_vest.right_chip.level = 1000, 2000
+    on_bus = [0]
+    overlaps: list[int] = []
+    answers: list[int] = []
+
+    def exclusive(address: int) -> Any:
+        def transaction(bus: SimI2CBus) -> int:
+            on_bus[0] += 1
+            try:
+                if on_bus[0] > 1:
+                    overlaps.append(on_bus[0])
+                return read_level(address)(bus)
+            finally:
+                on_bus[0] -= 1
+
+        return transaction
+
+    def driver(index: int) -> None:
+        for turn in range(100):
+            handle = handles[(index + turn) % 2]
+            transaction = exclusive(handle.address or 0)
+            if turn % 2:
+                answers.append(handle.call(transaction, timeout_s=WAIT_S))
+            else:
+                answers.append(handle.submit(transaction).result(WAIT_S))
+
+    drivers = [threading.Thread(target=driver, args=(index,)) for index in range(4)]
+    for thread in drivers:
+        thread.start()
+    for thread in drivers:
+        thread.join(WAIT_S)
+
+    assert overlaps == []
+    assert sorted(set(answers)) == [1000, 2000]
+    assert len(answers) == 400
+
+
 # -- retries -------------------------------------------------------------------------------
 def test_a_short_nack_is_retried_with_backoff_then_succeeds(vest: Vest) -> None:
     left = vest.claim_left()

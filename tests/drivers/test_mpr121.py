@@ -122,6 +122,15 @@ def test_status_reports_no_pad_in_stop_mode(bus: SimI2CBus, chip: SimMPR121) -> 
     assert bus.read_i2c_block_data(0x5A, 0x00, 2) == [0, 0]
 
 
+def test_status_reports_only_enabled_electrodes(bus: SimI2CBus, chip: SimMPR121) -> None:
+    pads = MPR121(bus)
+    bus.write_byte_data(0x5A, 0x5E, 0x00)
+    bus.write_byte_data(0x5A, 0x5E, 0x84)  # run ELE0..ELE3 only
+    chip.touch(2)
+    chip.touch(5)
+    assert [pad for pad, touched in enumerate(pads.touched()) if touched] == [2]
+
+
 def test_reading_the_status_clears_the_interrupt(bus: SimI2CBus, chip: SimMPR121) -> None:
     pads = MPR121(bus)
     chip.touch(7)

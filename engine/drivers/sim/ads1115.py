@@ -19,13 +19,15 @@ What it models, after the ADS111x data sheet (SBAS444, section 9):
 
 What it simplifies: a conversion uses the inputs as they were when it started (the real
 delta-sigma modulator averages over the conversion time), the internal oscillator is exact
-(the real one is within 10 %), there is no noise or offset, and the comparator and the
-ALERT/RDY pin are not modelled (the threshold registers only store their values).
+unless ``conversion_time_factor`` says otherwise (the real one is within 10 %), there is
+no noise or offset, and the comparator and the ALERT/RDY pin are not modelled (the
+threshold registers only store their values).
 """
 
 from __future__ import annotations
 
 import math
+import threading
 
 from engine.clock import Clock
 from engine.drivers.sim.i2c_bus import SimI2CDevice
@@ -72,15 +74,27 @@ class SimADS1115(SimI2CDevice):
     """An ADS1115 whose four inputs are set in volts against GND.
 
     ``supply_v`` is VDD; inputs beyond GND - 0.3 V .. VDD + 0.3 V would damage the chip,
-    so setting one is a ``ValueError``.
+    so setting one is a ``ValueError``. ``conversion_time_factor`` scales the conversion
+    time: 1.1 is an oscillator at the slow end of its 10 % tolerance, larger a faulty one.
     """
 
-    def __init__(self, clock: Clock, address: int = 0x48, *, supply_v: float = 3.3) -> None:
+    def __init__(
+        self,
+        clock: Clock,
+        address: int = 0x48,
+        *,
+        supply_v: float = 3.3,
+        conversion_time_factor: float = 1.0,
+    ) -> None:
         super().__init__(address)
         if not 2.0 <= supply_v <= 5.5:
             raise ValueError(f"ADS1115 supply {supply_v} V is outside 2.0..5.5 V")
+        if not conversion_time_factor > 0:
+            raise ValueError(f"conversion_time_factor {conversion_time_factor} must be positive")
+        self._lock = threading.RLock()  # inputs move on another thread than the bus
         self._clock = clock
         self._supply_v = supply_v
+        self._time_factor = conversion_time_factor
         self._inputs_v = [0.0, 0.0, 0.0, 0.0]
         self._pointer = CONVERSION
         self._config = CONFIG_POWER_ON & ~OS
@@ -103,35 +117,39 @@ class SimADS1115(SimI2CDevice):
                 f"ADS1115 AIN{channel} at {volts} V is outside its absolute maximum "
                 f"{low:.1f}..{high:.1f} V"
             )
-        self._update()
-        self._inputs_v[channel] = float(volts)
+        with self._lock:
+            self._update()
+            self._inputs_v[channel] = float(volts)
 
     @property
     def converting(self) -> bool:
         """True while a single-shot conversion is under way (OS reads 0)."""
-        self._update()
-        return self._busy_until_s is not None
+        with self._lock:
+            self._update()
+            return self._busy_until_s is not None
 
     # -- wire side ----------------------------------------------------------------------
     def write(self, data: bytes) -> None:
         if not data:
             return
-        self._update()
-        self._pointer = data[0] & POINTER_MASK
-        if len(data) < 3:
-            return  # a pointer write (a lone MSB is not latched)
-        value = data[1] << 8 | data[2]
-        if self._pointer == CONFIG:
-            self._write_config(value)
-        elif self._pointer == LO_THRESH:
-            self._lo_thresh = value
-        elif self._pointer == HI_THRESH:
-            self._hi_thresh = value
-        # the conversion register is read-only
+        with self._lock:
+            self._update()
+            self._pointer = data[0] & POINTER_MASK
+            if len(data) < 3:
+                return  # a pointer write (a lone MSB is not latched)
+            value = data[1] << 8 | data[2]
+            if self._pointer == CONFIG:
+                self._write_config(value)
+            elif self._pointer == LO_THRESH:
+                self._lo_thresh = value
+            elif self._pointer == HI_THRESH:
+                self._hi_thresh = value
+            # the conversion register is read-only
 
     def read(self, length: int) -> bytes:
-        self._update()
-        value = self._register(self._pointer)
+        with self._lock:
+            self._update()
+            value = self._register(self._pointer)
         pair = bytes([value >> 8, value & 0xFF])
         return (pair * (length // 2 + 1))[:length]
 
@@ -147,7 +165,7 @@ class SimADS1115(SimI2CDevice):
         return self._hi_thresh
 
     def _period_s(self) -> float:
-        return 1.0 / DATA_RATE_SPS[(self._config >> DR_SHIFT) & 0x07]
+        return self._time_factor / DATA_RATE_SPS[(self._config >> DR_SHIFT) & 0x07]
 
     def _code_now(self) -> int:
         positive, negative = MUX_INPUTS[(self._config >> MUX_SHIFT) & 0x07]

@@ -33,9 +33,7 @@ def fsr406_resistance_ohm(force_n: float) -> float:
     return FSR406_OHM_NEWTONS / force_n
 
 
-def fsr406_volts(
-    force_n: float, *, supply_v: float = 3.3, divider_ohm: float = 10_000
-) -> float:
+def fsr406_volts(force_n: float, *, supply_v: float = 3.3, divider_ohm: float = 10_000) -> float:
     """The divider's output in volts with ``force_n`` newtons on an FSR 406.
 
     Never decreases as the force grows; 0 V below the 0.2 N actuation force and

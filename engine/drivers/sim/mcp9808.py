@@ -28,6 +28,7 @@ and the temperature is exact (the real chip is within +/-0.25 degC typical).
 from __future__ import annotations
 
 import math
+import threading
 
 from engine.clock import Clock
 from engine.drivers.sim.i2c_bus import SimI2CDevice
@@ -75,6 +76,7 @@ class SimMCP9808(SimI2CDevice):
 
     def __init__(self, clock: Clock, address: int = 0x18, *, temperature_c: float = 22.0) -> None:
         super().__init__(address)
+        self._lock = threading.RLock()  # the world model sets the temperature on its thread
         self._clock = clock
         self._temperature_c = self._checked(temperature_c)
         self._pointer = T_AMBIENT
@@ -94,8 +96,9 @@ class SimMCP9808(SimI2CDevice):
     @temperature_c.setter
     def temperature_c(self, value: float) -> None:
         checked = self._checked(value)
-        self._update()  # conversions finished so far saw the old temperature
-        self._temperature_c = checked
+        with self._lock:
+            self._update()  # conversions finished so far saw the old temperature
+            self._temperature_c = checked
 
     @property
     def conversion_time_s(self) -> float:
@@ -115,20 +118,22 @@ class SimMCP9808(SimI2CDevice):
     def write(self, data: bytes) -> None:
         if not data:
             return
-        self._update()
-        self._pointer = data[0]
-        payload = data[1:]
-        if self._pointer == RESOLUTION and payload:
-            self._resolution = payload[0] & 0x03
-            self._cycle_start_s = self._clock.now()
-        elif len(payload) >= 2:
-            self._write_word(self._pointer, payload[0] << 8 | payload[1])
+        with self._lock:
+            self._update()
+            self._pointer = data[0]
+            payload = data[1:]
+            if self._pointer == RESOLUTION and payload:
+                self._resolution = payload[0] & 0x03
+                self._cycle_start_s = self._clock.now()
+            elif len(payload) >= 2:
+                self._write_word(self._pointer, payload[0] << 8 | payload[1])
 
     def read(self, length: int) -> bytes:
-        self._update()
-        if self._pointer == RESOLUTION:
-            return bytes([self._resolution]) * length
-        word = self._read_word(self._pointer)
+        with self._lock:
+            self._update()
+            if self._pointer == RESOLUTION:
+                return bytes([self._resolution]) * length
+            word = self._read_word(self._pointer)
         return (bytes([word >> 8, word & 0xFF]) * (length // 2 + 1))[:length]
 
     # -- chip internals -----------------------------------------------------------------
@@ -154,9 +159,8 @@ class SimMCP9808(SimI2CDevice):
         elif pointer == T_CRIT:
             if not self._config & CONFIG_CRIT_LOCK:
                 self._limits[T_CRIT] = value & LIMIT_MASK
-        elif pointer in (T_UPPER, T_LOWER):
-            if not self._config & CONFIG_WIN_LOCK:
-                self._limits[pointer] = value & LIMIT_MASK
+        elif pointer in (T_UPPER, T_LOWER) and not self._config & CONFIG_WIN_LOCK:
+            self._limits[pointer] = value & LIMIT_MASK
         # TA, the IDs and reserved registers are read-only
 
     def _write_config(self, value: int) -> None:

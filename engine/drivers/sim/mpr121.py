@@ -30,6 +30,8 @@ wraps from 0xFF to 0x00 (the data sheet's finer wrap rules are not modelled).
 
 from __future__ import annotations
 
+import threading
+
 from engine.drivers.sim.i2c_bus import SimI2CDevice
 
 # Register map (data sheet Table 1).
@@ -80,6 +82,7 @@ class SimMPR121(SimI2CDevice):
             raise ValueError(
                 f"touch_delta_counts {touch_delta_counts} is outside 0..{untouched_counts}"
             )
+        self._lock = threading.RLock()  # a world-model thread touches while the bus reads
         self._untouched_counts = untouched_counts
         self._touch_delta_counts = touch_delta_counts
         self._touching = [False] * PADS
@@ -96,13 +99,15 @@ class SimMPR121(SimI2CDevice):
         """Put a finger on ``pad`` (0..11), or take it away with ``touching=False``."""
         if not 0 <= pad < PADS:
             raise ValueError(f"MPR121 pad {pad} is outside 0..{PADS - 1}")
-        self._touching[pad] = touching
-        self._scan()
+        with self._lock:
+            self._touching[pad] = touching
+            self._scan()
 
     def release_all(self) -> None:
         """Take every finger off the pads."""
-        self._touching = [False] * PADS
-        self._scan()
+        with self._lock:
+            self._touching = [False] * PADS
+            self._scan()
 
     @property
     def running(self) -> bool:
@@ -116,30 +121,33 @@ class SimMPR121(SimI2CDevice):
 
     def reset(self) -> None:
         """Power-on reset: registers to defaults, stop mode, IRQ released."""
-        self._registers = bytearray(256)
-        self._registers[CONFIG1] = CONFIG1_DEFAULT
-        self._registers[CONFIG2] = CONFIG2_DEFAULT
-        self._data = [0] * PADS
-        self._baseline = [0] * PADS
-        self._touched = [False] * PADS
-        self.irq_asserted = False
+        with self._lock:
+            self._registers = bytearray(256)
+            self._registers[CONFIG1] = CONFIG1_DEFAULT
+            self._registers[CONFIG2] = CONFIG2_DEFAULT
+            self._data = [0] * PADS
+            self._baseline = [0] * PADS
+            self._touched = [False] * PADS
+            self.irq_asserted = False
 
     # -- wire side ----------------------------------------------------------------------
     def write(self, data: bytes) -> None:
         if not data:
             return
-        self._pointer = data[0]
-        for value in data[1:]:
-            self._write_register(self._pointer, value)
-            self._pointer = (self._pointer + 1) & 0xFF
+        with self._lock:
+            self._pointer = data[0]
+            for value in data[1:]:
+                self._write_register(self._pointer, value)
+                self._pointer = (self._pointer + 1) & 0xFF
 
     def read(self, length: int) -> bytes:
-        self._scan()
-        out = bytearray()
-        for _ in range(length):
-            out.append(self._read_register(self._pointer))
-            self._pointer = (self._pointer + 1) & 0xFF
-        return bytes(out)
+        with self._lock:
+            self._scan()
+            out = bytearray()
+            for _ in range(length):
+                out.append(self._read_register(self._pointer))
+                self._pointer = (self._pointer + 1) & 0xFF
+            return bytes(out)
 
     # -- chip internals -----------------------------------------------------------------
     def _enabled_pads(self) -> int:

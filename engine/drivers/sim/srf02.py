@@ -65,15 +65,26 @@ def in_units(distance_cm: float, command: int) -> int:
 
 
 class SimSRF02(SimI2CDevice):
-    """An SRF02 facing an object ``distance_cm`` away (``None``: nothing in range)."""
+    """An SRF02 facing an object ``distance_cm`` away (``None``: nothing in range).
+
+    ``ranging_time_s`` is how long a ranging keeps the chip busy (66 ms on a healthy one).
+    """
 
     def __init__(
-        self, clock: Clock, address: int = 0x70, *, software_revision: int = 6
+        self,
+        clock: Clock,
+        address: int = 0x70,
+        *,
+        software_revision: int = 6,
+        ranging_time_s: float = RANGING_TIME_S,
     ) -> None:
         super().__init__(address)
         if not 0 <= software_revision < BUSY:
             raise ValueError(f"SRF02 software revision {software_revision} is outside 0..254")
+        if not ranging_time_s > 0:
+            raise ValueError(f"SRF02 ranging time {ranging_time_s} s must be positive")
         self._clock = clock
+        self._ranging_time_s = ranging_time_s
         self._software_revision = software_revision
         self._distance_cm: float | None = None
         self._pointer = 0
@@ -160,7 +171,7 @@ class SimSRF02(SimI2CDevice):
 
     def _start(self, result: int, minimum_result: int) -> None:
         self._pending = (result, minimum_result)
-        self._busy_until_s = self._clock.now() + RANGING_TIME_S
+        self._busy_until_s = self._clock.now() + self._ranging_time_s
 
     def _update(self) -> None:
         if self._busy_until_s is None or self._clock.now() < self._busy_until_s:

@@ -104,8 +104,7 @@ class SimVL53L0X(SimI2CDevice):
             self._attach()
         elif address != POWER_ON_ADDRESS:
             raise ValueError(
-                f"a VL53L0X held in standby boots at 0x{POWER_ON_ADDRESS:02X}, "
-                f"not 0x{address:02X}"
+                f"a VL53L0X held in standby boots at 0x{POWER_ON_ADDRESS:02X}, not 0x{address:02X}"
             )
 
     # -- the world ---------------------------------------------------------------------------

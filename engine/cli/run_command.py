@@ -1,0 +1,114 @@
+"""Run the robot's behaviors on a scripted scenario and print what it does.
+
+Without arguments: every tree in trees/ on examples/scenarios/demo.yaml, in real time.
+--fast runs on a virtual clock as fast as the machine allows; --json prints one JSON
+object per robot action: {"t": seconds, "tree": name, "action": ..., "args": {...}}.
+In real time, a changed tree file is reloaded between ticks (an invalid change keeps the
+running tree); Ctrl-C or SIGTERM stops cleanly.
+"""
+
+from __future__ import annotations
+
+import argparse
+import signal
+import sys
+from pathlib import Path
+from types import FrameType
+
+from engine.blackboard.board import Blackboard
+from engine.blackboard.catalogue import default_catalogue
+from engine.cli.timeline import Timeline
+from engine.clock import Clock, RealClock, VirtualClock
+from engine.errors import ConfigError
+from engine.loader.problems import LoadError, Mark, Problem
+from engine.runtime.reload import TreeReloader
+from engine.runtime.robot import Robot, load_behaviors
+from engine.scenario.player import ScenarioPlayer
+from engine.scenario.scenario_file import load_scenario
+from engine.scenario.world import BlackboardSenses, World
+from engine.services.actions import ActionLog
+from engine.services.simulated import simulated_services
+
+NAME = "run"
+HELP = "run the behaviors on a scenario (default: the demo)"
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--trees", type=Path, nargs="+", default=[Path("trees")],
+                        metavar="PATH", help="tree files or folders (default: trees/)")
+    parser.add_argument("--dialogs", type=Path, default=Path("dialogs"),
+                        help="dialogs folder (default: dialogs/)")
+    parser.add_argument("--profile", default=None,
+                        help="a profile file, or a name in trees/profiles/ (child, adult)")
+    parser.add_argument("--scenario", type=Path, default=Path("examples/scenarios/demo.yaml"),
+                        help="scenario file (default: examples/scenarios/demo.yaml)")
+    parser.add_argument("--duration", type=_positive_seconds, default=None, metavar="S",
+                        help="seconds to run (default: the scenario's duration_s)")
+    parser.add_argument("--fast", action="store_true",
+                        help="virtual clock: run as fast as the machine allows")
+    parser.add_argument("--json", action="store_true", help="one JSON object per action")
+
+
+def _positive_seconds(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be a number of seconds, got {text!r}") from None
+    if not 0 < value <= 7 * 24 * 3600:
+        raise argparse.ArgumentTypeError(f"must be above 0 and at most a week, got {text}")
+    return value
+
+
+def resolve_profile(value: str | None, trees: list[Path]) -> Path | None:
+    if value is None:
+        return None
+    path = Path(value)
+    if path.suffix in (".yaml", ".yml") or path.exists():
+        return path
+    for folder in trees:
+        candidate = (folder if folder.is_dir() else folder.parent) / "profiles" / f"{value}.yaml"
+        if candidate.exists():
+            return candidate
+    raise LoadError([Problem(Mark(value, 1, 1), "no such profile",
+                             "give a file or a name in trees/profiles/")])
+
+
+def main(args: argparse.Namespace) -> int:
+    for path in args.trees:
+        if not path.exists():
+            raise ConfigError(f"{path}: no such file or folder (run from the project folder or "
+                              "pass --trees)")
+    dialogs = args.dialogs if args.dialogs.is_dir() else None
+    behaviors = load_behaviors(args.trees, dialogs_dir=dialogs,
+                               profile=resolve_profile(args.profile, args.trees))
+    scenario = load_scenario(args.scenario)
+    clock: Clock = VirtualClock() if args.fast else RealClock()
+    start_s = clock.now()
+    blackboard = Blackboard(default_catalogue(), clock)
+    blackboard.reset()
+    world = World()
+    senses = BlackboardSenses(blackboard, world)
+    world.listeners.append(senses)
+    senses.start()
+    timeline = Timeline(sys.stdout, start_s=start_s, as_json=args.json)
+    log = ActionLog(listeners=[timeline.action])
+    services = simulated_services(clock, readers=senses.readers(), realistic=True)
+    robot = Robot(behaviors, clock=clock, services=services, blackboard=blackboard,
+                  action_log=log)
+    player = ScenarioPlayer(scenario, world, start_s=start_s, on_event=timeline.world)
+    robot.scheduler.hooks.append(player)
+    if not args.fast:
+        robot.scheduler.hooks.append(TreeReloader(behaviors.loader, robot.trees, clock))
+
+    def stop(signum: int, frame: FrameType | None) -> None:
+        robot.scheduler.stop()
+
+    previous = {sig: signal.signal(sig, stop) for sig in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        duration = args.duration if args.duration is not None else scenario.duration_s
+        robot.scheduler.run(until_s=start_s + duration)
+    finally:
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+    timeline.summary(robot.trees)
+    return 0

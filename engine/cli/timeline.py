@@ -1,0 +1,67 @@
+"""The run's timeline: what happened around the robot and what it did, as readable lines."""
+
+from __future__ import annotations
+
+import json
+from typing import Any, TextIO
+
+from engine.runtime.scheduler import RunningTree
+from engine.scenario.scenario_file import ScenarioEvent
+from engine.services.actions import ActionRecord
+
+
+def describe_action(action: str, args: dict[str, Any]) -> str:
+    if action == "say":
+        return f'says "{args["text"]}"'
+    if action == "led":
+        seconds = f" for {args['seconds']:g} s" if args.get("seconds") else ""
+        return f"lights the face {args['color']}{seconds}"
+    if action == "servo":
+        speed = f" at {args['speed_dps']:g} deg/s" if args.get("speed_dps") else ""
+        return f"turns {args['joint']} to {args['angle_deg']:g} deg{speed}"
+    if action == "read":
+        return f"reads the {args['sensor']} sensor"
+    if action == "report":
+        result = f": {args['result']}" if args.get("result") is not None else ""
+        return f"reports {args['id']} {args['status']}{result}"
+    return f"{action} {args}"
+
+
+class Timeline:
+    """Prints world events and robot actions as they happen, relative to ``start_s``."""
+
+    def __init__(self, out: TextIO, *, start_s: float, as_json: bool = False) -> None:
+        self.out = out
+        self.start_s = start_s
+        self.as_json = as_json
+        if not as_json:
+            self.out.write(f"{'t (s)':>8}  {'who':14} what\n")
+
+    def world(self, at_s: float, event: ScenarioEvent) -> None:
+        if not self.as_json:
+            self._line(at_s, "world", event.describe())
+
+    def action(self, record: ActionRecord) -> None:
+        if self.as_json:
+            shown = record.to_json()
+            shown["t"] = round(record.t - self.start_s, 3)
+            self.out.write(json.dumps(shown) + "\n")
+            self.out.flush()
+        else:
+            self._line(record.t, record.tree, describe_action(record.action, record.args))
+
+    def _line(self, at_s: float, who: str, what: str) -> None:
+        self.out.write(f"{at_s - self.start_s:8.2f}  {who:14} {what}\n")
+        self.out.flush()
+
+    def summary(self, trees: list[RunningTree]) -> None:
+        if self.as_json:
+            return
+        self.out.write(f"\n{'tree':14} {'rate':>6} {'ticks':>6} {'tick p50':>9} "
+                       f"{'tick p99':>9} {'late p99':>9} {'skipped':>7}\n")
+        for tree in trees:
+            s = tree.stats.summary()
+            self.out.write(
+                f"{tree.name:14} {tree.definition.rate_hz:5g}/s {s['ticks']:6d} "
+                f"{s['duration_p50_ms']:7.3f}ms {s['duration_p99_ms']:7.3f}ms "
+                f"{s['lateness_p99_ms']:7.2f}ms {s['skipped']:7d}\n")

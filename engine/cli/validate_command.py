@@ -1,0 +1,145 @@
+"""Check YAML files: trees, subtrees, profiles, dialogs and scenarios.
+
+Give files or folders (searched recursively for *.yaml). Prints "ok" when everything is
+valid; otherwise every problem as file:line:column: message (hint), and exits 1.
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from engine.blackboard.catalogue import KeyCatalogue, default_catalogue
+from engine.dialogs.library import DialogLibrary, check_dialog, find_dialogs_folder
+from engine.loader.problems import LoadError, Mark, Problem, Problems
+from engine.loader.substitution import Profile, load_profile, read_params
+from engine.loader.tree_file import TreeLoader
+from engine.loader.yaml_source import YMap, load_yaml
+from engine.nodes.params import did_you_mean
+from engine.nodes.registry import NodeRegistry, default_registry
+from engine.runtime.robot import tree_files
+from engine.scenario.scenario_file import check_scenario
+
+NAME = "validate"
+HELP = "check trees, profiles, dialogs and scenarios"
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("paths", nargs="+", type=Path, metavar="PATH",
+                        help="YAML files or folders")
+    parser.add_argument("--dialogs", type=Path, default=None,
+                        help="dialogs folder (default: the nearest dialogs/ above each file)")
+
+
+def yaml_files(paths: list[Path]) -> list[Path]:
+    files: list[Path] = []
+    for path in paths:
+        if path.is_dir():
+            files.extend(sorted(p for p in path.rglob("*.y*ml")
+                                if not any(part.startswith(".") for part in p.parts)))
+        else:
+            files.append(path)
+    return files
+
+
+def kind_of(document: object) -> str | None:
+    if not isinstance(document, YMap):
+        return None
+    if "root" in document:
+        return "tree"
+    if "profile" in document:
+        return "profile"
+    if "rules" in document or "dialog" in document:
+        return "dialog"
+    if "events" in document or "duration_s" in document:
+        return "scenario"
+    return None
+
+
+class Validator:
+    def __init__(self, registry: NodeRegistry, catalogue: KeyCatalogue,
+                 dialogs_dir: Path | None) -> None:
+        self.registry = registry
+        self.catalogue = catalogue
+        self.dialogs_dir = dialogs_dir
+        self.problems = Problems()
+        self._dialogs: dict[Path, DialogLibrary | None] = {}
+
+    def dialogs_for(self, path: Path) -> DialogLibrary | None:
+        folder = self.dialogs_dir or find_dialogs_folder(path)
+        if folder is None:
+            return None
+        if folder not in self._dialogs:
+            try:
+                self._dialogs[folder] = DialogLibrary.from_folder(folder, self.catalogue)
+            except LoadError as error:
+                self.problems.extend(error.problems)
+                self._dialogs[folder] = None
+        return self._dialogs[folder]
+
+    def loader_for(self, path: Path, profile: Profile | None = None) -> TreeLoader:
+        return TreeLoader(self.registry, self.catalogue, dialogs=self.dialogs_for(path),
+                          profile=profile)
+
+    def check(self, path: Path) -> None:
+        try:
+            document = load_yaml(path)
+        except LoadError as error:
+            self.problems.extend(error.problems)
+            return
+        kind = kind_of(document)
+        try:
+            if kind == "tree":
+                self.loader_for(path).load(path)
+            elif kind == "profile":
+                self.check_profile(path)
+            elif kind == "dialog":
+                check_dialog(document, str(path), self.catalogue, default_name=path.stem)
+            elif kind == "scenario":
+                check_scenario(document, str(path), path)
+            else:
+                where = document.mark if document is not None else Mark(str(path), 1, 1)
+                self.problems.add(
+                    where, "cannot tell what this file is",
+                    "a tree has 'root:', a profile 'profile:', a dialog 'rules:', "
+                    "a scenario 'events:'")
+        except LoadError as error:
+            self.problems.extend(error.problems)
+
+    def check_profile(self, path: Path) -> None:
+        """A profile must fit the trees beside it: known names, values of the right kind."""
+        profile = load_profile(path)
+        trees_folder = path.parent.parent
+        declared: set[str] = set()
+        for tree in tree_files([trees_folder]):
+            try:
+                document = load_yaml(tree)
+            except LoadError:
+                continue  # the tree's own problems are reported when it is validated
+            if isinstance(document, YMap):
+                declared.update(read_params(document.get("params"), Problems()))
+            try:
+                self.loader_for(tree, profile).load(tree)
+            except LoadError as error:
+                self.problems.extend([p for p in error.problems if p.mark.file == str(path)])
+        for name, value in profile.params.items():
+            if name not in declared:
+                self.problems.add(value.source, f"no tree in {trees_folder}/ declares "
+                                  f"parameter {name!r}",
+                                  did_you_mean(name, sorted(declared)) or "check the spelling")
+
+
+def main(args: argparse.Namespace) -> int:
+    files = yaml_files(args.paths)
+    validator = Validator(default_registry(), default_catalogue(), args.dialogs)
+    for path in args.paths:
+        if not path.exists():
+            validator.problems.add(Mark(str(path), 1, 1), "no such file or folder")
+    for path in files:
+        validator.check(path)
+    if validator.problems:
+        raise LoadError(validator.problems.items)
+    if not files:
+        raise LoadError([Problem(Mark(str(args.paths[0]), 1, 1), "no YAML files found")])
+    print(f"ok: {len(files)} file{'s' if len(files) != 1 else ''}")
+    return 0

@@ -1,0 +1,1 @@
+"""Running trees: the fixed-rate scheduler, hot reload and the assembled robot."""

@@ -1,0 +1,118 @@
+"""Loading a robot's behaviors and running them: trees, dialogs, profile, scheduler."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+from engine.blackboard.board import Blackboard
+from engine.blackboard.catalogue import KeyCatalogue, default_catalogue
+from engine.clock import Clock
+from engine.dialogs.library import DialogLibrary
+from engine.loader.problems import LoadError, Mark, Problems
+from engine.loader.substitution import Profile, load_profile
+from engine.loader.tree_file import TreeDefinition, TreeLoader
+from engine.nodes.context import NodeErrorHandler, TreeContext, log_node_error
+from engine.nodes.registry import NodeRegistry, default_registry
+from engine.runtime.scheduler import RunningTree, Scheduler
+from engine.services.actions import ActionLog, TreeActions
+from engine.services.interfaces import Services
+
+
+def tree_files(paths: list[Path]) -> list[Path]:
+    """Tree files named directly, and the ``*.yaml`` directly inside named folders.
+
+    Subfolders (``parts/`` for subtrees, ``profiles/``) are not trees of their own.
+    """
+    files: list[Path] = []
+    for path in paths:
+        files.extend(sorted(path.glob("*.yaml")) if path.is_dir() else [path])
+    return files
+
+
+@dataclass
+class Behaviors:
+    """Every validated tree, the dialogs they use, and the loader (for hot reload)."""
+
+    trees: list[TreeDefinition]
+    dialogs: DialogLibrary
+    loader: TreeLoader
+
+
+def load_behaviors(
+    trees: list[Path],
+    *,
+    dialogs_dir: Path | None = None,
+    profile: Path | None = None,
+    registry: NodeRegistry | None = None,
+    catalogue: KeyCatalogue | None = None,
+) -> Behaviors:
+    """Validate dialogs, the profile and every tree; LoadError listing all problems."""
+    registry = registry or default_registry()
+    catalogue = catalogue or default_catalogue()
+    problems = Problems()
+    dialogs = DialogLibrary()
+    if dialogs_dir is not None:
+        try:
+            dialogs = DialogLibrary.from_folder(dialogs_dir, catalogue)
+        except LoadError as error:
+            problems.extend(error.problems)
+    loaded_profile: Profile | None = None
+    if profile is not None:
+        try:
+            loaded_profile = load_profile(profile)
+        except LoadError as error:
+            problems.extend(error.problems)
+    loader = TreeLoader(registry, catalogue, dialogs=dialogs, profile=loaded_profile)
+    definitions: list[TreeDefinition] = []
+    for path in tree_files(trees):
+        try:
+            definitions.append(loader.load(path))
+        except LoadError as error:
+            problems.extend(error.problems)
+    names: dict[str, Path] = {}
+    for definition in definitions:
+        if definition.name in names:
+            problems.add(definition.root.mark, f"two trees are named {definition.name!r} "
+                         f"(also {loader.shown(names[definition.name])})", "rename one")
+        names[definition.name] = definition.path
+    if not definitions and not problems:
+        where = Mark(str(trees[0]) if trees else ".", 1, 1)
+        problems.add(where, "no tree files (*.yaml) found", "name a tree file or a folder of them")
+    problems.raise_if_any()
+    return Behaviors(definitions, dialogs, loader)
+
+
+class Robot:
+    """Built trees on one blackboard and clock, ticked by one scheduler."""
+
+    def __init__(
+        self,
+        behaviors: Behaviors,
+        *,
+        clock: Clock,
+        services: Services,
+        blackboard: Blackboard,
+        action_log: ActionLog | None = None,
+        on_node_error: NodeErrorHandler = log_node_error,
+    ) -> None:
+        self.behaviors = behaviors
+        self.clock = clock
+        self.services = services
+        self.blackboard = blackboard
+        self.action_log = action_log or ActionLog()
+        self.scheduler = Scheduler(clock, blackboard)
+        for definition in behaviors.trees:
+            context = TreeContext(
+                tree=definition.name,
+                clock=clock,
+                blackboard=blackboard,
+                actions=TreeActions(services, clock, definition.name, self.action_log),
+                dialogs=behaviors.dialogs,
+                on_node_error=on_node_error,
+            )
+            self.scheduler.add(RunningTree(definition, context, definition.build(context)))
+
+    @property
+    def trees(self) -> list[RunningTree]:
+        return self.scheduler.trees

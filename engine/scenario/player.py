@@ -1,0 +1,123 @@
+"""Plays a scenario: changes the world at the events' times, as a scheduler hook."""
+
+from __future__ import annotations
+
+import heapq
+import itertools
+from collections.abc import Callable
+from typing import Any
+
+from engine.scenario.scenario_file import Scenario, ScenarioEvent
+from engine.scenario.world import SIDES, World
+
+Change = Callable[[World], None]
+
+
+def _touch(pad: int, down: bool) -> Change:
+    def change(world: World) -> None:
+        world.touched[pad] = down
+        world.changed("touch")
+
+    return change
+
+
+def _force(left_n: float, right_n: float) -> Change:
+    def change(world: World) -> None:
+        world.force_n.update(left=left_n, right=right_n)
+        world.changed("force")
+
+    return change
+
+
+def _ranges(values: dict[str, float | None]) -> Change:
+    def change(world: World) -> None:
+        world.range_mm.update(values)
+        world.changed("range")
+
+    return change
+
+
+def _set(attribute: str, value: Any, what: str) -> Change:
+    def change(world: World) -> None:
+        setattr(world, attribute, value)
+        world.changed(what)
+
+    return change
+
+
+def _happen(kind: str, value: Any) -> Change:
+    def change(world: World) -> None:
+        world.happened(kind, value)
+
+    return change
+
+
+def changes_of(event: ScenarioEvent) -> list[tuple[float, Change]]:
+    """The world changes one scenario event makes, with their times in seconds."""
+    value, at = event.value, event.at_s
+    if event.kind == "touch":
+        return [(at, _touch(value["pad"], True)),
+                (at + value["seconds"], _touch(value["pad"], False))]
+    if event.kind == "squeeze":
+        return [(at, _force(value["left_n"], value["right_n"])),
+                (at + value["seconds"], _force(0.0, 0.0))]
+    if event.kind == "obstacle":
+        seen = {side: value[f"{side}_mm"] for side in SIDES}
+        return [(at, _ranges(seen)), (at + value["seconds"], _ranges(dict.fromkeys(SIDES)))]
+    if event.kind == "temperature":
+        return [(at, _set("temperature_c", value["c"], "temperature"))]
+    if event.kind == "ultrasound":
+        return [(at, _set("ultrasound_cm", value["cm"], "ultrasound")),
+                (at + value["seconds"], _set("ultrasound_cm", None, "ultrasound"))]
+    if event.kind == "gesture":
+        return [(at, _happen("gesture", value))]
+    if event.kind == "hear":
+        return [(at, _happen("hear", value))]
+    if event.kind == "cloud":
+        command = {"id": value["id"], "type": value["type"], "args": value["args"] or {}}
+        return [(at, _happen("cloud", command))]
+    raise ValueError(f"no world change for event {event.kind!r}")
+
+
+class ScenarioPlayer:
+    """Applies a scenario's changes to ``world`` when the clock reaches them.
+
+    Times are relative to ``start_s``. ``on_event`` hears each scenario event as it
+    starts (for the timeline).
+    """
+
+    def __init__(
+        self,
+        scenario: Scenario,
+        world: World,
+        *,
+        start_s: float = 0.0,
+        on_event: Callable[[float, ScenarioEvent], None] | None = None,
+    ) -> None:
+        self.scenario = scenario
+        self.world = world
+        self.start_s = start_s
+        self.on_event = on_event
+        order = itertools.count()
+        self._pending: list[tuple[float, int, Change, ScenarioEvent | None]] = []
+        for event in scenario.events:
+            for index, (at, change) in enumerate(changes_of(event)):
+                announce = event if index == 0 else None
+                self._pending.append((at, next(order), change, announce))
+        heapq.heapify(self._pending)
+
+    def __call__(self, now_s: float) -> None:
+        self.advance_to(now_s)
+
+    def advance_to(self, now_s: float) -> None:
+        """Apply every change due at or before ``now_s`` (clock seconds), in order."""
+        elapsed = now_s - self.start_s
+        while self._pending and self._pending[0][0] <= elapsed + 1e-9:
+            at, _, change, event = heapq.heappop(self._pending)
+            if event is not None and self.on_event is not None:
+                self.on_event(self.start_s + at, event)
+            change(self.world)
+
+    @property
+    def finished(self) -> bool:
+        return not self._pending

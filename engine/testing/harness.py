@@ -1,0 +1,140 @@
+"""TreeHarness: load one YAML tree and drive it tick by tick on a virtual clock."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+from py_trees.common import Status
+
+from engine.blackboard.board import Blackboard
+from engine.blackboard.catalogue import KeyCatalogue, default_catalogue
+from engine.blackboard.events import EventLog
+from engine.clock import VirtualClock
+from engine.dialogs.library import DialogLibrary, find_dialogs_folder
+from engine.loader.substitution import load_profile
+from engine.loader.tree_file import TreeDefinition, TreeLoader
+from engine.nodes.context import TreeContext
+from engine.nodes.registry import NodeRegistry, default_registry
+from engine.scenario.world import BlackboardSenses, World
+from engine.services.actions import ActionLog, ActionRecord, TreeActions
+from engine.services.interfaces import Services
+from engine.services.simulated import simulated_services
+
+
+class TreeHarness:
+    """One tree, a fresh blackboard, a virtual clock, recording services and a world.
+
+    ``world`` answers on-request sensor reads (``world.temperature_c = 22.2``);
+    ``services`` are the simulated services (``services.speech.fail_next = "why"``).
+    """
+
+    def __init__(
+        self,
+        definition: TreeDefinition,
+        *,
+        dialogs: DialogLibrary | None = None,
+        catalogue: KeyCatalogue | None = None,
+        clock: VirtualClock | None = None,
+        services: Services | None = None,
+    ) -> None:
+        self.definition = definition
+        self.clock = clock or VirtualClock()
+        self.blackboard = Blackboard(catalogue or default_catalogue(), self.clock)
+        self.blackboard.reset()
+        self.world = World()
+        self.senses = BlackboardSenses(self.blackboard, self.world)
+        self.services = services or simulated_services(self.clock, readers=self.senses.readers())
+        self.log = ActionLog()
+        self.node_errors: list[tuple[str, BaseException]] = []
+        self.context = TreeContext(
+            tree=definition.name,
+            clock=self.clock,
+            blackboard=self.blackboard,
+            actions=TreeActions(self.services, self.clock, definition.name, self.log),
+            dialogs=dialogs,
+            on_node_error=lambda tree, path, error: self.node_errors.append((path, error)),
+        )
+        self.tree = definition.build(self.context)
+
+    @classmethod
+    def from_file(
+        cls,
+        path: str | Path,
+        profile: str | Path | None = None,
+        *,
+        dialogs_dir: str | Path | None = None,
+        registry: NodeRegistry | None = None,
+    ) -> TreeHarness:
+        """Load and validate a tree file (LoadError with file:line:column on problems).
+
+        ``dialogs_dir`` defaults to the nearest ``dialogs/`` folder at or above the tree.
+        """
+        path = Path(path)
+        catalogue = default_catalogue()
+        folder = Path(dialogs_dir) if dialogs_dir is not None else find_dialogs_folder(path)
+        dialogs = DialogLibrary.from_folder(folder, catalogue) if folder else DialogLibrary()
+        loaded_profile = load_profile(Path(profile)) if profile is not None else None
+        loader = TreeLoader(registry or default_registry(), catalogue, dialogs=dialogs,
+                            profile=loaded_profile)
+        return cls(loader.load(path), dialogs=dialogs, catalogue=catalogue)
+
+    # -- the world ------------------------------------------------------------------------
+    def set(self, key: str, value: Any) -> None:
+        """Write ``key`` (an event key gets one new event), seen from the next tick on."""
+        if self._is_event(key):
+            self.blackboard.stage_event(key, value)
+        else:
+            self.blackboard.stage(key, value)
+
+    def get(self, key: str, default: Any = None) -> Any:
+        """The value of ``key`` (for an event key, the latest event's value)."""
+        value = self.blackboard.get(key, default)
+        if isinstance(value, EventLog):
+            return value.latest.value if value.latest else default
+        return value
+
+    def _is_event(self, key: str) -> bool:
+        spec = self.blackboard.catalogue.lookup(key)
+        return spec is not None and spec.kind == "event"
+
+    # -- time -----------------------------------------------------------------------------
+    @property
+    def period_s(self) -> float:
+        return 1.0 / self.definition.rate_hz
+
+    @property
+    def now(self) -> float:
+        """Seconds since the harness started."""
+        return self.clock.now()
+
+    def tick(self, n: int = 1) -> Status:
+        """Tick ``n`` times, one tree period apart (as the scheduler would); the last status."""
+        for _ in range(n):
+            self.blackboard.commit()
+            self.tree.tick()
+            self.clock.advance(self.period_s)
+        return self.status
+
+    def advance(self, seconds: float) -> Status:
+        """Let ``seconds`` pass, ticking at the tree's rate."""
+        return self.tick(max(1, round(seconds * self.definition.rate_hz)))
+
+    # -- what happened --------------------------------------------------------------------
+    @property
+    def status(self) -> Status:
+        return self.tree.root.status
+
+    @property
+    def actions(self) -> list[ActionRecord]:
+        """Every service call so far: time, tree, action (say, led, servo, ...), args."""
+        return list(self.log.records)
+
+    def did(self, action: str) -> list[dict[str, Any]]:
+        """The arguments of every call of ``action`` (``"led"``, ``"servo"``, ...)."""
+        return [record.args for record in self.log.records if record.action == action]
+
+    @property
+    def said(self) -> list[str]:
+        """Every phrase the robot said, in order."""
+        return [args["text"] for args in self.did("say")]

@@ -1,0 +1,230 @@
+"""The VL53L0X driver against its simulated chip: ranging, identity, timing, re-addressing."""
+
+from __future__ import annotations
+
+import pytest
+
+from engine.clock import VirtualClock
+from engine.drivers.sim.gpio import SimOutputLine
+from engine.drivers.sim.i2c_bus import SimI2CBus, SimI2CDevice
+from engine.drivers.sim.vl53l0x import SimVL53L0X
+from engine.drivers.vl53l0x import (
+    VL53L0X,
+    bring_up_chain,
+    decode_range,
+    device_range_status,
+    signal_rate_limit_to_register,
+)
+from engine.errors import DeviceError
+
+
+@pytest.fixture
+def clock() -> VirtualClock:
+    return VirtualClock()
+
+
+@pytest.fixture
+def bus(clock: VirtualClock) -> SimI2CBus:
+    return SimI2CBus(clock)
+
+
+@pytest.fixture
+def chip(clock: VirtualClock, bus: SimI2CBus) -> SimVL53L0X:
+    return SimVL53L0X(clock, bus)
+
+
+class NotAVL53L0X(SimI2CDevice):
+    """Some other chip that answers 0x00 everywhere."""
+
+    def write(self, data: bytes) -> None:
+        pass
+
+    def read(self, length: int) -> bytes:
+        return bytes(length)
+
+
+# -- ranging ----------------------------------------------------------------------------------
+def test_a_hand_30_cm_away_reads_300_mm(clock: VirtualClock, bus: SimI2CBus, chip: SimVL53L0X):
+    sensor = VL53L0X(bus, clock=clock)
+    chip.distance_mm = 300
+    assert sensor.read_range_mm() == 300
+
+
+def test_a_person_walking_closer_reads_shrinking_distances(clock, bus, chip):
+    sensor = VL53L0X(bus, clock=clock)
+    readings = []
+    for distance in (900, 600, 350):
+        chip.distance_mm = distance
+        readings.append(sensor.read_range_mm())
+    assert readings == [900, 600, 350]
+
+
+def test_nothing_in_front_reads_none(clock, bus, chip):
+    sensor = VL53L0X(bus, clock=clock)
+    chip.distance_mm = None
+    assert sensor.read_range_mm() is None
+
+
+def test_a_wall_beyond_the_sensors_range_reads_none(clock, bus, chip):
+    sensor = VL53L0X(bus, clock=clock)
+    chip.distance_mm = 3000  # further than the ~1.2 m of the default mode
+    assert sensor.read_range_mm() is None
+
+
+def test_a_measurement_takes_the_timing_budget_on_the_clock(clock, bus, chip):
+    sensor = VL53L0X(bus, clock=clock)
+    chip.distance_mm = 500
+    started = clock.now()
+    sensor.read_range_mm()
+    assert clock.now() - started >= 0.033
+
+
+def test_the_result_is_not_ready_until_33_ms_have_passed(clock, bus, chip):
+    VL53L0X(bus, clock=clock)
+    chip.distance_mm = 250
+    bus.write_byte_data(0x29, 0x0B, 0x01)  # clear any interrupt
+    bus.write_byte_data(0x29, 0x00, 0x01)  # SYSRANGE_START: single shot
+    assert bus.read_byte_data(0x29, 0x00) & 0x01 == 0  # start bit cleared: ranging began
+    clock.advance(0.032)
+    assert bus.read_byte_data(0x29, 0x13) & 0x07 == 0  # still measuring
+    clock.advance(0.0015)
+    assert bus.read_byte_data(0x29, 0x13) & 0x07 == 0x04  # new sample ready
+    high, low = bus.read_i2c_block_data(0x29, 0x1E, 2)
+    assert (high << 8) | low == 250  # big-endian
+
+
+def test_reading_clears_the_interrupt(clock, bus, chip):
+    sensor = VL53L0X(bus, clock=clock)
+    chip.distance_mm = 400
+    sensor.read_range_mm()
+    assert chip.peek(0x13) == 0
+
+
+def test_a_chip_that_never_finishes_times_out_naming_the_address(clock, bus):
+    SimVL53L0X(clock, bus, timing_budget_s=5.0)
+    # The calibrations at init are quick; the slow part is ranging itself.
+    sensor = VL53L0X(bus, clock=clock, timeout_s=0.1)
+    with pytest.raises(DeviceError, match=r"VL53L0X at 0x29: ranging did not finish within 0.1 s"):
+        sensor.read_range_mm()
+
+
+# -- identity and init -------------------------------------------------------------------------
+def test_wrong_identity_raises_device_error_naming_chip_and_address(clock, bus):
+    bus.attach(NotAVL53L0X(0x29))
+    with pytest.raises(DeviceError, match=r"VL53L0X at 0x29.*0x00 0x00 0x00.*not a VL53L0X"):
+        VL53L0X(bus, clock=clock)
+
+
+def test_no_chip_raises_device_error_naming_chip_and_address(clock, bus):
+    with pytest.raises(DeviceError, match=r"VL53L0X at 0x29 did not answer"):
+        VL53L0X(bus, clock=clock)
+
+
+def test_init_sets_2v8_io_signal_rate_limit_and_sequence(clock, bus, chip):
+    VL53L0X(bus, clock=clock, signal_rate_limit_mcps=0.5)
+    assert chip.peek(0x89) & 0x01  # 2V8 I/O
+    assert chip.peek(0x60) & 0x12 == 0x12  # MSRC and pre-range limit checks off
+    assert (chip.peek(0x44) << 8) | chip.peek(0x45) == 64  # 0.5 MCPS in Q9.7
+    assert chip.peek(0x0A) == 0x04  # interrupt on new sample ready
+    assert chip.peek(0x01) == 0xE8  # DSS, pre-range, final range
+
+
+def test_each_measurement_writes_back_the_stop_variable(clock, bus, chip):
+    sensor = VL53L0X(bus, clock=clock)
+    chip.distance_mm = 100
+    sensor.read_range_mm()
+    assert chip.peek(0x91, private_page=True) == 0x3C
+
+
+# -- addresses and XSHUT -----------------------------------------------------------------------
+def test_set_address_moves_the_chip_on_the_bus(clock, bus, chip):
+    sensor = VL53L0X(bus, clock=clock)
+    chip.distance_mm = 700
+    sensor.set_address(0x30)
+    assert bus.addresses == [0x30]
+    assert sensor.address == 0x30
+    assert sensor.read_range_mm() == 700
+
+
+@pytest.mark.parametrize("address", [0x00, 0x07, 0x78, 0x80])
+def test_set_address_rejects_unusable_addresses(clock, bus, chip, address):
+    sensor = VL53L0X(bus, clock=clock)
+    with pytest.raises(ValueError, match=f"0x{address:02X}"):
+        sensor.set_address(address)
+
+
+def test_xshut_low_silences_the_chip_and_forgets_its_address(clock, bus, chip):
+    sensor = VL53L0X(bus, clock=clock)
+    sensor.set_address(0x31)
+    chip.set_xshut(False)
+    assert bus.addresses == []
+    with pytest.raises(OSError):
+        bus.read_byte_data(0x31, 0xC0)
+    chip.set_xshut(True)
+    assert bus.addresses == [0x29]
+    with pytest.raises(OSError):  # still booting: no acknowledge
+        bus.read_byte_data(0x29, 0xC0)
+    clock.advance(0.002)
+    assert bus.read_byte_data(0x29, 0xC0) == 0xEE
+
+
+def test_three_sensors_brought_up_through_xshut_each_read_their_own_distance(clock, bus):
+    chips = [SimVL53L0X(clock, bus, xshut_high=False) for _ in range(3)]
+    lines = [SimOutputLine(chip.set_xshut) for chip in chips]
+    for chip, distance in zip(chips, (150, 450, 900), strict=True):
+        chip.distance_mm = distance
+
+    left, centre, right = bring_up_chain(bus, lines, [0x30, 0x31, 0x32], clock=clock)
+
+    assert bus.addresses == [0x30, 0x31, 0x32]
+    assert [s.address for s in (left, centre, right)] == [0x30, 0x31, 0x32]
+    assert [s.read_range_mm() for s in (left, centre, right)] == [150, 450, 900]
+
+
+def test_the_chain_comes_up_again_after_a_restart(clock, bus):
+    chips = [SimVL53L0X(clock, bus, xshut_high=False) for _ in range(3)]
+    lines = [SimOutputLine(chip.set_xshut) for chip in chips]
+    bring_up_chain(bus, lines, [0x30, 0x31, 0x32], clock=clock)
+    chips[1].distance_mm = 321
+
+    # The engine restarts: the chips still sit at their new addresses until XSHUT drops.
+    sensors = bring_up_chain(bus, lines, [0x30, 0x31, 0x32], clock=clock)
+
+    assert bus.addresses == [0x30, 0x31, 0x32]
+    assert sensors[1].read_range_mm() == 321
+
+
+def test_a_dead_sensor_in_the_chain_is_named_by_position(clock, bus):
+    chips = [SimVL53L0X(clock, bus, xshut_high=False) for _ in range(2)]
+    lines = [SimOutputLine(chips[0].set_xshut), SimOutputLine(lambda high: None)]
+    with pytest.raises(DeviceError, match=r"#2 of the XSHUT chain \(for 0x31\)"):
+        bring_up_chain(bus, lines, [0x30, 0x31], clock=clock)
+
+
+def test_the_chain_needs_one_distinct_address_per_line(clock, bus):
+    lines = [SimOutputLine(lambda high: None) for _ in range(2)]
+    with pytest.raises(ValueError, match="2 XSHUT lines but 3 addresses"):
+        bring_up_chain(bus, lines, [0x30, 0x31, 0x32], clock=clock)
+    with pytest.raises(ValueError, match="must differ"):
+        bring_up_chain(bus, lines, [0x30, 0x30], clock=clock)
+    with pytest.raises(ValueError, match="only be the last"):
+        bring_up_chain(bus, lines, [0x29, 0x30], clock=clock)
+
+
+# -- pure conversions ---------------------------------------------------------------------------
+def test_range_decoding():
+    valid = 11 << 3
+    assert device_range_status(valid) == 11
+    assert decode_range(valid, 1234) == 1234
+    assert decode_range(valid, 8190) is None
+    assert decode_range(valid, 8191) is None
+    assert decode_range(4 << 3, 20) is None  # a failure status is no reading
+
+
+def test_signal_rate_limit_is_q9_7():
+    assert signal_rate_limit_to_register(0.25) == 32
+    assert signal_rate_limit_to_register(0.1) == 13
+    with pytest.raises(ValueError, match="-1"):
+        signal_rate_limit_to_register(-1)
+    with pytest.raises(ValueError, match="512"):
+        signal_rate_limit_to_register(512)
