@@ -18,9 +18,23 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def main(args: argparse.Namespace) -> int:
     specs = list(default_catalogue())
     if args.format == "json":
-        print(json.dumps([{"key": s.name, "type": s.type_name, "unit": s.unit, "kind": s.kind,
-                           "writer": s.writer, "alias": s.alias, "description": s.description}
-                          for s in specs], indent=2))
+        print(
+            json.dumps(
+                [
+                    {
+                        "key": s.name,
+                        "type": s.type_name,
+                        "unit": s.unit,
+                        "kind": s.kind,
+                        "writer": s.writer,
+                        "alias": s.alias,
+                        "description": s.description,
+                    }
+                    for s in specs
+                ],
+                indent=2,
+            )
+        )
         return 0
     for spec in specs:
         unit = f" [{spec.unit}]" if spec.unit else ""

@@ -16,8 +16,12 @@ HELP = "list node types and their parameters"
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--format", choices=("text", "md", "json"), default="text",
-                        help="text (default), md (Markdown reference) or json")
+    parser.add_argument(
+        "--format",
+        choices=("text", "md", "json"),
+        default="text",
+        help="text (default), md (Markdown reference) or json",
+    )
 
 
 def main(args: argparse.Namespace) -> int:

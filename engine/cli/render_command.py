@@ -20,16 +20,25 @@ NAME = "render"
 HELP = "draw a tree as ascii, dot, svg or png"
 
 _SHAPES = {"composite": "box", "decorator": "hexagon", "condition": "ellipse", "action": "box"}
-_COLORS = {"composite": "#FFD28C", "decorator": "#E6E6E6", "condition": "#B4DCFF",
-           "action": "#B9F0B9"}
+_COLORS = {
+    "composite": "#FFD28C",
+    "decorator": "#E6E6E6",
+    "condition": "#B4DCFF",
+    "action": "#B9F0B9",
+}
 _SYMBOLS = {"Sequence": "->", "Selector": "?", "Parallel": "=>"}
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("tree", type=Path, metavar="TREE.yaml")
     parser.add_argument("--format", choices=("ascii", "dot", "svg", "png"), default="ascii")
-    parser.add_argument("-o", "--output", type=Path, default=None,
-                        help="file to write (default: standard output; required for png)")
+    parser.add_argument(
+        "-o",
+        "--output",
+        type=Path,
+        default=None,
+        help="file to write (default: standard output; required for png)",
+    )
     parser.add_argument("--profile", type=Path, default=None, help="profile to apply")
 
 
@@ -62,10 +71,13 @@ def ascii_tree(definition: TreeDefinition) -> str:
 
 
 def dot_source(definition: TreeDefinition) -> str:
-    lines = [f'digraph "{definition.name}" {{', "  graph [rankdir=TB, fontname=Helvetica];",
-             "  node [style=filled, fontname=Helvetica, fontsize=11];",
-             f'  title [shape=plaintext, style="", label="{definition.name} '
-             f'({definition.rate_hz:g} Hz)"];']
+    lines = [
+        f'digraph "{definition.name}" {{',
+        "  graph [rankdir=TB, fontname=Helvetica];",
+        "  node [style=filled, fontname=Helvetica, fontsize=11];",
+        f'  title [shape=plaintext, style="", label="{definition.name} '
+        f'({definition.rate_hz:g} Hz)"];',
+    ]
     counter = iter(range(1_000_000))
 
     def escape(text: str) -> str:
@@ -74,8 +86,10 @@ def dot_source(definition: TreeDefinition) -> str:
     def walk(node: NodeDefinition) -> str:
         ident = f"n{next(counter)}"
         kind = node.type.kind
-        lines.append(f'  {ident} [shape={_SHAPES[kind]}, fillcolor="{_COLORS[kind]}", '
-                     f'label="{escape(label(node))}"];')
+        lines.append(
+            f'  {ident} [shape={_SHAPES[kind]}, fillcolor="{_COLORS[kind]}", '
+            f'label="{escape(label(node))}"];'
+        )
         for child in node.children:
             lines.append(f"  {ident} -> {walk(child)};")
         return ident
@@ -109,17 +123,20 @@ def _graphviz(source: str, fmt: str, output: Path | None) -> int:
 
     dot = shutil.which("dot")
     if dot is None:
-        print("vest render: svg and png need Graphviz's `dot` (apt-get install graphviz); "
-              "--format dot or ascii work without it", file=sys.stderr)
+        print(
+            "vest render: svg and png need Graphviz's `dot` (apt-get install graphviz); "
+            "--format dot or ascii work without it",
+            file=sys.stderr,
+        )
         return 3
     if fmt == "png" and output is None:
         print("vest render: png needs -o FILE", file=sys.stderr)
         return 2
-    result = subprocess.run([dot, f"-T{fmt}"], input=source.encode(), capture_output=True,
-                            check=False)
+    result = subprocess.run(
+        [dot, f"-T{fmt}"], input=source.encode(), capture_output=True, check=False
+    )
     if result.returncode != 0:
-        print(f"vest render: dot failed: {result.stderr.decode(errors='replace')}",
-              file=sys.stderr)
+        print(f"vest render: dot failed: {result.stderr.decode(errors='replace')}", file=sys.stderr)
         return 3
     if output:
         output.write_bytes(result.stdout)

@@ -12,6 +12,8 @@ from __future__ import annotations
 import argparse
 import signal
 import sys
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from types import FrameType
 
@@ -23,6 +25,7 @@ from engine.errors import ConfigError
 from engine.loader.problems import LoadError, Mark, Problem
 from engine.runtime.reload import TreeReloader
 from engine.runtime.robot import Robot, load_behaviors
+from engine.runtime.scheduler import Scheduler
 from engine.scenario.player import ScenarioPlayer
 from engine.scenario.scenario_file import load_scenario
 from engine.scenario.world import BlackboardSenses, World
@@ -34,18 +37,38 @@ HELP = "run the behaviors on a scenario (default: the demo)"
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--trees", type=Path, nargs="+", default=[Path("trees")],
-                        metavar="PATH", help="tree files or folders (default: trees/)")
-    parser.add_argument("--dialogs", type=Path, default=Path("dialogs"),
-                        help="dialogs folder (default: dialogs/)")
-    parser.add_argument("--profile", default=None,
-                        help="a profile file, or a name in trees/profiles/ (child, adult)")
-    parser.add_argument("--scenario", type=Path, default=Path("examples/scenarios/demo.yaml"),
-                        help="scenario file (default: examples/scenarios/demo.yaml)")
-    parser.add_argument("--duration", type=_positive_seconds, default=None, metavar="S",
-                        help="seconds to run (default: the scenario's duration_s)")
-    parser.add_argument("--fast", action="store_true",
-                        help="virtual clock: run as fast as the machine allows")
+    parser.add_argument(
+        "--trees",
+        type=Path,
+        nargs="+",
+        default=[Path("trees")],
+        metavar="PATH",
+        help="tree files or folders (default: trees/)",
+    )
+    parser.add_argument(
+        "--dialogs", type=Path, default=Path("dialogs"), help="dialogs folder (default: dialogs/)"
+    )
+    parser.add_argument(
+        "--profile",
+        default=None,
+        help="a profile file, or a name in trees/profiles/ (child, adult)",
+    )
+    parser.add_argument(
+        "--scenario",
+        type=Path,
+        default=Path("examples/scenarios/demo.yaml"),
+        help="scenario file (default: examples/scenarios/demo.yaml)",
+    )
+    parser.add_argument(
+        "--duration",
+        type=_positive_seconds,
+        default=None,
+        metavar="S",
+        help="seconds to run (default: the scenario's duration_s)",
+    )
+    parser.add_argument(
+        "--fast", action="store_true", help="virtual clock: run as fast as the machine allows"
+    )
     parser.add_argument("--json", action="store_true", help="one JSON object per action")
 
 
@@ -69,18 +92,21 @@ def resolve_profile(value: str | None, trees: list[Path]) -> Path | None:
         candidate = (folder if folder.is_dir() else folder.parent) / "profiles" / f"{value}.yaml"
         if candidate.exists():
             return candidate
-    raise LoadError([Problem(Mark(value, 1, 1), "no such profile",
-                             "give a file or a name in trees/profiles/")])
+    raise LoadError(
+        [Problem(Mark(value, 1, 1), "no such profile", "give a file or a name in trees/profiles/")]
+    )
 
 
 def main(args: argparse.Namespace) -> int:
     for path in args.trees:
         if not path.exists():
-            raise ConfigError(f"{path}: no such file or folder (run from the project folder or "
-                              "pass --trees)")
+            raise ConfigError(
+                f"{path}: no such file or folder (run from the project folder or pass --trees)"
+            )
     dialogs = args.dialogs if args.dialogs.is_dir() else None
-    behaviors = load_behaviors(args.trees, dialogs_dir=dialogs,
-                               profile=resolve_profile(args.profile, args.trees))
+    behaviors = load_behaviors(
+        args.trees, dialogs_dir=dialogs, profile=resolve_profile(args.profile, args.trees)
+    )
     scenario = load_scenario(args.scenario)
     clock: Clock = VirtualClock() if args.fast else RealClock()
     start_s = clock.now()
@@ -93,22 +119,30 @@ def main(args: argparse.Namespace) -> int:
     timeline = Timeline(sys.stdout, start_s=start_s, as_json=args.json)
     log = ActionLog(listeners=[timeline.action])
     services = simulated_services(clock, readers=senses.readers(), realistic=True)
-    robot = Robot(behaviors, clock=clock, services=services, blackboard=blackboard,
-                  action_log=log)
+    robot = Robot(behaviors, clock=clock, services=services, blackboard=blackboard, action_log=log)
     player = ScenarioPlayer(scenario, world, start_s=start_s, on_event=timeline.world)
     robot.scheduler.hooks.append(player)
     if not args.fast:
         robot.scheduler.hooks.append(TreeReloader(behaviors.loader, robot.trees, clock))
 
+    duration = args.duration if args.duration is not None else scenario.duration_s
+    with _stopped_by_signals(robot.scheduler):
+        timeline.start()
+        robot.scheduler.run(until_s=start_s + duration)
+    timeline.summary(robot.trees)
+    return 0
+
+
+@contextmanager
+def _stopped_by_signals(scheduler: Scheduler) -> Iterator[None]:
+    """Ctrl-C and SIGTERM ask the scheduler to stop after the current tick."""
+
     def stop(signum: int, frame: FrameType | None) -> None:
-        robot.scheduler.stop()
+        scheduler.stop()
 
     previous = {sig: signal.signal(sig, stop) for sig in (signal.SIGINT, signal.SIGTERM)}
     try:
-        duration = args.duration if args.duration is not None else scenario.duration_s
-        robot.scheduler.run(until_s=start_s + duration)
+        yield
     finally:
         for sig, handler in previous.items():
             signal.signal(sig, handler)
-    timeline.summary(robot.trees)
-    return 0

@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import json
+import os
+from collections.abc import Callable
 from typing import Any, TextIO
 
 from engine.runtime.scheduler import RunningTree
@@ -30,12 +32,38 @@ def describe_action(action: str, args: dict[str, Any]) -> str:
 class Timeline:
     """Prints world events and robot actions as they happen, relative to ``start_s``."""
 
-    def __init__(self, out: TextIO, *, start_s: float, as_json: bool = False) -> None:
+    def __init__(
+        self,
+        out: TextIO,
+        *,
+        start_s: float,
+        as_json: bool = False,
+        on_closed: Callable[[], None] | None = None,
+    ) -> None:
         self.out = out
         self.start_s = start_s
         self.as_json = as_json
-        if not as_json:
-            self.out.write(f"{'t (s)':>8}  {'who':14} what\n")
+        self.on_closed = on_closed
+        self.closed = False
+
+    def start(self) -> None:
+        """Print the header (the run has begun)."""
+        if not self.as_json:
+            self._write(f"{'t (s)':>8}  {'who':14} what\n")
+
+    def _write(self, text: str) -> None:
+        """Write and flush; a reader that went away (``| head``) ends the run quietly."""
+        if self.closed:
+            return
+        try:
+            self.out.write(text)
+            self.out.flush()
+        except BrokenPipeError:
+            self.closed = True
+            # nothing more can reach the reader; keep Python's exit flush from complaining
+            os.dup2(os.open(os.devnull, os.O_WRONLY), self.out.fileno())
+            if self.on_closed is not None:
+                self.on_closed()
 
     def world(self, at_s: float, event: ScenarioEvent) -> None:
         if not self.as_json:
@@ -45,23 +73,24 @@ class Timeline:
         if self.as_json:
             shown = record.to_json()
             shown["t"] = round(record.t - self.start_s, 3)
-            self.out.write(json.dumps(shown) + "\n")
-            self.out.flush()
+            self._write(json.dumps(shown) + "\n")
         else:
             self._line(record.t, record.tree, describe_action(record.action, record.args))
 
     def _line(self, at_s: float, who: str, what: str) -> None:
-        self.out.write(f"{at_s - self.start_s:8.2f}  {who:14} {what}\n")
-        self.out.flush()
+        self._write(f"{at_s - self.start_s:8.2f}  {who:14} {what}\n")
 
     def summary(self, trees: list[RunningTree]) -> None:
         if self.as_json:
             return
-        self.out.write(f"\n{'tree':14} {'rate':>6} {'ticks':>6} {'tick p50':>9} "
-                       f"{'tick p99':>9} {'late p99':>9} {'skipped':>7}\n")
+        self._write(
+            f"\n{'tree':14} {'rate':>6} {'ticks':>6} {'tick p50':>9} "
+            f"{'tick p99':>9} {'late p99':>9} {'skipped':>7}\n"
+        )
         for tree in trees:
             s = tree.stats.summary()
-            self.out.write(
+            self._write(
                 f"{tree.name:14} {tree.definition.rate_hz:5g}/s {s['ticks']:6d} "
                 f"{s['duration_p50_ms']:7.3f}ms {s['duration_p99_ms']:7.3f}ms "
-                f"{s['lateness_p99_ms']:7.2f}ms {s['skipped']:7d}\n")
+                f"{s['lateness_p99_ms']:7.2f}ms {s['skipped']:7d}\n"
+            )

@@ -25,18 +25,26 @@ HELP = "check trees, profiles, dialogs and scenarios"
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("paths", nargs="+", type=Path, metavar="PATH",
-                        help="YAML files or folders")
-    parser.add_argument("--dialogs", type=Path, default=None,
-                        help="dialogs folder (default: the nearest dialogs/ above each file)")
+    parser.add_argument("paths", nargs="+", type=Path, metavar="PATH", help="YAML files or folders")
+    parser.add_argument(
+        "--dialogs",
+        type=Path,
+        default=None,
+        help="dialogs folder (default: the nearest dialogs/ above each file)",
+    )
 
 
 def yaml_files(paths: list[Path]) -> list[Path]:
     files: list[Path] = []
     for path in paths:
         if path.is_dir():
-            files.extend(sorted(p for p in path.rglob("*.y*ml")
-                                if not any(part.startswith(".") for part in p.parts)))
+            files.extend(
+                sorted(
+                    p
+                    for p in path.rglob("*.y*ml")
+                    if not any(part.startswith(".") for part in p.parts)
+                )
+            )
         else:
             files.append(path)
     return files
@@ -57,8 +65,9 @@ def kind_of(document: object) -> str | None:
 
 
 class Validator:
-    def __init__(self, registry: NodeRegistry, catalogue: KeyCatalogue,
-                 dialogs_dir: Path | None) -> None:
+    def __init__(
+        self, registry: NodeRegistry, catalogue: KeyCatalogue, dialogs_dir: Path | None
+    ) -> None:
         self.registry = registry
         self.catalogue = catalogue
         self.dialogs_dir = dialogs_dir
@@ -78,8 +87,9 @@ class Validator:
         return self._dialogs[folder]
 
     def loader_for(self, path: Path, profile: Profile | None = None) -> TreeLoader:
-        return TreeLoader(self.registry, self.catalogue, dialogs=self.dialogs_for(path),
-                          profile=profile)
+        return TreeLoader(
+            self.registry, self.catalogue, dialogs=self.dialogs_for(path), profile=profile
+        )
 
     def check(self, path: Path) -> None:
         try:
@@ -100,9 +110,11 @@ class Validator:
             else:
                 where = document.mark if document is not None else Mark(str(path), 1, 1)
                 self.problems.add(
-                    where, "cannot tell what this file is",
+                    where,
+                    "cannot tell what this file is",
                     "a tree has 'root:', a profile 'profile:', a dialog 'rules:', "
-                    "a scenario 'events:'")
+                    "a scenario 'events:'",
+                )
         except LoadError as error:
             self.problems.extend(error.problems)
 
@@ -124,9 +136,11 @@ class Validator:
                 self.problems.extend([p for p in error.problems if p.mark.file == str(path)])
         for name, value in profile.params.items():
             if name not in declared:
-                self.problems.add(value.source, f"no tree in {trees_folder}/ declares "
-                                  f"parameter {name!r}",
-                                  did_you_mean(name, sorted(declared)) or "check the spelling")
+                self.problems.add(
+                    value.source,
+                    f"no tree in {trees_folder}/ declares parameter {name!r}",
+                    did_you_mean(name, sorted(declared)) or "check the spelling",
+                )
 
 
 def main(args: argparse.Namespace) -> int:

@@ -94,8 +94,11 @@ def check_dialog(
     assert isinstance(document, YMap)
     for key, mark in document.key_marks.items():
         if key not in _TOP_KEYS:
-            problems.add(mark, f"unknown dialog field {key!r}",
-                         did_you_mean(key, _TOP_KEYS) or "fields: " + ", ".join(_TOP_KEYS))
+            problems.add(
+                mark,
+                f"unknown dialog field {key!r}",
+                did_you_mean(key, _TOP_KEYS) or "fields: " + ", ".join(_TOP_KEYS),
+            )
     ctx = CheckContext(catalogue)
     dialog_name = _text(document.get("dialog"), problems, "dialog") or default_name
     concepts = _concepts(document.get("concepts"), problems)
@@ -119,8 +122,9 @@ def check_dialog(
     if raw_score is not None:
         value = raw_score.value if isinstance(raw_score, YScalar) else None
         if isinstance(value, bool) or not isinstance(value, int | float) or not 0 < value <= 1:
-            problems.add(raw_score.mark, f"'min_score' must be a number in 0..1, got "
-                         f"{describe(raw_score)}")
+            problems.add(
+                raw_score.mark, f"'min_score' must be a number in 0..1, got {describe(raw_score)}"
+            )
         else:
             min_score = float(value)
     problems.raise_if_any()
@@ -166,15 +170,19 @@ def _expand(phrase: str, concepts: dict[str, list[str]]) -> list[str] | str:
     return [" ".join(filter(None, combo)) for combo in itertools.product(*options)]
 
 
-def _rule(raw: YValue, concepts: dict[str, list[str]], ctx: CheckContext,
-          problems: Problems) -> DialogRule | None:
+def _rule(
+    raw: YValue, concepts: dict[str, list[str]], ctx: CheckContext, problems: Problems
+) -> DialogRule | None:
     if not isinstance(raw, YMap):
         problems.add(raw.mark, "each rule is a mapping with 'hear:' and 'say:'")
         return None
     for key, mark in raw.key_marks.items():
         if key not in _RULE_KEYS:
-            problems.add(mark, f"unknown rule field {key!r}",
-                         did_you_mean(key, _RULE_KEYS) or "fields: hear, say, read")
+            problems.add(
+                mark,
+                f"unknown rule field {key!r}",
+                did_you_mean(key, _RULE_KEYS) or "fields: hear, say, read",
+            )
     hear = raw.get("hear")
     phrases: list[str] = []
     if hear is None:
@@ -201,9 +209,11 @@ def _rule(raw: YValue, concepts: dict[str, list[str]], ctx: CheckContext,
     if raw_read is not None:
         read = _text(raw_read, problems, "read")
         if read is not None and read not in ON_REQUEST_SENSORS:
-            problems.add(raw_read.mark, f"cannot read {read!r} on request",
-                         did_you_mean(read, ON_REQUEST_SENSORS)
-                         or "use " + " or ".join(ON_REQUEST_SENSORS))
+            problems.add(
+                raw_read.mark,
+                f"cannot read {read!r} on request",
+                did_you_mean(read, ON_REQUEST_SENSORS) or "use " + " or ".join(ON_REQUEST_SENSORS),
+            )
             read = None
     if answer is None or not phrases:
         return None

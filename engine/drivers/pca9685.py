@@ -52,6 +52,12 @@ PRESCALE_MAX = 255
 OSCILLATOR_WAKE_S = 500e-6
 
 
+def _device_error(message: str, cause: OSError | None = None) -> DeviceError:
+    """A DeviceError that keeps the errno of the bus error behind it, if it had one."""
+    code = cause.errno if cause is not None else None
+    return DeviceError(code, message) if isinstance(code, int) else DeviceError(message)
+
+
 class SMBusLike(Protocol):
     def read_byte_data(self, i2c_addr: int, register: int) -> int: ...
 
@@ -148,7 +154,7 @@ class PCA9685:
         try:
             prescale = bus.read_byte_data(address, PRE_SCALE)
         except OSError as err:
-            raise DeviceError(f"{where} did not answer: {err}") from err
+            raise _device_error(f"{where} did not answer: {err.strerror or err}", err) from err
         if prescale < PRESCALE_MIN:
             raise DeviceError(
                 f"{where}: PRE_SCALE reads {prescale}, below the chip's hardware minimum "

@@ -27,6 +27,12 @@ CHANNELS = 8
 ADDRESSES = range(0x70, 0x78)
 
 
+def _device_error(message: str, cause: OSError | None = None) -> DeviceError:
+    """A DeviceError that keeps the errno of the bus error behind it, if it had one."""
+    code = cause.errno if cause is not None else None
+    return DeviceError(code, message) if isinstance(code, int) else DeviceError(message)
+
+
 class SMBusLike(Protocol):
     """The part of ``smbus2.SMBus`` the multiplexer itself uses."""
 
@@ -54,7 +60,8 @@ class TCA9548A:
         try:
             self._control: int | None = bus.read_byte(address)
         except OSError as err:
-            raise DeviceError(f"{CHIP} at 0x{address:02X} did not answer: {err}") from err
+            where = f"{CHIP} at 0x{address:02X}"
+            raise _device_error(f"{where} did not answer: {err.strerror or err}", err) from err
 
     def __repr__(self) -> str:
         return f"TCA9548A(address=0x{self.address:02X})"

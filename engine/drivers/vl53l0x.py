@@ -93,6 +93,12 @@ class SMBusLike(Protocol):
     def write_i2c_block_data(self, i2c_addr: int, register: int, data: Sequence[int]) -> None: ...
 
 
+def _device_error(message: str, cause: OSError | None = None) -> DeviceError:
+    """A DeviceError that keeps the errno of the bus error behind it, if it had one."""
+    code = cause.errno if cause is not None else None
+    return DeviceError(code, message) if isinstance(code, int) else DeviceError(message)
+
+
 # -- pure conversions -------------------------------------------------------------------------
 def signal_rate_limit_to_register(limit_mcps: float) -> int:
     """A signal rate limit in mega counts per second as the chip's Q9.7 fixed-point value."""
@@ -178,7 +184,9 @@ class VL53L0X:
                 self._bus.read_i2c_block_data(self._address, IDENTIFICATION_MODEL_ID, 3)
             )
         except OSError as err:
-            raise DeviceError(err.errno, f"{self._where()} did not answer: {err}") from err
+            raise _device_error(
+                f"{self._where()} did not answer: {err.strerror or err}", err
+            ) from err
         if identity != IDENTITY:
             found = " ".join(f"0x{b:02X}" for b in identity)
             raise DeviceError(
@@ -279,10 +287,10 @@ class VL53L0X:
             try:
                 self._read(IDENTIFICATION_MODEL_ID)
             except OSError as err:
-                raise DeviceError(
-                    err.errno,
+                raise _device_error(
                     f"{CHIP} moved from 0x{old:02X} but does not answer at "
-                    f"0x{new_address:02X}: {err}",
+                    f"0x{new_address:02X}: {err.strerror or err}",
+                    err,
                 ) from err
 
 
@@ -327,10 +335,10 @@ def bring_up_chain(
             if address != DEFAULT_ADDRESS:
                 sensor.set_address(address)
         except DeviceError as err:
-            raise DeviceError(
-                err.errno,
+            raise _device_error(
                 f"{CHIP} #{position + 1} of the XSHUT chain (for 0x{address:02X}): "
                 f"{err.strerror or err}",
+                err,
             ) from err
         sensors.append(sensor)
     return sensors

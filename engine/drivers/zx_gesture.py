@@ -58,6 +58,12 @@ GESTURE_NAMES = {
 }
 
 
+def _device_error(message: str, cause: OSError | None = None) -> DeviceError:
+    """A DeviceError that keeps the errno of the bus error behind it, if it had one."""
+    code = cause.errno if cause is not None else None
+    return DeviceError(code, message) if isinstance(code, int) else DeviceError(message)
+
+
 class SMBusLike(Protocol):
     def read_byte_data(self, i2c_addr: int, register: int) -> int: ...
 
@@ -91,7 +97,7 @@ class ZXGesture:
             model = bus.read_byte_data(address, MODEL)
             version = bus.read_byte_data(address, REGVER)
         except OSError as err:
-            raise DeviceError(f"{where} did not answer: {err}") from err
+            raise _device_error(f"{where} did not answer: {err.strerror or err}", err) from err
         if model != MODEL_ID or version != REGISTER_MAP_VERSION:
             raise DeviceError(
                 f"{where}: model 0x{model:02X}, register map 0x{version:02X}; expected "

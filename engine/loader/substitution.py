@@ -62,20 +62,27 @@ def read_params(raw: YValue | None, problems: Problems) -> dict[str, ParamValue]
         return params
     for name, value in raw.items():
         if not _NAME.match(name):
-            problems.add(raw.key_marks[name], f"parameter name {name!r} is not a plain word",
-                         "use letters, digits and _")
+            problems.add(
+                raw.key_marks[name],
+                f"parameter name {name!r} is not a plain word",
+                "use letters, digits and _",
+            )
             continue
         params[name] = ParamValue(value, value.mark)
     return params
 
 
-def check_override(name: str, default: ParamValue, given: ParamValue, problems: Problems,
-                   where: str) -> bool:
+def check_override(
+    name: str, default: ParamValue, given: ParamValue, problems: Problems, where: str
+) -> bool:
     """True when ``given`` may replace ``default`` (same kind of value)."""
     expected, got = kind_of(default.value), kind_of(given.value)
     if expected != got and expected != "nothing":
-        problems.add(given.source, f"{where} sets {name!r} to {describe(given.value)}, but the "
-                     f"tree expects {expected} (default at line {default.source.line})")
+        problems.add(
+            given.source,
+            f"{where} sets {name!r} to {describe(given.value)}, but the "
+            f"tree expects {expected} (default at line {default.source.line})",
+        )
         return False
     return True
 
@@ -83,8 +90,11 @@ def check_override(name: str, default: ParamValue, given: ParamValue, problems: 
 def substitute(value: YValue, params: dict[str, ParamValue], problems: Problems) -> YValue:
     """``value`` with every ``${name}`` replaced; unknown names are problems."""
     if isinstance(value, YMap):
-        return YMap({k: substitute(v, params, problems) for k, v in value.items()},
-                    value.mark, value.key_marks)
+        return YMap(
+            {k: substitute(v, params, problems) for k, v in value.items()},
+            value.mark,
+            value.key_marks,
+        )
     if isinstance(value, YList):
         return YList([substitute(item, params, problems) for item in value], value.mark)
     text = value.value
@@ -104,21 +114,26 @@ def substitute(value: YValue, params: dict[str, ParamValue], problems: Problems)
         if found is None:
             return match.group(0)
         if not isinstance(found, YScalar):
-            problems.add(value.mark, f"parameter {match.group(1)!r} is a {kind_of(found)} and "
-                         "cannot go inside text")
+            problems.add(
+                value.mark,
+                f"parameter {match.group(1)!r} is a {kind_of(found)} and cannot go inside text",
+            )
             return match.group(0)
         return str(found.value)
 
     return YScalar(_REFERENCE.sub(replace, text), value.mark)
 
 
-def _lookup(name: str, mark: Mark, params: dict[str, ParamValue],
-            problems: Problems) -> YValue | None:
+def _lookup(
+    name: str, mark: Mark, params: dict[str, ParamValue], problems: Problems
+) -> YValue | None:
     found = params.get(name.strip())
     if found is None:
         hint = did_you_mean(name, list(params)) or (
-            "declare it under params: at the top of the file" if params else
-            "add params: with a default at the top of the file")
+            "declare it under params: at the top of the file"
+            if params
+            else "add params: with a default at the top of the file"
+        )
         problems.add(mark, f"unknown parameter ${{{name}}}", hint)
         return None
     return found.value
@@ -134,9 +149,11 @@ def load_profile(path: Path, shown: str | None = None) -> Profile:
         raise LoadError([Problem(where, "a profile is a mapping with 'profile:' and 'params:'")])
     for key, mark in document.key_marks.items():
         if key not in _PROFILE_KEYS:
-            problems.add(mark, f"unknown profile field {key!r}",
-                         did_you_mean(key, _PROFILE_KEYS) or "fields: profile, description, "
-                         "params")
+            problems.add(
+                mark,
+                f"unknown profile field {key!r}",
+                did_you_mean(key, _PROFILE_KEYS) or "fields: profile, description, params",
+            )
     profile_name = path.stem
     raw_name = document.get("profile")
     if isinstance(raw_name, YScalar) and isinstance(raw_name.value, str):

@@ -119,8 +119,11 @@ class TreeLoader:
         name = path.stem
         raw_name = document.get("name")
         if raw_name is not None:
-            if isinstance(raw_name, YScalar) and isinstance(raw_name.value, str) \
-                    and raw_name.value.strip():
+            if (
+                isinstance(raw_name, YScalar)
+                and isinstance(raw_name.value, str)
+                and raw_name.value.strip()
+            ):
                 name = raw_name.value.strip()
             else:
                 problems.add(raw_name.mark, f"'name' must be text, got {describe(raw_name)}")
@@ -144,28 +147,43 @@ class TreeLoader:
         files.append(path)
         if not isinstance(document, YMap):
             where = document.mark if document is not None else Mark(shown, 1, 1)
-            problems.add(where, "a tree file is a mapping with 'name:', 'rate_hz:' and 'root:'",
-                         "see docs/therapist-guide.md")
+            problems.add(
+                where,
+                "a tree file is a mapping with 'name:', 'rate_hz:' and 'root:'",
+                "see docs/therapist-guide.md",
+            )
             return None
         for key, mark in document.key_marks.items():
             if key not in TOP_KEYS:
-                problems.add(mark, f"unknown field {key!r}",
-                             did_you_mean(key, TOP_KEYS) or "fields: " + ", ".join(TOP_KEYS))
+                problems.add(
+                    mark,
+                    f"unknown field {key!r}",
+                    did_you_mean(key, TOP_KEYS) or "fields: " + ", ".join(TOP_KEYS),
+                )
         return document
 
-    def _params(self, document: YMap, problems: Problems,
-                overrides: dict[str, ParamValue] | None, where: str) -> dict[str, ParamValue]:
+    def _params(
+        self,
+        document: YMap,
+        problems: Problems,
+        overrides: dict[str, ParamValue] | None,
+        where: str,
+    ) -> dict[str, ParamValue]:
         params = read_params(document.get("params"), problems)
         if self.profile is not None:
             for name, given in self.profile.params.items():
                 if name in params and check_override(
-                        name, params[name], given, problems, f"profile {self.profile.name!r}"):
+                    name, params[name], given, problems, f"profile {self.profile.name!r}"
+                ):
                     params[name] = given
         for name, given in (overrides or {}).items():
             if name not in params:
-                problems.add(given.source, f"{where} passes unknown parameter {name!r}",
-                             did_you_mean(name, list(params)) or
-                             "parameters: " + (", ".join(params) or "none"))
+                problems.add(
+                    given.source,
+                    f"{where} passes unknown parameter {name!r}",
+                    did_you_mean(name, list(params))
+                    or "parameters: " + (", ".join(params) or "none"),
+                )
             elif check_override(name, params[name], given, problems, where):
                 params[name] = given
         return params
@@ -177,17 +195,28 @@ class TreeLoader:
         raw = substitute(raw, params, problems)
         value = raw.value if isinstance(raw, YScalar) else None
         if isinstance(value, bool) or not isinstance(value, int | float):
-            problems.add(raw.mark, f"'rate_hz' must be a number, got {describe(raw)}",
-                         "ticks per second, e.g. 10")
+            problems.add(
+                raw.mark,
+                f"'rate_hz' must be a number, got {describe(raw)}",
+                "ticks per second, e.g. 10",
+            )
             return DEFAULT_RATE_HZ
         if not 0 < value <= MAX_RATE_HZ:
-            problems.add(raw.mark, f"'rate_hz' must be above 0 and at most {MAX_RATE_HZ:g}, "
-                         f"got {value:g}")
+            problems.add(
+                raw.mark, f"'rate_hz' must be above 0 and at most {MAX_RATE_HZ:g}, got {value:g}"
+            )
             return DEFAULT_RATE_HZ
         return float(value)
 
-    def _root(self, document: YMap, path: Path, params: dict[str, ParamValue],
-              problems: Problems, stack: list[Path], files: list[Path]) -> NodeDefinition | None:
+    def _root(
+        self,
+        document: YMap,
+        path: Path,
+        params: dict[str, ParamValue],
+        problems: Problems,
+        stack: list[Path],
+        files: list[Path],
+    ) -> NodeDefinition | None:
         raw = document.get("root")
         if raw is None:
             problems.add(document.mark, "the tree has no 'root:'", "add root: with one node")
@@ -195,13 +224,20 @@ class TreeLoader:
         return self._node(substitute(raw, params, problems), path, problems, stack, files)
 
     # -- nodes ----------------------------------------------------------------------------
-    def _node(self, raw: YValue, path: Path, problems: Problems, stack: list[Path],
-              files: list[Path]) -> NodeDefinition | None:
+    def _node(
+        self, raw: YValue, path: Path, problems: Problems, stack: list[Path], files: list[Path]
+    ) -> NodeDefinition | None:
         if not isinstance(raw, YMap) or len(raw) != 1:
-            got = describe(raw) if not isinstance(raw, YMap) else (
-                f"{len(raw)} keys ({', '.join(k for k, _ in raw.items()) or 'none'})")
-            problems.add(raw.mark, f"a node is a mapping with one key, its type; got {got}",
-                         "e.g. - Say: {text: hello}")
+            got = (
+                describe(raw)
+                if not isinstance(raw, YMap)
+                else (f"{len(raw)} keys ({', '.join(k for k, _ in raw.items()) or 'none'})")
+            )
+            problems.add(
+                raw.mark,
+                f"a node is a mapping with one key, its type; got {got}",
+                "e.g. - Say: {text: hello}",
+            )
             return None
         type_name, body = next(iter(raw.items()))
         mark = raw.key_marks[type_name]
@@ -220,21 +256,31 @@ class TreeLoader:
         elif isinstance(body, YMap):
             params_raw = body
         elif not (isinstance(body, YScalar) and body.value is None):
-            expected = {"many": "a list of children or a mapping with 'children:'",
-                        "one": "a mapping with 'child:'", "none": "a mapping of parameters"}
-            problems.add(body.mark, f"{type_name} takes {expected[node_type.children]}, "
-                         f"got {describe(body)}")
+            expected = {
+                "many": "a list of children or a mapping with 'children:'",
+                "one": "a mapping with 'child:'",
+                "none": "a mapping of parameters",
+            }
+            problems.add(
+                body.mark, f"{type_name} takes {expected[node_type.children]}, got {describe(body)}"
+            )
             return None
-        args, name, children_raw = self._arguments(node_type, params_raw, children_raw, mark,
-                                                   problems)
+        args, name, children_raw = self._arguments(
+            node_type, params_raw, children_raw, mark, problems
+        )
         children = self._children(node_type, children_raw, mark, path, problems, stack, files)
         if args is None or children is None:
             return None
         return NodeDefinition(node_type, name, args, children, mark)
 
-    def _arguments(self, node_type: NodeType, body: YMap | None, children_raw: YValue | None,
-                   mark: Mark, problems: Problems
-                   ) -> tuple[dict[str, Any] | None, str, YValue | None]:
+    def _arguments(
+        self,
+        node_type: NodeType,
+        body: YMap | None,
+        children_raw: YValue | None,
+        mark: Mark,
+        problems: Problems,
+    ) -> tuple[dict[str, Any] | None, str, YValue | None]:
         structural = {"many": "children", "one": "child"}.get(node_type.children)
         args: dict[str, Any] = {}
         name = node_type.name
@@ -255,9 +301,11 @@ class TreeLoader:
             if param is None:
                 options = [*known, "name", *([structural] if structural else [])]
                 hint = did_you_mean(key, options) or (
-                    f"{node_type.name} takes " + (", ".join(options)))
-                problems.add(key_marks[key], f"unknown parameter {key!r} for {node_type.name}",
-                             hint)
+                    f"{node_type.name} takes " + (", ".join(options))
+                )
+                problems.add(
+                    key_marks[key], f"unknown parameter {key!r} for {node_type.name}", hint
+                )
                 ok = False
                 continue
             try:
@@ -272,8 +320,7 @@ class TreeLoader:
             if param.name in args or param.name in given:
                 continue
             if param.required:
-                problems.add(mark, f"{node_type.name} needs {param.name!r}",
-                             param.doc or None)
+                problems.add(mark, f"{node_type.name} needs {param.name!r}", param.doc or None)
                 ok = False
             else:
                 args[param.name] = param.default
@@ -284,9 +331,16 @@ class TreeLoader:
                 ok = False
         return (args if ok else None), name, children_raw
 
-    def _children(self, node_type: NodeType, raw: YValue | None, mark: Mark, path: Path,
-                  problems: Problems, stack: list[Path],
-                  files: list[Path]) -> list[NodeDefinition] | None:
+    def _children(
+        self,
+        node_type: NodeType,
+        raw: YValue | None,
+        mark: Mark,
+        path: Path,
+        problems: Problems,
+        stack: list[Path],
+        files: list[Path],
+    ) -> list[NodeDefinition] | None:
         if node_type.children == "none":
             return []
         if node_type.children == "one":
@@ -294,36 +348,52 @@ class TreeLoader:
                 problems.add(mark, f"{node_type.name} needs 'child:' with one node")
                 return None
             if isinstance(raw, YList):
-                problems.add(raw.mark, f"{node_type.name} takes one child, got a list of "
-                             f"{len(raw)}", "wrap them in a Sequence")
+                problems.add(
+                    raw.mark,
+                    f"{node_type.name} takes one child, got a list of {len(raw)}",
+                    "wrap them in a Sequence",
+                )
                 return None
             child = self._node(raw, path, problems, stack, files)
             return [child] if child is not None else None
         if raw is None or not isinstance(raw, YList) or len(raw) == 0:
-            problems.add(raw.mark if raw is not None else mark,
-                         f"{node_type.name} needs a list of at least one child")
+            problems.add(
+                raw.mark if raw is not None else mark,
+                f"{node_type.name} needs a list of at least one child",
+            )
             return None
         children = [self._node(item, path, problems, stack, files) for item in raw]
         if any(child is None for child in children):
             return None
         return [child for child in children if child is not None]
 
-    def _subtree(self, body: YValue, mark: Mark, path: Path, problems: Problems,
-                 stack: list[Path], files: list[Path]) -> NodeDefinition | None:
+    def _subtree(
+        self,
+        body: YValue,
+        mark: Mark,
+        path: Path,
+        problems: Problems,
+        stack: list[Path],
+        files: list[Path],
+    ) -> NodeDefinition | None:
         if not isinstance(body, YMap) or not isinstance(body.get("file"), YScalar):
             problems.add(body.mark, "Subtree takes {file: path.yaml, params: {...}}")
             return None
         for key, key_mark in body.key_marks.items():
             if key not in ("file", "params", "name"):
-                problems.add(key_mark, f"unknown parameter {key!r} for Subtree",
-                             did_you_mean(key, ["file", "params", "name"]))
+                problems.add(
+                    key_mark,
+                    f"unknown parameter {key!r} for Subtree",
+                    did_you_mean(key, ["file", "params", "name"]),
+                )
         file_value = body.get("file")
         assert isinstance(file_value, YScalar)
         target = (path.parent / str(file_value.value)).resolve()
         if target in stack:
             chain = " -> ".join(self.shown(p) for p in [*stack, target])
-            problems.add(file_value.mark, f"subtree include cycle: {chain}",
-                         "a tree cannot include itself")
+            problems.add(
+                file_value.mark, f"subtree include cycle: {chain}", "a tree cannot include itself"
+            )
             return None
         before = len(problems)
         document = self._read(target, problems, files)

@@ -112,14 +112,23 @@ class _Converter:
     def convert(self, node: yaml.Node) -> YValue:
         self.count += 1
         if self.count > MAX_NODES:
-            raise LoadError([Problem(_mark(self.file, node.start_mark),
-                                     f"file expands to more than {MAX_NODES} values",
-                                     "remove deeply repeated aliases")])
+            raise LoadError(
+                [
+                    Problem(
+                        _mark(self.file, node.start_mark),
+                        f"file expands to more than {MAX_NODES} values",
+                        "remove deeply repeated aliases",
+                    )
+                ]
+            )
         mark = _mark(self.file, node.start_mark)
         if node.tag not in _STANDARD_TAGS:
             tag = node.tag.replace("tag:yaml.org,2002:", "!!")
-            self.problems.append(Problem(mark, f"YAML tag {tag!r} is not allowed",
-                                         "write plain values without '!' tags"))
+            self.problems.append(
+                Problem(
+                    mark, f"YAML tag {tag!r} is not allowed", "write plain values without '!' tags"
+                )
+            )
             return YScalar(None, mark)
         if isinstance(node, yaml.ScalarNode):
             try:
@@ -138,15 +147,21 @@ class _Converter:
         for key_node, value_node in node.value:
             key_mark = _mark(self.file, key_node.start_mark)
             if not isinstance(key_node, yaml.ScalarNode) or key_node.tag.endswith(":merge"):
-                self.problems.append(Problem(key_mark, "keys must be plain words",
-                                             "remove '<<' merges and complex keys"))
+                self.problems.append(
+                    Problem(
+                        key_mark, "keys must be plain words", "remove '<<' merges and complex keys"
+                    )
+                )
                 continue
             key = str(key_node.value)
             if key in entries:
-                self.problems.append(Problem(
-                    key_mark, f"duplicate key {key!r} (first at line {key_marks[key].line})",
-                    "keep only one",
-                ))
+                self.problems.append(
+                    Problem(
+                        key_mark,
+                        f"duplicate key {key!r} (first at line {key_marks[key].line})",
+                        "keep only one",
+                    )
+                )
                 continue
             entries[key] = self.convert(value_node)
             key_marks[key] = key_mark
@@ -162,15 +177,23 @@ def read_text(path: Path, shown: str | None = None, *, max_bytes: int = MAX_FILE
         if path.is_dir():
             raise LoadError([Problem(start, "is a folder, not a file")])
         if size > max_bytes:
-            raise LoadError([Problem(start, f"file is {size / 1024:.0f} KiB, more than the "
-                                     f"{max_bytes // 1024} KiB a vest YAML file may be",
-                                     "split it into subtrees")])
+            raise LoadError(
+                [
+                    Problem(
+                        start,
+                        f"file is {size / 1024:.0f} KiB, more than the "
+                        f"{max_bytes // 1024} KiB a vest YAML file may be",
+                        "split it into subtrees",
+                    )
+                ]
+            )
         data = path.read_bytes()
     except FileNotFoundError:
         raise LoadError([Problem(start, "file not found", "check the path")]) from None
     except PermissionError:
-        raise LoadError([Problem(start, "permission denied", "check the file's permissions")]) \
-            from None
+        raise LoadError(
+            [Problem(start, "permission denied", "check the file's permissions")]
+        ) from None
     except IsADirectoryError:
         raise LoadError([Problem(start, "is a folder, not a file")]) from None
     try:
@@ -179,9 +202,15 @@ def read_text(path: Path, shown: str | None = None, *, max_bytes: int = MAX_FILE
         before = data[: error.start]
         line = before.count(b"\n") + 1
         column = error.start - (before.rfind(b"\n") + 1) + 1
-        raise LoadError([Problem(Mark(name, line, column),
-                                 f"byte 0x{data[error.start]:02X} is not UTF-8 text",
-                                 "save the file as UTF-8")]) from None
+        raise LoadError(
+            [
+                Problem(
+                    Mark(name, line, column),
+                    f"byte 0x{data[error.start]:02X} is not UTF-8 text",
+                    "save the file as UTF-8",
+                )
+            ]
+        ) from None
 
 
 def parse_yaml(text: str, name: str) -> YValue | None:

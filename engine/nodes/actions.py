@@ -76,8 +76,12 @@ class SetLed(ServiceAction):
 
     params: ClassVar = (
         Param("color", Color(), doc="a color name (pink, blue, off, ...) or #RRGGBB"),
-        Param("seconds", Number(minimum=0.0, unit="s"), None,
-              "how long to keep it lit; empty: until another SetLed"),
+        Param(
+            "seconds",
+            Number(minimum=0.0, unit="s"),
+            None,
+            "how long to keep it lit; empty: until another SetLed",
+        ),
     )
 
     def start(self) -> Job:
@@ -94,8 +98,12 @@ class MoveServo(ServiceAction):
     params: ClassVar = (
         Param("joint", Text(), doc="joint name from the robot config, e.g. neck"),
         Param("angle_deg", Number(-180.0, 180.0, "deg"), doc="target angle in degrees"),
-        Param("speed_dps", Number(minimum=0.0, unit="deg/s"), None,
-              "degrees per second; empty: the joint's own maximum"),
+        Param(
+            "speed_dps",
+            Number(minimum=0.0, unit="deg/s"),
+            None,
+            "degrees per second; empty: the joint's own maximum",
+        ),
     )
 
     def start(self) -> Job:
@@ -205,9 +213,7 @@ class ReadSensor(ServiceAction):
     the sensor could not be read.
     """
 
-    params: ClassVar = (
-        Param("sensor", Choice(ON_REQUEST_SENSORS), doc="which sensor to read"),
-    )
+    params: ClassVar = (Param("sensor", Choice(ON_REQUEST_SENSORS), doc="which sensor to read"),)
     writes: ClassVar = (
         "/sensors/temperature/c",
         "/sensors/temperature/f",

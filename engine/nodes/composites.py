@@ -74,10 +74,18 @@ COMPOSITES = (
         SUCCESS when all children (or one, with succeed_when: one) succeeded; FAILURE as
         soon as any child fails; RUNNING otherwise.""",
         (
-            Param("succeed_when", Choice(("all", "one")), "all",
-                  "all: succeed when every child succeeded; one: when the first one did"),
-            Param("synchronise", Boolean(), True,
-                  "with succeed_when: all, do not tick again a child that already succeeded"),
+            Param(
+                "succeed_when",
+                Choice(("all", "one")),
+                "all",
+                "all: succeed when every child succeeded; one: when the first one did",
+            ),
+            Param(
+                "synchronise",
+                Boolean(),
+                True,
+                "with succeed_when: all, do not tick again a child that already succeeded",
+            ),
         ),
         _parallel,
     ),

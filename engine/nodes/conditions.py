@@ -26,8 +26,12 @@ class Check(Condition):
         Param("not_equals", Scalar(), None, "SUCCESS when the value differs from this"),
         Param("above", Number(), None, "SUCCESS when the value is greater than this"),
         Param("below", Number(), None, "SUCCESS when the value is less than this"),
-        Param("between", ListOf(Number(), 2, 2), None,
-              "[low, high]: SUCCESS when low <= value <= high"),
+        Param(
+            "between",
+            ListOf(Number(), 2, 2),
+            None,
+            "[low, high]: SUCCESS when low <= value <= high",
+        ),
         Param("item", Integer(minimum=0), None, "for list values: which element (from 0)"),
     )
 
@@ -39,20 +43,32 @@ class Check(Condition):
         problems: list[tuple[str | None, str, str | None]] = []
         if len(given) != 1:
             found = ", ".join(given) if given else "none"
-            problems.append((None, f"Check needs exactly one comparison, found {found}",
-                             "use one of " + ", ".join(_COMPARISONS)))
+            problems.append(
+                (
+                    None,
+                    f"Check needs exactly one comparison, found {found}",
+                    "use one of " + ", ".join(_COMPARISONS),
+                )
+            )
         between = args.get("between")
         if between is not None and between[0] > between[1]:
-            problems.append(("between", f"low {between[0]:g} is above high {between[1]:g}",
-                             "write [low, high]"))
+            problems.append(
+                ("between", f"low {between[0]:g} is above high {between[1]:g}", "write [low, high]")
+            )
         spec = ctx.catalogue.lookup(args.get("key", ""))
         numeric = {"above", "below", "between"} & set(given)
         if spec is not None and numeric and spec.value_type in (bool, str, dict):
-            problems.append((numeric.pop(), f"{args['key']} holds {spec.type_name}, not a number",
-                             "use equals"))
+            problems.append(
+                (numeric.pop(), f"{args['key']} holds {spec.type_name}, not a number", "use equals")
+            )
         if spec is not None and spec.value_type is list and args.get("item") is None:
-            problems.append(("item", f"{args['key']} holds a list: say which item to check",
-                             "add item: 0 for the first"))
+            problems.append(
+                (
+                    "item",
+                    f"{args['key']} holds a list: say which item to check",
+                    "add item: 0 for the first",
+                )
+            )
         return problems
 
     def __init__(self, *a: Any) -> None:

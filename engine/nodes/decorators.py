@@ -166,8 +166,14 @@ DECORATORS = (
         """Run the child until it has finished once, then never again.
 
         The child's status until then; afterwards the status it finished with, forever.""",
-        (Param("after", Choice(("success", "completion")), "success",
-               "success: only a success counts as done; completion: any finish does"),),
+        (
+            Param(
+                "after",
+                Choice(("success", "completion")),
+                "success",
+                "success: only a success counts as done; completion: any finish does",
+            ),
+        ),
         _one_shot,
     ),
 )

@@ -27,8 +27,11 @@ class Reply(Leaf):
         Param("heard", Key(), doc="the /vars/ key holding the utterance"),
         Param("dialog", Text(), "default", "which dialog (file in dialogs/, without .yaml)"),
     )
-    writes: ClassVar = ("/sensors/temperature/c", "/sensors/temperature/f",
-                        "/sensors/ultrasound/cm")
+    writes: ClassVar = (
+        "/sensors/temperature/c",
+        "/sensors/temperature/f",
+        "/sensors/ultrasound/cm",
+    )
 
     @classmethod
     def check_params(
@@ -37,8 +40,9 @@ class Reply(Leaf):
         dialog = args.get("dialog")
         if ctx.dialogs is not None and dialog is not None and ctx.dialogs.get(dialog) is None:
             known = ctx.dialogs.names
-            hint = did_you_mean(dialog, known) or ("dialogs: " + ", ".join(known) if known
-                                                   else "add dialogs/NAME.yaml")
+            hint = did_you_mean(dialog, known) or (
+                "dialogs: " + ", ".join(known) if known else "add dialogs/NAME.yaml"
+            )
             return [("dialog", f"no dialog named {dialog!r}", hint)]
         return []
 

@@ -181,8 +181,11 @@ class Key(ParamType):
         spec = ctx.catalogue.lookup(value)
         if spec is None:
             suggestion = ctx.catalogue.suggest(value)
-            hint = (f"did you mean {suggestion!r}?" if suggestion
-                    else "see `vest keys`; use /vars/NAME for a tree's own variable")
+            hint = (
+                f"did you mean {suggestion!r}?"
+                if suggestion
+                else "see `vest keys`; use /vars/NAME for a tree's own variable"
+            )
             raise ParamProblem(f"unknown blackboard key {value!r}", hint)
         if spec.kind == "event" and "event" not in self.kinds:
             raise ParamProblem(

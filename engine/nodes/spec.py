@@ -25,10 +25,13 @@ if TYPE_CHECKING:
 Kind = Literal["composite", "decorator", "condition", "action"]
 KINDS: tuple[Kind, ...] = ("composite", "decorator", "condition", "action")
 
-Builder = Callable[[str, SimpleNamespace, list[py_trees.behaviour.Behaviour], TreeContext],
-                   py_trees.behaviour.Behaviour]
+Builder = Callable[
+    [str, SimpleNamespace, list[py_trees.behaviour.Behaviour], TreeContext],
+    py_trees.behaviour.Behaviour,
+]
 ExtraCheck = Callable[[Mapping[str, Any], CheckContext], list[tuple[str | None, str, str | None]]]
 """Cross-parameter checks: returns (parameter or None, message, hint) per problem."""
+
 
 @dataclass(frozen=True)
 class NodeType:

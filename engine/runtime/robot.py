@@ -73,8 +73,12 @@ def load_behaviors(
     names: dict[str, Path] = {}
     for definition in definitions:
         if definition.name in names:
-            problems.add(definition.root.mark, f"two trees are named {definition.name!r} "
-                         f"(also {loader.shown(names[definition.name])})", "rename one")
+            problems.add(
+                definition.root.mark,
+                f"two trees are named {definition.name!r} "
+                f"(also {loader.shown(names[definition.name])})",
+                "rename one",
+            )
         names[definition.name] = definition.path
     if not definitions and not problems:
         where = Mark(str(trees[0]) if trees else ".", 1, 1)

@@ -56,19 +56,25 @@ def changes_of(event: ScenarioEvent) -> list[tuple[float, Change]]:
     """The world changes one scenario event makes, with their times in seconds."""
     value, at = event.value, event.at_s
     if event.kind == "touch":
-        return [(at, _touch(value["pad"], True)),
-                (at + value["seconds"], _touch(value["pad"], False))]
+        return [
+            (at, _touch(value["pad"], True)),
+            (at + value["seconds"], _touch(value["pad"], False)),
+        ]
     if event.kind == "squeeze":
-        return [(at, _force(value["left_n"], value["right_n"])),
-                (at + value["seconds"], _force(0.0, 0.0))]
+        return [
+            (at, _force(value["left_n"], value["right_n"])),
+            (at + value["seconds"], _force(0.0, 0.0)),
+        ]
     if event.kind == "obstacle":
         seen = {side: value[f"{side}_mm"] for side in SIDES}
         return [(at, _ranges(seen)), (at + value["seconds"], _ranges(dict.fromkeys(SIDES)))]
     if event.kind == "temperature":
         return [(at, _set("temperature_c", value["c"], "temperature"))]
     if event.kind == "ultrasound":
-        return [(at, _set("ultrasound_cm", value["cm"], "ultrasound")),
-                (at + value["seconds"], _set("ultrasound_cm", None, "ultrasound"))]
+        return [
+            (at, _set("ultrasound_cm", value["cm"], "ultrasound")),
+            (at + value["seconds"], _set("ultrasound_cm", None, "ultrasound")),
+        ]
     if event.kind == "gesture":
         return [(at, _happen("gesture", value))]
     if event.kind == "hear":

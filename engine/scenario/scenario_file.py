@@ -21,7 +21,7 @@ from typing import Any
 
 from engine.blackboard.catalogue import default_catalogue
 from engine.loader.problems import Mark, Problems
-from engine.loader.yaml_source import YList, YMap, YScalar, YValue, describe, load_yaml, plain
+from engine.loader.yaml_source import YList, YMap, YValue, describe, load_yaml, plain
 from engine.nodes.params import (
     REQUIRED,
     AnyValue,
@@ -36,30 +36,50 @@ from engine.nodes.params import (
     did_you_mean,
 )
 
-GESTURES = ("wave", "swipe_left", "swipe_right", "swipe_up", "hover", "hover_left",
-            "hover_right", "hover_up")
+GESTURES = (
+    "wave",
+    "swipe_left",
+    "swipe_right",
+    "swipe_up",
+    "hover",
+    "hover_left",
+    "hover_right",
+    "hover_up",
+)
 _SECONDS = Number(0.01, 3600.0, "s")
 _DISTANCE_MM = Number(0.0, 8190.0, "mm")
 
 EVENT_FIELDS: dict[str, tuple[Param, ...] | ParamType] = {
-    "touch": (Param("pad", Integer(0, 11), doc="pad number 0..11"),
-              Param("seconds", _SECONDS, 0.3, "how long the hand stays")),
-    "squeeze": (Param("left_n", Number(0.0, 100.0, "N"), 0.0, "force on the left side"),
-                Param("right_n", Number(0.0, 100.0, "N"), 0.0, "force on the right side"),
-                Param("seconds", _SECONDS, 1.0, "how long")),
+    "touch": (
+        Param("pad", Integer(0, 11), doc="pad number 0..11"),
+        Param("seconds", _SECONDS, 0.3, "how long the hand stays"),
+    ),
+    "squeeze": (
+        Param("left_n", Number(0.0, 100.0, "N"), 0.0, "force on the left side"),
+        Param("right_n", Number(0.0, 100.0, "N"), 0.0, "force on the right side"),
+        Param("seconds", _SECONDS, 1.0, "how long"),
+    ),
     "gesture": Choice(GESTURES),
-    "obstacle": (Param("left_mm", _DISTANCE_MM, None, "distance seen on the left"),
-                 Param("center_mm", _DISTANCE_MM, None, "distance seen in the center"),
-                 Param("right_mm", _DISTANCE_MM, None, "distance seen on the right"),
-                 Param("seconds", _SECONDS, 2.0, "how long it stays")),
-    "temperature": (Param("c", Number(-40.0, 125.0, "degC"), None, "degrees Celsius"),
-                    Param("f", Number(-40.0, 257.0, "degF"), None, "degrees Fahrenheit")),
-    "ultrasound": (Param("cm", Number(0.0, 600.0, "cm"), REQUIRED, "distance of the object"),
-                   Param("seconds", _SECONDS, 5.0, "how long it stays")),
+    "obstacle": (
+        Param("left_mm", _DISTANCE_MM, None, "distance seen on the left"),
+        Param("center_mm", _DISTANCE_MM, None, "distance seen in the center"),
+        Param("right_mm", _DISTANCE_MM, None, "distance seen on the right"),
+        Param("seconds", _SECONDS, 2.0, "how long it stays"),
+    ),
+    "temperature": (
+        Param("c", Number(-40.0, 125.0, "degC"), None, "degrees Celsius"),
+        Param("f", Number(-40.0, 257.0, "degF"), None, "degrees Fahrenheit"),
+    ),
+    "ultrasound": (
+        Param("cm", Number(0.0, 600.0, "cm"), REQUIRED, "distance of the object"),
+        Param("seconds", _SECONDS, 5.0, "how long it stays"),
+    ),
     "hear": Text(),
-    "cloud": (Param("type", Text(), REQUIRED, "command type: say, led, move, read"),
-              Param("args", AnyValue(), None, "the command's arguments"),
-              Param("id", Text(), None, "command id (default: cmd-N)")),
+    "cloud": (
+        Param("type", Text(), REQUIRED, "command type: say, led, move, read"),
+        Param("args", AnyValue(), None, "the command's arguments"),
+        Param("id", Text(), None, "command id (default: cmd-N)"),
+    ),
 }
 
 
@@ -76,12 +96,16 @@ class ScenarioEvent:
         if self.kind == "touch":
             return f"pad {value['pad']} touched for {value['seconds']:g} s"
         if self.kind == "squeeze":
-            return (f"squeezed left {value['left_n']:g} N, right {value['right_n']:g} N "
-                    f"for {value['seconds']:g} s")
+            return (
+                f"squeezed left {value['left_n']:g} N, right {value['right_n']:g} N "
+                f"for {value['seconds']:g} s"
+            )
         if self.kind == "obstacle":
-            seen = ", ".join(f"{side} {value[side + '_mm']:g} mm"
-                             for side in ("left", "center", "right")
-                             if value[side + "_mm"] is not None)
+            seen = ", ".join(
+                f"{side} {value[side + '_mm']:g} mm"
+                for side in ("left", "center", "right")
+                if value[side + "_mm"] is not None
+            )
             return f"obstacle at {seen or 'nothing'} for {value['seconds']:g} s"
         if self.kind == "temperature":
             return f"room at {value['c']:.1f} degC"
@@ -110,22 +134,29 @@ def load_scenario(path: Path, shown: str | None = None) -> Scenario:
 def check_scenario(document: YValue | None, name: str, path: Path) -> Scenario:
     problems = Problems()
     if not isinstance(document, YMap):
-        problems.add(document.mark if document else Mark(name, 1, 1),
-                     "a scenario is a mapping with 'duration_s:' and 'events:'")
+        problems.add(
+            document.mark if document else Mark(name, 1, 1),
+            "a scenario is a mapping with 'duration_s:' and 'events:'",
+        )
         problems.raise_if_any()
     assert isinstance(document, YMap)
     for key, mark in document.key_marks.items():
         if key not in ("duration_s", "events", "description"):
-            problems.add(mark, f"unknown scenario field {key!r}",
-                         did_you_mean(key, ["duration_s", "events", "description"]))
+            problems.add(
+                mark,
+                f"unknown scenario field {key!r}",
+                did_you_mean(key, ["duration_s", "events", "description"]),
+            )
     ctx = CheckContext(default_catalogue())
     duration = 0.0
     raw_duration = document.get("duration_s")
     if raw_duration is None:
         problems.add(document.mark, "a scenario needs 'duration_s:'", "seconds, e.g. 20")
     else:
-        duration = _convert(Number(0.01, 24 * 3600.0, "s"), raw_duration, "duration_s",
-                            ctx, problems) or 0.0
+        duration = (
+            _convert(Number(0.01, 24 * 3600.0, "s"), raw_duration, "duration_s", ctx, problems)
+            or 0.0
+        )
     events: list[ScenarioEvent] = []
     raw_events = document.get("events")
     if raw_events is not None and not isinstance(raw_events, YList):
@@ -136,16 +167,18 @@ def check_scenario(document: YValue | None, name: str, path: Path) -> Scenario:
             if event is None:
                 continue
             if duration and event.at_s > duration:
-                problems.add(raw.mark, f"event at {event.at_s:g} s is after the scenario ends "
-                             f"({duration:g} s)", "raise duration_s")
+                problems.add(
+                    raw.mark,
+                    f"event at {event.at_s:g} s is after the scenario ends ({duration:g} s)",
+                    "raise duration_s",
+                )
             events.append(event)
     problems.raise_if_any()
     events.sort(key=lambda e: e.at_s)
     return Scenario(duration, tuple(events), path)
 
 
-def _convert(kind: ParamType, raw: YValue, what: str, ctx: CheckContext,
-             problems: Problems) -> Any:
+def _convert(kind: ParamType, raw: YValue, what: str, ctx: CheckContext, problems: Problems) -> Any:
     try:
         return kind.convert(plain(raw), ctx)
     except ParamProblem as problem:
@@ -153,8 +186,7 @@ def _convert(kind: ParamType, raw: YValue, what: str, ctx: CheckContext,
         return None
 
 
-def _event(raw: YValue, ctx: CheckContext, problems: Problems, index: int
-           ) -> ScenarioEvent | None:
+def _event(raw: YValue, ctx: CheckContext, problems: Problems, index: int) -> ScenarioEvent | None:
     if not isinstance(raw, YMap):
         problems.add(raw.mark, "an event is a mapping like {at: 1.0, touch: {pad: 3}}")
         return None
@@ -166,14 +198,20 @@ def _event(raw: YValue, ctx: CheckContext, problems: Problems, index: int
     else:
         at_s = _convert(Number(0.0, unit="s"), at, "at", ctx, problems)
     if len(kinds) != 1:
-        problems.add(raw.mark, f"an event has 'at' and one kind, got {len(kinds)} kinds",
-                     "kinds: " + ", ".join(EVENT_FIELDS))
+        problems.add(
+            raw.mark,
+            f"an event has 'at' and one kind, got {len(kinds)} kinds",
+            "kinds: " + ", ".join(EVENT_FIELDS),
+        )
         return None
     kind = kinds[0]
     fields = EVENT_FIELDS.get(kind)
     if fields is None:
-        problems.add(raw.key_marks[kind], f"unknown event {kind!r}",
-                     did_you_mean(kind, list(EVENT_FIELDS)) or "kinds: " + ", ".join(EVENT_FIELDS))
+        problems.add(
+            raw.key_marks[kind],
+            f"unknown event {kind!r}",
+            did_you_mean(kind, list(EVENT_FIELDS)) or "kinds: " + ", ".join(EVENT_FIELDS),
+        )
         return None
     body = raw.entries[kind]
     if isinstance(fields, ParamType):
@@ -196,11 +234,16 @@ def _event(raw: YValue, ctx: CheckContext, problems: Problems, index: int
     return ScenarioEvent(float(at_s), kind, value, raw.mark)
 
 
-def _fields(kind: str, params: tuple[Param, ...], body: YValue, ctx: CheckContext,
-            problems: Problems) -> dict[str, Any] | None:
+def _fields(
+    kind: str, params: tuple[Param, ...], body: YValue, ctx: CheckContext, problems: Problems
+) -> dict[str, Any] | None:
     if not isinstance(body, YMap):
-        problems.add(body.mark, f"{kind} takes a mapping of "
-                     + ", ".join(p.name for p in params) + f", got {describe(body)}")
+        problems.add(
+            body.mark,
+            f"{kind} takes a mapping of "
+            + ", ".join(p.name for p in params)
+            + f", got {describe(body)}",
+        )
         return None
     names = [p.name for p in params]
     values: dict[str, Any] = {}
@@ -208,8 +251,11 @@ def _fields(kind: str, params: tuple[Param, ...], body: YValue, ctx: CheckContex
     for key, value in body.items():
         param = next((p for p in params if p.name == key), None)
         if param is None:
-            problems.add(body.key_marks[key], f"unknown {kind} field {key!r}",
-                         did_you_mean(key, names) or "fields: " + ", ".join(names))
+            problems.add(
+                body.key_marks[key],
+                f"unknown {kind} field {key!r}",
+                did_you_mean(key, names) or "fields: " + ", ".join(names),
+            )
             ok = False
             continue
         converted = _convert(param.type, value, key, ctx, problems)

@@ -7,6 +7,7 @@ the :class:`ActionLog`: the timeline printer, the ``--json`` writer, the test ha
 
 from __future__ import annotations
 
+import logging
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
@@ -14,6 +15,8 @@ from typing import Any
 from engine.clock import Clock
 from engine.services.interfaces import Services
 from engine.services.jobs import ImmediateJob, Job
+
+_log = logging.getLogger("vest.actions")
 
 
 @dataclass(frozen=True)
@@ -39,7 +42,10 @@ class ActionLog:
     def add(self, record: ActionRecord) -> None:
         self.records.append(record)
         for listener in self.listeners:
-            listener(record)
+            try:
+                listener(record)
+            except Exception:  # a broken display must not stop the robot acting
+                _log.exception("action listener %r failed", listener)
 
 
 class TreeActions:
@@ -72,9 +78,7 @@ class TreeActions:
         args: dict[str, Any] = {"color": color}
         if seconds is not None:
             args["seconds"] = seconds
-        return self._call(
-            "led", args, lambda: self.services.leds.set_color(color, seconds=seconds)
-        )
+        return self._call("led", args, lambda: self.services.leds.set_color(color, seconds=seconds))
 
     def move_servo(self, joint: str, angle_deg: float, *, speed_dps: float | None = None) -> Job:
         args: dict[str, Any] = {"joint": joint, "angle_deg": angle_deg}

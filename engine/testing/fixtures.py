@@ -23,8 +23,7 @@ def clean_blackboard() -> Iterator[None]:
 def tree_harness() -> Callable[..., TreeHarness]:
     """``tree_harness("trees/hug.yaml", profile=None)`` -> a :class:`TreeHarness`."""
 
-    def make(path: str | Path, profile: str | Path | None = None, **options: object
-             ) -> TreeHarness:
+    def make(path: str | Path, profile: str | Path | None = None, **options: object) -> TreeHarness:
         return TreeHarness.from_file(path, profile, **options)  # type: ignore[arg-type]
 
     return make

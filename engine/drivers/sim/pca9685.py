@@ -1,6 +1,6 @@
 """A register-level model of the NXP PCA9685 16-channel PWM controller.
 
-What it models, from the datasheet (Rev. 4, section 7):
+What it models, from the NXP datasheet (section 7, "Functional description"):
 
 * power-on registers: MODE1 0x11 (SLEEP, ALLCALL), MODE2 0x04, every LEDn "full off",
   PRE_SCALE 0x1E (200 Hz);

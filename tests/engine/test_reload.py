@@ -1,0 +1,75 @@
+"""Hot reload: an edited tree is swapped in between ticks; a broken edit keeps the old one."""
+
+import os
+import textwrap
+
+from engine.blackboard import Blackboard, default_catalogue
+from engine.clock import VirtualClock
+from engine.runtime.reload import TreeReloader
+from engine.runtime.robot import Robot, load_behaviors
+from engine.services.simulated import simulated_services
+
+GREETER = """\
+    name: greeter
+    rate_hz: 10
+    root:
+      Sequence:
+        - Check: {key: /sensors/touch/any, equals: true}
+        - Say: {text: "PHRASE"}
+    """
+
+
+def edit(path, text, bump):
+    path.write_text(textwrap.dedent(text))
+    stat = path.stat()
+    os.utime(path, ns=(stat.st_atime_ns, stat.st_mtime_ns + bump * 1_000_000_000))
+
+
+def start(tmp_path):
+    tree_file = tmp_path / "greeter.yaml"
+    edit(tree_file, GREETER.replace("PHRASE", "Hello"), 0)
+    clock = VirtualClock()
+    board = Blackboard(default_catalogue(), clock)
+    board.reset()
+    behaviors = load_behaviors([tmp_path])
+    robot = Robot(behaviors, clock=clock, services=simulated_services(clock), blackboard=board)
+    reports = []
+    reloader = TreeReloader(
+        behaviors.loader,
+        robot.trees,
+        clock,
+        check_every_s=1.0,
+        on_reload=lambda name, error: reports.append((name, error)),
+    )
+    robot.scheduler.hooks.append(reloader)
+    board.set("/sensors/touch/any", True)
+    return robot, tree_file, reports
+
+
+def said(robot):
+    return [r.args["text"] for r in robot.action_log.records]
+
+
+def test_a_changed_phrase_is_spoken_after_the_next_reload_check(tmp_path):
+    robot, tree_file, reports = start(tmp_path)
+    robot.scheduler.run(until_s=0.05)
+    edit(tree_file, GREETER.replace("PHRASE", "Good morning"), 1)
+    robot.scheduler.run(until_s=1.05)
+    assert said(robot)[0] == "Hello"
+    assert said(robot)[-1] == "Good morning"
+    assert reports == [("greeter", None)]
+    assert robot.trees[0].stats.ticks == 11  # statistics survive the swap
+
+
+def test_a_broken_edit_keeps_the_running_tree_and_is_reported_once(tmp_path):
+    robot, tree_file, reports = start(tmp_path)
+    edit(tree_file, GREETER.replace("Say", "Sya"), 1)
+    robot.scheduler.run(until_s=3.0)
+    assert set(said(robot)) == {"Hello"}
+    assert len(reports) == 1
+    name, error = reports[0]
+    assert name == "greeter"
+    assert "greeter.yaml:6:7: unknown node type 'Sya' (did you mean 'Say'?)" in str(error)
+    edit(tree_file, GREETER.replace("PHRASE", "Fixed"), 2)
+    robot.scheduler.run(until_s=4.0)
+    assert said(robot)[-1] == "Fixed"
