@@ -59,6 +59,9 @@ class RunningTree:
         old_root = self.tree.root
         if old_root.status == py_trees.common.Status.RUNNING:
             old_root.stop(py_trees.common.Status.INVALID)
+        for node in old_root.iterate():  # the old nodes' blackboard clients go with them
+            for client in node.blackboards:
+                client.unregister(clear=False)
         self.definition = definition
         self.tree = definition.build(self.context)
         self.origin_s = self.next_deadline_s

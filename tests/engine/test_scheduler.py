@@ -106,7 +106,7 @@ def test_an_exception_in_a_leaf_makes_it_fail_is_reported_with_its_path_and_tick
 
 def test_stop_ends_the_run_after_the_current_tick(tmp_path):
     write(tmp_path, "t.yaml", "rate_hz: 10\nroot:\n  Wait: {seconds: 100}\n")
-    robot, clock = make_robot(tmp_path)
+    robot, _ = make_robot(tmp_path)
     robot.scheduler.hooks.append(lambda now: robot.scheduler.stop() if now >= 0.3 else None)
     robot.scheduler.run()
     assert robot.trees[0].stats.ticks == 4  # 0.0, 0.1, 0.2, 0.3
