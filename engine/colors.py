@@ -6,15 +6,17 @@ import re
 
 NAMED_COLORS: dict[str, tuple[float, float, float]] = {
     "off": (0.0, 0.0, 0.0),
+    "black": (0.0, 0.0, 0.0),
     "white": (1.0, 1.0, 1.0),
     "red": (1.0, 0.0, 0.0),
     "green": (0.0, 1.0, 0.0),
     "blue": (0.0, 0.0, 1.0),
     "yellow": (1.0, 0.8, 0.0),
     "orange": (1.0, 0.4, 0.0),
-    "pink": (1.0, 0.35, 0.55),
+    "pink": (1.0, 0.125, 0.375),  # an LED's pink needs far less green and blue than a screen's
     "purple": (0.6, 0.0, 1.0),
     "cyan": (0.0, 1.0, 1.0),
+    "magenta": (1.0, 0.0, 1.0),
     "warm_white": (1.0, 0.75, 0.45),
 }
 

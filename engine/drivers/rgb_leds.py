@@ -1,46 +1,23 @@
 """RGB LEDs on PCA9685 channels: the robot's face lights.
 
-Colours are (red, green, blue) fractions of full brightness, 0.0..1.0. Named colours are
-tuned for RGB LEDs rather than copied from CSS: an LED's pink needs far less green and
-blue than a screen's.
+Colours are (red, green, blue) fractions of full brightness, 0.0..1.0; names and
+``#RRGGBB`` are parsed by :func:`engine.colors.parse_color`, shared with the tree loader.
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping
 
+from engine.colors import parse_color
 from engine.drivers.pca9685 import CHANNELS, PCA9685
 
 Rgb = tuple[float, float, float]
 
 ALL = "all"
 
-NAMED_COLORS: dict[str, str] = {
-    "off": "#000000",
-    "black": "#000000",
-    "white": "#FFFFFF",
-    "red": "#FF0000",
-    "green": "#00FF00",
-    "blue": "#0000FF",
-    "pink": "#FF2060",
-    "orange": "#FF4000",
-    "yellow": "#FFB000",
-    "purple": "#8000FF",
-    "cyan": "#00FFFF",
-    "magenta": "#FF00FF",
-}
-
-
 def color_to_rgb(color: str) -> Rgb:
     """A colour name (``pink``, ``blue``, ``off``...) or ``#RRGGBB`` as (r, g, b) in 0..1."""
-    text = color.strip().lower()
-    hex_text = NAMED_COLORS.get(text, text).lower()
-    digits = hex_text[1:] if hex_text.startswith("#") else ""
-    if len(digits) != 6 or any(c not in "0123456789abcdef" for c in digits):
-        known = ", ".join(sorted(NAMED_COLORS))
-        raise ValueError(f"unknown colour {color!r}: use #RRGGBB or one of {known}")
-    red, green, blue = (int(digits[i : i + 2], 16) / 255 for i in (0, 2, 4))
-    return (red, green, blue)
+    return parse_color(color)
 
 
 def _check_rgb(rgb: Rgb) -> Rgb:

@@ -96,7 +96,7 @@ def test_colour_names_and_hex():
     assert color_to_rgb(" #FF8000 ") == (1.0, pytest.approx(128 / 255), 0.0)
     for name in ("pink", "red", "green", "white", "orange", "yellow", "purple"):
         assert all(0.0 <= value <= 1.0 for value in color_to_rgb(name))
-    with pytest.raises(ValueError, match=r"unknown colour 'chartreuse'.*pink"):
+    with pytest.raises(ValueError, match=r"unknown color 'chartreuse'.*pink"):
         color_to_rgb("chartreuse")
     with pytest.raises(ValueError, match="#12345"):
         color_to_rgb("#12345")

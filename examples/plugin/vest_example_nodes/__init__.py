@@ -10,10 +10,12 @@ names :func:`register`. After ``pip install -e examples/plugin`` they appear in
 
 from __future__ import annotations
 
+from types import SimpleNamespace
 from typing import ClassVar
 
 from engine.nodes import Condition, Integer, Leaf, NodeRegistry, Number, Param, Status
 from engine.nodes.actions import Color
+from engine.nodes.context import TreeContext
 from engine.services import Job
 
 TEMPERATURE_C = "/sensors/temperature/c"
@@ -55,8 +57,8 @@ class Blink(Leaf):
         Param("off_s", Number(0.05, 5.0, "s"), 0.3, "the dark pause between flashes"),
     )
 
-    def __init__(self, *args: object) -> None:
-        super().__init__(*args)  # type: ignore[arg-type]
+    def __init__(self, name: str, args: SimpleNamespace, ctx: TreeContext) -> None:
+        super().__init__(name, args, ctx)
         self.job: Job | None = None  # the flash being shown, None while dark
         self.flashes_left = 0
         self.dark_until_s = 0.0
