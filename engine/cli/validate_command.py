@@ -45,7 +45,7 @@ def yaml_files(paths: list[Path]) -> list[Path]:
                     if not any(part.startswith(".") for part in p.parts)
                 )
             )
-        else:
+        elif path.exists():
             files.append(path)
     return files
 

@@ -15,6 +15,7 @@ Rgb = tuple[float, float, float]
 
 ALL = "all"
 
+
 def color_to_rgb(color: str) -> Rgb:
     """A colour name (``pink``, ``blue``, ``off``...) or ``#RRGGBB`` as (r, g, b) in 0..1."""
     return parse_color(color)

@@ -19,6 +19,16 @@ from engine.nodes.params import did_you_mean
 _REFERENCE = re.compile(r"\$\{([^}]*)\}")
 _NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
 _PROFILE_KEYS = ("profile", "description", "params")
+UNRESOLVED: object = type("Unresolved", (), {"__repr__": lambda self: "<unresolved>"})()
+
+
+def unresolved(value: YValue) -> bool:
+    """True when a ``${name}`` in ``value`` could not be replaced (already a problem)."""
+    if isinstance(value, YMap):
+        return any(unresolved(item) for _, item in value.items())
+    if isinstance(value, YList):
+        return any(unresolved(item) for item in value)
+    return value.value is UNRESOLVED
 
 
 @dataclass(frozen=True)
@@ -104,7 +114,7 @@ def substitute(value: YValue, params: dict[str, ParamValue], problems: Problems)
     if whole:
         found = _lookup(whole.group(1), value.mark, params, problems)
         if found is None:
-            return YScalar(None, value.mark)
+            return YScalar(UNRESOLVED, value.mark)
         if isinstance(found, YScalar):
             return YScalar(found.value, value.mark)
         return found
@@ -121,7 +131,9 @@ def substitute(value: YValue, params: dict[str, ParamValue], problems: Problems)
             return match.group(0)
         return str(found.value)
 
-    return YScalar(_REFERENCE.sub(replace, text), value.mark)
+    before = len(problems)
+    replaced = _REFERENCE.sub(replace, text)
+    return YScalar(UNRESOLVED if len(problems) > before else replaced, value.mark)
 
 
 def _lookup(

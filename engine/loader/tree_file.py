@@ -36,6 +36,7 @@ from engine.loader.substitution import (
     check_override,
     read_params,
     substitute,
+    unresolved,
 )
 from engine.loader.yaml_source import YList, YMap, YScalar, YValue, describe, load_yaml, plain
 from engine.nodes.context import TreeContext
@@ -193,6 +194,8 @@ class TreeLoader:
         if raw is None:
             return DEFAULT_RATE_HZ
         raw = substitute(raw, params, problems)
+        if unresolved(raw):
+            return DEFAULT_RATE_HZ
         value = raw.value if isinstance(raw, YScalar) else None
         if isinstance(value, bool) or not isinstance(value, int | float):
             problems.add(
@@ -298,6 +301,9 @@ class TreeLoader:
         known = [p.name for p in node_type.params]
         for key, value in given.items():
             param = node_type.param(key)
+            if param is not None and unresolved(value):
+                ok = False  # the unknown ${name} is the problem, already reported
+                continue
             if param is None:
                 options = [*known, "name", *([structural] if structural else [])]
                 hint = did_you_mean(key, options) or (

@@ -225,6 +225,19 @@ def parse_yaml(text: str, name: str) -> YValue | None:
         if error.context:
             message += f" ({error.context})"
         raise LoadError([Problem(where, message, _hint_for(problem))]) from None
+    except yaml.reader.ReaderError as error:
+        before = text[: error.position]
+        where = Mark(name, before.count("\n") + 1, error.position - (before.rfind("\n") + 1) + 1)
+        char = error.character if isinstance(error.character, str) else chr(error.character)
+        raise LoadError(
+            [
+                Problem(
+                    where,
+                    f"character U+{ord(char):04X} is not allowed in YAML",
+                    "delete it or retype the line",
+                )
+            ]
+        ) from None
     except yaml.composer.ComposerError as error:  # e.g. several documents in one file
         raise LoadError([Problem(Mark(name, 1, 1), f"YAML error: {error}")]) from None
     except yaml.YAMLError as error:

@@ -152,6 +152,7 @@ class LookToward(Leaf):
         if target is None or target == self.angle_deg:
             self.feedback_message = f"nearest: {side or 'nothing'}; no turn needed"
             return
+        self.previous_deg = self.angle_deg
         self.angle_deg = target
         self.feedback_message = f"nearest: {side}; turning to {target:g} deg"
         self.job = self.ctx.actions.move_servo(
@@ -166,6 +167,7 @@ class LookToward(Leaf):
         error = self.job.error()
         if error is not None:
             self.feedback_message = f"could not turn: {error}"
+            self.angle_deg = self.previous_deg  # not there: try again next tick
             return Status.FAILURE
         return Status.SUCCESS
 

@@ -7,6 +7,7 @@ type and the value found, and a hint where one helps. The loader adds the place.
 from __future__ import annotations
 
 import difflib
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, Literal
@@ -89,6 +90,8 @@ class Number(ParamType):
         if isinstance(value, bool) or not isinstance(value, int | float):
             raise ParamProblem(f"must be a number, got {_shown(value)}", self._example())
         number = float(value)
+        if not math.isfinite(number):
+            raise ParamProblem(f"must be a finite number, got {number}", self._example())
         if self.minimum is not None and number < self.minimum:
             raise ParamProblem(f"must be at least {self.minimum:g}, got {number:g}")
         if self.maximum is not None and number > self.maximum:

@@ -1,0 +1,99 @@
+"""dialog: a heard phrase -> the answer from dialogs/default.yaml (paper, sections 4.7-4.8)."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from pathlib import Path
+
+import pytest
+from py_trees.common import Status
+
+from engine.testing import TreeHarness
+
+TREE = Path(__file__).resolve().parents[2] / "trees" / "dialog.yaml"
+NAME = "My name is H B S 2"
+COLOR = "My favorite color is blue. My vest is blue."
+FALLBACK = "Sorry, I did not understand."
+
+
+@pytest.fixture
+def robot(tree_harness: Callable[..., TreeHarness]) -> TreeHarness:
+    return tree_harness(TREE)
+
+
+def hear(robot: TreeHarness, *utterances: str) -> None:
+    """Someone says each utterance (all in the same tick), then a second passes."""
+    for utterance in utterances:
+        robot.set("/speech/heard", utterance)
+    robot.advance(1.0)
+
+
+def test_asked_its_name_the_robot_says_it(robot: TreeHarness) -> None:
+    hear(robot, "what is your name")
+    assert robot.said == [NAME]
+
+
+def test_asked_its_favorite_color_the_robot_says_blue(robot: TreeHarness) -> None:
+    hear(robot, "what is your favorite color")
+    assert robot.said == [COLOR]
+
+
+def test_asked_the_temperature_it_reads_the_sensor_then_answers_in_fahrenheit(
+    robot: TreeHarness,
+) -> None:
+    robot.world.temperature_c = 22.2
+    hear(robot, "what is the temperature")
+    assert [record.action for record in robot.actions] == ["read", "say"]
+    assert robot.said == ["The temperature is 72 degrees"]
+
+
+@pytest.mark.parametrize(
+    ("utterance", "answer"),
+    [
+        ("what is you name", NAME),  # a small recognition error
+        ("What's your name?", NAME),
+        ("who are you", NAME),
+        ("which colour do you like", COLOR),
+        ("how warm is it", "The temperature is 72 degrees"),
+    ],
+)
+def test_other_ways_of_asking_get_the_same_answer(
+    robot: TreeHarness, utterance: str, answer: str
+) -> None:
+    robot.world.temperature_c = 22.2
+    hear(robot, utterance)
+    assert robot.said == [answer]
+
+
+def test_nonsense_gets_the_fallback_answer(robot: TreeHarness) -> None:
+    hear(robot, "purple monkey dishwasher")
+    assert robot.said == [FALLBACK]
+
+
+def test_one_question_gets_one_answer_although_it_stays_on_the_blackboard(
+    robot: TreeHarness,
+) -> None:
+    hear(robot, "what is your name")
+    robot.advance(5.0)
+    assert robot.said == [NAME]
+
+
+def test_two_questions_heard_in_the_same_tick_are_both_answered_in_order(
+    robot: TreeHarness,
+) -> None:
+    hear(robot, "what is your name", "what is your favorite color")
+    assert robot.said == [NAME, COLOR]
+
+
+def test_an_unplugged_speaker_fails_the_answer(robot: TreeHarness) -> None:
+    robot.services.speech.fail_next = "speaker unplugged"
+    robot.set("/speech/heard", "what is your name")
+    assert robot.tick() == Status.FAILURE
+    assert robot.tree.root.tip().feedback_message == "could not answer: speaker unplugged"
+
+
+def test_a_temperature_sensor_that_cannot_be_read_fails_the_answer(robot: TreeHarness) -> None:
+    robot.services.sensors.fail_next = "MCP9808 not answering"
+    robot.set("/speech/heard", "what is the temperature")
+    assert robot.tick() == Status.FAILURE
+    assert robot.did("read") == [{"sensor": "temperature"}]

@@ -1,0 +1,94 @@
+"""touch_thanks: a pat on the back or shoulders -> "Thank you" (paper, section 4.5.1)."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from pathlib import Path
+
+import pytest
+from py_trees.common import Status
+
+from engine.testing import TreeHarness
+
+TREES = Path(__file__).resolve().parents[2] / "trees"
+TREE = TREES / "touch_thanks.yaml"
+
+
+@pytest.fixture
+def robot(tree_harness: Callable[..., TreeHarness]) -> TreeHarness:
+    return tree_harness(TREE)
+
+
+def pat(robot: TreeHarness, seconds: float = 0.3) -> None:
+    """A hand on a pad for ``seconds``, then lifted."""
+    robot.set("/sensors/touch/any", True)
+    robot.advance(seconds)
+    robot.set("/sensors/touch/any", False)
+    robot.tick()
+
+
+def test_a_pat_on_the_back_is_thanked_once(robot: TreeHarness) -> None:
+    pat(robot)
+    robot.advance(1.0)
+    assert robot.did("say") == [{"text": "Thank you", "volume": 0.8}]
+
+
+def test_nobody_touching_means_nothing_is_said(robot: TreeHarness) -> None:
+    assert robot.advance(5.0) == Status.FAILURE
+    assert robot.said == []
+
+
+def test_a_hand_resting_on_the_back_is_not_thanked_every_tick(robot: TreeHarness) -> None:
+    robot.set("/sensors/touch/any", True)
+    robot.advance(2.0)  # the rest is 3 s
+    assert robot.said == ["Thank you"]
+
+
+def test_a_second_pat_during_the_rest_is_not_thanked_again(robot: TreeHarness) -> None:
+    pat(robot)
+    robot.advance(1.0)
+    pat(robot)
+    assert robot.said == ["Thank you"]
+
+
+def test_a_pat_after_the_rest_is_thanked_again(robot: TreeHarness) -> None:
+    pat(robot)
+    robot.advance(3.0)
+    pat(robot)
+    assert robot.said == ["Thank you", "Thank you"]
+
+
+def test_the_child_profile_thanks_like_a_friend_with_a_softer_voice(
+    tree_harness: Callable[..., TreeHarness],
+) -> None:
+    robot = tree_harness(TREE, TREES / "profiles" / "child.yaml")
+    pat(robot)
+    assert robot.did("say") == [{"text": "Thank you, friend!", "volume": 0.6}]
+
+
+def test_the_child_profile_rests_only_two_seconds_between_thanks(
+    tree_harness: Callable[..., TreeHarness],
+) -> None:
+    robot = tree_harness(TREE, TREES / "profiles" / "child.yaml")
+    pat(robot)
+    robot.advance(2.0)
+    pat(robot)
+    assert robot.said == ["Thank you, friend!"] * 2
+
+
+def test_the_adult_profile_speaks_clearly(
+    tree_harness: Callable[..., TreeHarness],
+) -> None:
+    robot = tree_harness(TREE, TREES / "profiles" / "adult.yaml")
+    pat(robot)
+    assert robot.did("say") == [{"text": "Thank you", "volume": 0.9}]
+
+
+def test_an_unplugged_speaker_fails_the_tree_and_it_thanks_once_it_is_back(
+    robot: TreeHarness,
+) -> None:
+    robot.services.speech.fail_next = "speaker unplugged"
+    robot.set("/sensors/touch/any", True)
+    assert robot.tick() == Status.FAILURE
+    assert robot.tree.root.tip().feedback_message == "could not act: speaker unplugged"
+    assert robot.tick() == Status.SUCCESS
