@@ -36,6 +36,4 @@ def main(args: argparse.Namespace) -> int:
             print(f"{node_type.name:13} {node_type.kind:10} {node_type.summary}")
             if params:
                 print(f"{'':24} params: {params}")
-    for error in registry.plugin_errors:
-        print(f"warning: {error}")
     return 0

@@ -44,15 +44,29 @@ class DialogRule:
     read: str | None = None
     line: int = 0
 
-    def score(self, heard: str) -> float:
+    def literal_score(self, heard: str) -> float:
+        """1.0 for an exact phrase, 0.95 for a phrase inside the utterance, else 0."""
         best = 0.0
+        padded = f" {heard} "
         for phrase in self.phrases:
             if heard == phrase:
                 return 1.0
-            if f" {phrase} " in f" {heard} ":
-                best = max(best, 0.95)
-            else:
-                best = max(best, difflib.SequenceMatcher(None, heard, phrase).ratio())
+            if f" {phrase} " in padded:
+                best = 0.95
+        return best
+
+    def fuzzy_score(self, heard: str, at_least: float) -> float:
+        """The best similarity of ``heard`` to a phrase, skipping phrases that cannot beat
+        ``at_least`` (cheap upper bounds first: difflib is the costly part of matching)."""
+        best = 0.0
+        matcher = difflib.SequenceMatcher(None, heard)
+        for phrase in self.phrases:
+            matcher.set_seq2(phrase)
+            if matcher.real_quick_ratio() < at_least or matcher.quick_ratio() < at_least:
+                continue
+            ratio = matcher.ratio()
+            if ratio >= at_least:
+                best, at_least = max(best, ratio), max(at_least, ratio)
         return best
 
 
@@ -78,9 +92,16 @@ class Dialog:
         if not heard:
             return None
         best: Match | None = None
+        for rule in self.rules:  # exact and contained phrases win before any fuzzy match
+            score = rule.literal_score(heard)
+            if score > 0 and (best is None or score > best.score):
+                best = Match(rule, score)
+        if best is not None:
+            return best
         for rule in self.rules:
-            score = rule.score(heard)
-            if score >= self.min_score and (best is None or score > best.score):
+            floor = best.score if best is not None else self.min_score
+            score = rule.fuzzy_score(heard, floor)
+            if score >= floor and (best is None or score > best.score):
                 best = Match(rule, score)
         return best
 

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import difflib
 import inspect
+import logging
 from collections.abc import Callable, Iterator
 from importlib.metadata import EntryPoint, entry_points
 
@@ -16,6 +17,8 @@ from engine.nodes.base import Leaf
 from engine.nodes.spec import NodeType, leaf_type
 
 ENTRY_POINT_GROUP = "vest.nodes"
+
+_log = logging.getLogger("vest.plugins")
 
 
 class NodeRegistry:
@@ -109,8 +112,10 @@ def builtin_registry() -> NodeRegistry:
 
 
 def default_registry(*, plugins: bool = True) -> NodeRegistry:
-    """Built-in node types plus those of installed plugins."""
+    """Built-in node types plus those of installed plugins (a broken one is logged)."""
     registry = builtin_registry()
     if plugins:
         registry.load_plugins()
+        for error in registry.plugin_errors:
+            _log.warning("%s", error)
     return registry

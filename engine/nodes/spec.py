@@ -18,6 +18,7 @@ import py_trees
 
 from engine.nodes.context import TreeContext
 from engine.nodes.params import CheckContext, Key, ListOf, Param
+from engine.nodes.templates import CompiledTemplate
 
 if TYPE_CHECKING:
     from engine.nodes.base import Leaf
@@ -67,6 +68,9 @@ class NodeType:
         for param in self.params:
             value = args.get(param.name)
             if value is None:
+                continue
+            if isinstance(value, CompiledTemplate):
+                reads.extend(value.keys)
                 continue
             key_type = param.type.item if isinstance(param.type, ListOf) else param.type
             if not isinstance(key_type, Key):

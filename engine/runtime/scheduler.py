@@ -87,7 +87,9 @@ class Scheduler:
         self._stop = threading.Event()
 
     def add(self, tree: RunningTree) -> RunningTree:
-        tree.origin_s = self.clock.now()
+        """Schedule ``tree``; trees added before the run share one origin for their deadlines."""
+        started = any(t.stats.ticks for t in self.trees)
+        tree.origin_s = self.clock.now() if started or not self.trees else self.trees[0].origin_s
         tree.period_index = 0
         self.trees.append(tree)
         return tree
@@ -114,6 +116,12 @@ class Scheduler:
         """Tick until :meth:`stop` or, when given, until clock time ``until_s``."""
         if not self.trees:
             raise ValueError("no trees to run")
+        if not any(tree.stats.ticks for tree in self.trees):
+            # the first run: every tree's first deadline is now, so trees of one rate tick
+            # together (one wake-up, one snapshot) and none starts late
+            start = self.clock.now()
+            for tree in self.trees:
+                tree.origin_s, tree.period_index = start, 0
         while not self._stop.is_set():
             deadline = self.next_deadline_s()
             if until_s is not None and deadline > until_s:

@@ -56,6 +56,8 @@ class TreeHarness:
             on_node_error=lambda tree, path, error: self.node_errors.append((path, error)),
         )
         self.tree = definition.build(self.context)
+        self.origin_s = self.clock.now()
+        self.ticks = 0
 
     @classmethod
     def from_file(
@@ -114,7 +116,9 @@ class TreeHarness:
         for _ in range(n):
             self.blackboard.commit()
             self.tree.tick()
-            self.clock.advance(self.period_s)
+            self.ticks += 1
+            # deadlines as the scheduler computes them: no float drift from repeated sums
+            self.clock.sleep_until(self.origin_s + self.ticks * self.period_s)
         return self.status
 
     def advance(self, seconds: float) -> Status:

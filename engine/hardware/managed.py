@@ -1,0 +1,207 @@
+"""Drivers on managed buses, and the device status the blackboard shows.
+
+A driver takes an ``smbus2.SMBus``-compatible bus and makes one register access after
+another, sleeping on its clock in between where its chip needs time (an ADC conversion, a
+time-of-flight measurement). :class:`ManagedI2C` is such a bus whose every access is one
+transaction of the device's :class:`~engine.drivers.bus_manager.DeviceHandle`: the bus
+manager retries it, counts it, refuses it while the device is offline, and between two
+accesses the bus is free for the other devices, so a 33 ms measurement never holds the
+bus for 33 ms. :class:`ManagedSpi` does the same for an ``spidev``-compatible node.
+
+:class:`DeviceHealth` keeps ``/devices/<name>/ok``: true while the bus manager has the
+device online and its driver reads sensible answers.
+"""
+
+from __future__ import annotations
+
+import threading
+from collections.abc import Callable, Sequence
+from typing import Any, TypeVar
+
+from smbus2 import i2c_msg
+
+from engine.blackboard.board import Blackboard
+from engine.drivers.bus_manager import DeviceHandle, Priority
+
+T = TypeVar("T")
+
+DEFAULT_WAIT_S = 2.0
+"""How long (real seconds) a driver waits for one access of a busy threaded bus."""
+
+
+class ManagedI2C:
+    """An ``smbus2.SMBus``-compatible bus: each call is one transaction of ``handle``.
+
+    ``priority`` is that of every access (:attr:`Priority.POLL` for pollers: refused while
+    the device is offline). Bus errors arrive as the manager raises them
+    (:class:`~engine.errors.DeviceError` naming device, bus and errno in words).
+    """
+
+    def __init__(
+        self,
+        handle: DeviceHandle[Any],
+        *,
+        priority: Priority = Priority.POLL,
+        wait_s: float | None = DEFAULT_WAIT_S,
+    ) -> None:
+        self.handle = handle
+        self.priority = priority
+        self.wait_s = wait_s
+
+    def __repr__(self) -> str:
+        return f"<ManagedI2C {self.handle!r}>"
+
+    def _call(self, fn: Callable[[Any], T]) -> T:
+        return self.handle.call(fn, priority=self.priority, timeout_s=self.wait_s)
+
+    def write_quick(self, i2c_addr: int, force: bool | None = None) -> None:
+        self._call(lambda bus: bus.write_quick(i2c_addr))
+
+    def read_byte(self, i2c_addr: int, force: bool | None = None) -> int:
+        return self._call(lambda bus: bus.read_byte(i2c_addr))
+
+    def write_byte(self, i2c_addr: int, value: int, force: bool | None = None) -> None:
+        self._call(lambda bus: bus.write_byte(i2c_addr, value))
+
+    def read_byte_data(self, i2c_addr: int, register: int, force: bool | None = None) -> int:
+        return self._call(lambda bus: bus.read_byte_data(i2c_addr, register))
+
+    def write_byte_data(
+        self, i2c_addr: int, register: int, value: int, force: bool | None = None
+    ) -> None:
+        self._call(lambda bus: bus.write_byte_data(i2c_addr, register, value))
+
+    def read_word_data(self, i2c_addr: int, register: int, force: bool | None = None) -> int:
+        return self._call(lambda bus: bus.read_word_data(i2c_addr, register))
+
+    def write_word_data(
+        self, i2c_addr: int, register: int, value: int, force: bool | None = None
+    ) -> None:
+        self._call(lambda bus: bus.write_word_data(i2c_addr, register, value))
+
+    def read_i2c_block_data(
+        self, i2c_addr: int, register: int, length: int, force: bool | None = None
+    ) -> list[int]:
+        return self._call(lambda bus: bus.read_i2c_block_data(i2c_addr, register, length))
+
+    def write_i2c_block_data(
+        self, i2c_addr: int, register: int, data: Sequence[int], force: bool | None = None
+    ) -> None:
+        values = list(data)
+        self._call(lambda bus: bus.write_i2c_block_data(i2c_addr, register, values))
+
+    def i2c_rdwr(self, *i2c_msgs: i2c_msg) -> None:
+        self._call(lambda bus: bus.i2c_rdwr(*i2c_msgs))
+
+    def close(self) -> None:
+        """Nothing to release: the bus belongs to its manager's owner."""
+
+
+class ManagedSpi:
+    """An ``spidev.SpiDev``-compatible node: each exchange is one transaction of ``handle``."""
+
+    def __init__(
+        self,
+        handle: DeviceHandle[Any],
+        *,
+        priority: Priority = Priority.POLL,
+        wait_s: float | None = DEFAULT_WAIT_S,
+    ) -> None:
+        self.handle = handle
+        self.priority = priority
+        self.wait_s = wait_s
+
+    def _call(self, fn: Callable[[Any], T]) -> T:
+        return self.handle.call(fn, priority=self.priority, timeout_s=self.wait_s)
+
+    @property
+    def mode(self) -> int:
+        return self._call(lambda spi: spi.mode)
+
+    @mode.setter
+    def mode(self, value: int) -> None:
+        self._call(lambda spi: setattr(spi, "mode", value))
+
+    @property
+    def max_speed_hz(self) -> int:
+        return self._call(lambda spi: spi.max_speed_hz)
+
+    @max_speed_hz.setter
+    def max_speed_hz(self, value: int) -> None:
+        self._call(lambda spi: setattr(spi, "max_speed_hz", value))
+
+    def xfer(self, values: Sequence[int], speed_hz: int = 0) -> list[int]:
+        data = list(values)
+        return self._call(lambda spi: spi.xfer(data, speed_hz))
+
+    def xfer2(self, values: Sequence[int], speed_hz: int = 0) -> list[int]:
+        data = list(values)
+        return self._call(lambda spi: spi.xfer2(data, speed_hz))
+
+    def readbytes(self, length: int) -> list[int]:
+        return self._call(lambda spi: spi.readbytes(length))
+
+    def writebytes(self, values: Sequence[int]) -> None:
+        data = list(values)
+        self._call(lambda spi: spi.writebytes(data))
+
+
+def ok_key(device: str) -> str:
+    """``/devices/<device>/ok``."""
+    return f"/devices/{device}/ok"
+
+
+class DeviceHealth:
+    """Whether one device works, staged as ``/devices/<name>/ok`` when it changes.
+
+    Two opinions make it: the bus manager's (online / offline, from its ``on_status``) and
+    the driver's (its answers make sense: identity, conversions finishing). ``last_error``
+    says why it last failed. Thread-safe.
+    """
+
+    def __init__(self, name: str, blackboard: Blackboard | None) -> None:
+        self.name = name
+        self.blackboard = blackboard
+        self._lock = threading.Lock()
+        self._bus_ok = True
+        self._driver_ok = True
+        self._shown: bool | None = None
+        self.last_error: str | None = None
+        self.changes = 0
+
+    @property
+    def ok(self) -> bool:
+        return self._bus_ok and self._driver_ok
+
+    @property
+    def bus_ok(self) -> bool:
+        """The bus manager has the device online."""
+        return self._bus_ok
+
+    @property
+    def driver_ok(self) -> bool:
+        """The driver's last answers made sense."""
+        return self._driver_ok
+
+    def bus_status(self, ok: bool) -> None:
+        """The bus manager's ``on_status``: online (True) or offline (False)."""
+        with self._lock:
+            self._bus_ok = ok
+            self._publish()
+
+    def driver_status(self, ok: bool, why: str | None = None) -> None:
+        """The driver's answers make sense (True), or stopped making sense because ``why``."""
+        with self._lock:
+            self._driver_ok = ok
+            if why is not None:
+                self.last_error = why
+            self._publish()
+
+    def _publish(self) -> None:
+        ok = self.ok
+        if ok == self._shown:
+            return
+        self._shown = ok
+        self.changes += 1
+        if self.blackboard is not None:
+            self.blackboard.stage(ok_key(self.name), ok)

@@ -1,0 +1,330 @@
+"""Pollers (the paper's "hardware nodes"): each polled device read at its rate, staged.
+
+A :class:`Poller` owns one device's driver. At its rate it reads the device through the
+device's bus-manager handle and stages what it read onto the blackboard:
+
+- touch (MPR121): ``/sensors/touch/pads`` (12 booleans) and ``/sensors/touch/any``;
+- force (ADS1115 or MCP3008 + FSR 406): each pad's volts through its
+  :class:`~engine.drivers.force_calibration.ForceCalibration`, ``/sensors/force/left_n``...;
+- range (VL53L0X): ``/sensors/range/<side>_mm``, ``None`` when nothing is in range;
+- gesture (ZX): one event on ``/sensors/gesture/last`` per gesture, named as the config's
+  ``gesture_names`` say.
+
+Two ways to run them, same code:
+
+- as scheduler hooks (``poller(now_s)`` polls when due, on drift-free deadlines): inline,
+  deterministic, for a :class:`~engine.clock.VirtualClock` with ``threaded=False`` bus
+  managers (``vest run --fast``, tests). On a
+  :class:`~engine.hardware.timing.BranchingClock` each poll's waits stay in its branch;
+- on threads (:class:`PollerThreads`), one per poller, for the robot.
+
+A device that fails is not the end: the poller drops its driver, stages the readings of a
+device that senses nothing (no pad touched, no force, nothing in range) so that a stale
+"touched" does not keep a behavior firing, and ``/devices/<name>/ok`` goes false (the bus
+manager's offline mark, or :attr:`Poller.offline_after` failed polls in a row). Every due
+poll tries again; the bus manager refuses polls of an offline device without touching the
+bus until its next re-probe. When the device answers, a new driver is made (identity check,
+init: a replugged chip starts from power-on) and the readings flow again.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import threading
+from collections.abc import Callable, Iterable, Sequence
+from dataclasses import dataclass
+from typing import Any, Generic, TypeVar
+
+from engine.blackboard.board import Blackboard
+from engine.clock import Clock
+from engine.drivers.ads1115 import ADS1115
+from engine.drivers.bus_errors import describe_exception
+from engine.drivers.bus_manager import DeviceHandle
+from engine.drivers.force_calibration import ForceCalibration
+from engine.drivers.mcp3008 import MCP3008
+from engine.drivers.mpr121 import MPR121, PADS
+from engine.drivers.vl53l0x import VL53L0X
+from engine.drivers.zx_gesture import ZXGesture
+from engine.hardware.config import DeviceConfig
+from engine.hardware.managed import DeviceHealth, ManagedI2C, ManagedSpi
+from engine.hardware.timing import branch_of
+
+_log = logging.getLogger("vest.pollers")
+
+D = TypeVar("D")
+
+
+@dataclass(frozen=True)
+class Staged:
+    """One blackboard write a poll makes: ``key = value``, or an event when ``event``."""
+
+    key: str
+    value: Any
+    event: bool = False
+
+
+class Poller(Generic[D]):
+    """Reads one device every ``1 / rate_hz`` seconds and stages what it read.
+
+    ``connect()`` makes the driver (identity check and init); ``read(driver)`` reads it and
+    returns the writes to stage; ``rest`` are the writes that say "this device senses
+    nothing", staged when it stops working. ``offline_after`` failed polls in a row mark the
+    device not ok even when the bus still answers (a chip answering nonsense).
+    """
+
+    def __init__(
+        self,
+        name: str,
+        *,
+        rate_hz: float,
+        clock: Clock,
+        blackboard: Blackboard,
+        health: DeviceHealth,
+        connect: Callable[[], D],
+        read: Callable[[D], Sequence[Staged]],
+        rest: Sequence[Staged] = (),
+        offline_after: int = 3,
+    ) -> None:
+        if not rate_hz > 0:
+            raise ValueError(f"poller {name!r}: rate_hz must be positive, got {rate_hz}")
+        self.name = name
+        self.rate_hz = rate_hz
+        self.clock = clock
+        self.blackboard = blackboard
+        self.health = health
+        self._connect = connect
+        self._read = read
+        self.rest = tuple(rest)
+        self.offline_after = offline_after
+        self.driver: D | None = None
+        self.origin_s = clock.now()
+        self.period_index = 0
+        self.polls = 0
+        self.failures = 0
+        self.consecutive_failures = 0
+        self.last_error: str | None = None
+        self._resting = False
+        self._lock = threading.Lock()  # one poll at a time (a hook and `vest devices`)
+
+    def __repr__(self) -> str:
+        return f"<Poller {self.name} {self.rate_hz:g} Hz>"
+
+    @property
+    def period_s(self) -> float:
+        return 1.0 / self.rate_hz
+
+    @property
+    def next_due_s(self) -> float:
+        return self.origin_s + self.period_index * self.period_s
+
+    # -- as a scheduler hook ---------------------------------------------------------------
+    def __call__(self, now_s: float) -> None:
+        """Poll if due at ``now_s`` (clock seconds); a scheduler hook."""
+        if now_s + 1e-9 < self.next_due_s:
+            return
+        with branch_of(self.clock):
+            self.poll_once()
+        self._advance(now_s)
+
+    def _advance(self, now_s: float) -> None:
+        """Move to the next deadline after ``now_s`` (skipping any that were missed)."""
+        self.period_index = max(
+            self.period_index + 1, math.floor((now_s - self.origin_s) / self.period_s + 1e-9) + 1
+        )
+
+    # -- one poll ------------------------------------------------------------------------
+    def poll_once(self) -> bool:
+        """Read the device once and stage what it read; False when it failed."""
+        with self._lock:
+            self.polls += 1
+            try:
+                if self.driver is None:
+                    self.driver = self._connect()
+                writes = self._read(self.driver)
+            except Exception as error:  # a failing device must never stop the robot
+                self._failed(error)
+                return False
+            self.consecutive_failures = 0
+            if not self.health.driver_ok:
+                self.health.driver_status(True)
+            self._resting = False
+            self._stage(writes)
+            return True
+
+    def read_now(self) -> list[Staged]:
+        """Read once without staging (for ``vest devices``); raises what the read raised."""
+        with self._lock:
+            if self.driver is None:
+                self.driver = self._connect()
+            try:
+                return list(self._read(self.driver))
+            except Exception:
+                self.driver = None
+                raise
+
+    def _failed(self, error: BaseException) -> None:
+        self.driver = None  # a replugged chip starts from power-on: connect again
+        self.failures += 1
+        self.consecutive_failures += 1
+        why = describe_exception(error)
+        if why != self.last_error:
+            _log.warning("%s: %s", self.name, why)
+        self.last_error = why
+        if not isinstance(error, OSError):  # a driver bug: say so loudly, keep going
+            _log.error("%s: poll failed with %s", self.name, why)
+        if self.consecutive_failures >= self.offline_after:
+            self.health.driver_status(False, why)
+        if not self.health.ok and not self._resting:
+            self._resting = True
+            self._stage(self.rest)
+
+    def _stage(self, writes: Iterable[Staged]) -> None:
+        for write in writes:
+            if write.event:
+                self.blackboard.stage_event(write.key, write.value)
+            else:
+                self.blackboard.stage(write.key, write.value)
+
+
+class PollerThreads:
+    """Runs pollers on threads of their own, each at its rate, until :meth:`stop`.
+
+    Waits are real time (``threading.Event.wait``) computed from ``clock``; meant for a
+    :class:`~engine.clock.RealClock` with threaded bus managers.
+    """
+
+    def __init__(self, pollers: Sequence[Poller[Any]], clock: Clock) -> None:
+        self.pollers = list(pollers)
+        self.clock = clock
+        self._stop = threading.Event()
+        self._threads: list[threading.Thread] = []
+
+    def start(self) -> None:
+        if self._threads:
+            return
+        self._stop.clear()
+        for poller in self.pollers:
+            thread = threading.Thread(
+                target=self._run, args=(poller,), name=f"poller-{poller.name}", daemon=True
+            )
+            self._threads.append(thread)
+            thread.start()
+
+    def _run(self, poller: Poller[Any]) -> None:
+        while not self._stop.is_set():
+            wait_s = poller.next_due_s - self.clock.now()
+            if wait_s > 0 and self._stop.wait(wait_s):
+                return
+            poller.poll_once()
+            poller._advance(self.clock.now())
+
+    def stop(self, timeout_s: float = 2.0) -> None:
+        """Ask every thread to end and wait for them (``timeout_s`` real seconds each)."""
+        self._stop.set()
+        for thread in self._threads:
+            thread.join(timeout_s)
+        self._threads.clear()
+
+    @property
+    def running(self) -> bool:
+        return any(thread.is_alive() for thread in self._threads)
+
+
+# -- the pollers of each role -------------------------------------------------------------------
+def make_poller(
+    device: DeviceConfig,
+    handle: DeviceHandle[Any],
+    *,
+    clock: Clock,
+    blackboard: Blackboard,
+    health: DeviceHealth,
+) -> Poller[Any]:
+    """The poller for a polled device of the config (touch, force, range, gesture)."""
+    makers = {
+        "touch": _touch,
+        "force": _force,
+        "range": _range,
+        "gesture": _gesture,
+    }
+    maker = makers.get(device.role)
+    if maker is None or device.rate_hz is None:
+        raise ValueError(f"device {device.name!r} ({device.chip}) is not polled")
+    connect, read, rest = maker(device, handle, clock)
+    return Poller(
+        device.name,
+        rate_hz=device.rate_hz,
+        clock=clock,
+        blackboard=blackboard,
+        health=health,
+        connect=connect,
+        read=read,
+        rest=rest,
+    )
+
+
+Parts = tuple[Callable[[], Any], Callable[[Any], Sequence[Staged]], Sequence[Staged]]
+
+
+def _touch(device: DeviceConfig, handle: DeviceHandle[Any], clock: Clock) -> Parts:
+    pads_key, any_key = device.keys["pads"], device.keys["any"]
+
+    def connect() -> MPR121:
+        return MPR121(ManagedI2C(handle), address=_address(device), **device.options)
+
+    def read(driver: MPR121) -> list[Staged]:
+        pads = driver.touched()
+        return [Staged(pads_key, pads), Staged(any_key, any(pads))]
+
+    return connect, read, [Staged(pads_key, [False] * PADS), Staged(any_key, False)]
+
+
+def _force(device: DeviceConfig, handle: DeviceHandle[Any], clock: Clock) -> Parts:
+    calibrations = [(pad, ForceCalibration(pad.calibration)) for pad in device.pads]
+
+    def connect() -> ADS1115 | MCP3008:
+        if device.chip == "mcp3008":
+            return MCP3008(ManagedSpi(handle), **device.options)
+        return ADS1115(ManagedI2C(handle), address=_address(device), clock=clock, **device.options)
+
+    def read(driver: ADS1115 | MCP3008) -> list[Staged]:
+        return [
+            Staged(pad.key, calibration.newtons(driver.read_volts(pad.channel)))
+            for pad, calibration in calibrations
+        ]
+
+    return connect, read, [Staged(pad.key, 0.0) for pad in device.pads]
+
+
+def _range(device: DeviceConfig, handle: DeviceHandle[Any], clock: Clock) -> Parts:
+    key = device.keys["range"]
+
+    def connect() -> VL53L0X:
+        return VL53L0X(ManagedI2C(handle), address=_address(device), clock=clock, **device.options)
+
+    def read(driver: VL53L0X) -> list[Staged]:
+        distance_mm = driver.read_range_mm()
+        return [Staged(key, None if distance_mm is None else float(distance_mm))]
+
+    return connect, read, [Staged(key, None)]
+
+
+def _gesture(device: DeviceConfig, handle: DeviceHandle[Any], clock: Clock) -> Parts:
+    key = device.keys["gesture"]
+    names = device.gesture_names
+
+    def connect() -> ZXGesture:
+        return ZXGesture(ManagedI2C(handle), address=_address(device))
+
+    def read(driver: ZXGesture) -> list[Staged]:
+        gesture = driver.read_gesture()
+        if gesture is None:
+            return []
+        return [Staged(key, names.get(gesture, gesture), event=True)]
+
+    return connect, read, []
+
+
+def _address(device: DeviceConfig) -> int:
+    assert device.address is not None, f"{device.name} is an I2C device"
+    return device.address
