@@ -145,12 +145,22 @@ class Poller(Generic[D]):
             except Exception as error:  # a failing device must never stop the robot
                 self._failed(error)
                 return False
+            if self.consecutive_failures:
+                _log.info(
+                    "%s answers again after %d failed polls", self.name, self.consecutive_failures
+                )
             self.consecutive_failures = 0
             if not self.health.driver_ok:
                 self.health.driver_status(True)
             self._resting = False
             self._stage(writes)
             return True
+
+    def connect(self) -> None:
+        """Make the driver now (identity check and init); raises what that raised."""
+        with self._lock:
+            if self.driver is None:
+                self.driver = self._connect()
 
     def read_now(self) -> list[Staged]:
         """Read once without staging (for ``vest devices``); raises what the read raised."""
@@ -168,11 +178,11 @@ class Poller(Generic[D]):
         self.failures += 1
         self.consecutive_failures += 1
         why = describe_exception(error)
-        if why != self.last_error:
-            _log.warning("%s: %s", self.name, why)
         self.last_error = why
         if not isinstance(error, OSError):  # a driver bug: say so loudly, keep going
             _log.error("%s: poll failed with %s", self.name, why)
+        elif self.consecutive_failures == 1:  # once per streak, not at every poll
+            _log.warning("%s: %s", self.name, why)
         if self.consecutive_failures >= self.offline_after:
             self.health.driver_status(False, why)
         if not self.health.ok and not self._resting:

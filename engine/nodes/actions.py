@@ -162,18 +162,10 @@ class LookToward(Leaf):
     def update(self) -> Status:
         if self.job is None:
             return Status.SUCCESS
-        if not self.job.done():
-            return Status.RUNNING
-        error = self.job.error()
-        if error is not None:
-            self.feedback_message = f"could not turn: {error}"
+        status = self.job_status(self.job, failed="could not turn")
+        if status == Status.FAILURE:
             self.angle_deg = self.previous_deg  # not there: try again next tick
-            return Status.FAILURE
-        return Status.SUCCESS
-
-    def terminate(self, new_status: Status) -> None:
-        if new_status == Status.INVALID and self.job is not None and not self.job.done():
-            self.job.cancel()
+        return status
 
 
 class Wait(Leaf):

@@ -97,6 +97,23 @@ class Leaf(py_trees.behaviour.Behaviour):
         """The engine clock, in seconds."""
         return self.ctx.clock.now()
 
+    def job_status(self, job: Job, *, failed: str = "could not act") -> Status:
+        """RUNNING while ``job`` runs; FAILURE when it failed (the feedback says why and
+        starts with ``failed``); SUCCESS when it is done."""
+        if not job.done():
+            return Status.RUNNING
+        error = job.error()
+        if error is not None:
+            self.feedback_message = f"{failed}: {error}"
+            return Status.FAILURE
+        return Status.SUCCESS
+
+    def terminate(self, new_status: Status) -> None:
+        """Pre-empted (INVALID): cancel the service job this node started, if still going."""
+        job = getattr(self, "job", None)
+        if new_status == Status.INVALID and job is not None and not job.done():
+            job.cancel()
+
     # -- the safety net -----------------------------------------------------------------
     def tick(self) -> Any:
         """py_trees' leaf tick, but an exception makes this node FAILURE, not the tree crash."""
@@ -161,17 +178,7 @@ class ServiceAction(Leaf):
         self.job = self.start()
 
     def update(self) -> Status:
-        job = self.job
-        if job is None:
+        if self.job is None:
             return Status.FAILURE
-        if not job.done():
-            return Status.RUNNING
-        error = job.error()
-        if error is not None:
-            self.feedback_message = f"could not act: {error}"
-            return Status.FAILURE
-        return self.finished(job)
-
-    def terminate(self, new_status: Status) -> None:
-        if new_status == Status.INVALID and self.job is not None and not self.job.done():
-            self.job.cancel()
+        status = self.job_status(self.job)
+        return self.finished(self.job) if status == Status.SUCCESS else status

@@ -84,22 +84,13 @@ class Reply(Leaf):
     def update(self) -> Status:
         if self.job is None:
             return Status.FAILURE
-        if not self.job.done():
-            return Status.RUNNING
-        error = self.job.error()
-        if error is not None:
-            self.feedback_message = f"could not answer: {error}"
-            return Status.FAILURE
-        if self.phase == "reading" and self.answer is not None:
+        status = self.job_status(self.job, failed="could not answer")
+        if status == Status.SUCCESS and self.phase == "reading" and self.answer is not None:
             for key, value in (self.job.result() or {}).items():
                 self.ctx.blackboard.set(key, value)
             self._speak(self.answer)
             return self.update()
-        return Status.SUCCESS
-
-    def terminate(self, new_status: Status) -> None:
-        if new_status == Status.INVALID and self.job is not None and not self.job.done():
-            self.job.cancel()
+        return status
 
 
 DIALOG_NODES = (Reply,)

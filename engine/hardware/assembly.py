@@ -1,0 +1,554 @@
+"""Putting one robot's hardware together: buses, bus managers, drivers, pollers, services.
+
+:func:`build_hardware` takes a checked :class:`~engine.hardware.config.RobotConfig` and
+gives a :class:`Hardware`: a :class:`~engine.drivers.bus_manager.BusManager` per bus (and
+per TCA9548A channel in use), every device claimed at its address with a probe that
+re-checks its identity while it is offline, the VL53L0X chips moved to their addresses
+through their XSHUT lines, a :class:`~engine.hardware.pollers.Poller` per polled device,
+and the services (LEDs, servos, on-request sensors) on their drivers.
+
+Buses come from the simulated vest (``vest=``, see :mod:`engine.hardware.sim_vest`) or from
+the machine: ``smbus2.SMBus(n)`` for ``/dev/i2c-n``, ``spidev.SpiDev`` for SPI nodes,
+pyserial (through :class:`~engine.drivers.maestro.Maestro`) for the Maestro's port, the
+GPIO character device for XSHUT lines. Those modules are imported only when a real bus
+is opened.
+
+Two ways to run, chosen by the clock unless ``threaded`` says otherwise:
+
+- inline (a :class:`~engine.clock.VirtualClock`: ``vest run --fast``, tests): bus managers
+  run each transaction in the caller's thread; the pollers, the LED timer and the re-probes
+  are scheduler hooks (:attr:`Hardware.hooks`) and each poll's waits stay in its own
+  :class:`~engine.hardware.timing.BranchingClock` branch. Deterministic.
+- threaded (a real clock; always on real buses): one worker per bus, one thread per
+  poller (:meth:`Hardware.start`), the LED timer still a scheduler hook.
+
+A device that does not answer at start-up does not stop the robot: it is listed in
+:attr:`Hardware.startup_problems`, shown offline on the blackboard, and tried again by
+its poller or at its next request.
+"""
+
+from __future__ import annotations
+
+import errno
+import logging
+import os
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any, Protocol
+
+from engine.blackboard.board import Blackboard
+from engine.clock import Clock, VirtualClock
+from engine.drivers import mcp9808, mpr121, pca9685, srf02, vl53l0x, zx_gesture
+from engine.drivers.bus_errors import describe_exception
+from engine.drivers.bus_manager import BusManager, DeviceHandle, DeviceStats
+from engine.drivers.gpio import OutputLine
+from engine.drivers.maestro import Maestro
+from engine.drivers.tca9548a import TCA9548A
+from engine.errors import ConfigError, DeviceError
+from engine.hardware.config import BusConfig, DeviceConfig, RobotConfig, hex_address
+from engine.hardware.managed import DeviceHealth
+from engine.hardware.pollers import Poller, PollerThreads, make_poller
+from engine.hardware.services import (
+    HardwareLeds,
+    HardwareSensors,
+    HardwareServos,
+    TemperatureSensor,
+    UltrasoundSensor,
+)
+from engine.hardware.timing import BranchingClock, branch_of
+from engine.services.interfaces import IotResults, Services, Speech
+
+_log = logging.getLogger("vest.hardware")
+
+Hook = Callable[[float], None]
+
+
+class BusProvider(Protocol):
+    """Where the buses come from: the machine's device files, or the simulated vest."""
+
+    def open_i2c(self, bus: BusConfig) -> Any: ...
+
+    def open_spi(self, bus: BusConfig) -> Any: ...
+
+    def serial_port(self, bus: BusConfig) -> Any:
+        """A port name (opened by the Maestro driver) or an open pyserial-compatible port."""
+        ...
+
+    def output_line(self, offset: int, consumer: str) -> OutputLine: ...
+
+
+# -- probes: is the chip back, and is it the right chip? ------------------------------------------
+def _expect(what: str, got: object, wanted: object) -> None:
+    if got != wanted:
+        raise DeviceError(f"{what} reads {got!r}, expected {wanted!r}")
+
+
+def _probe_for(device: DeviceConfig) -> Callable[[Any], object] | None:
+    """A read of the chip's identity (or of a harmless register) that raises unless it is there."""
+    address = device.address
+    if address is None:
+        return None
+    chip = device.chip
+    if chip == "mpr121":
+        return lambda bus: bus.read_byte_data(address, mpr121.CONFIG2)
+    if chip == "ads1115":
+        return lambda bus: bus.read_i2c_block_data(address, 0x01, 2)
+    if chip == "vl53l0x":
+        return lambda bus: _expect(
+            "VL53L0X model ID",
+            bus.read_byte_data(address, vl53l0x.IDENTIFICATION_MODEL_ID),
+            vl53l0x.IDENTITY[0],
+        )
+    if chip == "zx_gesture":
+        return lambda bus: _expect(
+            "ZX model", bus.read_byte_data(address, zx_gesture.MODEL), zx_gesture.MODEL_ID
+        )
+    if chip == "srf02":
+        return lambda bus: _expect(
+            "SRF02 register 1", bus.read_byte_data(address, srf02.UNUSED), srf02.UNUSED_VALUE
+        )
+    if chip == "mcp9808":
+        return lambda bus: _expect(
+            "MCP9808 manufacturer ID",
+            bus.read_i2c_block_data(address, mcp9808.MANUFACTURER_ID, 2),
+            [0x00, 0x54],
+        )
+    if chip == "pca9685":
+        return lambda bus: bus.read_byte_data(address, pca9685.PRE_SCALE)
+    if chip == "tca9548a":
+        return lambda bus: bus.read_byte(address)
+    return None
+
+
+# -- the machine's buses ---------------------------------------------------------------------------
+_OPEN_WORDS = {
+    errno.ENOENT: "no such device file",
+    errno.EACCES: "permission denied",
+    errno.EPERM: "permission denied",
+    errno.EBUSY: "busy: another program has it",
+}
+
+
+class RealBuses:
+    """The machine's buses, opened on demand and closed by :meth:`close`."""
+
+    def __init__(self, config: RobotConfig) -> None:
+        self.config = config
+        self._opened: list[Any] = []
+
+    def open_i2c(self, bus: BusConfig) -> Any:
+        import smbus2  # only on a robot
+
+        try:
+            handle = smbus2.SMBus(bus.number)
+        except OSError as error:
+            hint = {
+                errno.ENOENT: "enable I2C (raspi-config, or the board's device tree) and check N",
+                errno.EACCES: "add yourself to the i2c group",
+                errno.EPERM: "add yourself to the i2c group",
+            }.get(error.errno or 0, "")
+            raise self._error(bus, error, hint) from error
+        self._opened.append(handle)
+        return handle
+
+    def open_spi(self, bus: BusConfig) -> Any:
+        try:
+            import spidev  # type: ignore[import-not-found]  # only on a robot
+        except ImportError as error:
+            raise DeviceError(
+                f"{bus.describe()} ({bus.path}): the spidev package is not installed "
+                "(pip install spidev)"
+            ) from error
+        node = spidev.SpiDev()
+        try:
+            node.open(bus.number, bus.chip_select)
+        except OSError as error:
+            raise self._error(bus, error, "enable SPI and add yourself to the spi group") from error
+        self._opened.append(node)
+        return node
+
+    def serial_port(self, bus: BusConfig) -> Any:
+        return bus.port
+
+    def output_line(self, offset: int, consumer: str) -> OutputLine:
+        from engine.drivers.gpio import GpioOutputLine
+
+        line = GpioOutputLine(self.config.gpio_chip, offset, consumer=consumer)
+        self._opened.append(line)
+        return line
+
+    @staticmethod
+    def _error(bus: BusConfig, error: OSError, hint: str) -> DeviceError:
+        code = error.errno or errno.EIO
+        words = _OPEN_WORDS.get(code, os.strerror(code).lower())
+        text = f"cannot open {bus.describe()} ({bus.path}): {words}"
+        return DeviceError(code, text + (f"; {hint}" if hint else ""))
+
+    def close(self) -> None:
+        for thing in reversed(self._opened):
+            try:
+                thing.close()
+            except OSError as error:
+                _log.warning("closing %r: %s", thing, error)
+        self._opened.clear()
+
+
+# -- the hardware ---------------------------------------------------------------------------------
+@dataclass
+class Hardware:
+    """One robot's buses, devices, pollers and services. Close it when done."""
+
+    config: RobotConfig
+    clock: Clock
+    """The drivers' clock (a :class:`BranchingClock` when inline on a virtual clock)."""
+    threaded: bool
+    managers: dict[str, BusManager[Any]] = field(default_factory=dict)
+    handles: dict[str, DeviceHandle[Any]] = field(default_factory=dict)
+    health: dict[str, DeviceHealth] = field(default_factory=dict)
+    pollers: list[Poller[Any]] = field(default_factory=list)
+    leds: HardwareLeds | None = None
+    servos: HardwareServos | None = None
+    sensors: HardwareSensors = field(default_factory=HardwareSensors)
+    startup_problems: dict[str, str] = field(default_factory=dict)
+    """Devices that did not start, and why (they are retried while the robot runs)."""
+    muxes: dict[str, TCA9548A] = field(default_factory=dict)
+    _owned: list[Any] = field(default_factory=list)
+    _threads: PollerThreads | None = None
+    _closed: bool = False
+
+    # -- running -------------------------------------------------------------------------
+    @property
+    def hooks(self) -> list[Hook]:
+        """Scheduler hooks: inline, the pollers and re-probes; always the LED timer."""
+        hooks: list[Hook] = []
+        if not self.threaded:
+            hooks.extend(self.pollers)
+            hooks.append(self.run_due_probes)
+        if self.leds is not None:
+            hooks.append(self.leds)
+        return hooks
+
+    def run_due_probes(self, now_s: float) -> None:
+        """Re-probe offline devices that are due (inline; workers do it themselves)."""
+        for manager in self.managers.values():
+            with branch_of(self.clock):
+                manager.run_due_probes()
+
+    def start(self) -> None:
+        """Threaded: start the poller threads (inline, the hooks poll)."""
+        if self.threaded and self._threads is None:
+            self._threads = PollerThreads(self.pollers, self.clock)
+            self._threads.start()
+
+    def stop(self) -> None:
+        """Stop the poller threads, if running."""
+        if self._threads is not None:
+            self._threads.stop()
+            self._threads = None
+
+    def services(
+        self, *, speech: Speech, iot: IotResults, fallback: Services | None = None
+    ) -> Services:
+        """The robot's services: LEDs, servos and sensors from this hardware, ``speech`` and
+        ``iot`` as given; what the config lacks comes from ``fallback``."""
+        missing = [
+            what for what, have in (("leds", self.leds), ("servos", self.servos)) if have is None
+        ]
+        if missing and fallback is None:
+            raise ConfigError(
+                f"{self.config.path}: no device for {', '.join(missing)}; add one or pass a "
+                "fallback"
+            )
+        return Services(
+            speech=speech,
+            leds=self.leds if self.leds is not None else fallback.leds,  # type: ignore[union-attr]
+            servos=self.servos if self.servos is not None else fallback.servos,  # type: ignore[union-attr]
+            sensors=self.sensors,
+            iot=iot,
+        )
+
+    def stats(self) -> dict[str, DeviceStats]:
+        """Every device's bus statistics, by device name."""
+        snapshot: dict[str, DeviceStats] = {}
+        for manager in self.managers.values():
+            snapshot.update(manager.stats())
+        return snapshot
+
+    def poller(self, name: str) -> Poller[Any]:
+        for poller in self.pollers:
+            if poller.name == name:
+                return poller
+        raise KeyError(f"no poller for device {name!r}")
+
+    def close(self) -> None:
+        """Stop pollers and bus workers; close what was opened here (never the sim vest)."""
+        if self._closed:
+            return
+        self._closed = True
+        self.stop()
+        for manager in self.managers.values():
+            manager.close()
+        for thing in reversed(self._owned):
+            try:
+                thing.close()
+            except OSError as error:
+                _log.warning("closing %r: %s", thing, error)
+
+    def __enter__(self) -> Hardware:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
+def build_hardware(
+    config: RobotConfig,
+    clock: Clock,
+    blackboard: Blackboard | None,
+    *,
+    vest: BusProvider | None = None,
+    threaded: bool | None = None,
+    home_servos: bool = True,
+) -> Hardware:
+    """The hardware of ``config``: on the simulated ``vest``, or on the machine's buses.
+
+    ``clock`` is the robot's clock; with a vest from :func:`~engine.hardware.sim_vest.
+    build_sim_vest`, the drivers use the vest's clock (the same time). ``threaded``
+    defaults to False on a :class:`~engine.clock.VirtualClock`, True otherwise; real buses
+    need threads on a real clock. ``blackboard`` receives ``/devices/<name>/ok`` and the
+    pollers' readings (None: nothing is staged, for ``vest devices``).
+
+    Raises :class:`~engine.errors.DeviceError` when a bus cannot be opened; a device that
+    does not answer is only listed in :attr:`Hardware.startup_problems`.
+    """
+    virtual = isinstance(clock, VirtualClock)
+    if threaded is None:
+        threaded = not virtual
+    driver_clock: Clock = getattr(vest, "clock", None) or (
+        BranchingClock(clock) if virtual and not threaded else clock
+    )
+    if isinstance(driver_clock, BranchingClock) and driver_clock.base is not clock:
+        raise ValueError("the simulated vest was built on another clock than the robot's")
+    if vest is None and not threaded and not virtual:
+        raise ValueError(
+            "real buses on a real clock need threaded=True (drivers wait in real time)"
+        )
+    provider: BusProvider = vest if vest is not None else RealBuses(config)
+    hardware = Hardware(config=config, clock=driver_clock, threaded=threaded)
+    if isinstance(provider, RealBuses):
+        hardware._owned.append(provider)
+    try:
+        _Assembler(hardware, provider, blackboard).build(home_servos=home_servos)
+    except BaseException:
+        hardware.close()
+        raise
+    for name, why in hardware.startup_problems.items():
+        _log.warning("%s did not start: %s", name, why)
+    return hardware
+
+
+class _Assembler:
+    def __init__(
+        self, hardware: Hardware, provider: BusProvider, blackboard: Blackboard | None
+    ) -> None:
+        self.hw = hardware
+        self.config = hardware.config
+        self.provider = provider
+        self.blackboard = blackboard
+        self.clock = hardware.clock
+
+    def _manager(self, bus: Any, *, name: str, kind: str) -> BusManager[Any]:
+        health = self.hw.health
+
+        def on_status(device: str, ok: bool) -> None:
+            status = health.get(device)
+            if status is not None:
+                status.bus_status(ok)
+
+        return BusManager(
+            bus,
+            name=name,
+            clock=self.clock,
+            kind=kind,
+            threaded=self.hw.threaded,
+            on_status=on_status,
+        )
+
+    def build(self, *, home_servos: bool) -> None:
+        config = self.config
+        for device in config.devices.values():
+            self.hw.health[device.name] = DeviceHealth(device.name, self.blackboard)
+        used = {device.bus for device in config.devices.values()}
+        for bus in config.buses.values():
+            if bus.name in used and bus.kind != "serial":
+                opened = (
+                    self.provider.open_i2c(bus)
+                    if bus.kind == "i2c"
+                    else self.provider.open_spi(bus)
+                )
+                name = str(bus.number) if bus.kind == "i2c" else bus.path
+                self.hw.managers[bus.name] = self._manager(opened, name=name, kind=bus.kind.upper())
+        for device in config.devices.values():
+            if device.chip == "tca9548a":
+                self._mux(device)
+        for bus in config.buses.values():
+            chain = [
+                d
+                for d in config.devices.values()
+                if d.bus == bus.name and d.chip == "vl53l0x" and d.xshut is not None
+            ]
+            if chain:
+                self._xshut_chain(bus, chain)
+        for device in config.devices.values():
+            if device.chip != "tca9548a":
+                self._device(device)
+        if home_servos and self.hw.servos is not None:
+            try:
+                self.hw.servos.home()
+            except Exception as error:
+                self._failed(self.hw.servos.device, error)
+
+    def _failed(self, device: DeviceConfig, error: BaseException) -> None:
+        self.hw.startup_problems[device.name] = describe_exception(error)
+
+    def _claim(self, device: DeviceConfig) -> DeviceHandle[Any] | None:
+        if device.mux is not None:
+            assert device.mux_channel is not None
+            manager = self.hw.managers.get(f"{device.bus}:{device.mux}.{device.mux_channel}")
+            if manager is None:
+                self.hw.startup_problems[device.name] = f"its mux {device.mux!r} did not start"
+                self.hw.health[device.name].driver_status(False, "mux did not start")
+                return None
+        else:
+            manager = self.hw.managers[device.bus]
+        handle = manager.claim(device.name, device.address, probe=_probe_for(device))
+        self.hw.handles[device.name] = handle
+        return handle
+
+    def _mux(self, device: DeviceConfig) -> None:
+        handle = self._claim(device)
+        assert handle is not None and device.address is not None
+        address = device.address
+        try:
+            mux = handle.call(lambda bus: TCA9548A(bus, address=address))
+        except Exception as error:
+            self._failed(device, error)
+            return
+        self.hw.muxes[device.name] = mux
+        channels = sorted(
+            {
+                d.mux_channel
+                for d in self.config.devices.values()
+                if d.mux == device.name and d.mux_channel is not None
+            }
+        )
+        for channel in channels:
+            self.hw.managers[f"{device.bus}:{device.name}.{channel}"] = self._manager(
+                mux.channel_bus(channel),
+                name=f"{self.config.buses[device.bus].number} via {device.name} ch{channel}",
+                kind="I2C",
+            )
+
+    def _xshut_chain(self, bus: BusConfig, chain: list[DeviceConfig]) -> None:
+        """Switch the VL53L0X chips on one at a time, each moved off 0x29 before the next."""
+        manager = self.hw.managers[bus.name]
+        lines = [
+            (device, self.provider.output_line(device.xshut or 0, f"vest {device.name} XSHUT"))
+            for device in chain
+        ]
+        self.hw._owned.extend(line for _, line in lines if hasattr(line, "close"))
+        for _, line in lines:
+            line.set(False)  # every chip in standby, forgetting any earlier address
+        booting = manager.claim(
+            f"VL53L0X start-up on {bus.name}",
+            vl53l0x.DEFAULT_ADDRESS,
+        )
+        try:
+            for device, line in lines:
+                line.set(True)
+                self.clock.sleep(vl53l0x.BOOT_TIME_S)
+                target = device.address
+                assert target is not None
+                options = device.options
+
+                def move(raw: Any, target: int = target, options: dict[str, Any] = options) -> None:
+                    sensor = vl53l0x.VL53L0X(
+                        raw, address=vl53l0x.DEFAULT_ADDRESS, clock=self.clock, **options
+                    )
+                    if target != vl53l0x.DEFAULT_ADDRESS:
+                        sensor.set_address(target)
+
+                try:
+                    booting.call(move)
+                except Exception as error:
+                    line.set(False)  # back to standby, off the bus, out of the next chip's way
+                    self.hw.startup_problems[device.name] = (
+                        f"did not come up at 0x29 to be moved to {hex_address(target)}: "
+                        + describe_exception(error)
+                    )
+        finally:
+            booting.release()
+
+    def _device(self, device: DeviceConfig) -> None:
+        hw = self.hw
+        if device.role == "servos":
+            self._servos(device)
+            return
+        handle = self._claim(device)
+        if handle is None:
+            return
+        role = device.role
+        try:
+            if device.polled:
+                poller = make_poller(
+                    device,
+                    handle,
+                    clock=self.clock,
+                    blackboard=self.blackboard or _NO_BLACKBOARD,
+                    health=hw.health[device.name],
+                )
+                hw.pollers.append(poller)
+                if device.name not in hw.startup_problems:
+                    poller.connect()
+            elif role == "leds":
+                hw.leds = HardwareLeds(device, handle, self.clock)
+                hw.leds.connect()
+            elif role == "temperature":
+                hw.sensors.temperature = TemperatureSensor(device, handle, self.clock)
+                hw.sensors.temperature.connect()
+            elif role == "ultrasound":
+                hw.sensors.ultrasound = UltrasoundSensor(device, handle, self.clock)
+                hw.sensors.ultrasound.connect()
+        except Exception as error:
+            if device.name not in hw.startup_problems:
+                self._failed(device, error)
+
+    def _servos(self, device: DeviceConfig) -> None:
+        bus = self.config.buses[device.bus]
+        maestro = Maestro(
+            self.provider.serial_port(bus),
+            device=device.options["device_number"],
+            protocol=device.options["protocol"],
+            channels=device.options["channels"],
+            clock=self.clock,
+            baudrate=bus.baudrate,
+        )
+        self.hw._owned.append(maestro)
+        manager = self._manager(maestro, name=bus.path, kind="serial")
+        self.hw.managers[bus.name] = manager
+        handle = manager.claim(device.name, None)
+        self.hw.handles[device.name] = handle
+        self.hw.servos = HardwareServos(device, handle, self.clock)
+
+
+class _NoBlackboard:
+    """Where pollers stage when nobody listens (``vest devices``)."""
+
+    def stage(self, key: str, value: Any) -> None:
+        """Dropped."""
+
+    def stage_event(self, key: str, value: Any) -> None:
+        """Dropped."""
+
+
+_NO_BLACKBOARD: Any = _NoBlackboard()
