@@ -61,6 +61,7 @@ from engine.services.interfaces import IotResults, Services, Speech
 _log = logging.getLogger("vest.hardware")
 
 Hook = Callable[[float], None]
+_OFFLINE_AFTER = 3  # the bus managers' default: failed transactions that mark a device offline
 
 
 class BusProvider(Protocol):
@@ -83,7 +84,7 @@ def _expect(what: str, got: object, wanted: object) -> None:
         raise DeviceError(f"{what} reads {got!r}, expected {wanted!r}")
 
 
-def _probe_for(device: DeviceConfig) -> Callable[[Any], object] | None:
+def probe_for(device: DeviceConfig) -> Callable[[Any], object] | None:
     """A read of the chip's identity (or of a harmless register) that raises unless it is there."""
     address = device.address
     if address is None:
@@ -181,8 +182,11 @@ class RealBuses:
     def _error(bus: BusConfig, error: OSError, hint: str) -> DeviceError:
         code = error.errno or errno.EIO
         words = _OPEN_WORDS.get(code, os.strerror(code).lower())
-        text = f"cannot open {bus.describe()} ({bus.path}): {words}"
-        return DeviceError(code, text + (f"; {hint}" if hint else ""))
+        failure = DeviceError(
+            f"cannot open {bus.describe()} ({bus.path}): {words}" + (f"; {hint}" if hint else "")
+        )
+        failure.errno = code  # kept for callers, out of the message a person reads
+        return failure
 
     def close(self) -> None:
         for thing in reversed(self._opened):
@@ -314,8 +318,8 @@ def build_hardware(
 
     ``clock`` is the robot's clock; with a vest from :func:`~engine.hardware.sim_vest.
     build_sim_vest`, the drivers use the vest's clock (the same time). ``threaded``
-    defaults to False on a :class:`~engine.clock.VirtualClock`, True otherwise; real buses
-    need threads on a real clock. ``blackboard`` receives ``/devices/<name>/ok`` and the
+    defaults to False on a :class:`~engine.clock.VirtualClock`, True otherwise; a real
+    clock needs threads. ``blackboard`` receives ``/devices/<name>/ok`` and the
     pollers' readings (None: nothing is staged, for ``vest devices``).
 
     Raises :class:`~engine.errors.DeviceError` when a bus cannot be opened; a device that
@@ -329,9 +333,10 @@ def build_hardware(
     )
     if isinstance(driver_clock, BranchingClock) and driver_clock.base is not clock:
         raise ValueError("the simulated vest was built on another clock than the robot's")
-    if vest is None and not threaded and not virtual:
+    if not threaded and not virtual:
         raise ValueError(
-            "real buses on a real clock need threaded=True (drivers wait in real time)"
+            "inline hardware needs a VirtualClock; on a real clock use threaded=True "
+            "(the drivers' waits would stall the trees)"
         )
     provider: BusProvider = vest if vest is not None else RealBuses(config)
     hardware = Hardware(config=config, clock=driver_clock, threaded=threaded)
@@ -421,7 +426,7 @@ class _Assembler:
                 return None
         else:
             manager = self.hw.managers[device.bus]
-        handle = manager.claim(device.name, device.address, probe=_probe_for(device))
+        handle = manager.claim(device.name, device.address, probe=probe_for(device))
         self.hw.handles[device.name] = handle
         return handle
 
@@ -456,7 +461,6 @@ class _Assembler:
             (device, self.provider.output_line(device.xshut or 0, f"vest {device.name} XSHUT"))
             for device in chain
         ]
-        self.hw._owned.extend(line for _, line in lines if hasattr(line, "close"))
         for _, line in lines:
             line.set(False)  # every chip in standby, forgetting any earlier address
         booting = manager.claim(
@@ -522,6 +526,23 @@ class _Assembler:
         except Exception as error:
             if device.name not in hw.startup_problems:
                 self._failed(device, error)
+            if not device.polled:
+                self._until_offline(device, handle)
+
+    def _until_offline(self, device: DeviceConfig, handle: DeviceHandle[Any]) -> None:
+        """A device read on request that failed at start-up: probe it until the bus manager
+        takes it offline (then it is re-probed by itself, and back when it answers)."""
+        probe = probe_for(device)
+        if probe is None:
+            return
+        for _ in range(_OFFLINE_AFTER):
+            try:
+                handle.call(probe)
+            except Exception:
+                if not handle.online:
+                    return
+            else:
+                return  # it answers after all; its driver is made at the first request
 
     def _servos(self, device: DeviceConfig) -> None:
         bus = self.config.buses[device.bus]

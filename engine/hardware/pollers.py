@@ -98,7 +98,7 @@ class Poller(Generic[D]):
         self.rest = tuple(rest)
         self.offline_after = offline_after
         self.driver: D | None = None
-        self.origin_s = clock.now()
+        self.origin_s: float | None = None  # the first poll sets the phase
         self.period_index = 0
         self.polls = 0
         self.failures = 0
@@ -116,12 +116,20 @@ class Poller(Generic[D]):
 
     @property
     def next_due_s(self) -> float:
+        """When the next poll is due (clock seconds); at once before the first poll."""
+        if self.origin_s is None:
+            return float("-inf")
         return self.origin_s + self.period_index * self.period_s
 
     # -- as a scheduler hook ---------------------------------------------------------------
     def __call__(self, now_s: float) -> None:
-        """Poll if due at ``now_s`` (clock seconds); a scheduler hook."""
-        if now_s + 1e-9 < self.next_due_s:
+        """Poll if due at ``now_s`` (clock seconds); a scheduler hook.
+
+        The first call sets the phase, so the polls fall on the scheduler's steps.
+        """
+        if self.origin_s is None:
+            self.origin_s = now_s
+        elif now_s + 1e-9 < self.next_due_s:
             return
         with branch_of(self.clock):
             self.poll_once()
@@ -129,6 +137,8 @@ class Poller(Generic[D]):
 
     def _advance(self, now_s: float) -> None:
         """Move to the next deadline after ``now_s`` (skipping any that were missed)."""
+        if self.origin_s is None:
+            self.origin_s = now_s
         self.period_index = max(
             self.period_index + 1, math.floor((now_s - self.origin_s) / self.period_s + 1e-9) + 1
         )
@@ -162,10 +172,14 @@ class Poller(Generic[D]):
             if self.driver is None:
                 self.driver = self._connect()
 
-    def read_now(self) -> list[Staged]:
-        """Read once without staging (for ``vest devices``); raises what the read raised."""
+    def read_now(self, *, fresh: bool = False) -> list[Staged]:
+        """Read once without staging (for ``vest devices``); raises what the read raised.
+
+        ``fresh`` makes a new driver first, so the chip's identity is checked again.
+        """
         with self._lock:
-            if self.driver is None:
+            if fresh or self.driver is None:
+                self.driver = None
                 self.driver = self._connect()
             try:
                 return list(self._read(self.driver))
@@ -186,6 +200,7 @@ class Poller(Generic[D]):
         if self.consecutive_failures >= self.offline_after:
             self.health.driver_status(False, why)
         if not self.health.ok and not self._resting:
+            _log.warning("%s is offline; its readings say it senses nothing", self.name)
             self._resting = True
             self._stage(self.rest)
 
@@ -222,6 +237,8 @@ class PollerThreads:
             thread.start()
 
     def _run(self, poller: Poller[Any]) -> None:
+        if poller.origin_s is None:
+            poller.origin_s = self.clock.now()
         while not self._stop.is_set():
             wait_s = poller.next_due_s - self.clock.now()
             if wait_s > 0 and self._stop.wait(wait_s):

@@ -31,7 +31,7 @@ take their time on the chips without holding up the robot.
 from __future__ import annotations
 
 import logging
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from typing import Any
 
 from engine.blackboard.board import Blackboard
@@ -53,6 +53,8 @@ from engine.drivers.sim.vl53l0x import SimVL53L0X
 from engine.drivers.sim.zx_gesture import SimZXGesture
 from engine.hardware.config import BusConfig, DeviceConfig, RobotConfig
 from engine.hardware.timing import BranchingClock
+from engine.loader.problems import Problem
+from engine.nodes.params import did_you_mean
 from engine.scenario.world import EVENT_KEYS, World
 
 _log = logging.getLogger("vest.sim_vest")
@@ -65,7 +67,7 @@ FSR_SUPPLY_V = 3.3
 FSR_DIVIDER_OHM = 10_000.0
 
 
-class _SpiSocket(SimSpiDevice):
+class SpiSocket(SimSpiDevice):
     """A chip's socket on an SPI node: unplugged, MISO is pulled high (reads all ones);
     with garbage, it floats (random bits)."""
 
@@ -104,7 +106,7 @@ class SimVest:
         self.spi: dict[str, SimSpiDev] = {}
         self.chips: dict[str, Any] = {}
         self.maestro: MaestroEmulator | None = None
-        self._sockets: dict[str, _SpiSocket] = {}
+        self._sockets: dict[str, SpiSocket] = {}
         self._places: dict[str, tuple[SimI2CBus, int]] = {}
         self._mux_buses: dict[tuple[str, int], SimI2CBus] = {}
         self._lines: dict[int, SimOutputLine] = {}
@@ -132,7 +134,7 @@ class SimVest:
             return
         if bus_config.kind == "spi":
             chip = SimMCP3008(vref_v=device.options.get("vref_v", 3.3))
-            socket = _SpiSocket(chip, self.clock)
+            socket = SpiSocket(chip, self.clock)
             node = SimSpiDev(socket, bus_config.number, bus_config.chip_select)
             self.spi[bus_config.name] = node
             self._sockets[device.name] = socket
@@ -338,3 +340,44 @@ class UnwiredSenses:
     def world_event(self, kind: str, value: Any) -> None:
         if kind in self.KINDS:
             self.blackboard.stage_event(EVENT_KEYS[kind], value)
+
+
+def check_fault_events(events: Iterable[Any], config: RobotConfig) -> list[Problem]:
+    """Problems with the ``unplug`` and ``fault`` events of a scenario against ``config``.
+
+    ``events`` are :class:`~engine.scenario.scenario_file.ScenarioEvent` (``kind``,
+    ``value`` with ``device``, ``kind`` and ``seconds``, ``mark``); each problem names the
+    event's place: an unknown device (with the nearest name), a device the simulation
+    cannot fail (the Maestro), a fault an SPI device cannot have.
+    """
+    problems: list[Problem] = []
+    for event in events:
+        if event.kind not in ("unplug", "fault"):
+            continue
+        name = event.value["device"]
+        device = config.devices.get(name)
+        if device is None:
+            hint = did_you_mean(name, list(config.devices))
+            known = "devices: " + ", ".join(config.devices)
+            problems.append(
+                Problem(event.mark, f"no device {name!r} in {config.path}", hint or known)
+            )
+            continue
+        kind = event.value.get("kind", "unplugged")
+        bus = config.bus_of(device)
+        if bus.kind == "serial":
+            problems.append(
+                Problem(
+                    event.mark,
+                    f"{name!r} ({device.chip}) cannot be failed in the simulation",
+                    "the simulated vest fails I2C and SPI devices",
+                )
+            )
+        elif bus.kind == "spi" and kind not in SPI_FAULTS:
+            problems.append(
+                Problem(
+                    event.mark,
+                    f"{name!r} is on SPI: it can be {' or '.join(SPI_FAULTS)}, not {kind!r}",
+                )
+            )
+    return problems

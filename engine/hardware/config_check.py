@@ -1,0 +1,1007 @@
+"""Checking a robot config: every rule, each problem with its file:line:column.
+
+:func:`engine.hardware.config.load_robot_config` runs :class:`ConfigChecker` on a parsed
+file: the buses, each device (its chip, bus, address, rate, keys, the driver's options and
+the chip's own fields: force pads and their calibration tables, range sensors' side and
+XSHUT line or mux channel, gesture names, LED channels, servo joints), then the rules
+between devices (one device per address of one bus, the PCA9685's All Call address, the
+VL53L0X chain, muxes, one feeder per blackboard key, one device per service). Every problem
+is collected before the LoadError is raised, so a person fixes them all in one go.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+from engine.blackboard.catalogue import KeyCatalogue
+from engine.drivers.servo_joints import Joint
+from engine.hardware.config import (
+    BUS_KINDS,
+    CHIPS,
+    COMMON_FIELDS,
+    ENGINE_GESTURES,
+    PCA9685_ALL_CALL,
+    SIDES,
+    VL53L0X_BOOT_ADDRESS,
+    ZX_GESTURES,
+    BusConfig,
+    ChipSpec,
+    DeviceConfig,
+    ForcePad,
+    RobotConfig,
+    hex_address,
+)
+from engine.loader.problems import Mark, Problems
+from engine.loader.yaml_source import YList, YMap, YScalar, YValue, describe, plain
+from engine.nodes.params import (
+    REQUIRED,
+    Boolean,
+    CheckContext,
+    Choice,
+    Integer,
+    Key,
+    Number,
+    Param,
+    ParamProblem,
+    ParamType,
+    Text,
+    did_you_mean,
+)
+
+TOP_FIELDS = ("name", "description", "simulated", "buses", "gpio", "devices")
+BUS_FIELDS: dict[str, tuple[Param, ...]] = {
+    "i2c": (Param("number", Integer(0, 255), REQUIRED, "N of /dev/i2c-N"),),
+    "spi": (
+        Param("number", Integer(0, 255), REQUIRED, "N of /dev/spidevN.C"),
+        Param("chip_select", Integer(0, 255), 0, "C of /dev/spidevN.C"),
+    ),
+    "serial": (
+        Param("port", Text(), REQUIRED, "the port, e.g. /dev/ttyACM0"),
+        Param("baudrate", Integer(300, 4_000_000), 115200, "baud rate (ignored over USB)"),
+    ),
+}
+JOINT_FIELDS = (
+    Param("channel", Integer(0, 23), REQUIRED, "Maestro channel"),
+    Param("min_deg", Number(-360.0, 360.0, "deg"), REQUIRED, "lowest angle"),
+    Param("max_deg", Number(-360.0, 360.0, "deg"), REQUIRED, "highest angle"),
+    Param("max_speed_dps", Number(0.0, 10_000.0, "deg/s"), REQUIRED, "speed limit"),
+    Param("min_us", Number(0.0, 4000.0, "us"), 1000.0, "pulse width at min_deg"),
+    Param("max_us", Number(0.0, 4000.0, "us"), 2000.0, "pulse width at max_deg"),
+    Param("home_deg", Number(-360.0, 360.0, "deg"), 0.0, "resting angle"),
+)
+LED_FIELDS = ("red", "green", "blue")
+# Options whose YAML value is a number but which the drivers take from a fixed set.
+_NUMERIC_CHOICES = {"gain", "data_rate_sps", "resolution_c", "channels"}
+
+
+class ConfigChecker:
+    """Checks one parsed config file named ``name``; :meth:`check` raises every problem."""
+
+    def __init__(self, name: str, path: Path, catalogue: KeyCatalogue) -> None:
+        self.name = name
+        self.path = path
+        self.ctx = CheckContext(catalogue)
+        self.problems = Problems()
+        self.start = Mark(name, 1, 1)
+
+    # -- small helpers ---------------------------------------------------------------------
+    def convert(self, kind: ParamType, raw: YValue, what: str) -> Any:
+        """``kind.convert`` of a value, or None after adding the problem at its place."""
+        try:
+            return kind.convert(plain(raw), self.ctx)
+        except ParamProblem as problem:
+            self.problems.add(raw.mark, f"{what!r} {problem.message}", problem.hint)
+            return None
+
+    def unknown_fields(self, raw: YMap, known: tuple[str, ...] | list[str], what: str) -> None:
+        for key, mark in raw.key_marks.items():
+            if key not in known:
+                self.problems.add(
+                    mark,
+                    f"unknown {what} field {key!r}",
+                    did_you_mean(key, list(known)) or "fields: " + ", ".join(known),
+                )
+
+    def fields(self, raw: YMap, params: tuple[Param, ...], what: str) -> dict[str, Any] | None:
+        """Convert the declared ``params`` of ``raw`` (unknown fields are checked apart)."""
+        values: dict[str, Any] = {}
+        ok = True
+        for param in params:
+            value = raw.get(param.name)
+            if value is None:
+                if param.required:
+                    self.problems.add(raw.mark, f"{what} needs {param.name!r}", param.doc)
+                    ok = False
+                else:
+                    values[param.name] = param.default
+                continue
+            converted = self.convert(param.type, value, param.name)
+            ok = ok and converted is not None
+            values[param.name] = converted
+        return values if ok else None
+
+    def mapping(self, raw: YValue | None, what: str, example: str) -> YMap | None:
+        if raw is None:
+            return None
+        if not isinstance(raw, YMap):
+            self.problems.add(raw.mark, f"{what} must be a mapping, got {describe(raw)}", example)
+            return None
+        return raw
+
+    # -- the document ----------------------------------------------------------------------
+    def check(self, document: YValue | None) -> RobotConfig:
+        if not isinstance(document, YMap):
+            self.problems.add(
+                document.mark if document is not None else self.start,
+                "a robot config is a mapping with 'buses:' and 'devices:'",
+                "see examples/robots/sim.yaml",
+            )
+            self.problems.raise_if_any()
+        assert isinstance(document, YMap)
+        self.unknown_fields(document, TOP_FIELDS, "robot config")
+        robot_name = self._text(document, "name", Path(self.name).stem)
+        description = self._text(document, "description", "")
+        simulated = False
+        if "simulated" in document:
+            simulated = bool(self.convert(Boolean(), document.entries["simulated"], "simulated"))
+        gpio_chip = "/dev/gpiochip0"
+        gpio = self.mapping(document.get("gpio"), "'gpio'", "e.g. gpio: {chip: /dev/gpiochip0}")
+        if gpio is not None:
+            self.unknown_fields(gpio, ("chip",), "gpio")
+            if "chip" in gpio:
+                gpio_chip = self.convert(Text(), gpio.entries["chip"], "chip") or gpio_chip
+        buses = self._buses(document)
+        devices = self._devices(document, buses)
+        self.problems.raise_if_any()
+        return RobotConfig(
+            name=robot_name,
+            path=self.path,
+            simulated=simulated,
+            buses=buses,
+            devices=devices,
+            gpio_chip=gpio_chip,
+            description=description,
+        )
+
+    def _text(self, document: YMap, key: str, default: str) -> str:
+        raw = document.get(key)
+        if raw is None:
+            return default
+        value = self.convert(Text(), raw, key)
+        return value if value is not None else default
+
+    # -- buses ---------------------------------------------------------------------------
+    def _buses(self, document: YMap) -> dict[str, BusConfig]:
+        raw = document.get("buses")
+        if raw is None:
+            self.problems.add(
+                document.mark, "a robot config needs 'buses:'", "e.g. i2c: {kind: i2c, number: 1}"
+            )
+            return {}
+        section = self.mapping(raw, "'buses'", "e.g. i2c: {kind: i2c, number: 1}")
+        buses: dict[str, BusConfig] = {}
+        for name, body in section.items() if section is not None else ():
+            bus = self._bus(name, body)
+            if bus is not None:
+                buses[name] = bus
+        return buses
+
+    def _bus(self, name: str, body: YValue) -> BusConfig | None:
+        raw = self.mapping(body, f"bus {name!r}", "e.g. {kind: i2c, number: 1}")
+        if raw is None:
+            return None
+        kind_raw = raw.get("kind")
+        if kind_raw is None:
+            self.problems.add(raw.mark, f"bus {name!r} needs 'kind'", "i2c, spi or serial")
+            return None
+        kind = self.convert(Choice(BUS_KINDS), kind_raw, "kind")
+        if kind is None:
+            return None
+        params = BUS_FIELDS[kind]
+        self.unknown_fields(raw, ["kind", *(p.name for p in params)], f"{kind} bus")
+        values = self.fields(raw, params, f"{kind} bus {name!r}")
+        if values is None:
+            return None
+        return BusConfig(name=name, kind=kind, mark=raw.mark, **values)
+
+    # -- devices ---------------------------------------------------------------------------
+    def _devices(self, document: YMap, buses: dict[str, BusConfig]) -> dict[str, DeviceConfig]:
+        raw = document.get("devices")
+        if raw is None:
+            self.problems.add(
+                document.mark, "a robot config needs 'devices:'", "e.g. touch: {chip: mpr121}"
+            )
+            return {}
+        section = self.mapping(raw, "'devices'", "e.g. touch: {chip: mpr121}")
+        devices: dict[str, DeviceConfig] = {}
+        marks: dict[str, YMap] = {}
+        if section is None:
+            return devices
+        for name, body in section.items():
+            if isinstance(body, YMap):  # problems about a device as a whole point at its name
+                body = YMap(body.entries, section.key_marks[name], body.key_marks)
+            device = self._device(name, body, buses)
+            if device is not None:
+                devices[name] = device
+                assert isinstance(body, YMap)
+                marks[name] = body
+        _CrossChecks(self, buses, devices, marks).run()
+        return devices
+
+    def _device(self, name: str, body: YValue, buses: dict[str, BusConfig]) -> DeviceConfig | None:
+        raw = self.mapping(body, f"device {name!r}", "e.g. {chip: mpr121, address: 0x5A}")
+        if raw is None:
+            return None
+        chip_raw = raw.get("chip")
+        if chip_raw is None:
+            self.problems.add(
+                raw.mark, f"device {name!r} needs 'chip'", "chips: " + ", ".join(CHIPS)
+            )
+            return None
+        chip = plain(chip_raw)
+        spec = CHIPS.get(chip) if isinstance(chip, str) else None
+        if spec is None:
+            self.problems.add(
+                chip_raw.mark,
+                f"unknown chip {chip!r}",
+                (did_you_mean(chip, list(CHIPS)) if isinstance(chip, str) else None)
+                or "chips: " + ", ".join(CHIPS),
+            )
+            return None
+        known = [*COMMON_FIELDS, *(p.name for p in spec.options), *spec.fields]
+        self.unknown_fields(raw, known, spec.chip)
+        bus = self._device_bus(name, raw, spec, buses)
+        address = self._address(raw, spec)
+        rate_hz = self._rate(raw, spec)
+        options = self._options(raw, spec)
+        extra = _ChipFields(self, name, raw, spec).check()
+        keys = self._keys(raw, spec, (extra or {}).get("side"))
+        if bus is None or options is None or extra is None or keys is None:
+            return None
+        if spec.has_address and address is None:
+            return None
+        description = self._text(raw, "description", "")
+        return DeviceConfig(
+            name=name,
+            chip=spec.chip,
+            bus=bus,
+            mark=raw.mark,
+            address=address,
+            rate_hz=rate_hz,
+            keys=keys,
+            options=options,
+            description=description,
+            **extra,
+        )
+
+    def _device_bus(
+        self, name: str, raw: YMap, spec: ChipSpec, buses: dict[str, BusConfig]
+    ) -> str | None:
+        wanted = spec.bus_kind
+        raw_bus = raw.get("bus")
+        if raw_bus is None:
+            fitting = [bus.name for bus in buses.values() if bus.kind == wanted]
+            if len(fitting) == 1:
+                return fitting[0]
+            self.problems.add(
+                raw.mark,
+                f"device {name!r} needs 'bus:' ({len(fitting)} {wanted} buses are configured)",
+                "name one of: " + ", ".join(fitting) if fitting else f"add a {wanted} bus",
+            )
+            return None
+        bus_name = self.convert(Text(), raw_bus, "bus")
+        if bus_name is None:
+            return None
+        bus = buses.get(bus_name)
+        if bus is None:
+            self.problems.add(
+                raw_bus.mark,
+                f"unknown bus {bus_name!r}",
+                did_you_mean(bus_name, list(buses)) or "buses: " + (", ".join(buses) or "none"),
+            )
+            return None
+        if bus.kind != wanted:
+            self.problems.add(
+                raw_bus.mark,
+                f"{spec.chip} is on {wanted.upper() if wanted != 'serial' else 'a serial port'}, "
+                f"but bus {bus_name!r} is {bus.kind}",
+                "name a bus of kind " + wanted,
+            )
+            return None
+        return bus_name
+
+    def _address(self, raw: YMap, spec: ChipSpec) -> int | None:
+        value = raw.get("address")
+        if not spec.has_address:
+            if value is not None:
+                self.problems.add(
+                    raw.key_marks["address"],
+                    f"{spec.chip} has no I2C address ({spec.bus_kind})",
+                    "remove 'address'",
+                )
+            return None
+        if value is None:
+            return spec.default_address
+        address = self.convert(Integer(0, 0x7F), value, "address")
+        if address is None:
+            return None
+        if address not in spec.addresses:
+            hint = f"use {spec.addresses_text()}"
+            if spec.chip == "pca9685" and address == PCA9685_ALL_CALL:
+                hint = "0x70 is every PCA9685's LED All Call address; " + hint
+            self.problems.add(
+                value.mark,
+                f"{spec.chip} cannot be at address {hex_address(address)}",
+                hint,
+            )
+            return None
+        return address
+
+    def _rate(self, raw: YMap, spec: ChipSpec) -> float | None:
+        value = raw.get("rate_hz")
+        if not spec.polled:
+            if value is not None:
+                self.problems.add(
+                    raw.key_marks["rate_hz"],
+                    f"{spec.chip} is not polled ({spec.role} is read on request or commanded)",
+                    "remove 'rate_hz'",
+                )
+            return None
+        if value is None:
+            return spec.default_rate_hz
+        return self.convert(Number(0.1, 1000.0, "Hz"), value, "rate_hz")
+
+    def _options(self, raw: YMap, spec: ChipSpec) -> dict[str, Any] | None:
+        values: dict[str, Any] = {}
+        ok = True
+        for param in spec.options:
+            value = raw.get(param.name)
+            if value is None:
+                converted = param.default
+            elif param.name in _NUMERIC_CHOICES:
+                # YAML reads 0.0625 and 12 as numbers; the choices are spelled as text.
+                text = _number_text(plain(value))
+                converted = self.convert(param.type, YScalar(text, value.mark), param.name)
+            else:
+                converted = self.convert(param.type, value, param.name)
+            if converted is None:
+                ok = False
+                continue
+            values[param.name] = _numeric_choice(param.name, converted)
+        return values if ok else None
+
+    def _keys(self, raw: YMap, spec: ChipSpec, side: str | None) -> dict[str, str] | None:
+        keys = dict(spec.outputs)
+        if spec.role == "range" and side is not None:
+            keys["range"] = f"/sensors/range/{side}_mm"
+        section = self.mapping(raw.get("keys"), "'keys'", "e.g. keys: {any: /sensors/touch/any}")
+        ok = True
+        if section is not None:
+            if not spec.outputs:
+                self.problems.add(
+                    section.mark,
+                    f"{spec.chip} feeds no keys of its own here",
+                    "give each pad its 'key' under 'pads'" if spec.role == "force" else None,
+                )
+                return None
+            for output, value in section.items():
+                if output not in spec.outputs:
+                    self.problems.add(
+                        section.key_marks[output],
+                        f"{spec.chip} has no reading {output!r}",
+                        did_you_mean(output, list(spec.outputs))
+                        or "readings: " + ", ".join(spec.outputs),
+                    )
+                    ok = False
+                    continue
+                kinds = ("event",) if spec.role == "gesture" else ("state",)
+                key = self.convert(Key(kinds=kinds), value, output)
+                if key is None:
+                    ok = False
+                else:
+                    keys[output] = key
+        missing = [output for output, key in keys.items() if not key]
+        if missing and spec.role == "range" and side is None:
+            return None  # the missing 'side' was reported
+        if missing:
+            self.problems.add(raw.mark, f"{spec.chip} needs keys for " + ", ".join(missing))
+            return None
+        return keys if ok else None
+
+
+def _number_text(value: Any) -> Any:
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        return value
+    return f"{value:g}" if isinstance(value, float) else str(value)
+
+
+def _numeric_choice(name: str, value: Any) -> Any:
+    if name not in _NUMERIC_CHOICES:
+        return value
+    if value == "2/3":
+        return 2 / 3
+    number = float(value)
+    return int(number) if number.is_integer() and name != "resolution_c" else number
+
+
+class _ChipFields:
+    """The structured fields of one chip: pads, joints, leds, side/xshut/mux, gesture names."""
+
+    def __init__(self, checker: ConfigChecker, name: str, raw: YMap, spec: ChipSpec) -> None:
+        self.c = checker
+        self.name = name
+        self.raw = raw
+        self.spec = spec
+
+    def check(self) -> dict[str, Any] | None:
+        values: dict[str, Any] = {}
+        ok = True
+        role = self.spec.role
+        if role == "force":
+            pads = self._pads()
+            ok = pads is not None
+            values["pads"] = pads or ()
+        elif role == "range":
+            placed = self._range_place()
+            ok = placed is not None
+            values.update(placed or {})
+        elif role == "gesture":
+            names = self._gesture_names()
+            ok = names is not None
+            values["gesture_names"] = names or {}
+        elif role == "leds":
+            leds = self._leds()
+            ok = leds is not None
+            values["leds"] = leds or {}
+        elif role == "servos":
+            joints = self._joints()
+            ok = joints is not None
+            values["joints"] = joints or ()
+        return values if ok else None
+
+    # -- force pads ------------------------------------------------------------------------
+    def _pads(self) -> tuple[ForcePad, ...] | None:
+        section = self.c.mapping(
+            self.raw.get("pads"),
+            "'pads'",
+            "e.g. pads: {left: {channel: 0, calibration: [[0.0, 0.0], [3.0, 6.0]]}}",
+        )
+        if section is None:
+            if "pads" not in self.raw:
+                self.c.problems.add(
+                    self.raw.mark,
+                    f"{self.spec.chip} device {self.name!r} needs 'pads'",
+                    "e.g. pads: {left: {channel: 0, calibration: [[0.0, 0.0], [3.0, 6.0]]}}",
+                )
+            return None
+        channels = 4 if self.spec.chip == "ads1115" else 8
+        pads: list[ForcePad] = []
+        used: dict[int, str] = {}
+        ok = True
+        for pad_name, body in section.items():
+            pad = self._pad(pad_name, body, channels)
+            if pad is None:
+                ok = False
+                continue
+            if pad.channel in used:
+                self.c.problems.add(
+                    pad.mark,
+                    f"pad {pad_name!r} uses channel {pad.channel}, already used by pad "
+                    f"{used[pad.channel]!r}",
+                    "give each pad its own channel",
+                )
+                ok = False
+            used[pad.channel] = pad_name
+            pads.append(pad)
+        if not pads and ok:
+            self.c.problems.add(section.mark, "'pads' lists no pad", "e.g. left: {channel: 0}")
+            ok = False
+        return tuple(pads) if ok else None
+
+    def _pad(self, pad_name: str, body: YValue, channels: int) -> ForcePad | None:
+        raw = self.c.mapping(body, f"pad {pad_name!r}", "e.g. {channel: 0, calibration: [...]}")
+        if raw is None:
+            return None
+        self.c.unknown_fields(raw, ("channel", "key", "calibration"), "pad")
+        values = self.c.fields(
+            raw,
+            (
+                Param("channel", Integer(0, channels - 1), REQUIRED, "ADC input"),
+                Param("key", Key(), f"/sensors/force/{pad_name}_n", "blackboard key"),
+            ),
+            f"pad {pad_name!r}",
+        )
+        table_raw = raw.get("calibration")
+        if table_raw is None:
+            self.c.problems.add(
+                raw.mark,
+                f"pad {pad_name!r} needs 'calibration'",
+                "a volts -> newtons table, e.g. [[0.0, 0.0], [0.83, 0.2], [3.0, 6.0]]",
+            )
+            return None
+        table = self._calibration(table_raw)
+        if values is None or table is None:
+            return None
+        if self.c.ctx.catalogue.lookup(values["key"]) is None:  # the default key
+            self.c.problems.add(
+                raw.mark,
+                f"pad {pad_name!r} would feed {values['key']}, which is not a blackboard key",
+                "name its 'key', e.g. /sensors/force/left_n",
+            )
+            return None
+        return ForcePad(pad_name, values["channel"], values["key"], table, raw.mark)
+
+    def _calibration(self, raw: YValue) -> tuple[tuple[float, float], ...] | None:
+        example = "pairs of [volts, newtons], e.g. [[0.0, 0.0], [0.83, 0.2], [3.0, 6.0]]"
+        if not isinstance(raw, YList):
+            self.c.problems.add(
+                raw.mark, f"'calibration' must be a list, got {describe(raw)}", example
+            )
+            return None
+        points: list[tuple[float, float]] = []
+        ok = True
+        for index, item in enumerate(raw):
+            value = plain(item)
+            if (
+                not isinstance(value, list)
+                or len(value) != 2
+                or any(isinstance(v, bool) or not isinstance(v, int | float) for v in value)
+            ):
+                self.c.problems.add(
+                    item.mark,
+                    f"calibration point {index + 1} must be [volts, newtons], got {describe(item)}",
+                    example,
+                )
+                ok = False
+                continue
+            volts, newtons = float(value[0]), float(value[1])
+            if newtons < 0:
+                self.c.problems.add(
+                    item.mark, f"calibration point {index + 1} has negative force {newtons:g} N"
+                )
+                ok = False
+                continue
+            if points and volts <= points[-1][0]:
+                self.c.problems.add(
+                    item.mark,
+                    f"calibration is not increasing: point {index + 1} has {volts:g} V after "
+                    f"{points[-1][0]:g} V",
+                    "list the points by strictly increasing volts",
+                )
+                ok = False
+            elif points and newtons < points[-1][1]:
+                self.c.problems.add(
+                    item.mark,
+                    f"calibration is not increasing: point {index + 1} has {newtons:g} N after "
+                    f"{points[-1][1]:g} N",
+                    "a harder squeeze must never read as a lighter one",
+                )
+                ok = False
+            points.append((volts, newtons))
+        if ok and len(points) < 2:
+            self.c.problems.add(
+                raw.mark, f"calibration needs at least two points, got {len(points)}", example
+            )
+            ok = False
+        return tuple(points) if ok else None
+
+    # -- range sensors ---------------------------------------------------------------------
+    def _range_place(self) -> dict[str, Any] | None:
+        values: dict[str, Any] = {"side": None, "xshut": None, "mux": None, "mux_channel": None}
+        ok = True
+        side_raw = self.raw.get("side")
+        if side_raw is None:
+            self.c.problems.add(
+                self.raw.mark,
+                f"vl53l0x device {self.name!r} needs 'side'",
+                "left, center or right: the way it looks",
+            )
+            ok = False
+        else:
+            values["side"] = self.c.convert(Choice(SIDES), side_raw, "side")
+            ok = ok and values["side"] is not None
+        xshut_raw = self.raw.get("xshut")
+        if xshut_raw is not None:
+            values["xshut"] = self.c.convert(Integer(0, 1023), xshut_raw, "xshut")
+            ok = ok and values["xshut"] is not None
+        mux_raw, channel_raw = self.raw.get("mux"), self.raw.get("channel")
+        if mux_raw is not None:
+            values["mux"] = self.c.convert(Text(), mux_raw, "mux")
+            ok = ok and values["mux"] is not None
+            if channel_raw is None:
+                self.c.problems.add(
+                    self.raw.key_marks["mux"],
+                    f"device {self.name!r} names a mux but no 'channel'",
+                    "the TCA9548A channel it is wired to, 0..7",
+                )
+                ok = False
+        if channel_raw is not None:
+            if mux_raw is None:
+                self.c.problems.add(
+                    self.raw.key_marks["channel"],
+                    "'channel' is a TCA9548A channel, but no 'mux' is named",
+                    "add mux: NAME of the tca9548a device",
+                )
+                ok = False
+            values["mux_channel"] = self.c.convert(Integer(0, 7), channel_raw, "channel")
+            ok = ok and values["mux_channel"] is not None
+        if xshut_raw is not None and mux_raw is not None:
+            self.c.problems.add(
+                self.raw.key_marks["xshut"],
+                "a VL53L0X is either re-addressed through its XSHUT line or behind a mux",
+                "remove 'xshut' or 'mux'",
+            )
+            ok = False
+        return values if ok else None
+
+    # -- gestures --------------------------------------------------------------------------
+    def _gesture_names(self) -> dict[str, str] | None:
+        section = self.c.mapping(
+            self.raw.get("gesture_names"), "'gesture_names'", "e.g. {swipe_left: wave}"
+        )
+        names = {gesture: gesture for gesture in ZX_GESTURES}
+        if section is None:
+            return None if "gesture_names" in self.raw else names
+        ok = True
+        for reported, value in section.items():
+            if reported not in ZX_GESTURES:
+                self.c.problems.add(
+                    section.key_marks[reported],
+                    f"the ZX sensor reports no gesture {reported!r}",
+                    did_you_mean(reported, ZX_GESTURES) or "it reports " + ", ".join(ZX_GESTURES),
+                )
+                ok = False
+                continue
+            engine_name = self.c.convert(Choice(ENGINE_GESTURES), value, reported)
+            if engine_name is None:
+                ok = False
+            else:
+                names[reported] = engine_name
+        return names if ok else None
+
+    # -- LEDs ------------------------------------------------------------------------------
+    def _leds(self) -> dict[str, tuple[int, int, int]] | None:
+        section = self.c.mapping(
+            self.raw.get("leds"), "'leds'", "e.g. leds: {face: {red: 0, green: 1, blue: 2}}"
+        )
+        if section is None:
+            if "leds" not in self.raw:
+                self.c.problems.add(
+                    self.raw.mark,
+                    f"pca9685 device {self.name!r} needs 'leds'",
+                    "e.g. leds: {face: {red: 0, green: 1, blue: 2}}",
+                )
+            return None
+        leds: dict[str, tuple[int, int, int]] = {}
+        owner: dict[int, str] = {}
+        ok = True
+        for led, body in section.items():
+            if led == "all":
+                self.c.problems.add(
+                    section.key_marks[led], "'all' names every LED", "choose another LED name"
+                )
+                ok = False
+                continue
+            raw = self.c.mapping(body, f"LED {led!r}", "e.g. {red: 0, green: 1, blue: 2}")
+            if raw is None:
+                ok = False
+                continue
+            self.c.unknown_fields(raw, LED_FIELDS, "LED")
+            values = self.c.fields(
+                raw,
+                tuple(
+                    Param(color, Integer(0, 15), REQUIRED, "PCA9685 channel")
+                    for color in LED_FIELDS
+                ),
+                f"LED {led!r}",
+            )
+            if values is None:
+                ok = False
+                continue
+            for color in LED_FIELDS:
+                channel = values[color]
+                if channel in owner:
+                    self.c.problems.add(
+                        raw.entries[color].mark,
+                        f"PCA9685 channel {channel} is already used by LED {owner[channel]!r}",
+                        "give each color its own channel",
+                    )
+                    ok = False
+                owner[channel] = f"{led}.{color}"
+            leds[led] = (values["red"], values["green"], values["blue"])
+        if not leds and ok:
+            self.c.problems.add(section.mark, "'leds' lists no LED")
+            ok = False
+        return leds if ok else None
+
+    # -- servo joints ----------------------------------------------------------------------
+    def _joints(self) -> tuple[Joint, ...] | None:
+        section = self.c.mapping(
+            self.raw.get("joints"),
+            "'joints'",
+            "e.g. joints: {neck: {channel: 0, min_deg: -60, max_deg: 60, max_speed_dps: 120}}",
+        )
+        if section is None:
+            if "joints" not in self.raw:
+                self.c.problems.add(
+                    self.raw.mark,
+                    f"maestro device {self.name!r} needs 'joints'",
+                    "e.g. joints: {neck: {channel: 0, min_deg: -60, max_deg: 60, "
+                    "max_speed_dps: 120}}",
+                )
+            return None
+        channels_raw = self.raw.get("channels")
+        channels = 12
+        if channels_raw is not None and _number_text(plain(channels_raw)) in (
+            "6",
+            "12",
+            "18",
+            "24",
+        ):
+            channels = int(_number_text(plain(channels_raw)))
+        joints: list[Joint] = []
+        owner: dict[int, str] = {}
+        ok = True
+        for joint_name, body in section.items():
+            joint = self._joint(joint_name, body, channels)
+            if joint is None:
+                ok = False
+                continue
+            if joint.channel in owner:
+                self.c.problems.add(
+                    section.entries[joint_name].mark,
+                    f"joint {joint_name!r} uses channel {joint.channel}, already used by joint "
+                    f"{owner[joint.channel]!r}",
+                    "give each joint its own channel",
+                )
+                ok = False
+            owner[joint.channel] = joint_name
+            joints.append(joint)
+        if not joints and ok:
+            self.c.problems.add(section.mark, "'joints' lists no joint")
+            ok = False
+        return tuple(joints) if ok else None
+
+    def _joint(self, joint_name: str, body: YValue, channels: int) -> Joint | None:
+        raw = self.c.mapping(
+            body, f"joint {joint_name!r}", "e.g. {channel: 0, min_deg: -60, max_deg: 60, ...}"
+        )
+        if raw is None:
+            return None
+        self.c.unknown_fields(raw, [p.name for p in JOINT_FIELDS], "joint")
+        values = self.c.fields(raw, JOINT_FIELDS, f"joint {joint_name!r}")
+        if values is None:
+            return None
+        place = raw.entries.get
+        problems = self.c.problems
+        before = len(problems)
+        if values["channel"] >= channels:
+            problems.add(
+                place("channel", raw).mark,
+                f"joint {joint_name!r}: channel {values['channel']} is beyond the Maestro's "
+                f"{channels} channels (0..{channels - 1})",
+            )
+        if not values["min_deg"] < values["max_deg"]:
+            problems.add(
+                place("min_deg", raw).mark,
+                f"joint {joint_name!r}: limits inverted, min_deg {values['min_deg']:g} is not "
+                f"below max_deg {values['max_deg']:g}",
+                "swap them",
+            )
+        if not 0 < values["min_us"] < values["max_us"]:
+            problems.add(
+                place("min_us", raw).mark,
+                f"joint {joint_name!r}: pulse limits {values['min_us']:g}..{values['max_us']:g} "
+                "us are not increasing and positive",
+            )
+        if not values["max_speed_dps"] > 0:
+            problems.add(
+                place("max_speed_dps", raw).mark,
+                f"joint {joint_name!r}: max_speed_dps must be above 0",
+            )
+        if len(problems) > before:
+            return None
+        if not values["min_deg"] <= values["home_deg"] <= values["max_deg"]:
+            problems.add(
+                place("home_deg", raw).mark,
+                f"joint {joint_name!r}: home_deg {values['home_deg']:g} is outside its limits "
+                f"{values['min_deg']:g}..{values['max_deg']:g}",
+            )
+            return None
+        try:
+            return Joint(name=joint_name, **values)
+        except ValueError as error:  # e.g. a speed limit the Maestro cannot express
+            problems.add(place("max_speed_dps", raw).mark, str(error))
+            return None
+
+
+class _CrossChecks:
+    """Rules between devices: addresses, the All Call trap, XSHUT chains, muxes, keys."""
+
+    def __init__(
+        self,
+        checker: ConfigChecker,
+        buses: dict[str, BusConfig],
+        devices: dict[str, DeviceConfig],
+        raws: dict[str, YMap],
+    ) -> None:
+        self.c = checker
+        self.buses = buses
+        self.devices = devices
+        self.raws = raws
+
+    def mark(self, device: DeviceConfig, field_name: str) -> Mark:
+        raw = self.raws[device.name]
+        value = raw.entries.get(field_name)
+        return value.mark if value is not None else raw.mark
+
+    def run(self) -> None:
+        self.addresses()
+        self.all_call()
+        self.muxes()
+        self.range_chains()
+        self.keys()
+        self.singletons()
+
+    def _line(self, device: DeviceConfig) -> str:
+        return f"line {device.mark.line}"
+
+    def addresses(self) -> None:
+        """One device per address of one bus (or mux channel); one device per SPI node or port."""
+        holders: dict[tuple[str, str | None, int | None, int | None], DeviceConfig] = {}
+        for device in self.devices.values():
+            bus = self.buses[device.bus]
+            if device.address is None:
+                place: tuple[str, str | None, int | None, int | None] = (bus.name, None, None, None)
+            else:
+                place = (bus.name, device.mux, device.mux_channel, device.address)
+            holder = holders.get(place)
+            if holder is not None:
+                where = (
+                    f"{bus.path}"
+                    if device.address is None
+                    else f"I2C {hex_address(device.address)} on bus {bus.name!r}"
+                    + (f" ({device.mux} channel {device.mux_channel})" if device.mux else "")
+                )
+                self.c.problems.add(
+                    self.mark(device, "address" if device.address is not None else "bus"),
+                    f"{where} is used by both {holder.name!r} ({self._line(holder)}) and "
+                    f"{device.name!r}",
+                    "give each device its own address"
+                    if device.address is not None
+                    else "one device per SPI node or serial port",
+                )
+                continue
+            holders[place] = device
+        # A chip on the upstream bus answers on every mux channel too.
+        for device in self.devices.values():
+            if device.mux is None:
+                continue
+            upstream = holders.get((device.bus, None, None, device.address))
+            if upstream is not None:
+                self.c.problems.add(
+                    self.mark(device, "address"),
+                    f"I2C {hex_address(device.address)} behind {device.mux} clashes with "
+                    f"{upstream.name!r} ({self._line(upstream)}) on the upstream bus",
+                    "chips on the upstream bus answer on every channel; move one",
+                )
+
+    def all_call(self) -> None:
+        """Until the PCA9685 driver turns All Call off, the chip also takes writes to 0x70."""
+        for pwm in self.devices.values():
+            if pwm.chip != "pca9685":
+                continue
+            for device in self.devices.values():
+                if (
+                    device is pwm
+                    or device.bus != pwm.bus
+                    or device.address != PCA9685_ALL_CALL
+                    or device.mux is not None
+                ):
+                    continue
+                hint = "move it to 0x71..0x77"
+                if device.chip == "srf02":
+                    hint = (
+                        "change the SRF02's address to 0x71..0x7F (0xE2..0xFE in Devantech's "
+                        "8-bit numbering), e.g. 0x75"
+                    )
+                self.c.problems.add(
+                    self.mark(device, "address"),
+                    f"{device.name!r} at 0x70 shares its bus with PCA9685 {pwm.name!r}, whose "
+                    "LED All Call address is 0x70: at power-up the PCA9685 also takes every "
+                    "write to 0x70 into its own registers",
+                    hint,
+                )
+
+    def muxes(self) -> None:
+        for device in self.devices.values():
+            if device.mux is None:
+                continue
+            mux = self.devices.get(device.mux)
+            if mux is None or mux.chip != "tca9548a":
+                muxes = [d.name for d in self.devices.values() if d.chip == "tca9548a"]
+                self.c.problems.add(
+                    self.mark(device, "mux"),
+                    f"{device.mux!r} is not a tca9548a device of this config",
+                    did_you_mean(device.mux, muxes) or "muxes: " + (", ".join(muxes) or "none"),
+                )
+            elif mux.bus != device.bus:
+                self.c.problems.add(
+                    self.mark(device, "mux"),
+                    f"mux {mux.name!r} is on bus {mux.bus!r}, not on {device.bus!r}",
+                    f"put {device.name!r} on bus {mux.bus!r}",
+                )
+
+    def range_chains(self) -> None:
+        """VL53L0X chips all boot at 0x29: each needs XSHUT or a mux, but for one at 0x29."""
+        lines: dict[int, DeviceConfig] = {}
+        for device in self.devices.values():
+            if device.xshut is None:
+                continue
+            holder = lines.get(device.xshut)
+            if holder is not None:
+                self.c.problems.add(
+                    self.mark(device, "xshut"),
+                    f"GPIO line {device.xshut} is already the XSHUT of {holder.name!r}",
+                    "each VL53L0X needs its own XSHUT line",
+                )
+            lines[device.xshut] = device
+        for bus in self.buses.values():
+            direct = [
+                d
+                for d in self.devices.values()
+                if d.chip == "vl53l0x" and d.bus == bus.name and d.mux is None
+            ]
+            unswitched = [d for d in direct if d.xshut is None]
+            for device in unswitched:
+                if device.address != VL53L0X_BOOT_ADDRESS:
+                    self.c.problems.add(
+                        self.mark(device, "address"),
+                        f"VL53L0X {device.name!r} has no XSHUT line, so it boots at 0x29 and "
+                        f"cannot be moved to {hex_address(device.address)}",
+                        "add 'xshut: LINE' or use address 0x29",
+                    )
+            if unswitched and len(direct) > 1:
+                self.c.problems.add(
+                    self.mark(unswitched[-1], "xshut"),
+                    f"{len(direct)} VL53L0X share bus {bus.name!r} but "
+                    f"{', '.join(repr(d.name) for d in unswitched)} has no XSHUT line; every "
+                    "chip boots at 0x29",
+                    "give each its own XSHUT line, or put them behind a TCA9548A",
+                )
+            chained = [d for d in direct if d.xshut is not None]
+            for device in chained[:-1]:
+                if device.address == VL53L0X_BOOT_ADDRESS:
+                    self.c.problems.add(
+                        self.mark(device, "address"),
+                        f"VL53L0X {device.name!r} stays at 0x29, where the chips switched on "
+                        "after it boot",
+                        "give it another address, or list it last",
+                    )
+
+    def keys(self) -> None:
+        feeders: dict[str, DeviceConfig] = {}
+        for device in self.devices.values():
+            for key in device.fed_keys:
+                holder = feeders.get(key)
+                if holder is not None:
+                    self.c.problems.add(
+                        device.mark,
+                        f"{device.name!r} and {holder.name!r} ({self._line(holder)}) both feed "
+                        f"{key}",
+                        "give one of them other keys",
+                    )
+                feeders[key] = device
+
+    def singletons(self) -> None:
+        """The on-request sensors and the actuators are one device each."""
+        for role in ("temperature", "ultrasound", "leds", "servos"):
+            doing = [d for d in self.devices.values() if d.role == role]
+            for device in doing[1:]:
+                self.c.problems.add(
+                    self.mark(device, "chip"),
+                    f"two devices serve {role}: {doing[0].name!r} ({self._line(doing[0])}) and "
+                    f"{device.name!r}",
+                    "keep one",
+                )

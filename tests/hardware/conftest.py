@@ -1,0 +1,101 @@
+"""The robot on the simulated vest, without the CLI: world, chips, drivers, pollers, trees."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+
+from engine.blackboard.board import Blackboard
+from engine.blackboard.catalogue import default_catalogue
+from engine.clock import VirtualClock
+from engine.hardware.assembly import Hardware, build_hardware
+from engine.hardware.config import RobotConfig, load_robot_config
+from engine.hardware.sim_vest import SimVest, UnwiredSenses, build_sim_vest
+from engine.runtime.robot import Robot, load_behaviors
+from engine.scenario.world import World
+from engine.services.simulated import SimulatedIot, SimulatedSpeech
+
+ROOT = Path(__file__).resolve().parents[2]
+SIM_CONFIG = ROOT / "examples" / "robots" / "sim.yaml"
+
+
+class SimRobot:
+    """Every tree of trees/ on the simulated vest of examples/robots/sim.yaml.
+
+    Speech is simulated (``said``); LEDs, servos and sensors go through the drivers to the
+    simulated chips. Time is virtual: :meth:`run_for` ticks the scheduler, whose hooks poll.
+    """
+
+    def __init__(self, config: RobotConfig) -> None:
+        self.clock = VirtualClock()
+        self.blackboard = Blackboard(default_catalogue(), self.clock)
+        self.blackboard.reset()
+        self.world = World()
+        self.vest: SimVest = build_sim_vest(config, self.world, self.clock)
+        self.world.listeners.append(UnwiredSenses(self.blackboard))
+        self.hardware: Hardware = build_hardware(
+            config, self.clock, self.blackboard, vest=self.vest
+        )
+        self.speech = SimulatedSpeech(self.clock)
+        self.iot = SimulatedIot()
+        behaviors = load_behaviors([ROOT / "trees"], dialogs_dir=ROOT / "dialogs")
+        self.services = self.hardware.services(speech=self.speech, iot=self.iot)
+        self.robot = Robot(
+            behaviors, clock=self.clock, services=self.services, blackboard=self.blackboard
+        )
+        self.robot.scheduler.hooks.extend(self.hardware.hooks)
+
+    @property
+    def said(self) -> list[str]:
+        return [text for text, _volume in self.speech.calls]
+
+    def run_for(self, seconds: float) -> None:
+        """Tick the robot for ``seconds`` of virtual time."""
+        self.robot.scheduler.run(until_s=self.clock.now() + seconds)
+
+    def key(self, key: str) -> object:
+        return self.blackboard.get(key)
+
+    # -- the world -------------------------------------------------------------------------
+    def touch(self, pad: int, down: bool = True) -> None:
+        self.world.touched[pad] = down
+        self.world.changed("touch")
+
+    def squeeze(self, left_n: float, right_n: float) -> None:
+        self.world.force_n.update(left=left_n, right=right_n)
+        self.world.changed("force")
+
+    def obstacle(self, **sides_mm: float | None) -> None:
+        self.world.range_mm.update(sides_mm)
+        self.world.changed("range")
+
+    def room_at(self, celsius: float) -> None:
+        self.world.temperature_c = celsius
+        self.world.changed("temperature")
+
+    def object_ahead(self, cm: float | None) -> None:
+        self.world.ultrasound_cm = cm
+        self.world.changed("ultrasound")
+
+    def hear(self, text: str) -> None:
+        self.world.happened("hear", text)
+
+    def close(self) -> None:
+        self.hardware.close()
+        self.vest.close()
+
+
+@pytest.fixture
+def sim_config() -> RobotConfig:
+    return load_robot_config(SIM_CONFIG)
+
+
+@pytest.fixture
+def sim_robot(sim_config: RobotConfig) -> Iterator[SimRobot]:
+    robot = SimRobot(sim_config)
+    try:
+        yield robot
+    finally:
+        robot.close()

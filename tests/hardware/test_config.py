@@ -1,0 +1,299 @@
+"""Robot configs: what a wrong one says, with file:line:column, and what a right one holds."""
+
+from __future__ import annotations
+
+import textwrap
+from pathlib import Path
+
+import pytest
+
+from engine.hardware.config import RobotConfig, load_robot_config
+from engine.loader.problems import LoadError
+
+from .conftest import ROOT
+
+HEAD = """\
+name: test
+buses:
+  i2c: {kind: i2c, number: 1}
+  servos: {kind: serial, port: /dev/ttyACM0}
+devices:
+"""
+
+
+def load(tmp_path: Path, devices: str, head: str = HEAD) -> RobotConfig:
+    path = tmp_path / "robot.yaml"
+    path.write_text(head + textwrap.indent(textwrap.dedent(devices), "  "))
+    return load_robot_config(path, "robot.yaml")
+
+
+def problems(tmp_path: Path, devices: str, head: str = HEAD) -> list[str]:
+    with pytest.raises(LoadError) as caught:
+        load(tmp_path, devices, head)
+    return [str(problem) for problem in caught.value.problems]
+
+
+def test_the_example_configs_load():
+    for name in ("hbs2", "sim"):
+        config = load_robot_config(ROOT / "examples" / "robots" / f"{name}.yaml")
+        assert [d.chip for d in config.with_role("range")] == ["vl53l0x"] * 3
+        assert config.device("force").pads[0].key == "/sensors/force/left_n"
+        assert config.device("ultrasound").address == 0x75
+        assert config.device("servos").joints[0].name == "neck"
+
+
+def test_defaults_come_from_the_chip(tmp_path):
+    config = load(tmp_path, "touch: {chip: mpr121}\nrange: {chip: vl53l0x, side: left}\n")
+
+    touch = config.device("touch")
+    assert (touch.bus, touch.address, touch.rate_hz) == ("i2c", 0x5A, 20.0)
+    assert touch.keys == {"pads": "/sensors/touch/pads", "any": "/sensors/touch/any"}
+    assert touch.options == {"touch_threshold": 12, "release_threshold": 6}
+    assert config.device("range").keys == {"range": "/sensors/range/left_mm"}
+
+
+def test_an_unknown_chip_is_named_with_its_place_and_the_nearest_chip(tmp_path):
+    assert problems(tmp_path, "touch: {chip: mpr12, address: 0x5A}\n") == [
+        "robot.yaml:6:17: unknown chip 'mpr12' (did you mean 'mpr121'?)"
+    ]
+
+
+def test_an_unknown_field_suggests_the_nearest(tmp_path):
+    assert problems(tmp_path, "touch: {chip: mpr121, adress: 0x5A}\n") == [
+        "robot.yaml:6:25: unknown mpr121 field 'adress' (did you mean 'address'?)"
+    ]
+
+
+def test_two_devices_on_one_address_of_one_bus_name_both(tmp_path):
+    found = problems(
+        tmp_path,
+        """\
+        temperature: {chip: mcp9808, address: 0x18}
+        spare: {chip: tca9548a, address: 0x70}
+        mux2: {chip: tca9548a, address: 0x70}
+        """,
+    )
+    assert found == [
+        "robot.yaml:8:35: I2C 0x70 on bus 'i2c' is used by both 'spare' (line 7) and 'mux2' "
+        "(give each device its own address)"
+    ]
+
+
+def test_the_srf02_at_0x70_beside_a_pca9685_is_the_all_call_trap(tmp_path):
+    found = problems(
+        tmp_path,
+        """\
+        ultrasound: {chip: srf02}
+        face: {chip: pca9685, leds: {face: {red: 0, green: 1, blue: 2}}}
+        """,
+    )
+    assert len(found) == 1
+    assert found[0].startswith("robot.yaml:6:3: 'ultrasound' at 0x70 shares its bus with PCA9685")
+    assert "LED All Call" in found[0] and "e.g. 0x75" in found[0]
+
+
+def test_a_pca9685_cannot_sit_on_its_all_call_address(tmp_path):
+    found = problems(
+        tmp_path, "face: {chip: pca9685, address: 0x70, leds: {f: {red: 0, green: 1, blue: 2}}}\n"
+    )
+    assert len(found) == 1
+    assert found[0].startswith("robot.yaml:6:34: pca9685 cannot be at address 0x70 (0x70 is")
+
+
+def test_an_address_the_chip_cannot_have_lists_the_ones_it_can(tmp_path):
+    assert problems(tmp_path, "touch: {chip: mpr121, address: 0x48}\n") == [
+        "robot.yaml:6:34: mpr121 cannot be at address 0x48 (use 0x5A..0x5D)"
+    ]
+
+
+def test_inverted_joint_limits_are_refused(tmp_path):
+    found = problems(
+        tmp_path,
+        """\
+        servos:
+          chip: maestro
+          joints:
+            neck: {channel: 0, min_deg: 60, max_deg: -60, max_speed_dps: 90}
+        """,
+    )
+    assert found == [
+        "robot.yaml:9:35: joint 'neck': limits inverted, min_deg 60 is not below max_deg -60 "
+        "(swap them)"
+    ]
+
+
+def test_a_joint_on_a_channel_the_maestro_lacks_is_refused(tmp_path):
+    found = problems(
+        tmp_path,
+        """\
+        servos:
+          chip: maestro
+          channels: 6
+          joints:
+            neck: {channel: 7, min_deg: -60, max_deg: 60, max_speed_dps: 90}
+        """,
+    )
+    assert found == [
+        "robot.yaml:10:23: joint 'neck': channel 7 is beyond the Maestro's 6 channels (0..5)"
+    ]
+
+
+def test_a_calibration_table_that_does_not_increase_points_at_the_point(tmp_path):
+    found = problems(
+        tmp_path,
+        """\
+        force:
+          chip: ads1115
+          pads:
+            left:
+              channel: 0
+              calibration: [[0.0, 0.0], [2.0, 1.0], [1.5, 3.0]]
+        """,
+    )
+    assert found == [
+        "robot.yaml:11:47: calibration is not increasing: point 3 has 1.5 V after 2 V "
+        "(list the points by strictly increasing volts)"
+    ]
+
+
+def test_a_calibration_whose_force_falls_is_refused(tmp_path):
+    found = problems(
+        tmp_path,
+        """\
+        force:
+          chip: ads1115
+          pads:
+            left: {channel: 0, calibration: [[0.0, 0.0], [2.0, 5.0], [3.0, 4.0]]}
+        """,
+    )
+    assert len(found) == 1
+    assert found[0].startswith("robot.yaml:9:64: calibration is not increasing: point 3 has 4 N")
+
+
+def test_two_pads_on_one_channel_are_refused(tmp_path):
+    found = problems(
+        tmp_path,
+        """\
+        force:
+          chip: ads1115
+          pads:
+            left: {channel: 0, calibration: [[0.0, 0.0], [3.0, 6.0]]}
+            right: {channel: 0, calibration: [[0.0, 0.0], [3.0, 6.0]]}
+        """,
+    )
+    assert found == [
+        "robot.yaml:10:14: pad 'right' uses channel 0, already used by pad 'left' "
+        "(give each pad its own channel)"
+    ]
+
+
+def test_an_unknown_blackboard_key_suggests_the_nearest(tmp_path):
+    found = problems(tmp_path, "touch: {chip: mpr121, keys: {any: /sensors/touch/anny}}\n")
+    assert found == [
+        "robot.yaml:6:37: 'any' unknown blackboard key '/sensors/touch/anny' "
+        "(did you mean '/sensors/touch/any'?)"
+    ]
+
+
+def test_a_sensor_read_on_request_takes_no_poll_rate(tmp_path):
+    found = problems(tmp_path, "temperature: {chip: mcp9808, rate_hz: 5}\n")
+    assert found == [
+        "robot.yaml:6:32: mcp9808 is not polled (temperature is read on request or commanded) "
+        "(remove 'rate_hz')"
+    ]
+
+
+def test_a_chip_on_the_wrong_kind_of_bus_is_refused(tmp_path):
+    found = problems(tmp_path, "touch: {chip: mpr121, bus: servos}\n")
+    assert found == [
+        "robot.yaml:6:30: mpr121 is on I2C, but bus 'servos' is serial (name a bus of kind i2c)"
+    ]
+
+
+def test_three_range_sensors_without_xshut_lines_cannot_share_a_bus(tmp_path):
+    found = problems(
+        tmp_path,
+        """\
+        range_left: {chip: vl53l0x, side: left}
+        range_right: {chip: vl53l0x, side: right}
+        """,
+    )
+    assert found == [
+        "robot.yaml:7:3: 2 VL53L0X share bus 'i2c' but 'range_left', 'range_right' has no "
+        "XSHUT line; every chip boots at 0x29 (give each its own XSHUT line, or put them "
+        "behind a TCA9548A)",
+        "robot.yaml:7:3: I2C 0x29 on bus 'i2c' is used by both 'range_left' (line 6) and "
+        "'range_right' (give each device its own address)",
+    ]
+
+
+def test_only_the_last_chip_of_an_xshut_chain_may_stay_at_0x29(tmp_path):
+    found = problems(
+        tmp_path,
+        """\
+        range_left: {chip: vl53l0x, side: left, xshut: 17}
+        range_right: {chip: vl53l0x, side: right, address: 0x30, xshut: 27}
+        """,
+    )
+    assert found == [
+        "robot.yaml:6:3: VL53L0X 'range_left' stays at 0x29, where the chips switched on after "
+        "it boot (give it another address, or list it last)"
+    ]
+
+
+def test_range_sensors_behind_a_mux_may_all_keep_0x29(tmp_path):
+    config = load(
+        tmp_path,
+        """\
+        mux: {chip: tca9548a, address: 0x71}
+        range_left: {chip: vl53l0x, side: left, mux: mux, channel: 0}
+        range_right: {chip: vl53l0x, side: right, mux: mux, channel: 1}
+        """,
+    )
+    assert [d.mux_channel for d in config.with_role("range")] == [0, 1]
+
+
+def test_a_mux_that_is_not_there_is_named(tmp_path):
+    found = problems(
+        tmp_path,
+        """\
+        mux: {chip: tca9548a, address: 0x71}
+        range_left: {chip: vl53l0x, side: left, mux: mx, channel: 0}
+        """,
+    )
+    assert found == [
+        "robot.yaml:7:48: 'mx' is not a tca9548a device of this config (did you mean 'mux'?)"
+    ]
+
+
+def test_gesture_names_map_the_chip_s_names_to_the_trees(tmp_path):
+    config = load(tmp_path, "gesture: {chip: zx_gesture, gesture_names: {swipe_left: wave}}\n")
+    assert config.device("gesture").gesture_names["swipe_left"] == "wave"
+    assert config.device("gesture").gesture_names["swipe_right"] == "swipe_right"
+
+    found = problems(tmp_path, "gesture: {chip: zx_gesture, gesture_names: {swipe_left: wav}}\n")
+    assert len(found) == 1 and found[0].endswith("(did you mean 'wave'?)")
+
+
+def test_every_problem_is_reported_at_once(tmp_path):
+    found = problems(
+        tmp_path,
+        """\
+        touch: {chip: mpr121, address: 0x48}
+        range: {chip: vl53l0x}
+        leds: {chip: pca9685}
+        """,
+    )
+    assert [line.split(": ", 1)[0] for line in found] == [
+        "robot.yaml:6:34",
+        "robot.yaml:7:3",
+        "robot.yaml:8:3",
+    ]
+
+
+def test_a_config_without_devices_or_buses_says_what_it_needs(tmp_path):
+    found = problems(tmp_path, "", head="name: empty\n")
+    assert found == [
+        "robot.yaml:1:1: a robot config needs 'buses:' (e.g. i2c: {kind: i2c, number: 1})",
+        "robot.yaml:1:1: a robot config needs 'devices:' (e.g. touch: {chip: mpr121})",
+    ]

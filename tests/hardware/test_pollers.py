@@ -1,0 +1,248 @@
+"""Pollers: at their rate, onto the blackboard, through a device failing and coming back."""
+
+from __future__ import annotations
+
+import threading
+from typing import Any
+
+import pytest
+
+from engine.clock import RealClock, VirtualClock
+from engine.drivers.bus_manager import BusManager
+from engine.drivers.sim.i2c_bus import SimI2CBus
+from engine.drivers.sim.mcp3008 import SimMCP3008
+from engine.drivers.sim.mpr121 import SimMPR121
+from engine.drivers.sim.spi_bus import SimSpiDev
+from engine.drivers.sim.zx_gesture import SimZXGesture
+from engine.hardware.config import DeviceConfig, ForcePad
+from engine.hardware.managed import DeviceHealth
+from engine.hardware.pollers import Poller, PollerThreads, Staged, make_poller
+from engine.hardware.sim_vest import SpiSocket
+from engine.hardware.timing import BranchingClock
+from engine.loader.problems import Mark
+
+HERE = Mark("test", 1, 1)
+
+
+class RecordingBoard:
+    """A blackboard that keeps what was staged, in order."""
+
+    def __init__(self) -> None:
+        self.staged: list[tuple[str, Any, bool]] = []
+        self.changed = threading.Event()
+
+    def stage(self, key: str, value: Any) -> None:
+        self.staged.append((key, value, False))
+        self.changed.set()
+
+    def stage_event(self, key: str, value: Any) -> None:
+        self.staged.append((key, value, True))
+        self.changed.set()
+
+    def last(self, key: str) -> Any:
+        return next(value for k, value, _ in reversed(self.staged) if k == key)
+
+
+class Bench:
+    """One simulated I2C bus and its inline bus manager, on a virtual clock."""
+
+    def __init__(self) -> None:
+        self.base = VirtualClock()
+        self.clock = BranchingClock(self.base)
+        self.bus = SimI2CBus(self.clock)
+        self.board = RecordingBoard()
+        self.health: dict[str, DeviceHealth] = {}
+        self.manager = BusManager(
+            self.bus,
+            name="1",
+            clock=self.clock,
+            threaded=False,
+            on_status=lambda device, ok: self.health[device].bus_status(ok),
+        )
+
+    def poller(self, device: DeviceConfig) -> Poller[Any]:
+        self.health[device.name] = DeviceHealth(device.name, self.board)  # type: ignore[arg-type]
+        handle = self.manager.claim(device.name, device.address)
+        poller = make_poller(
+            device,
+            handle,
+            clock=self.clock,
+            blackboard=self.board,  # type: ignore[arg-type]
+            health=self.health[device.name],
+        )
+        poller.connect()  # as at start-up: a chip calibrates on what it senses then
+        return poller
+
+    def run(self, poller: Poller[Any], seconds: float, step_s: float = 0.01) -> None:
+        """Call the hook now and every ``step_s`` for ``seconds``, as a scheduler would."""
+        end = self.base.now() + seconds
+        while self.base.now() < end - 1e-9:
+            poller(self.base.now())
+            self.base.advance(step_s)
+
+
+@pytest.fixture
+def bench() -> Bench:
+    return Bench()
+
+
+TOUCH = DeviceConfig(
+    name="touch",
+    chip="mpr121",
+    bus="i2c",
+    mark=HERE,
+    address=0x5A,
+    rate_hz=10.0,
+    keys={"pads": "/sensors/touch/pads", "any": "/sensors/touch/any"},
+    options={"touch_threshold": 12, "release_threshold": 6},
+)
+
+
+def test_a_hook_polls_on_its_own_deadlines_not_every_call(bench: Bench):
+    bench.bus.attach(SimMPR121())
+    poller = bench.poller(TOUCH)
+
+    bench.run(poller, 1.0, step_s=0.025)  # 40 scheduler steps
+
+    assert poller.polls == 10  # 10 Hz
+
+
+def test_a_late_hook_skips_the_polls_it_missed(bench: Bench):
+    bench.bus.attach(SimMPR121())
+    poller = bench.poller(TOUCH)
+    poller(bench.base.now())
+
+    bench.base.advance(0.55)
+    poller(bench.base.now())
+
+    assert poller.polls == 2
+    assert poller.next_due_s == pytest.approx(0.6)
+
+
+def test_a_touched_pad_is_staged_as_pads_and_any(bench: Bench):
+    chip = bench.bus.attach(SimMPR121())
+    poller = bench.poller(TOUCH)
+    chip.touch(2)  # type: ignore[attr-defined]
+
+    bench.run(poller, 0.1)
+
+    pads = bench.board.last("/sensors/touch/pads")
+    assert [pad for pad, on in enumerate(pads) if on] == [2]
+    assert bench.board.last("/sensors/touch/any") is True
+
+
+def test_an_unplugged_chip_goes_offline_rests_its_readings_and_comes_back(bench: Bench):
+    chip = bench.bus.attach(SimMPR121())
+    poller = bench.poller(TOUCH)
+    chip.touch(2)  # type: ignore[attr-defined]
+    bench.run(poller, 0.2)
+    assert bench.board.last("/sensors/touch/any") is True
+
+    bench.bus.inject("unplugged", 1.0, 0x5A)
+    bench.run(poller, 0.5)
+
+    assert bench.board.last("/devices/touch/ok") is False
+    assert bench.board.last("/sensors/touch/any") is False
+    assert poller.driver is None  # made again once the chip answers
+
+    chip.touch(2, False)  # type: ignore[attr-defined]
+    bench.run(poller, 3.0)  # the unplug ends; the re-probe (every 2 s) finds it
+    assert bench.board.last("/devices/touch/ok") is True
+    chip.touch(7)  # type: ignore[attr-defined]
+    bench.run(poller, 0.2)
+    assert bench.board.last("/sensors/touch/pads")[7] is True
+
+
+def test_a_chip_answering_nonsense_is_marked_not_ok_though_the_bus_is_fine(bench: Bench):
+    adc = SimMCP3008()
+    socket = SpiSocket(adc, bench.clock)
+    node = SimSpiDev(socket, 0, 0)
+    spi_manager = BusManager(
+        node,
+        name="0.0",
+        kind="SPI",
+        clock=bench.clock,
+        threaded=False,
+        on_status=lambda device, ok: bench.health[device].bus_status(ok),
+    )
+    device = DeviceConfig(
+        name="force",
+        chip="mcp3008",
+        bus="spi",
+        mark=HERE,
+        rate_hz=10.0,
+        options={"vref_v": 3.3, "max_speed_hz": 1_000_000},
+        pads=(ForcePad("left", 0, "/sensors/force/left_n", ((0.0, 0.0), (3.3, 10.0)), HERE),),
+    )
+    bench.health["force"] = DeviceHealth("force", bench.board)  # type: ignore[arg-type]
+    poller = make_poller(
+        device,
+        spi_manager.claim("force"),
+        clock=bench.clock,
+        blackboard=bench.board,  # type: ignore[arg-type]
+        health=bench.health["force"],
+    )
+    adc.set_input_volts(0, 1.65)
+    bench.run(poller, 0.1)
+    assert bench.board.last("/sensors/force/left_n") == pytest.approx(5.0, abs=0.02)
+
+    socket.inject("unplugged", 1.0)  # MISO pulled high: the null bit is never low
+    bench.run(poller, 0.5)
+
+    assert bench.board.last("/devices/force/ok") is False
+    assert bench.board.last("/sensors/force/left_n") == 0.0
+    assert "null bit" in (poller.last_error or "")
+    bench.run(poller, 1.0)
+    assert bench.board.last("/devices/force/ok") is True
+
+
+def test_each_gesture_is_one_event_named_as_the_config_says(bench: Bench):
+    zx = bench.bus.attach(SimZXGesture(bench.clock))
+    device = DeviceConfig(
+        name="gesture",
+        chip="zx_gesture",
+        bus="i2c",
+        mark=HERE,
+        address=0x10,
+        rate_hz=20.0,
+        keys={"gesture": "/sensors/gesture/last"},
+        gesture_names={"swipe_left": "wave", "swipe_up": "swipe_up"},
+    )
+    poller = bench.poller(device)
+
+    zx.perform("swipe_left")  # type: ignore[attr-defined]
+    bench.run(poller, 0.5)
+    zx.perform("swipe_up")  # type: ignore[attr-defined]
+    bench.run(poller, 0.5)
+
+    events = [(key, value) for key, value, event in bench.board.staged if event]
+    assert events == [("/sensors/gesture/last", "wave"), ("/sensors/gesture/last", "swipe_up")]
+
+
+def test_pollers_on_threads_poll_by_themselves():
+    clock = RealClock()
+    board = RecordingBoard()
+    reads: list[int] = []
+
+    def read(driver: object) -> list[Staged]:
+        reads.append(1)
+        return [Staged("/sensors/touch/any", True)]
+
+    poller: Poller[object] = Poller(
+        "touch",
+        rate_hz=50.0,
+        clock=clock,
+        blackboard=board,  # type: ignore[arg-type]
+        health=DeviceHealth("touch", None),
+        connect=object,
+        read=read,
+    )
+    threads = PollerThreads([poller], clock)
+    threads.start()
+    try:
+        assert board.changed.wait(timeout=5.0)
+    finally:
+        threads.stop()
+
+    assert not threads.running
+    assert reads and board.last("/sensors/touch/any") is True
