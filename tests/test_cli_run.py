@@ -8,6 +8,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 from engine.cli import main
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -43,7 +45,8 @@ def test_every_demo_event_is_answered_by_the_right_behavior_once(capsys, monkeyp
         ("cmd-8", "succeeded"),
         ("cmd-9", "succeeded"),
     ]
-    assert reports[1]["result"]["/sensors/temperature/c"] == 22.2
+    # read through the simulated MCP9808, which resolves 1/16 degC
+    assert reports[1]["result"]["/sensors/temperature/c"] == pytest.approx(22.2, abs=0.0625)
 
 
 def test_json_lines_carry_time_tree_action_and_args(capsys, monkeypatch):
@@ -119,3 +122,39 @@ def test_sigterm_stops_a_real_time_run_cleanly_with_its_statistics():
     assert process.returncode == 0, err
     assert "tick p99" in out
     assert "Traceback" not in err
+
+
+def test_unplugging_the_touch_sensor_mid_run_keeps_the_other_behaviors_and_touch_returns(
+    capsys, monkeypatch
+):
+    monkeypatch.chdir(ROOT)
+    actions = run_json(capsys, "--scenario", "examples/scenarios/unplug_touch.yaml")
+    said = [(round(a["t"]), a["tree"], a["args"]["text"]) for a in actions if a["action"] == "say"]
+    assert said == [
+        (1, "touch_thanks", "Thank you"),
+        (4, "hug", "I love hugs!"),
+        (9, "touch_thanks", "Thank you"),
+    ]
+
+
+def test_a_fault_for_a_device_the_robot_does_not_have_is_reported_with_its_place(
+    tmp_path, capsys, monkeypatch
+):
+    monkeypatch.chdir(ROOT)
+    scenario = tmp_path / "fault.yaml"
+    scenario.write_text("duration_s: 5\nevents:\n  - {at: 1.0, unplug: {device: tuoch}}\n")
+    assert main(["run", "--fast", "--scenario", str(scenario)]) == 1
+    err = capsys.readouterr().err
+    assert f"{scenario}:3:" in err
+    assert "'tuoch'" in err
+    assert "touch" in err
+
+
+def test_vest_devices_probes_every_device_of_the_simulated_vest(capsys, monkeypatch):
+    monkeypatch.chdir(ROOT)
+    assert main(["devices"]) == 0
+    out = capsys.readouterr().out
+    assert "touch         mpr121" in out
+    assert "answers as mcp9808" in out
+    assert "22.00 degC" in out
+    assert "answers as a Maestro" in out

@@ -11,7 +11,14 @@ import logging
 import sys
 from collections.abc import Sequence
 
-from engine.cli import keys_command, nodes_command, render_command, run_command, validate_command
+from engine.cli import (
+    devices_command,
+    keys_command,
+    nodes_command,
+    render_command,
+    run_command,
+    validate_command,
+)
 from engine.errors import VestError
 from engine.loader.problems import LoadError
 
@@ -29,7 +36,14 @@ def build_parser() -> argparse.ArgumentParser:
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     commands = parser.add_subparsers(dest="command", metavar="COMMAND")
-    for module in (run_command, validate_command, render_command, nodes_command, keys_command):
+    for module in (
+        run_command,
+        validate_command,
+        render_command,
+        nodes_command,
+        keys_command,
+        devices_command,
+    ):
         sub = commands.add_parser(
             module.NAME,
             help=module.HELP,

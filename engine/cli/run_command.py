@@ -1,6 +1,9 @@
 """Run the robot's behaviors on a scripted scenario and print what it does.
 
-Without arguments: every tree in trees/ on examples/scenarios/demo.yaml, in real time.
+Without arguments: every tree in trees/ on examples/scenarios/demo.yaml, in real time,
+through the simulated vest (examples/robots/sim.yaml): the scenario moves register-level
+chip models that the real drivers read. --hardware CONFIG names a robot config; on a robot
+(e.g. examples/robots/hbs2.yaml) the same drivers read the real chips.
 --fast runs on a virtual clock as fast as the machine allows; --json prints one JSON
 object per robot action: {"t": seconds, "tree": name, "action": ..., "args": {...}}.
 In real time, a changed tree file is reloaded between ticks (an invalid change keeps the
@@ -22,13 +25,16 @@ from engine.blackboard.catalogue import default_catalogue
 from engine.cli.timeline import Timeline
 from engine.clock import Clock, RealClock, VirtualClock
 from engine.errors import ConfigError
+from engine.hardware.assembly import build_hardware
+from engine.hardware.config import load_robot_config
+from engine.hardware.sim_vest import UnwiredSenses, build_sim_vest, check_fault_events
 from engine.loader.problems import LoadError, Mark, Problem
 from engine.runtime.reload import TreeReloader
 from engine.runtime.robot import Robot, load_behaviors
 from engine.runtime.scheduler import Scheduler
 from engine.scenario.player import ScenarioPlayer
 from engine.scenario.scenario_file import load_scenario
-from engine.scenario.world import BlackboardSenses, World
+from engine.scenario.world import World
 from engine.services.actions import ActionLog
 from engine.services.simulated import simulated_services
 
@@ -70,6 +76,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--fast", action="store_true", help="virtual clock: run as fast as the machine allows"
     )
     parser.add_argument("--json", action="store_true", help="one JSON object per action")
+    parser.add_argument(
+        "--hardware",
+        type=Path,
+        default=Path("examples/robots/sim.yaml"),
+        metavar="CONFIG",
+        help="robot config (default: examples/robots/sim.yaml, the simulated vest)",
+    )
 
 
 def _positive_seconds(text: str) -> float:
@@ -108,28 +121,48 @@ def main(args: argparse.Namespace) -> int:
         args.trees, dialogs_dir=dialogs, profile=resolve_profile(args.profile, args.trees)
     )
     scenario = load_scenario(args.scenario)
+    config = load_robot_config(args.hardware)
+    problems = check_fault_events(scenario.events, config)
+    if problems:
+        raise LoadError(problems)
+    if args.fast and not config.simulated:
+        raise ConfigError(f"{args.hardware}: --fast needs a simulated vest (simulated: true)")
     clock: Clock = VirtualClock() if args.fast else RealClock()
-    start_s = clock.now()
     blackboard = Blackboard(default_catalogue(), clock)
     blackboard.reset()
     world = World()
-    senses = BlackboardSenses(blackboard, world)
-    world.listeners.append(senses)
-    senses.start()
-    timeline = Timeline(sys.stdout, start_s=start_s, as_json=args.json)
-    log = ActionLog(listeners=[timeline.action])
-    services = simulated_services(clock, readers=senses.readers(), realistic=True)
-    robot = Robot(behaviors, clock=clock, services=services, blackboard=blackboard, action_log=log)
-    player = ScenarioPlayer(scenario, world, start_s=start_s, on_event=timeline.world)
-    robot.scheduler.hooks.append(player)
-    if not args.fast:
-        robot.scheduler.hooks.append(TreeReloader(behaviors.loader, robot.trees, clock))
-
-    duration = args.duration if args.duration is not None else scenario.duration_s
-    with _stopped_by_signals(robot.scheduler):
-        timeline.start()
-        robot.scheduler.run(until_s=start_s + duration)
-    timeline.summary(robot.trees)
+    vest = build_sim_vest(config, world, clock) if config.simulated else None
+    world.listeners.append(UnwiredSenses(blackboard))  # speech and cloud have no devices yet
+    hardware = build_hardware(config, clock, blackboard, vest=vest)
+    try:
+        start_s = clock.now()  # after start-up, which takes simulated time too
+        timeline = Timeline(sys.stdout, start_s=start_s, as_json=args.json)
+        for problem in hardware.startup_problems:
+            print(f"warning: {problem}", file=sys.stderr)
+        log = ActionLog(listeners=[timeline.action])
+        simulated = simulated_services(clock, realistic=True)
+        services = hardware.services(speech=simulated.speech, iot=simulated.iot, fallback=simulated)
+        robot = Robot(
+            behaviors, clock=clock, services=services, blackboard=blackboard, action_log=log
+        )
+        timeline.on_closed = robot.scheduler.stop
+        # the world moves first, then the pollers read it, then the trees tick
+        robot.scheduler.hooks.append(
+            ScenarioPlayer(scenario, world, start_s=start_s, on_event=timeline.world)
+        )
+        robot.scheduler.hooks.extend(hardware.hooks)
+        if not args.fast:
+            robot.scheduler.hooks.append(TreeReloader(behaviors.loader, robot.trees, clock))
+        hardware.start()
+        duration = args.duration if args.duration is not None else scenario.duration_s
+        with _stopped_by_signals(robot.scheduler):
+            timeline.start()
+            robot.scheduler.run(until_s=start_s + duration)
+        timeline.summary(robot.trees)
+    finally:
+        hardware.close()
+        if vest is not None:
+            vest.close()
     return 0
 
 

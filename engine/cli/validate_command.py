@@ -1,4 +1,4 @@
-"""Check YAML files: trees, subtrees, profiles, dialogs and scenarios.
+"""Check YAML files: trees, subtrees, profiles, dialogs, scenarios and robot configs.
 
 Give files or folders (searched recursively for *.yaml). Prints "ok" when everything is
 valid; otherwise every problem as file:line:column: message (hint), and exits 1.
@@ -11,6 +11,7 @@ from pathlib import Path
 
 from engine.blackboard.catalogue import KeyCatalogue, default_catalogue
 from engine.dialogs.library import DialogLibrary, check_dialog, find_dialogs_folder
+from engine.hardware.config import check_robot_config
 from engine.loader.problems import LoadError, Mark, Problem, Problems
 from engine.loader.substitution import Profile, load_profile, read_params
 from engine.loader.tree_file import TreeLoader
@@ -61,6 +62,8 @@ def kind_of(document: object) -> str | None:
         return "dialog"
     if "events" in document or "duration_s" in document:
         return "scenario"
+    if "devices" in document or "buses" in document:
+        return "robot config"
     return None
 
 
@@ -107,13 +110,15 @@ class Validator:
                 check_dialog(document, str(path), self.catalogue, default_name=path.stem)
             elif kind == "scenario":
                 check_scenario(document, str(path), path)
+            elif kind == "robot config":
+                check_robot_config(document, str(path), path, catalogue=self.catalogue)
             else:
                 where = document.mark if document is not None else Mark(str(path), 1, 1)
                 self.problems.add(
                     where,
                     "cannot tell what this file is",
                     "a tree has 'root:', a profile 'profile:', a dialog 'rules:', "
-                    "a scenario 'events:'",
+                    "a scenario 'events:', a robot config 'devices:'",
                 )
         except LoadError as error:
             self.problems.extend(error.problems)

@@ -77,6 +77,8 @@ def changes_of(event: ScenarioEvent) -> list[tuple[float, Change]]:
         ]
     if event.kind == "gesture":
         return [(at, _happen("gesture", value))]
+    if event.kind in ("unplug", "fault"):
+        return [(at, _happen(event.kind, dict(value)))]
     if event.kind == "hear":
         return [(at, _happen("hear", value))]
     if event.kind == "cloud":

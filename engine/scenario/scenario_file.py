@@ -75,6 +75,17 @@ EVENT_FIELDS: dict[str, tuple[Param, ...] | ParamType] = {
         Param("seconds", _SECONDS, 5.0, "how long it stays"),
     ),
     "hear": Text(),
+    "unplug": (
+        Param("device", Text(), REQUIRED, "a device of the robot config"),
+        Param("seconds", _SECONDS, 3.0, "how long it stays unplugged"),
+    ),
+    "fault": (
+        Param("device", Text(), REQUIRED, "a device of the robot config"),
+        Param(
+            "kind", Choice(("nack", "unplugged", "garbage", "hold")), REQUIRED, "what goes wrong"
+        ),
+        Param("seconds", _SECONDS, 1.0, "how long"),
+    ),
     "cloud": (
         Param("type", Text(), REQUIRED, "command type: say, led, move, read"),
         Param("args", AnyValue(), None, "the command's arguments"),
@@ -111,6 +122,10 @@ class ScenarioEvent:
             return f"room at {value['c']:.1f} degC"
         if self.kind == "ultrasound":
             return f"object {value['cm']:g} cm ahead for {value['seconds']:g} s"
+        if self.kind == "unplug":
+            return f"{value['device']} unplugged for {value['seconds']:g} s"
+        if self.kind == "fault":
+            return f"{value['device']}: {value['kind']} for {value['seconds']:g} s"
         if self.kind == "hear":
             return f"someone says {value!r}"
         if self.kind == "cloud":

@@ -77,7 +77,9 @@ class BlackboardSenses:
                 self.blackboard.stage(f"/sensors/range/{side}_mm", world.range_mm[side])
 
     def world_event(self, kind: str, value: Any) -> None:
-        self.blackboard.stage_event(EVENT_KEYS[kind], value)
+        key = EVENT_KEYS.get(kind)
+        if key is not None:  # unplug and fault concern devices, which this view has none of
+            self.blackboard.stage_event(key, value)
 
     def start(self) -> None:
         """Stage the world's initial state."""

@@ -1,0 +1,55 @@
+"""List the robot's configured devices, probe each, and show its identity and one reading.
+
+On the simulated vest (the default config) it works the same as on the robot: the real
+drivers talk to register-level chip models. Exits 1 when a device does not answer as the
+chip it should be.
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from engine.clock import Clock, RealClock, VirtualClock
+from engine.hardware.assembly import build_hardware
+from engine.hardware.config import load_robot_config
+from engine.hardware.devices_command import describe_devices, format_rows
+from engine.hardware.sim_vest import build_sim_vest
+from engine.scenario.world import World
+
+NAME = "devices"
+HELP = "probe the robot's devices and read each once"
+
+# the MCP9808's first conversion takes 250 ms; a simulated vest is given that long first
+SIMULATED_WARM_UP_S = 0.3
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--hardware",
+        type=Path,
+        default=Path("examples/robots/sim.yaml"),
+        metavar="CONFIG",
+        help="robot config (default: examples/robots/sim.yaml, the simulated vest)",
+    )
+
+
+def main(args: argparse.Namespace) -> int:
+    config = load_robot_config(args.hardware)
+    clock: Clock = VirtualClock() if config.simulated else RealClock()
+    vest = build_sim_vest(config, World(), clock) if config.simulated else None
+    hardware = build_hardware(config, clock, None, vest=vest)
+    try:
+        if vest is not None:
+            vest.clock.sleep(SIMULATED_WARM_UP_S)
+        rows = describe_devices(hardware)
+    finally:
+        hardware.close()
+        if vest is not None:
+            vest.close()
+    print(format_rows(rows))
+    failing = [row.name for row in rows if not row.ok]
+    if failing:
+        print(f"{len(failing)} device(s) not answering: {', '.join(failing)}")
+        return 1
+    return 0
