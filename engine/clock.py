@@ -29,7 +29,7 @@ class Clock(Protocol):
         ...
 
     def wake(self) -> None:
-        """Cut short any sleep in progress (used for a prompt shutdown)."""
+        """Cut short any sleep in progress, and every later one: the engine is shutting down."""
         ...
 
 
