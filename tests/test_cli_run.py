@@ -158,3 +158,14 @@ def test_vest_devices_probes_every_device_of_the_simulated_vest(capsys, monkeypa
     assert "answers as mcp9808" in out
     assert "22.00 degC" in out
     assert "answers as a Maestro" in out
+
+
+def test_a_misspelt_profile_parameter_stops_the_run_with_its_place(tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(ROOT)
+    profile = tmp_path / "kid.yaml"
+    profile.write_text("profile: kid\nparams:\n  hug_treshold_n: 2.0\n")
+    assert main(["run", "--fast", "--profile", str(profile)]) == 1
+    assert (
+        f"{profile}:3:19: no tree in the trees declares parameter 'hug_treshold_n' "
+        "(did you mean 'hug_threshold_n'?)"
+    ) in capsys.readouterr().err

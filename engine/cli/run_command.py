@@ -153,11 +153,12 @@ def main(args: argparse.Namespace) -> int:
         robot.scheduler.hooks.extend(hardware.hooks)
         if not args.fast:
             robot.scheduler.hooks.append(TreeReloader(behaviors.loader, robot.trees, clock))
-        hardware.start()
         duration = args.duration if args.duration is not None else scenario.duration_s
         with _stopped_by_signals(robot.scheduler):
             timeline.start()
-            robot.scheduler.run(until_s=start_s + duration)
+            first_tick_s = clock.now()
+            hardware.start(origin_s=first_tick_s)  # readings staged just before each tick
+            robot.scheduler.run(until_s=start_s + duration, start_s=first_tick_s)
         timeline.summary(robot.trees)
     finally:
         hardware.close()

@@ -13,10 +13,9 @@ from engine.blackboard.catalogue import KeyCatalogue, default_catalogue
 from engine.dialogs.library import DialogLibrary, check_dialog, find_dialogs_folder
 from engine.hardware.config import check_robot_config
 from engine.loader.problems import LoadError, Mark, Problem, Problems
-from engine.loader.substitution import Profile, load_profile, read_params
+from engine.loader.substitution import Profile, load_profile, read_params, undeclared_params
 from engine.loader.tree_file import TreeLoader
 from engine.loader.yaml_source import YMap, load_yaml
-from engine.nodes.params import did_you_mean
 from engine.nodes.registry import NodeRegistry, default_registry
 from engine.runtime.robot import tree_files
 from engine.scenario.scenario_file import check_scenario
@@ -130,22 +129,22 @@ class Validator:
         declared: set[str] = set()
         for tree in tree_files([trees_folder]):
             try:
-                document = load_yaml(tree)
-            except LoadError:
-                continue  # the tree's own problems are reported when it is validated
-            if isinstance(document, YMap):
-                declared.update(read_params(document.get("params"), Problems()))
-            try:
-                self.loader_for(tree, profile).load(tree)
-            except LoadError as error:
+                declared |= self.loader_for(tree, profile).load(tree).declared_params
+            except LoadError as error:  # the tree's own problems come when it is validated
                 self.problems.extend([p for p in error.problems if p.mark.file == str(path)])
-        for name, value in profile.params.items():
-            if name not in declared:
-                self.problems.add(
-                    value.source,
-                    f"no tree in {trees_folder}/ declares parameter {name!r}",
-                    did_you_mean(name, sorted(declared)) or "check the spelling",
-                )
+                declared |= _declared_names(tree)
+        self.problems.extend(undeclared_params(profile, declared, f"{trees_folder}/"))
+
+
+def _declared_names(tree: Path) -> set[str]:
+    """The parameter names a tree file that does not load declares, as far as readable."""
+    try:
+        document = load_yaml(tree)
+    except LoadError:
+        return set()
+    if not isinstance(document, YMap):
+        return set()
+    return set(read_params(document.get("params"), Problems()))
 
 
 def main(args: argparse.Namespace) -> int:

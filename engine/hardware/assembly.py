@@ -238,11 +238,14 @@ class Hardware:
             with branch_of(self.clock):
                 manager.run_due_probes()
 
-    def start(self) -> None:
-        """Threaded: start the poller threads (inline, the hooks poll)."""
+    def start(self, origin_s: float | None = None) -> None:
+        """Threaded: start the poller threads (inline, the hooks poll).
+
+        ``origin_s``: the trees' first deadline, so readings are staged just before ticks.
+        """
         if self.threaded and self._threads is None:
             self._threads = PollerThreads(self.pollers, self.clock)
-            self._threads.start()
+            self._threads.start(origin_s)
 
     def stop(self) -> None:
         """Stop the poller threads, if running."""

@@ -32,6 +32,7 @@ from __future__ import annotations
 import logging
 import math
 import threading
+from collections import deque
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 from typing import Any, Generic, TypeVar
@@ -212,6 +213,11 @@ class Poller(Generic[D]):
                 self.blackboard.stage(write.key, write.value)
 
 
+POLL_MARGIN_S = 0.003
+"""How long before the trees' deadline a threaded poll aims to have staged its reading."""
+POLL_DURATION_WINDOW = 16
+
+
 class PollerThreads:
     """Runs pollers on threads of their own, each at its rate, until :meth:`stop`.
 
@@ -225,11 +231,19 @@ class PollerThreads:
         self._stop = threading.Event()
         self._threads: list[threading.Thread] = []
 
-    def start(self) -> None:
+    def start(self, origin_s: float | None = None) -> None:
+        """Start one thread per poller.
+
+        ``origin_s`` is the trees' first deadline (clock seconds): each poller then reads
+        its device so that the reading is staged just before the trees' deadlines rather
+        than just after them, which would cost the reading a whole tree period.
+        """
         if self._threads:
             return
         self._stop.clear()
         for poller in self.pollers:
+            if origin_s is not None:
+                poller.origin_s, poller.period_index = origin_s, 0
             thread = threading.Thread(
                 target=self._run, args=(poller,), name=f"poller-{poller.name}", daemon=True
             )
@@ -239,12 +253,18 @@ class PollerThreads:
     def _run(self, poller: Poller[Any]) -> None:
         if poller.origin_s is None:
             poller.origin_s = self.clock.now()
+        durations_s: deque[float] = deque(maxlen=POLL_DURATION_WINDOW)
         while not self._stop.is_set():
-            wait_s = poller.next_due_s - self.clock.now()
+            # start early by the longest recent poll, so the reading is ready at the deadline
+            lead_s = max(durations_s, default=0.0) + POLL_MARGIN_S
+            wait_s = poller.next_due_s - lead_s - self.clock.now()
             if wait_s > 0 and self._stop.wait(wait_s):
                 return
+            started_s = self.clock.now()
             poller.poll_once()
-            poller._advance(self.clock.now())
+            finished_s = self.clock.now()
+            durations_s.append(finished_s - started_s)
+            poller._advance(finished_s)
 
     def stop(self, timeout_s: float = 2.0) -> None:
         """Ask every thread to end and wait for them (``timeout_s`` real seconds each)."""

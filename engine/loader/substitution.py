@@ -179,3 +179,17 @@ def load_profile(path: Path, shown: str | None = None) -> Profile:
     problems.raise_if_any()
     text = description.value if isinstance(description, YScalar) else ""
     return Profile(profile_name, params, str(text or ""), path)
+
+
+def undeclared_params(profile: Profile, declared: set[str], trees: str) -> list[Problem]:
+    """A problem for each parameter ``profile`` sets that no tree in ``trees`` declares
+    (a misspelt name would otherwise be ignored without a word)."""
+    return [
+        Problem(
+            value.source,
+            f"no tree in {trees} declares parameter {name!r}",
+            did_you_mean(name, sorted(declared)) or "check the spelling",
+        )
+        for name, value in profile.params.items()
+        if name not in declared
+    ]

@@ -71,6 +71,8 @@ class TreeDefinition:
     root: NodeDefinition
     path: Path
     files: list[Path] = field(default_factory=list)
+    declared_params: frozenset[str] = frozenset()
+    """Parameter names this tree and its subtrees declare (what a profile may set)."""
 
     def build(self, ctx: TreeContext) -> py_trees.trees.BehaviourTree:
         """A fresh py_trees tree whose nodes use ``ctx``."""
@@ -80,6 +82,14 @@ class TreeDefinition:
 def _build(node: NodeDefinition, ctx: TreeContext) -> py_trees.behaviour.Behaviour:
     children = [_build(child, ctx) for child in node.children]
     return node.type.build(node.name, SimpleNamespace(**node.args), children, ctx)
+
+
+@dataclass
+class _Seen:
+    """What one load met on its way: the files read and the parameters they declare."""
+
+    files: list[Path] = field(default_factory=list)
+    declared: set[str] = field(default_factory=set)
 
 
 class TreeLoader:
@@ -112,8 +122,8 @@ class TreeLoader:
     def load(self, path: Path) -> TreeDefinition:
         """Validate the tree file at ``path``; LoadError listing every problem."""
         problems = Problems()
-        files: list[Path] = []
-        document = self._read(path, problems, files)
+        seen = _Seen()
+        document = self._read(path, problems, seen)
         if document is None:
             problems.raise_if_any()
             raise LoadError([])  # pragma: no cover - _read always reports why
@@ -131,21 +141,23 @@ class TreeLoader:
         params = self._params(document, problems, overrides=None, where="")
         rate_hz = self._rate(document, params, problems)
         description = document.get("description")
-        root = self._root(document, path, params, problems, [path.resolve()], files)
+        root = self._root(document, path, params, problems, [path.resolve()], seen)
         problems.raise_if_any()
         assert root is not None
         text = plain(description) if description is not None else ""
-        return TreeDefinition(name, rate_hz, str(text or ""), root, path, files)
+        return TreeDefinition(
+            name, rate_hz, str(text or ""), root, path, seen.files, frozenset(seen.declared)
+        )
 
     # -- file level -----------------------------------------------------------------------
-    def _read(self, path: Path, problems: Problems, files: list[Path]) -> YMap | None:
+    def _read(self, path: Path, problems: Problems, seen: _Seen) -> YMap | None:
         shown = self.shown(path)
         try:
             document = load_yaml(path, shown)
         except LoadError as error:
             problems.extend(error.problems)
             return None
-        files.append(path)
+        seen.files.append(path)
         if not isinstance(document, YMap):
             where = document.mark if document is not None else Mark(shown, 1, 1)
             problems.add(
@@ -161,6 +173,9 @@ class TreeLoader:
                     f"unknown field {key!r}",
                     did_you_mean(key, TOP_KEYS) or "fields: " + ", ".join(TOP_KEYS),
                 )
+        declared = document.get("params")
+        if isinstance(declared, YMap):
+            seen.declared.update(declared.entries)
         return document
 
     def _params(
@@ -218,17 +233,17 @@ class TreeLoader:
         params: dict[str, ParamValue],
         problems: Problems,
         stack: list[Path],
-        files: list[Path],
+        seen: _Seen,
     ) -> NodeDefinition | None:
         raw = document.get("root")
         if raw is None:
             problems.add(document.mark, "the tree has no 'root:'", "add root: with one node")
             return None
-        return self._node(substitute(raw, params, problems), path, problems, stack, files)
+        return self._node(substitute(raw, params, problems), path, problems, stack, seen)
 
     # -- nodes ----------------------------------------------------------------------------
     def _node(
-        self, raw: YValue, path: Path, problems: Problems, stack: list[Path], files: list[Path]
+        self, raw: YValue, path: Path, problems: Problems, stack: list[Path], seen: _Seen
     ) -> NodeDefinition | None:
         if not isinstance(raw, YMap) or len(raw) != 1:
             got = (
@@ -245,7 +260,7 @@ class TreeLoader:
         type_name, body = next(iter(raw.items()))
         mark = raw.key_marks[type_name]
         if type_name == SUBTREE:
-            return self._subtree(body, mark, path, problems, stack, files)
+            return self._subtree(body, mark, path, problems, stack, seen)
         node_type = self.registry.get(type_name)
         if node_type is None:
             suggestion = self.registry.suggest(type_name)
@@ -271,7 +286,7 @@ class TreeLoader:
         args, name, children_raw = self._arguments(
             node_type, params_raw, children_raw, mark, problems
         )
-        children = self._children(node_type, children_raw, mark, path, problems, stack, files)
+        children = self._children(node_type, children_raw, mark, path, problems, stack, seen)
         if args is None or children is None:
             return None
         return NodeDefinition(node_type, name, args, children, mark)
@@ -345,7 +360,7 @@ class TreeLoader:
         path: Path,
         problems: Problems,
         stack: list[Path],
-        files: list[Path],
+        seen: _Seen,
     ) -> list[NodeDefinition] | None:
         if node_type.children == "none":
             return []
@@ -360,7 +375,7 @@ class TreeLoader:
                     "wrap them in a Sequence",
                 )
                 return None
-            child = self._node(raw, path, problems, stack, files)
+            child = self._node(raw, path, problems, stack, seen)
             return [child] if child is not None else None
         if raw is None or not isinstance(raw, YList) or len(raw) == 0:
             problems.add(
@@ -368,7 +383,7 @@ class TreeLoader:
                 f"{node_type.name} needs a list of at least one child",
             )
             return None
-        children = [self._node(item, path, problems, stack, files) for item in raw]
+        children = [self._node(item, path, problems, stack, seen) for item in raw]
         if any(child is None for child in children):
             return None
         return [child for child in children if child is not None]
@@ -380,7 +395,7 @@ class TreeLoader:
         path: Path,
         problems: Problems,
         stack: list[Path],
-        files: list[Path],
+        seen: _Seen,
     ) -> NodeDefinition | None:
         if not isinstance(body, YMap) or not isinstance(body.get("file"), YScalar):
             problems.add(body.mark, "Subtree takes {file: path.yaml, params: {...}}")
@@ -402,7 +417,7 @@ class TreeLoader:
             )
             return None
         before = len(problems)
-        document = self._read(target, problems, files)
+        document = self._read(target, problems, seen)
         if document is None:
             if len(problems) > before:
                 # the included file's own problem names it; say where it was included from
@@ -410,7 +425,7 @@ class TreeLoader:
             return None
         overrides = read_params(body.get("params"), problems)
         params = self._params(document, problems, overrides, "Subtree")
-        root = self._root(document, target, params, problems, [*stack, target], files)
+        root = self._root(document, target, params, problems, [*stack, target], seen)
         raw_name = body.get("name")
         if root is not None and isinstance(raw_name, YScalar) and raw_name.value:
             root.name = str(raw_name.value)

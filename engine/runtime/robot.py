@@ -10,7 +10,7 @@ from engine.blackboard.catalogue import KeyCatalogue, default_catalogue
 from engine.clock import Clock
 from engine.dialogs.library import DialogLibrary
 from engine.loader.problems import LoadError, Mark, Problems
-from engine.loader.substitution import Profile, load_profile
+from engine.loader.substitution import Profile, load_profile, undeclared_params
 from engine.loader.tree_file import TreeDefinition, TreeLoader
 from engine.nodes.context import NodeErrorHandler, TreeContext, log_node_error
 from engine.nodes.registry import NodeRegistry, default_registry
@@ -70,6 +70,9 @@ def load_behaviors(
             definitions.append(loader.load(path))
         except LoadError as error:
             problems.extend(error.problems)
+    if loaded_profile is not None and definitions and not problems:
+        declared = set().union(*(d.declared_params for d in definitions))
+        problems.extend(undeclared_params(loaded_profile, declared, "the trees"))
     names: dict[str, Path] = {}
     for definition in definitions:
         if definition.name in names:

@@ -112,14 +112,17 @@ class Scheduler:
     def next_deadline_s(self) -> float:
         return min(tree.next_deadline_s for tree in self.trees)
 
-    def run(self, *, until_s: float | None = None) -> None:
-        """Tick until :meth:`stop` or, when given, until clock time ``until_s``."""
+    def run(self, *, until_s: float | None = None, start_s: float | None = None) -> None:
+        """Tick until :meth:`stop` or, when given, until clock time ``until_s``.
+
+        On the first run every tree's first deadline is ``start_s`` (default: now), so
+        trees of one rate tick together (one wake-up, one snapshot) and none starts late;
+        producers that pace themselves on the trees (pollers) are given the same origin.
+        """
         if not self.trees:
             raise ValueError("no trees to run")
         if not any(tree.stats.ticks for tree in self.trees):
-            # the first run: every tree's first deadline is now, so trees of one rate tick
-            # together (one wake-up, one snapshot) and none starts late
-            start = self.clock.now()
+            start = self.clock.now() if start_s is None else start_s
             for tree in self.trees:
                 tree.origin_s, tree.period_index = start, 0
         while not self._stop.is_set():

@@ -1,0 +1,195 @@
+"""CPU use of `vest run` in real time, every tree and poller running, as % of one core.
+
+Run: ``.venv/bin/python bench/bench_cpu.py`` (``--seconds S``, ``--help``); about 20 s.
+
+``vest run --duration S`` runs as a subprocess, exactly as a person starts it: every tree
+in trees/, the demo scenario, in real time on the simulated vest (examples/robots/
+sim.yaml: one worker thread per bus, one thread per poller, the Maestro emulator on a
+pseudo-terminal). Its CPU time (user + system) comes from ``getrusage(RUSAGE_CHILDREN)``
+around the subprocess; wall time from the bench's own stopwatch.
+
+A run's CPU time includes start-up (Python, imports, loading and checking the trees,
+building the hardware) and shutdown, which a long-running robot pays once. Two baselines
+in the same run, each run ``--repeat`` times, half before and half after the long run
+(medians), take them out:
+
+- ``python -c "import engine.cli"``: the interpreter and the imports;
+- ``vest run --duration 0.01``: the whole of ``vest run``'s start-up and shutdown with
+  next to no running.
+
+steady state = (CPU of the long run - CPU of the short run) / (wall of the long run - wall
+of the short run). As a cross-check, the bench also reads the long run's
+``/proc/PID/stat`` (utime + stime, clock ticks) every 0.25 s and reports the CPU used
+between ``--skip`` seconds after the start and the last reading, measured inside the run,
+free of start-up by construction (Linux only).
+
+There is no target in DESIGN.md for this figure: it is printed for the reader. What a
+steady-state percentage means: the share of one core the robot needs, all threads
+together, with the demo's events (touch, hug, wave, obstacle, speech) going on.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import platform
+import re
+import resource
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # run from a checkout
+
+from engine.clock import stopwatch
+
+ROOT = Path(__file__).resolve().parents[1]
+VEST = [sys.executable, "-c", "import sys; from engine.cli import main; sys.exit(main())"]
+IMPORT_ONLY = [sys.executable, "-c", "import engine.cli"]
+TIMELINE_LINE = re.compile(r"^\s*\d+\.\d+\s+(\S+)\s")  # "    3.10  hug   says ..."
+SAMPLE_EVERY_S = 0.25
+TICKS_PER_S = os.sysconf("SC_CLK_TCK") if hasattr(os, "sysconf") else 100
+
+
+@dataclass
+class Run:
+    """One subprocess: its wall time, CPU time, and CPU readings taken while it ran."""
+
+    wall_s: float
+    user_s: float
+    system_s: float
+    readings: list[tuple[float, float]] = field(default_factory=list)
+    """(seconds since start, CPU seconds so far) from /proc/PID/stat."""
+    output: str = ""
+
+    @property
+    def cpu_s(self) -> float:
+        return self.user_s + self.system_s
+
+
+def proc_cpu_s(pid: int) -> float | None:
+    """utime + stime of a live process, in seconds (None off Linux or once it is gone)."""
+    try:
+        text = Path(f"/proc/{pid}/stat").read_text()
+    except OSError:
+        return None
+    fields = text[text.rindex(")") + 2 :].split()  # after "pid (comm) "
+    return (int(fields[11]) + int(fields[12])) / TICKS_PER_S  # fields 14 and 15 of stat
+
+
+def measure(command: list[str], *, sample: bool = False) -> Run:
+    """Run ``command`` from the project folder; its CPU time from RUSAGE_CHILDREN."""
+    with tempfile.TemporaryFile(mode="w+") as out:
+        before = resource.getrusage(resource.RUSAGE_CHILDREN)
+        started = stopwatch()
+        process = subprocess.Popen(command, cwd=ROOT, stdout=out, stderr=subprocess.STDOUT)
+        readings: list[tuple[float, float]] = []
+        while process.poll() is None:
+            if sample:
+                cpu_s = proc_cpu_s(process.pid)
+                if cpu_s is not None:
+                    readings.append((stopwatch() - started, cpu_s))
+            time.sleep(SAMPLE_EVERY_S if sample else 0.005)
+        wall_s = stopwatch() - started
+        after = resource.getrusage(resource.RUSAGE_CHILDREN)
+        out.seek(0)
+        output = out.read()
+    if process.returncode != 0:
+        raise SystemExit(f"{' '.join(command)} exited with {process.returncode}:\n{output}")
+    return Run(
+        wall_s,
+        after.ru_utime - before.ru_utime,
+        after.ru_stime - before.ru_stime,
+        readings,
+        output,
+    )
+
+
+def median_run(runs: list[Run]) -> Run:
+    return Run(
+        statistics.median(r.wall_s for r in runs),
+        statistics.median(r.user_s for r in runs),
+        statistics.median(r.system_s for r in runs),
+    )
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument(
+        "--seconds", type=float, default=15.0, help="how long vest run runs (default 15)"
+    )
+    parser.add_argument(
+        "--repeat", type=int, default=4, help="runs of each baseline, half before and half after"
+    )
+    parser.add_argument(
+        "--skip",
+        type=float,
+        default=2.0,
+        help="seconds of the long run left out of the /proc reading (start-up; default 2)",
+    )
+    args = parser.parse_args(argv)
+    if args.seconds <= 1.0 or args.repeat < 2 or not 0 <= args.skip < args.seconds:
+        parser.error("--seconds above 1, --repeat at least 2, --skip within 0..--seconds")
+
+    run_args = ["run", "--duration"]
+    baselines: dict[str, list[str]] = {
+        'python -c "import engine.cli"': IMPORT_ONLY,
+        "vest run --duration 0.01": [*VEST, *run_args, "0.01"],
+    }
+    measured: dict[str, list[Run]] = {name: [] for name in baselines}
+    for command in baselines.values():  # warm the file cache first, untimed
+        measure(command)
+    for _ in range(args.repeat // 2):
+        for name, command in baselines.items():
+            measured[name].append(measure(command))
+    long_run = measure([*VEST, *run_args, f"{args.seconds:g}"], sample=True)
+    for _ in range(args.repeat - args.repeat // 2):
+        for name, command in baselines.items():
+            measured[name].append(measure(command))
+
+    medians = {name: median_run(runs) for name, runs in measured.items()}
+    imports = medians['python -c "import engine.cli"']
+    short = medians["vest run --duration 0.01"]
+    actions = [m.group(1) for m in map(TIMELINE_LINE.match, long_run.output.splitlines()) if m]
+    acted = sum(1 for who in actions if who != "world")
+    print(
+        f"CPU use of `vest run --duration {args.seconds:g}` (real time, simulated vest, every "
+        f"tree and poller; the demo scenario: {len(actions) - acted} world events, {acted} robot "
+        f"actions); Python "
+        f"{platform.python_version()}, {os.cpu_count()} CPUs"
+    )
+    print(f"  {'run':<48}{'wall s':>8}{'CPU s':>8}{'user s':>8}{'sys s':>8}")
+    rows = [(f"{name} (median of {len(measured[name])})", medians[name]) for name in baselines] + [
+        (f"vest run --duration {args.seconds:g}", long_run)
+    ]
+    for name, run in rows:
+        print(
+            f"  {name:<48}{run.wall_s:>8.2f}{run.cpu_s:>8.2f}{run.user_s:>8.2f}{run.system_s:>8.2f}"
+        )
+    total = long_run.cpu_s / long_run.wall_s
+    steady = (long_run.cpu_s - short.cpu_s) / (long_run.wall_s - short.wall_s)
+    print(f"  total:        {100 * total:5.1f} % of one core (CPU / wall of the long run)")
+    print(
+        f"  steady state: {100 * steady:5.1f} % of one core (long run minus the short run: "
+        f"{long_run.cpu_s - short.cpu_s:.2f} s CPU in {long_run.wall_s - short.wall_s:.2f} s)"
+    )
+    window = [(t, cpu) for t, cpu in long_run.readings if t >= args.skip]
+    if len(window) >= 2 and window[-1][0] > window[0][0]:
+        (t0, cpu0), (t1, cpu1) = window[0], window[-1]
+        print(
+            f"  steady state: {100 * (cpu1 - cpu0) / (t1 - t0):5.1f} % of one core, read "
+            f"inside the run (/proc/PID/stat, {t0:.1f} s .. {t1:.1f} s after the start)"
+        )
+    print(
+        f"  start-up: {imports.cpu_s:.2f} s CPU for Python and the imports, "
+        f"{short.cpu_s - imports.cpu_s:+.2f} s more for vest run's own start-up and shutdown"
+    )
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
