@@ -169,3 +169,16 @@ def test_a_misspelt_profile_parameter_stops_the_run_with_its_place(tmp_path, cap
         f"{profile}:3:19: no tree in the trees declares parameter 'hug_treshold_n' "
         "(did you mean 'hug_threshold_n'?)"
     ) in capsys.readouterr().err
+
+
+def test_the_timeline_shows_a_device_going_offline_and_coming_back(capsys, monkeypatch):
+    monkeypatch.chdir(ROOT)
+    assert main(["run", "--fast", "--scenario", "examples/scenarios/unplug_touch.yaml"]) == 0
+    lines = [line.split(None, 2) for line in capsys.readouterr().out.splitlines()]
+    vest_lines = [
+        (float(t), what) for t, who, what in (ln for ln in lines if len(ln) == 3) if who == "vest"
+    ]
+    assert [what for _, what in vest_lines] == ["touch is offline", "touch is back online"]
+    offline_at, back_at = (t for t, _ in vest_lines)
+    assert 2.0 <= offline_at < 2.5  # a few failed polls after the unplug at 2 s
+    assert 6.0 <= back_at < 8.5  # re-probed after the 4 s unplug ends

@@ -10,6 +10,7 @@ read through py_trees blackboard clients and write during their tick with :meth:
 from __future__ import annotations
 
 import threading
+from collections.abc import Callable
 from typing import Any
 
 import py_trees
@@ -33,6 +34,8 @@ class Blackboard:
         self._pending: list[tuple[str, Any, bool]] = []
         self._lock = threading.Lock()
         self._updated_s: dict[str, float] = {}
+        self.watchers: list[Callable[[str, Any], None]] = []
+        """Called as (key, value) for every committed write (debug views, the timeline)."""
 
     # -- producers (any thread) ---------------------------------------------------------
     def stage(self, key: str, value: Any) -> None:
@@ -55,6 +58,8 @@ class Blackboard:
                 self._append_event(key, value)
             else:
                 self._write(key, value)
+            for watcher in self.watchers:
+                watcher(key, value)
         return len(pending)
 
     def set(self, key: str, value: Any) -> None:

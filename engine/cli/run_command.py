@@ -140,6 +140,9 @@ def main(args: argparse.Namespace) -> int:
         for problem in hardware.startup_problems:
             print(f"warning: {problem}", file=sys.stderr)
         log = ActionLog(listeners=[timeline.action])
+        blackboard.watchers.append(
+            lambda key, value: timeline.blackboard_write(key, value, clock.now())
+        )
         simulated = simulated_services(clock, realistic=True)
         services = hardware.services(speech=simulated.speech, iot=simulated.iot, fallback=simulated)
         robot = Robot(

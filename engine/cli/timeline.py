@@ -45,6 +45,7 @@ class Timeline:
         self.as_json = as_json
         self.on_closed = on_closed
         self.closed = False
+        self._device_ok: dict[str, bool] = {}
 
     def start(self) -> None:
         """Print the header (the run has begun)."""
@@ -68,6 +69,17 @@ class Timeline:
     def world(self, at_s: float, event: ScenarioEvent) -> None:
         if not self.as_json:
             self._line(at_s, "world", event.describe())
+
+    def blackboard_write(self, key: str, value: Any, at_s: float) -> None:
+        """Show a device going offline or coming back (``/devices/<name>/ok`` changing)."""
+        if self.as_json or not (key.startswith("/devices/") and key.endswith("/ok")):
+            return
+        previous = self._device_ok.get(key)
+        self._device_ok[key] = bool(value)
+        if previous is None or previous == bool(value):
+            return  # the first report at start-up, or no change
+        device = key.removeprefix("/devices/").removesuffix("/ok")
+        self._line(at_s, "vest", f"{device} is {'back online' if value else 'offline'}")
 
     def action(self, record: ActionRecord) -> None:
         if self.as_json:
