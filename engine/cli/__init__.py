@@ -17,6 +17,7 @@ from engine.cli import (
     nodes_command,
     render_command,
     run_command,
+    schema_command,
     validate_command,
 )
 from engine.errors import VestError
@@ -43,6 +44,7 @@ def build_parser() -> argparse.ArgumentParser:
         nodes_command,
         keys_command,
         devices_command,
+        schema_command,
     ):
         sub = commands.add_parser(
             module.NAME,

@@ -37,6 +37,9 @@ class Color(ParamType):
 
     name = "color"
 
+    def json_schema(self) -> dict[str, Any]:
+        return {"anyOf": [{"enum": list(NAMED_COLORS)}, {"type": "string", "pattern": "^#"}]}
+
     def convert(self, value: Any, ctx: CheckContext) -> str:
         try:
             parse_color(str(value))

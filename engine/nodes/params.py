@@ -67,9 +67,16 @@ class ParamType:
     def describe(self) -> str:
         return self.name
 
+    def json_schema(self) -> dict[str, Any]:
+        """The JSON Schema of a valid value (for editors; the loader's checks are stricter)."""
+        return {}
+
 
 class Text(ParamType):
     name = "text"
+
+    def json_schema(self) -> dict[str, Any]:
+        return {"type": ["string", "number"]}
 
     def convert(self, value: Any, ctx: CheckContext) -> str:
         if isinstance(value, bool) or value is None or isinstance(value, dict | list):
@@ -98,6 +105,14 @@ class Number(ParamType):
             raise ParamProblem(f"must be at most {self.maximum:g}, got {number:g}")
         return number
 
+    def json_schema(self) -> dict[str, Any]:
+        schema: dict[str, Any] = {"type": "number"}
+        if self.minimum is not None:
+            schema["minimum"] = self.minimum
+        if self.maximum is not None:
+            schema["maximum"] = self.maximum
+        return schema
+
     def _example(self) -> str:
         return "write digits, e.g. 3.0" + (f" ({self.unit})" if self.unit else "")
 
@@ -125,6 +140,14 @@ class Integer(ParamType):
             raise ParamProblem(f"must be at most {self.maximum}, got {value}")
         return value
 
+    def json_schema(self) -> dict[str, Any]:
+        schema: dict[str, Any] = {"type": "integer"}
+        if self.minimum is not None:
+            schema["minimum"] = self.minimum
+        if self.maximum is not None:
+            schema["maximum"] = self.maximum
+        return schema
+
     def describe(self) -> str:
         if self.minimum is None and self.maximum is None:
             return "integer"
@@ -135,6 +158,9 @@ class Integer(ParamType):
 
 class Boolean(ParamType):
     name = "true/false"
+
+    def json_schema(self) -> dict[str, Any]:
+        return {"type": "boolean"}
 
     def convert(self, value: Any, ctx: CheckContext) -> bool:
         if not isinstance(value, bool):
@@ -156,6 +182,9 @@ class Choice(ParamType):
 
     def describe(self) -> str:
         return " | ".join(self.options)
+
+    def json_schema(self) -> dict[str, Any]:
+        return {"enum": list(self.options)}
 
 
 @dataclass(frozen=True)
@@ -206,6 +235,9 @@ class Key(ParamType):
             )
         return value
 
+    def json_schema(self) -> dict[str, Any]:
+        return {"type": "string", "pattern": "^/"}
+
     def describe(self) -> str:
         kind = "event key" if self.kinds == ("event",) else "blackboard key"
         return f"{kind} ({self.access})"
@@ -236,11 +268,22 @@ class ListOf(ParamType):
     def describe(self) -> str:
         return f"list of {self.item.describe()}"
 
+    def json_schema(self) -> dict[str, Any]:
+        schema: dict[str, Any] = {"type": "array", "items": self.item.json_schema()}
+        if self.min_items:
+            schema["minItems"] = self.min_items
+        if self.max_items is not None:
+            schema["maxItems"] = self.max_items
+        return schema
+
 
 class Scalar(ParamType):
     """A number, text, or true/false (what a key is compared with)."""
 
     name = "number, text or true/false"
+
+    def json_schema(self) -> dict[str, Any]:
+        return {"type": ["string", "number", "boolean"]}
 
     def convert(self, value: Any, ctx: CheckContext) -> Any:
         if isinstance(value, dict | list) or value is None:

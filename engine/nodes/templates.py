@@ -97,6 +97,9 @@ class Template(ParamType):
 
     name = "text with {fields}"
 
+    def json_schema(self) -> dict[str, Any]:
+        return {"type": ["string", "number"]}
+
     def convert(self, value: Any, ctx: CheckContext) -> CompiledTemplate:
         if isinstance(value, bool) or value is None or isinstance(value, dict | list):
             raise ParamProblem("must be text", "put the text in quotes")
