@@ -137,8 +137,8 @@ def main(args: argparse.Namespace) -> int:
     try:
         start_s = clock.now()  # after start-up, which takes simulated time too
         timeline = Timeline(sys.stdout, start_s=start_s, as_json=args.json)
-        for problem in hardware.startup_problems:
-            print(f"warning: {problem}", file=sys.stderr)
+        for name, why in hardware.startup_problems.items():
+            print(f"warning: {name} did not start ({why}); it will be tried again", file=sys.stderr)
         log = ActionLog(listeners=[timeline.action])
         blackboard.watchers.append(
             lambda key, value: timeline.blackboard_write(key, value, clock.now())
