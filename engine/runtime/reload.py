@@ -12,13 +12,14 @@ from collections.abc import Callable
 from pathlib import Path
 
 from engine.clock import Clock
-from engine.loader.problems import LoadError
+from engine.loader.problems import LoadError, Mark, Problem
 from engine.loader.tree_file import TreeDefinition, TreeLoader
 from engine.runtime.scheduler import RunningTree
 
 _log = logging.getLogger("vest.reload")
 
 Stamp = tuple[int, int] | None
+MAX_WATCHED = 500
 
 
 def _stamp(path: Path) -> Stamp:
@@ -64,22 +65,58 @@ class TreeReloader:
         """Reload every tree whose files changed; returns the names reloaded."""
         reloaded = []
         for tree in self.trees:
-            old = self._stamps[tree.definition.path]
-            current = {path: _stamp(path) for path in old}
+            path = tree.definition.path
+            old = self._stamps[path]
+            current = {file: _stamp(file) for file in old}
             if current == old:
                 continue
-            # remember the bad version so it is reported once, not at every check
-            self._stamps[tree.definition.path] = current
-            try:
-                definition = self.loader.load(tree.definition.path)
-            except LoadError as error:
-                self.on_reload(tree.name, error)
-                continue
-            tree.replace(definition)
-            self._stamps[tree.definition.path] = self._stamps_of(definition)
-            reloaded.append(tree.name)
-            self.on_reload(tree.name, None)
+            # the refused version is remembered (reported once, not at every check), and
+            # while it is refused every YAML file near it is watched: the fix may be in a
+            # subtree the running version did not include
+            self._stamps[path] = {**current, **_stamps_near(path)}
+            problem = self._reload(tree)
+            self.on_reload(tree.name, problem)
+            if problem is None:
+                self._stamps[path] = self._stamps_of(tree.definition)
+                reloaded.append(tree.name)
         return reloaded
+
+    def _reload(self, tree: RunningTree) -> LoadError | None:
+        """Swap in the changed file, or say why the running tree is kept."""
+        shown = self.loader.shown(tree.definition.path)
+        try:
+            definition = self.loader.load(tree.definition.path)
+            if definition.name != tree.name:
+                return LoadError(
+                    [
+                        Problem(
+                            definition.root.mark,
+                            f"the tree is renamed "
+                            f"{tree.name!r} -> {definition.name!r} while running",
+                            "restart vest run to rename a tree",
+                        )
+                    ]
+                )
+            tree.replace(definition)
+        except LoadError as error:
+            return error
+        except Exception as error:  # whatever went wrong, the running robot goes on
+            _log.exception("reloading %s failed", shown)
+            return LoadError(
+                [Problem(Mark(shown, 1, 1), f"could not reload: {type(error).__name__}: {error}")]
+            )
+        return None
+
+
+def _stamps_near(tree_file: Path) -> dict[Path, Stamp]:
+    """Every YAML file in the tree file's folder and below (bounded)."""
+    found: dict[Path, Stamp] = {}
+    try:
+        for file in sorted(tree_file.parent.rglob("*.yaml"))[:MAX_WATCHED]:
+            found[file] = _stamp(file)
+    except OSError:
+        pass
+    return found
 
 
 def _log_reload(name: str, error: LoadError | None) -> None:

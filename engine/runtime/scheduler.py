@@ -55,17 +55,26 @@ class RunningTree:
         return self.tree.root.status
 
     def replace(self, definition: TreeDefinition) -> None:
-        """Swap in a new version of the tree between ticks (statistics kept)."""
+        """Swap in a new version of the tree between ticks (statistics kept).
+
+        The new tree is built first: if building fails, the running tree is untouched.
+        """
+        new_tree = definition.build(self.context)
         old_root = self.tree.root
-        if old_root.status == py_trees.common.Status.RUNNING:
-            old_root.stop(py_trees.common.Status.INVALID)
+        self.halt()
         for node in old_root.iterate():  # the old nodes' blackboard clients go with them
             for client in node.blackboards:
                 client.unregister(clear=False)
-        self.definition = definition
-        self.tree = definition.build(self.context)
         self.origin_s = self.next_deadline_s
         self.period_index = 0
+        self.definition = definition
+        self.tree = new_tree
+
+    def halt(self) -> None:
+        """Stop whatever is running (cancels service jobs: speech, moves, lights)."""
+        root = self.tree.root
+        if root.status == py_trees.common.Status.RUNNING:
+            root.stop(py_trees.common.Status.INVALID)
 
 
 class Scheduler:
@@ -85,6 +94,7 @@ class Scheduler:
         self.trees: list[RunningTree] = []
         self._measure = measure
         self._stop = threading.Event()
+        self.hook_errors = 0
 
     def add(self, tree: RunningTree) -> RunningTree:
         """Schedule ``tree``; trees added before the run share one origin for their deadlines."""
@@ -125,28 +135,42 @@ class Scheduler:
             start = self.clock.now() if start_s is None else start_s
             for tree in self.trees:
                 tree.origin_s, tree.period_index = start, 0
-        while not self._stop.is_set():
-            deadline = self.next_deadline_s()
-            if until_s is not None and deadline > until_s:
-                self.clock.sleep_until(until_s)
-                break
-            self.clock.sleep_until(deadline)
-            if self._stop.is_set():
-                break
-            self.step()
+        try:
+            while not self._stop.is_set():
+                deadline = self.next_deadline_s()
+                if until_s is not None and deadline > until_s:
+                    self.clock.sleep_until(until_s)
+                    break
+                self.clock.sleep_until(deadline)
+                if self._stop.is_set():
+                    break
+                self.step()
+        finally:
+            for tree in self.trees:  # nothing keeps speaking or moving after the run
+                try:
+                    tree.halt()
+                except Exception as error:  # a terminate() failing must not hide the others
+                    _log.error(
+                        "%s: stopping failed: %s: %s", tree.name, type(error).__name__, error
+                    )
 
     def step(self) -> list[RunningTree]:
         """Run hooks, commit, and tick every tree whose deadline has come; returns them."""
         now = self.clock.now()
         for hook in self.hooks:
-            hook(now)
+            try:
+                hook(now)
+            except Exception as error:  # a broken hook (scenario, reload, poller) is reported
+                self.hook_errors += 1
+                _log.exception("scheduler hook %r failed: %s", hook, error)
         self.blackboard.commit()
         due = [tree for tree in self.trees if tree.next_deadline_s <= now + 1e-9]
         for tree in due:
-            self._tick(tree, now)
+            self._tick(tree)
         return due
 
-    def _tick(self, tree: RunningTree, now: float) -> None:
+    def _tick(self, tree: RunningTree) -> None:
+        now = self.clock.now()  # hooks and earlier trees of this step count as lateness
         lateness = now - tree.next_deadline_s
         started = self._measure()
         try:

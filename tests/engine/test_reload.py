@@ -73,3 +73,40 @@ def test_a_broken_edit_keeps_the_running_tree_and_is_reported_once(tmp_path):
     edit(tree_file, GREETER.replace("PHRASE", "Fixed"), 2)
     robot.scheduler.run(until_s=4.0)
     assert said(robot)[-1] == "Fixed"
+
+
+def test_a_rename_while_running_is_refused_and_the_tree_keeps_its_name(tmp_path):
+    robot, tree_file, reports = start(tmp_path)
+    edit(tree_file, GREETER.replace("name: greeter", "name: welcomer"), 1)
+    robot.scheduler.run(until_s=1.5)
+    assert robot.trees[0].name == "greeter"
+    assert "renamed 'greeter' -> 'welcomer' while running" in str(reports[0][1])
+
+
+def test_fixing_a_subtree_that_a_refused_edit_added_reloads_the_tree(tmp_path):
+    robot, tree_file, reports = start(tmp_path)
+    parts = tmp_path / "parts"
+    parts.mkdir()
+    edit(parts / "hello.yaml", "root:\n  Say: {txt: broken}\n", 0)
+    with_subtree = GREETER.replace('- Say: {text: "PHRASE"}', "- Subtree: {file: parts/hello.yaml}")
+    edit(tree_file, with_subtree, 1)
+    robot.scheduler.run(until_s=1.5)
+    assert reports[-1][1] is not None  # refused: the subtree is broken
+    edit(parts / "hello.yaml", 'root:\n  Say: {text: "From the part"}\n', 2)
+    robot.scheduler.run(until_s=3.5)
+    assert reports[-1] == ("greeter", None)
+    assert said(robot)[-1] == "From the part"
+
+
+def test_a_reload_that_crashes_while_building_keeps_the_running_tree(tmp_path, monkeypatch):
+    robot, tree_file, reports = start(tmp_path)
+    from engine.loader.tree_file import TreeDefinition
+
+    def broken_build(self, ctx):
+        raise RuntimeError("disk on fire")
+
+    edit(tree_file, GREETER.replace("PHRASE", "Changed"), 1)
+    monkeypatch.setattr(TreeDefinition, "build", broken_build)
+    robot.scheduler.run(until_s=1.5)
+    assert set(said(robot)) == {"Hello"}
+    assert "could not reload: RuntimeError: disk on fire" in str(reports[0][1])

@@ -110,3 +110,43 @@ def test_stop_ends_the_run_after_the_current_tick(tmp_path):
     robot.scheduler.hooks.append(lambda now: robot.scheduler.stop() if now >= 0.3 else None)
     robot.scheduler.run()
     assert robot.trees[0].stats.ticks == 4  # 0.0, 0.1, 0.2, 0.3
+
+
+def test_stopping_the_run_cancels_what_a_tree_was_still_doing(tmp_path):
+    write(
+        tmp_path,
+        "t.yaml",
+        'name: talker\nrate_hz: 10\nroot:\n  Say: {text: "a very long story indeed"}\n',
+    )
+    clock = VirtualClock()
+    board = Blackboard(default_catalogue(), clock)
+    board.reset()
+    services = simulated_services(clock, realistic=True)  # speaking takes time
+    robot = Robot(load_behaviors([tmp_path]), clock=clock, services=services, blackboard=board)
+    jobs = []
+    original = services.speech.say
+    services.speech.say = lambda text, **kw: jobs.append(original(text, **kw)) or jobs[-1]
+    robot.scheduler.run(until_s=0.3)
+    assert robot.trees[0].status != Status.RUNNING
+    assert jobs[0].cancelled
+
+
+def test_time_spent_in_hooks_counts_as_lateness(tmp_path):
+    write(tmp_path, "t.yaml", "rate_hz: 10\nroot:\n  Wait: {seconds: 100}\n")
+    robot, clock = make_robot(tmp_path)
+    robot.scheduler.hooks.append(lambda now: clock.advance(0.03))
+    robot.scheduler.run(until_s=0.25)
+    assert max(robot.trees[0].stats.lateness_s) >= 0.03 - 1e-9
+
+
+def test_a_failing_hook_is_counted_and_the_trees_keep_ticking(tmp_path):
+    write(tmp_path, "t.yaml", "rate_hz: 10\nroot:\n  Wait: {seconds: 100}\n")
+    robot, _ = make_robot(tmp_path)
+
+    def broken(now):
+        raise ValueError("scenario bug")
+
+    robot.scheduler.hooks.append(broken)
+    robot.scheduler.run(until_s=0.2)
+    assert robot.scheduler.hook_errors == 3
+    assert robot.trees[0].stats.ticks == 3
