@@ -69,3 +69,9 @@ def test_rendering_a_broken_tree_lists_its_problems(tmp_path, capsys):
     assert "broken.yaml:3:7: unknown node type 'Sya' (did you mean 'Say'?)" in (
         capsys.readouterr().err
     )
+
+
+def test_an_output_file_that_cannot_be_written_is_named_with_the_reason(capsys, monkeypatch):
+    monkeypatch.chdir(ROOT)
+    assert main(["render", "trees/hug.yaml", "-o", "/nonexistent/hug.txt"]) == 1
+    assert "-o /nonexistent/hug.txt: No such file or directory" in capsys.readouterr().err

@@ -166,7 +166,7 @@ def test_a_misspelt_profile_parameter_stops_the_run_with_its_place(tmp_path, cap
     profile.write_text("profile: kid\nparams:\n  hug_treshold_n: 2.0\n")
     assert main(["run", "--fast", "--profile", str(profile)]) == 1
     assert (
-        f"{profile}:3:19: no tree in the trees declares parameter 'hug_treshold_n' "
+        f"{profile}:3:19: no tree in the trees run declares parameter 'hug_treshold_n' "
         "(did you mean 'hug_threshold_n'?)"
     ) in capsys.readouterr().err
 
@@ -182,3 +182,9 @@ def test_the_timeline_shows_a_device_going_offline_and_coming_back(capsys, monke
     offline_at, back_at = (t for t, _ in vest_lines)
     assert 2.0 <= offline_at < 2.5  # a few failed polls after the unplug at 2 s
     assert 6.0 <= back_at < 8.5  # re-probed after the 4 s unplug ends
+
+
+def test_a_dialogs_folder_that_does_not_exist_is_named(capsys, monkeypatch):
+    monkeypatch.chdir(ROOT)
+    assert main(["run", "--fast", "--dialogs", "nodialogs"]) == 1
+    assert "--dialogs nodialogs: no such folder" in capsys.readouterr().err

@@ -201,3 +201,21 @@ def test_the_installed_command_validates_and_fails_in_words(broken: Path) -> Non
         "trees/folder.yaml:1:1: is a folder, not a file",
         "trees/latin.yaml:2:18: byte 0xE9 is not UTF-8 text (save the file as UTF-8)",
     ]
+
+
+def test_two_trees_of_one_folder_with_one_name_are_reported(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    tree = "name: greeter\nroot:\n  Say: {text: hi}\n"
+    write(tmp_path, "a.yaml", tree)
+    write(tmp_path, "b.yaml", tree)
+    assert main(["validate", str(tmp_path)]) == 1
+    assert f"{tmp_path / 'b.yaml'}:1:7: two trees are named 'greeter'" in capsys.readouterr().err
+
+
+def test_a_misspelt_root_is_recognised_as_a_tree_with_a_suggestion(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    write(tmp_path, "a.yaml", "rot:\n  Say: {text: hi}\n")
+    assert main(["validate", str(tmp_path / "a.yaml")]) == 1
+    assert "unknown field 'rot' (did you mean 'root'?)" in capsys.readouterr().err

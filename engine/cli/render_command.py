@@ -12,6 +12,7 @@ from pathlib import Path
 
 from engine.blackboard.catalogue import default_catalogue
 from engine.dialogs.library import DialogLibrary, find_dialogs_folder
+from engine.errors import ConfigError
 from engine.loader.tree_file import NodeDefinition, TreeDefinition, TreeLoader
 from engine.nodes.registry import default_registry
 from engine.nodes.templates import CompiledTemplate
@@ -111,7 +112,7 @@ def main(args: argparse.Namespace) -> int:
     if args.format in ("ascii", "dot"):
         text = ascii_tree(definition) if args.format == "ascii" else dot_source(definition)
         if args.output:
-            args.output.write_text(text, encoding="utf-8")
+            _write(args.output, text.encode("utf-8"))
         else:
             sys.stdout.write(text)
         return 0
@@ -139,7 +140,14 @@ def _graphviz(source: str, fmt: str, output: Path | None) -> int:
         print(f"vest render: dot failed: {result.stderr.decode(errors='replace')}", file=sys.stderr)
         return 3
     if output:
-        output.write_bytes(result.stdout)
+        _write(output, result.stdout)
     else:
         sys.stdout.buffer.write(result.stdout)
     return 0
+
+
+def _write(path: Path, data: bytes) -> None:
+    try:
+        path.write_bytes(data)
+    except OSError as error:
+        raise ConfigError(f"-o {path}: {error.strerror or error}") from None

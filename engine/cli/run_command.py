@@ -39,6 +39,7 @@ from engine.services.actions import ActionLog
 from engine.services.simulated import simulated_services
 
 NAME = "run"
+DEFAULT_DIALOGS = Path("dialogs")
 HELP = "run the behaviors on a scenario (default: the demo)"
 
 
@@ -52,7 +53,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="tree files or folders (default: trees/)",
     )
     parser.add_argument(
-        "--dialogs", type=Path, default=Path("dialogs"), help="dialogs folder (default: dialogs/)"
+        "--dialogs", type=Path, default=DEFAULT_DIALOGS, help="dialogs folder (default: dialogs/)"
     )
     parser.add_argument(
         "--profile",
@@ -117,6 +118,8 @@ def main(args: argparse.Namespace) -> int:
                 f"{path}: no such file or folder (run from the project folder or pass --trees)"
             )
     dialogs = args.dialogs if args.dialogs.is_dir() else None
+    if dialogs is None and args.dialogs != DEFAULT_DIALOGS:
+        raise ConfigError(f"--dialogs {args.dialogs}: no such folder")
     behaviors = load_behaviors(
         args.trees, dialogs_dir=dialogs, profile=resolve_profile(args.profile, args.trees)
     )

@@ -13,11 +13,12 @@ from engine.blackboard.catalogue import KeyCatalogue, default_catalogue
 from engine.dialogs.library import DialogLibrary, check_dialog, find_dialogs_folder
 from engine.hardware.config import check_robot_config
 from engine.loader.problems import LoadError, Mark, Problem, Problems
-from engine.loader.substitution import Profile, load_profile, read_params, undeclared_params
+from engine.loader.substitution import Profile, load_profile, undeclared_params
 from engine.loader.tree_file import TreeLoader
-from engine.loader.yaml_source import YMap, load_yaml
+from engine.loader.yaml_source import YMap, YScalar, load_yaml
+from engine.nodes.params import did_you_mean
 from engine.nodes.registry import NodeRegistry, default_registry
-from engine.runtime.robot import tree_files
+from engine.runtime.robot import declared_beside, tree_files
 from engine.scenario.scenario_file import check_scenario
 
 NAME = "validate"
@@ -53,7 +54,7 @@ def yaml_files(paths: list[Path]) -> list[Path]:
 def kind_of(document: object) -> str | None:
     if not isinstance(document, YMap):
         return None
-    if "root" in document:
+    if "root" in document or "rate_hz" in document or did_you_mean("root", list(document.entries)):
         return "tree"
     if "profile" in document:
         return "profile"
@@ -126,25 +127,35 @@ class Validator:
         """A profile must fit the trees beside it: known names, values of the right kind."""
         profile = load_profile(path)
         trees_folder = path.parent.parent
-        declared: set[str] = set()
         for tree in tree_files([trees_folder]):
             try:
-                declared |= self.loader_for(tree, profile).load(tree).declared_params
+                self.loader_for(tree, profile).load(tree)
             except LoadError as error:  # the tree's own problems come when it is validated
                 self.problems.extend([p for p in error.problems if p.mark.file == str(path)])
-                declared |= _declared_names(tree)
+        declared = declared_beside(path)
         self.problems.extend(undeclared_params(profile, declared, f"{trees_folder}/"))
 
-
-def _declared_names(tree: Path) -> set[str]:
-    """The parameter names a tree file that does not load declares, as far as readable."""
-    try:
-        document = load_yaml(tree)
-    except LoadError:
-        return set()
-    if not isinstance(document, YMap):
-        return set()
-    return set(read_params(document.get("params"), Problems()))
+    def check_tree_names(self, files: list[Path]) -> None:
+        """Two trees of one folder run together, so their names must differ."""
+        seen: dict[tuple[Path, str], Path] = {}
+        for path in files:
+            try:
+                document = load_yaml(path)
+            except LoadError:
+                continue
+            if kind_of(document) != "tree" or path.parent.name in ("parts", "profiles"):
+                continue
+            assert isinstance(document, YMap)
+            raw = document.get("name")
+            name = str(raw.value) if isinstance(raw, YScalar) and raw.value else path.stem
+            key = (path.parent.resolve(), name)
+            if key in seen:
+                where = raw.mark if raw is not None else Mark(str(path), 1, 1)
+                self.problems.add(
+                    where, f"two trees are named {name!r} (also {seen[key]})", "rename one"
+                )
+            else:
+                seen[key] = path
 
 
 def main(args: argparse.Namespace) -> int:
@@ -155,6 +166,7 @@ def main(args: argparse.Namespace) -> int:
             validator.problems.add(Mark(str(path), 1, 1), "no such file or folder")
     for path in files:
         validator.check(path)
+    validator.check_tree_names(files)
     if validator.problems:
         raise LoadError(validator.problems.items)
     if not files:

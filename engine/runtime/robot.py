@@ -10,8 +10,9 @@ from engine.blackboard.catalogue import KeyCatalogue, default_catalogue
 from engine.clock import Clock
 from engine.dialogs.library import DialogLibrary
 from engine.loader.problems import LoadError, Mark, Problems
-from engine.loader.substitution import Profile, load_profile, undeclared_params
+from engine.loader.substitution import Profile, load_profile, read_params, undeclared_params
 from engine.loader.tree_file import TreeDefinition, TreeLoader
+from engine.loader.yaml_source import YMap, load_yaml
 from engine.nodes.context import NodeErrorHandler, TreeContext, log_node_error
 from engine.nodes.registry import NodeRegistry, default_registry
 from engine.runtime.scheduler import RunningTree, Scheduler
@@ -28,6 +29,25 @@ def tree_files(paths: list[Path]) -> list[Path]:
     for path in paths:
         files.extend(sorted(path.glob("*.yaml")) if path.is_dir() else [path])
     return files
+
+
+def declared_beside(profile: Path) -> set[str]:
+    """Parameter names declared by the tree files a profile sits beside (its folder's
+    parent, subfolders such as parts/ included), read from their ``params:`` only."""
+    names: set[str] = set()
+    if profile.parent.name != "profiles":
+        return names  # a profile kept elsewhere serves the trees it is run with
+    folder = profile.parent.parent
+    for path in sorted(folder.rglob("*.yaml")):
+        if path.parent == profile.parent:
+            continue  # the profiles themselves
+        try:
+            document = load_yaml(path)
+        except LoadError:
+            continue  # a broken tree speaks for itself when it is loaded or validated
+        if isinstance(document, YMap):
+            names |= set(read_params(document.get("params"), Problems()))
+    return names
 
 
 @dataclass
@@ -70,9 +90,14 @@ def load_behaviors(
             definitions.append(loader.load(path))
         except LoadError as error:
             problems.extend(error.problems)
-    if loaded_profile is not None and definitions and not problems:
+    if loaded_profile is not None and profile is not None and definitions and not problems:
+        # a profile serves every tree beside it, not only those run now
         declared = set().union(*(d.declared_params for d in definitions))
-        problems.extend(undeclared_params(loaded_profile, declared, "the trees"))
+        declared |= declared_beside(profile)
+        where = (
+            f"{profile.parent.parent}/" if profile.parent.name == "profiles" else "the trees run"
+        )
+        problems.extend(undeclared_params(loaded_profile, declared, where))
     names: dict[str, Path] = {}
     for definition in definitions:
         if definition.name in names:
