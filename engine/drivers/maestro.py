@@ -21,8 +21,10 @@ port; :class:`Maestro` only moves bytes.
 
 from __future__ import annotations
 
+import contextlib
 import errno
 import os
+import termios
 import threading
 from types import TracebackType
 from typing import Literal, Protocol, Self
@@ -202,7 +204,11 @@ class Maestro:
     """A Pololu Maestro on a serial port.
 
     ``port`` is an open pyserial-compatible port (the caller keeps ownership) or a port name
-    that this class opens and, on :meth:`close`, closes. ``device`` is the Pololu-protocol
+    that this class opens and, on :meth:`close`, closes. A port opened by name is also
+    closed when it fails (the USB cable was pulled: every write fails from then on) and
+    opened again by the next command, so a Maestro plugged back in under the same name
+    carries on; until then each command fails with a :class:`DeviceError` saying why.
+    ``device`` is the Pololu-protocol
     device number (0..127), used when ``protocol="pololu"``; ``channels`` is 12 for a Mini
     Maestro 12. ``clock`` is only needed by :meth:`wait_until_stopped`. ``baudrate`` and
     ``timeout_s`` apply only when the port is opened here; a borrowed port must have a
@@ -234,8 +240,11 @@ class Maestro:
         self._clock = clock if clock is not None else RealClock()
         self._lock = threading.Lock()
         self._closed = False
+        self._baudrate = baudrate
+        self._timeout_s = timeout_s
+        self._port: SerialPort | None
         if isinstance(port, str):
-            self._port: SerialPort = _open_port(port, baudrate=baudrate, timeout_s=timeout_s)
+            self._port = _open_port(port, baudrate=baudrate, timeout_s=timeout_s)
             self._owns_port = True
             self._port_name = port
         else:
@@ -250,8 +259,15 @@ class Maestro:
 
     @property
     def port(self) -> SerialPort:
-        """The serial port in use (owned by this object only if it was opened by name)."""
-        return self._port
+        """The serial port in use (owned by this object only if it was opened by name).
+
+        Raises :class:`DeviceError` while a port opened by name is lost (the next command
+        opens it again).
+        """
+        port = self._port
+        if port is None:
+            raise DeviceError(errno.ENODEV, f"Maestro on {self._port_name}: the port is not open")
+        return port
 
     @property
     def port_name(self) -> str:
@@ -322,7 +338,7 @@ class Maestro:
             if self._closed:
                 return
             self._closed = True
-            if self._owns_port:
+            if self._owns_port and self._port is not None:
                 self._port.close()
 
     def __enter__(self) -> Self:
@@ -354,22 +370,22 @@ class Maestro:
 
     def _query(self, packet: bytes, reply_length: int, what: str) -> bytes:
         with self._lock:
-            self._check_open()
+            port = self._ready_port()
             try:
                 # A reply that came too late for an earlier query must not answer this one.
-                self._port.reset_input_buffer()
-            except OSError as error:
+                port.reset_input_buffer()
+            except _PORT_ERRORS as error:
                 raise self._io_error(error) from error
             self._write(packet)
             try:
-                reply = self._port.read(reply_length)
-            except OSError as error:
+                reply = port.read(reply_length)
+            except _PORT_ERRORS as error:
                 raise self._io_error(error) from error
         if len(reply) < reply_length:
             raise DeviceError(
                 errno.ETIMEDOUT,
                 f"Maestro on {self._port_name}: no reply to {what} within "
-                f"{self._port.timeout} s (got {len(reply)} of {reply_length} bytes; "
+                f"{port.timeout} s (got {len(reply)} of {reply_length} bytes; "
                 f"protocol {self.protocol}, device number {self.device})",
             )
         return reply
@@ -378,19 +394,45 @@ class Maestro:
         if self._closed:
             raise DeviceError(errno.EBADF, f"Maestro on {self._port_name} is closed")
 
-    def _write(self, packet: bytes) -> None:
+    def _ready_port(self) -> SerialPort:
+        """The port, opened again by name if it was lost (lock held)."""
         self._check_open()
+        if self._port is None:
+            self._port = _open_port(
+                self._port_name, baudrate=self._baudrate, timeout_s=self._timeout_s
+            )
+        return self._port
+
+    def _write(self, packet: bytes) -> None:
+        port = self._ready_port()
         try:
-            self._port.write(self._frame(packet))
-            self._port.flush()
-        except OSError as error:
+            port.write(self._frame(packet))
+            port.flush()
+        except _PORT_ERRORS as error:
             raise self._io_error(error) from error
 
-    def _io_error(self, error: OSError) -> DeviceError:
+    def _io_error(self, error: OSError | termios.error) -> DeviceError:
+        """The port failed: words for it; a port opened by name is closed, to open again."""
         if isinstance(error, DeviceError):
             return error
-        words = describe_port_error(error.errno) if error.errno else str(error)
-        return DeviceError(error.errno or errno.EIO, f"Maestro on {self._port_name}: {words}")
+        code = error.errno if isinstance(error, OSError) else _termios_errno(error)
+        words = describe_port_error(code) if code else str(error)
+        if self._owns_port and self._port is not None:
+            lost, self._port = self._port, None
+            with contextlib.suppress(*_PORT_ERRORS):  # it is gone already
+                lost.close()
+            words += "; the port is opened again at the next command"
+        return DeviceError(code or errno.EIO, f"Maestro on {self._port_name}: {words}")
+
+
+_PORT_ERRORS = (OSError, termios.error)
+"""What a failing port raises: pyserial's SerialException (an OSError), or termios.error
+from its flush and buffer resets."""
+
+
+def _termios_errno(error: termios.error) -> int | None:
+    code = error.args[0] if error.args else None
+    return code if isinstance(code, int) else None
 
 
 def _open_port(name: str, *, baudrate: int, timeout_s: float) -> serial.Serial:

@@ -18,11 +18,17 @@ from dataclasses import dataclass, fields
 from typing import Any, Protocol
 
 from engine.clock import Clock
+from engine.drivers.maestro import us_to_quarter_us
 from engine.errors import ConfigError, DeviceError, ServiceError
 
 MAESTRO_SPEED_UNIT_US_PER_S = 0.25 / 0.010
 """One Maestro speed unit, (0.25 us)/(10 ms), in us per second (25 us/s)."""
 MAX_MAESTRO_SPEED = 0x3FFF
+MAESTRO_MIN_US = 64.0
+"""The shortest servo pulse a Maestro channel can be set to (its lowest Min setting), us."""
+MAESTRO_MAX_US = 4000.0
+"""The longest pulse a joint may ask for, us: beyond every hobby servo, and within the
+4095.75 us a Set Target command can carry."""
 
 
 class ServoController(Protocol):
@@ -194,7 +200,8 @@ class ServoJoints:
 
         ``speed_dps`` defaults to the joint's limit. Raises ValueError (naming the joint, the
         value and the limit) for an angle outside the joint's range or a speed above its
-        limit; nothing is sent then. Returns at once; see :meth:`is_moving`.
+        limit, and for a pulse too short to tell from "off" (0); nothing is sent then.
+        Returns at once; see :meth:`is_moving`.
         """
         joint = self.joint(joint_name)
         if not joint.min_deg <= angle_deg <= joint.max_deg:
@@ -210,8 +217,14 @@ class ServoJoints:
                 f"0 < speed <= {joint.max_speed_dps} deg/s"
             )
         units = speed_dps_to_maestro(joint, speed_dps)
+        pulse_us = angle_to_us(joint, angle_deg)
+        if us_to_quarter_us(pulse_us) == 0:
+            raise ValueError(
+                f"joint {joint.name!r}: angle {angle_deg} deg is a pulse of {pulse_us:g} us, "
+                "which the Maestro takes as 0, 'off'; check the joint's min_us/max_us"
+            )
         self._maestro.set_speed(joint.channel, units)
-        self._maestro.set_target_us(joint.channel, angle_to_us(joint, angle_deg))
+        self._maestro.set_target_us(joint.channel, pulse_us)
 
     def position_deg(self, joint_name: str) -> float:
         """The angle in degrees the controller is driving ``joint_name`` to right now.

@@ -8,6 +8,13 @@ same fixed address (three VL53L0X at 0x29) sit on one bus, one per channel.
 each call selects that channel (when it is not already the selected one) and forwards,
 holding the multiplexer's lock, so traffic for two channels is never interleaved.
 
+The upstream bus is one adapter shared by the chips on it and the chips behind every
+channel. ``smbus2`` keeps the target address as state of the open file (``ioctl
+I2C_SLAVE``, then the transfer), so two threads using one ``SMBus`` at once can send a
+transfer to the other's chip. Give the multiplexer a :class:`LockedBus` and use that same
+object for the upstream chips: each call then holds one lock, and a channel's selection and
+transfer hold it together, so every access to the adapter is serialized.
+
 Note: 0x70 is also the default address of the vest's SRF02 ranger; with both on one bus,
 strap the TCA9548A to 0x71..0x77 (pins A0..A2).
 """
@@ -15,7 +22,7 @@ strap the TCA9548A to 0x71..0x77 (pins A0..A2).
 from __future__ import annotations
 
 import threading
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import Any, Protocol
 
 from smbus2 import i2c_msg
@@ -48,27 +55,118 @@ def channel_mask(channel: int) -> int:
     return 1 << channel
 
 
-class TCA9548A:
-    """A TCA9548A on ``bus``; construction checks it answers (it has no identity register)."""
+class LockedBus:
+    """An ``smbus2.SMBus``-compatible view of ``bus`` whose every call holds :attr:`lock`.
 
-    def __init__(self, bus: Any, *, address: int = 0x70) -> None:
+    Hand the same object to the bus manager of the upstream chips and to the
+    :class:`TCA9548A`: channel traffic (selection and transfer) and upstream traffic then
+    never reach the adapter at the same time. ``lock`` is re-entrant, so a channel can hold
+    it across its selection and transfer.
+    """
+
+    def __init__(self, bus: Any, *, lock: threading.RLock | None = None) -> None:
+        self.bus = bus
+        self.lock = lock if lock is not None else threading.RLock()
+
+    def __repr__(self) -> str:
+        return f"LockedBus({self.bus!r})"
+
+    def _call(self, method: str, *args: Any) -> Any:
+        with self.lock:
+            return getattr(self.bus, method)(*args)
+
+    def write_quick(self, i2c_addr: int, force: bool | None = None) -> None:
+        self._call("write_quick", i2c_addr)
+
+    def read_byte(self, i2c_addr: int, force: bool | None = None) -> int:
+        return self._call("read_byte", i2c_addr)
+
+    def write_byte(self, i2c_addr: int, value: int, force: bool | None = None) -> None:
+        self._call("write_byte", i2c_addr, value)
+
+    def read_byte_data(self, i2c_addr: int, register: int, force: bool | None = None) -> int:
+        return self._call("read_byte_data", i2c_addr, register)
+
+    def write_byte_data(
+        self, i2c_addr: int, register: int, value: int, force: bool | None = None
+    ) -> None:
+        self._call("write_byte_data", i2c_addr, register, value)
+
+    def read_word_data(self, i2c_addr: int, register: int, force: bool | None = None) -> int:
+        return self._call("read_word_data", i2c_addr, register)
+
+    def write_word_data(
+        self, i2c_addr: int, register: int, value: int, force: bool | None = None
+    ) -> None:
+        self._call("write_word_data", i2c_addr, register, value)
+
+    def read_i2c_block_data(
+        self, i2c_addr: int, register: int, length: int, force: bool | None = None
+    ) -> list[int]:
+        return self._call("read_i2c_block_data", i2c_addr, register, length)
+
+    def write_i2c_block_data(
+        self, i2c_addr: int, register: int, data: Sequence[int], force: bool | None = None
+    ) -> None:
+        self._call("write_i2c_block_data", i2c_addr, register, data)
+
+    def i2c_rdwr(self, *i2c_msgs: i2c_msg) -> None:
+        self._call("i2c_rdwr", *i2c_msgs)
+
+    def close(self) -> None:
+        """Nothing to release: the adapter belongs to whoever opened it."""
+
+
+class TCA9548A:
+    """A TCA9548A on ``bus``.
+
+    Options (keyword-only):
+
+    - ``address``: 0x70..0x77 (pins A0..A2).
+    - ``lock``: held while a channel is selected and used; by default the lock of a
+      :class:`LockedBus` ``bus``, else a lock of its own (then nothing else may use ``bus``).
+    - ``check``: read the control byte now, raising :class:`DeviceError` when the chip does
+      not answer (it has no identity register). With ``check=False`` nothing is sent yet:
+      the first channel access writes the control byte, so a multiplexer that is late or
+      missing fails those accesses as ordinary bus errors, retried and re-probed by their
+      bus manager.
+    - ``on_answer(ok, why)``: called when the chip starts or stops answering its control
+      byte (``why`` says what failed), from the thread that made the access.
+    """
+
+    def __init__(
+        self,
+        bus: Any,
+        *,
+        address: int = 0x70,
+        lock: threading.RLock | None = None,
+        check: bool = True,
+        on_answer: Callable[[bool, str | None], None] | None = None,
+    ) -> None:
         if address not in ADDRESSES:
             raise ValueError(f"{CHIP} address must be 0x70..0x77, got 0x{address:02X}")
         self.bus = bus
         self.address = address
-        self._lock = threading.RLock()
-        try:
-            self._control: int | None = bus.read_byte(address)
-        except OSError as err:
-            where = f"{CHIP} at 0x{address:02X}"
-            raise _device_error(f"{where} did not answer: {err.strerror or err}", err) from err
+        if lock is None:
+            lock = bus.lock if isinstance(bus, LockedBus) else threading.RLock()
+        self._lock = lock
+        self._on_answer = on_answer
+        self.answering: bool | None = None
+        """Whether the chip answered its last control-byte access (None: not asked yet)."""
+        self._control: int | None = None
+        if check:
+            try:
+                self.selected()
+            except OSError as err:
+                where = f"{CHIP} at 0x{address:02X}"
+                raise _device_error(f"{where} did not answer: {err.strerror or err}", err) from err
 
     def __repr__(self) -> str:
         return f"TCA9548A(address=0x{self.address:02X})"
 
     @property
     def lock(self) -> threading.RLock:
-        """Held while a channel is selected and used."""
+        """Held while a channel is selected and used (shared with a :class:`LockedBus`)."""
         return self._lock
 
     def select(self, channel: int) -> None:
@@ -80,17 +178,37 @@ class TCA9548A:
         self._write_control(0x00)
 
     def selected(self) -> list[int]:
-        """The channels connected now, as the chip reports them."""
+        """The channels connected now, as the chip reports them (bus errors as raised)."""
         with self._lock:
-            control = self.bus.read_byte(self.address)
+            try:
+                control = self.bus.read_byte(self.address)
+            except OSError as err:
+                self._answered(err)
+                raise
             self._control = control
+            self._answered(None)
         return [channel for channel in range(CHANNELS) if control & (1 << channel)]
 
     def _write_control(self, control: int) -> None:
         with self._lock:
             self._control = None  # unknown until the write has gone through
-            self.bus.write_byte(self.address, control)
+            try:
+                self.bus.write_byte(self.address, control)
+            except OSError as err:
+                self._answered(err)
+                raise
             self._control = control
+            self._answered(None)
+
+    def _answered(self, error: OSError | None) -> None:
+        """Note whether the chip answered; tell ``on_answer`` when that changed."""
+        ok = error is None
+        if ok == self.answering:
+            return
+        self.answering = ok
+        if self._on_answer is not None:
+            why = None if error is None else f"{CHIP} at 0x{self.address:02X}: {error}"
+            self._on_answer(ok, why)
 
     def ensure_selected(self, channel: int) -> None:
         """Select ``channel`` unless it already is the only one (call holding :attr:`lock`)."""

@@ -5,7 +5,9 @@ through GESTURE (0x04) and flags them in STATUS (0x00); it reports the hand's po
 X (0x08, across the sensor, 0..240) and Z (0x0A, away from it, 0..240) and flags each new
 coordinate with STATUS.DAV. Every flag in STATUS clears when STATUS is read, so this driver
 keeps the flags it has seen but not yet consumed: reading the position never loses a
-gesture, and each gesture is reported once.
+gesture, and each gesture is reported once. A new driver reads STATUS once and discards it:
+a gesture the chip latched before (while nobody read it: the bus was down, the robot was
+starting) is stale, and must not set off a greeting seconds after the hand went.
 
 The engine calls a left or right swipe a "wave": that mapping belongs to the behaviour
 tree; this driver reports what the chip reports.
@@ -104,6 +106,7 @@ class ZXGesture:
                 f"model 0x{MODEL_ID:02X} with register map 0x{REGISTER_MAP_VERSION:02X}"
             )
         bus.write_byte_data(address, DRE, 0x00)  # polled: the DR pin stays quiet
+        bus.read_byte_data(address, STATUS)  # clears what was latched before: stale
 
     def __repr__(self) -> str:
         return f"ZXGesture(address=0x{self.address:02X})"

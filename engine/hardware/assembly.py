@@ -4,8 +4,16 @@
 gives a :class:`Hardware`: a :class:`~engine.drivers.bus_manager.BusManager` per bus (and
 per TCA9548A channel in use), every device claimed at its address with a probe that
 re-checks its identity while it is offline, the VL53L0X chips moved to their addresses
-through their XSHUT lines, a :class:`~engine.hardware.pollers.Poller` per polled device,
-and the services (LEDs, servos, on-request sensors) on their drivers.
+through their XSHUT lines (an :class:`~engine.hardware.xshut.XshutChain` per bus, which
+keeps the lines to bring a lost chip back), a :class:`~engine.hardware.pollers.Poller` per
+polled device, and the services (LEDs, servos, on-request sensors) on their drivers.
+
+A bus with a TCA9548A is one adapter for the chips on it and those behind every channel:
+its bus manager and the channels' managers share one
+:class:`~engine.drivers.tca9548a.LockedBus`, so no two of them reach the adapter at once
+(smbus2 keeps the target address per open file). The channels' managers exist whether the
+mux answers at start-up or not; a channel access selects its channel first, so a mux that
+is late or gone fails those accesses as ordinary bus errors, re-probed until it answers.
 
 Buses come from the simulated vest (``vest=``, see :mod:`engine.hardware.sim_vest`) or from
 the machine: ``smbus2.SMBus(n)`` for ``/dev/i2c-n``, ``spidev.SpiDev`` for SPI nodes,
@@ -43,9 +51,9 @@ from engine.drivers.bus_errors import describe_exception
 from engine.drivers.bus_manager import BusManager, DeviceHandle, DeviceStats
 from engine.drivers.gpio import OutputLine
 from engine.drivers.maestro import Maestro
-from engine.drivers.tca9548a import TCA9548A
+from engine.drivers.tca9548a import TCA9548A, LockedBus
 from engine.errors import ConfigError, DeviceError
-from engine.hardware.config import BusConfig, DeviceConfig, RobotConfig, hex_address
+from engine.hardware.config import BusConfig, DeviceConfig, RobotConfig
 from engine.hardware.managed import DeviceHealth
 from engine.hardware.pollers import Poller, PollerThreads, make_poller
 from engine.hardware.services import (
@@ -56,6 +64,7 @@ from engine.hardware.services import (
     UltrasoundSensor,
 )
 from engine.hardware.timing import BranchingClock, branch_of
+from engine.hardware.xshut import XshutChain
 from engine.services.interfaces import IotResults, Services, Speech
 
 _log = logging.getLogger("vest.hardware")
@@ -216,6 +225,8 @@ class Hardware:
     startup_problems: dict[str, str] = field(default_factory=dict)
     """Devices that did not start, and why (they are retried while the robot runs)."""
     muxes: dict[str, TCA9548A] = field(default_factory=dict)
+    chains: dict[str, XshutChain] = field(default_factory=dict)
+    """The VL53L0X XSHUT chain of each bus that has one, by bus name."""
     _owned: list[Any] = field(default_factory=list)
     _threads: PollerThreads | None = None
     _closed: bool = False
@@ -364,6 +375,7 @@ class _Assembler:
         self.provider = provider
         self.blackboard = blackboard
         self.clock = hardware.clock
+        self._upstream: dict[str, LockedBus] = {}
 
     def _manager(self, bus: Any, *, name: str, kind: str) -> BusManager[Any]:
         health = self.hw.health
@@ -387,6 +399,7 @@ class _Assembler:
         for device in config.devices.values():
             self.hw.health[device.name] = DeviceHealth(device.name, self.blackboard)
         used = {device.bus for device in config.devices.values()}
+        muxed = {device.bus for device in config.devices.values() if device.chip == "tca9548a"}
         for bus in config.buses.values():
             if bus.name in used and bus.kind != "serial":
                 opened = (
@@ -394,6 +407,11 @@ class _Assembler:
                     if bus.kind == "i2c"
                     else self.provider.open_spi(bus)
                 )
+                if bus.name in muxed:
+                    # One adapter for the upstream chips and every mux channel: each access
+                    # holds one lock (smbus2 sets the target address per open file).
+                    opened = LockedBus(opened)
+                    self._upstream[bus.name] = opened
                 name = str(bus.number) if bus.kind == "i2c" else bus.path
                 self.hw.managers[bus.name] = self._manager(opened, name=name, kind=bus.kind.upper())
         for device in config.devices.values():
@@ -419,14 +437,9 @@ class _Assembler:
     def _failed(self, device: DeviceConfig, error: BaseException) -> None:
         self.hw.startup_problems[device.name] = describe_exception(error)
 
-    def _claim(self, device: DeviceConfig) -> DeviceHandle[Any] | None:
+    def _claim(self, device: DeviceConfig) -> DeviceHandle[Any]:
         if device.mux is not None:
-            assert device.mux_channel is not None
-            manager = self.hw.managers.get(f"{device.bus}:{device.mux}.{device.mux_channel}")
-            if manager is None:
-                self.hw.startup_problems[device.name] = f"its mux {device.mux!r} did not start"
-                self.hw.health[device.name].driver_status(False, "mux did not start")
-                return None
+            manager = self.hw.managers[f"{device.bus}:{device.mux}.{device.mux_channel}"]
         else:
             manager = self.hw.managers[device.bus]
         handle = manager.claim(device.name, device.address, probe=probe_for(device))
@@ -434,15 +447,28 @@ class _Assembler:
         return handle
 
     def _mux(self, device: DeviceConfig) -> None:
-        handle = self._claim(device)
-        assert handle is not None and device.address is not None
-        address = device.address
-        try:
-            mux = handle.call(lambda bus: TCA9548A(bus, address=address))
-        except Exception as error:
-            self._failed(device, error)
-            return
+        """The TCA9548A and a bus manager per channel in use, whether it answers now or not.
+
+        Nothing is sent to build it: each channel access selects its channel, so a mux that
+        is late or missing fails those accesses as ordinary bus errors, which the channel's
+        bus manager retries and re-probes. Its health follows its answers.
+        """
+        assert device.address is not None
+        health = self.hw.health[device.name]
+        mux = TCA9548A(
+            self._upstream[device.bus],
+            address=device.address,
+            check=False,
+            on_answer=lambda ok, why: health.driver_status(ok, why),
+        )
         self.hw.muxes[device.name] = mux
+        manager = self.hw.managers[device.bus]
+
+        def check(bus: Any) -> list[int]:
+            return mux.selected()
+
+        handle = manager.claim(device.name, device.address, probe=check)
+        self.hw.handles[device.name] = handle
         channels = sorted(
             {
                 d.mux_channel
@@ -456,45 +482,22 @@ class _Assembler:
                 name=f"{self.config.buses[device.bus].number} via {device.name} ch{channel}",
                 kind="I2C",
             )
+        try:
+            handle.call(check)
+        except Exception as error:
+            self._failed(device, error)
+            self._until_offline(device, handle, check)
 
-    def _xshut_chain(self, bus: BusConfig, chain: list[DeviceConfig]) -> None:
-        """Switch the VL53L0X chips on one at a time, each moved off 0x29 before the next."""
-        manager = self.hw.managers[bus.name]
+    def _xshut_chain(self, bus: BusConfig, members: list[DeviceConfig]) -> None:
+        """Switch the VL53L0X chips on one at a time, each moved off 0x29 before the next;
+        the chain keeps their lines to bring a chip back later."""
         lines = [
             (device, self.provider.output_line(device.xshut or 0, f"vest {device.name} XSHUT"))
-            for device in chain
+            for device in members
         ]
-        for _, line in lines:
-            line.set(False)  # every chip in standby, forgetting any earlier address
-        booting = manager.claim(
-            f"VL53L0X start-up on {bus.name}",
-            vl53l0x.DEFAULT_ADDRESS,
-        )
-        try:
-            for device, line in lines:
-                line.set(True)
-                self.clock.sleep(vl53l0x.BOOT_TIME_S)
-                target = device.address
-                assert target is not None
-                options = device.options
-
-                def move(raw: Any, target: int = target, options: dict[str, Any] = options) -> None:
-                    sensor = vl53l0x.VL53L0X(
-                        raw, address=vl53l0x.DEFAULT_ADDRESS, clock=self.clock, **options
-                    )
-                    if target != vl53l0x.DEFAULT_ADDRESS:
-                        sensor.set_address(target)
-
-                try:
-                    booting.call(move)
-                except Exception as error:
-                    line.set(False)  # back to standby, off the bus, out of the next chip's way
-                    self.hw.startup_problems[device.name] = (
-                        f"did not come up at 0x29 to be moved to {hex_address(target)}: "
-                        + describe_exception(error)
-                    )
-        finally:
-            booting.release()
+        chain = XshutChain(self.hw.managers[bus.name], lines, self.clock)
+        self.hw.chains[bus.name] = chain
+        self.hw.startup_problems.update(chain.start())
 
     def _device(self, device: DeviceConfig) -> None:
         hw = self.hw
@@ -502,19 +505,25 @@ class _Assembler:
             self._servos(device)
             return
         handle = self._claim(device)
-        if handle is None:
-            return
         role = device.role
-        try:
-            if device.polled:
+        poller: Poller[Any] | None = None
+        if device.polled:
+            try:
                 poller = make_poller(
                     device,
                     handle,
                     clock=self.clock,
                     blackboard=self.blackboard or _NO_BLACKBOARD,
                     health=hw.health[device.name],
+                    chain=hw.chains.get(device.bus) if device.xshut is not None else None,
                 )
-                hw.pollers.append(poller)
+            except Exception as error:  # nothing will ever read it: say so, for good
+                self._failed(device, error)
+                hw.health[device.name].driver_status(False, describe_exception(error))
+                return
+            hw.pollers.append(poller)
+        try:
+            if poller is not None:
                 if device.name not in hw.startup_problems:
                     poller.connect()
             elif role == "leds":
@@ -532,10 +541,15 @@ class _Assembler:
             if not device.polled:
                 self._until_offline(device, handle)
 
-    def _until_offline(self, device: DeviceConfig, handle: DeviceHandle[Any]) -> None:
+    def _until_offline(
+        self,
+        device: DeviceConfig,
+        handle: DeviceHandle[Any],
+        probe: Callable[[Any], object] | None = None,
+    ) -> None:
         """A device read on request that failed at start-up: probe it until the bus manager
         takes it offline (then it is re-probed by itself, and back when it answers)."""
-        probe = probe_for(device)
+        probe = probe or probe_for(device)
         if probe is None:
             return
         for _ in range(_OFFLINE_AFTER):

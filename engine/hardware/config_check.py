@@ -11,11 +11,13 @@ is collected before the LoadError is raised, so a person fixes them all in one g
 
 from __future__ import annotations
 
+import math
+import re
 from pathlib import Path
 from typing import Any
 
 from engine.blackboard.catalogue import KeyCatalogue
-from engine.drivers.servo_joints import Joint
+from engine.drivers.servo_joints import MAESTRO_MAX_US, MAESTRO_MIN_US, Joint
 from engine.hardware.config import (
     BUS_KINDS,
     CHIPS,
@@ -66,11 +68,13 @@ JOINT_FIELDS = (
     Param("min_deg", Number(-360.0, 360.0, "deg"), REQUIRED, "lowest angle"),
     Param("max_deg", Number(-360.0, 360.0, "deg"), REQUIRED, "highest angle"),
     Param("max_speed_dps", Number(0.0, 10_000.0, "deg/s"), REQUIRED, "speed limit"),
-    Param("min_us", Number(0.0, 4000.0, "us"), 1000.0, "pulse width at min_deg"),
-    Param("max_us", Number(0.0, 4000.0, "us"), 2000.0, "pulse width at max_deg"),
+    Param("min_us", Number(unit="us"), 1000.0, "pulse width at min_deg, 64..4000 us"),
+    Param("max_us", Number(unit="us"), 2000.0, "pulse width at max_deg, 64..4000 us"),
     Param("home_deg", Number(-360.0, 360.0, "deg"), 0.0, "resting angle"),
 )
 LED_FIELDS = ("red", "green", "blue")
+DEVICE_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
+"""A device name: it names ``/devices/<name>/ok`` and is written in trees, so an identifier."""
 # Options whose YAML value is a number but which the drivers take from a fixed set.
 _NUMERIC_CHOICES = {"gain", "data_rate_sps", "resolution_c", "channels"}
 
@@ -185,7 +189,24 @@ class ConfigChecker:
             bus = self._bus(name, body)
             if bus is not None:
                 buses[name] = bus
+        self._one_entry_per_adapter(buses)
         return buses
+
+    def _one_entry_per_adapter(self, buses: dict[str, BusConfig]) -> None:
+        """Two entries for one device file would be two bus managers on one adapter."""
+        first: dict[str, BusConfig] = {}
+        for bus in buses.values():
+            holder = first.get(bus.path)
+            if holder is None:
+                first[bus.path] = bus
+                continue
+            self.problems.add(
+                bus.mark,
+                f"bus {bus.name!r} is {bus.path}, like bus {holder.name!r} "
+                f"(line {holder.mark.line}): one adapter needs one bus entry, or two owners "
+                "would use it at once",
+                f"remove {bus.name!r} and put its devices on bus {holder.name!r}",
+            )
 
     def _bus(self, name: str, body: YValue) -> BusConfig | None:
         raw = self.mapping(body, f"bus {name!r}", "e.g. {kind: i2c, number: 1}")
@@ -219,6 +240,14 @@ class ConfigChecker:
         if section is None:
             return devices
         for name, body in section.items():
+            if not DEVICE_NAME.fullmatch(name):
+                self.problems.add(
+                    section.key_marks[name],
+                    f"device name {name!r} is not an identifier: use letters, digits and _, "
+                    "starting with a letter or _",
+                    f"it names /devices/<name>/ok on the blackboard, e.g. {_identifier(name)!r}",
+                )
+                continue
             if isinstance(body, YMap):  # problems about a device as a whole point at its name
                 body = YMap(body.entries, section.key_marks[name], body.key_marks)
             device = self._device(name, body, buses)
@@ -410,6 +439,12 @@ class ConfigChecker:
         return keys if ok else None
 
 
+def _identifier(name: str) -> str:
+    """``name`` made an identifier (for a hint): other characters become ``_``."""
+    text = re.sub(r"[^A-Za-z0-9_]", "_", name) or "device"
+    return text if not text[0].isdigit() else "_" + text
+
+
 def _number_text(value: Any) -> Any:
     if isinstance(value, bool) or not isinstance(value, int | float):
         return value
@@ -556,6 +591,15 @@ class _ChipFields:
                 ok = False
                 continue
             volts, newtons = float(value[0]), float(value[1])
+            if not (math.isfinite(volts) and math.isfinite(newtons)):
+                self.c.problems.add(
+                    item.mark,
+                    f"calibration point {index + 1} is [{volts:g}, {newtons:g}]: volts and "
+                    "newtons must be finite numbers",
+                    example,
+                )
+                ok = False
+                continue
             if newtons < 0:
                 self.c.problems.add(
                     item.mark, f"calibration point {index + 1} has negative force {newtons:g} N"
@@ -795,6 +839,17 @@ class _ChipFields:
                 f"joint {joint_name!r}: pulse limits {values['min_us']:g}..{values['max_us']:g} "
                 "us are not increasing and positive",
             )
+        else:
+            for name in ("min_us", "max_us"):
+                if not MAESTRO_MIN_US <= values[name] <= MAESTRO_MAX_US:
+                    problems.add(
+                        place(name, raw).mark,
+                        f"joint {joint_name!r}: {name} {values[name]:g} us is outside the "
+                        f"Maestro's pulse range {MAESTRO_MIN_US:g}..{MAESTRO_MAX_US:g} us "
+                        f"({MAESTRO_MIN_US:g} us is its lowest Min setting)",
+                        "hobby servos take about 500..2500 us; match the Min and Max set in "
+                        "the Maestro Control Center",
+                    )
         if not values["max_speed_dps"] > 0:
             problems.add(
                 place("max_speed_dps", raw).mark,
@@ -885,6 +940,22 @@ class _CrossChecks:
                     f"I2C {hex_address(device.address)} behind {device.mux} clashes with "
                     f"{upstream.name!r} ({self._line(upstream)}) on the upstream bus",
                     "chips on the upstream bus answer on every channel; move one",
+                )
+        # A mux keeps its channel selected while the other mux selects one of its own.
+        behind: dict[tuple[str, int | None], DeviceConfig] = {}
+        for device in self.devices.values():
+            if device.mux is None:
+                continue
+            other = behind.setdefault((device.bus, device.address), device)
+            if other.mux != device.mux:
+                self.c.problems.add(
+                    self.mark(device, "address"),
+                    f"I2C {hex_address(device.address)} is behind mux {device.mux!r} and, "
+                    f"as {other.name!r} ({self._line(other)}), behind mux {other.mux!r} on "
+                    f"the same bus {device.bus!r}: each mux keeps its channel selected, so "
+                    "both chips would answer at once",
+                    f"put both behind {other.mux!r} on different channels, or give one "
+                    "another address",
                 )
 
     def all_call(self) -> None:

@@ -24,7 +24,9 @@ device that senses nothing (no pad touched, no force, nothing in range) so that 
 manager's offline mark, or :attr:`Poller.offline_after` failed polls in a row). Every due
 poll tries again; the bus manager refuses polls of an offline device without touching the
 bus until its next re-probe. When the device answers, a new driver is made (identity check,
-init: a replugged chip starts from power-on) and the readings flow again.
+init: a replugged chip starts from power-on) and the readings flow again. A VL53L0X on an
+XSHUT line that no longer answers at its address (power-cycled, it is back at 0x29) is
+rebooted through its line and moved back by its :class:`~engine.hardware.xshut.XshutChain`.
 """
 
 from __future__ import annotations
@@ -41,7 +43,7 @@ from engine.blackboard.board import Blackboard
 from engine.clock import Clock
 from engine.drivers.ads1115 import ADS1115
 from engine.drivers.bus_errors import describe_exception
-from engine.drivers.bus_manager import DeviceHandle
+from engine.drivers.bus_manager import DeviceHandle, Priority
 from engine.drivers.force_calibration import ForceCalibration
 from engine.drivers.mcp3008 import MCP3008
 from engine.drivers.mpr121 import MPR121, PADS
@@ -50,6 +52,7 @@ from engine.drivers.zx_gesture import ZXGesture
 from engine.hardware.config import DeviceConfig
 from engine.hardware.managed import DeviceHealth, ManagedI2C, ManagedSpi
 from engine.hardware.timing import branch_of
+from engine.hardware.xshut import XshutChain
 
 _log = logging.getLogger("vest.pollers")
 
@@ -194,10 +197,11 @@ class Poller(Generic[D]):
         self.consecutive_failures += 1
         why = describe_exception(error)
         self.last_error = why
-        if not isinstance(error, OSError):  # a driver bug: say so loudly, keep going
-            _log.error("%s: poll failed with %s", self.name, why)
-        elif self.consecutive_failures == 1:  # once per streak, not at every poll
-            _log.warning("%s: %s", self.name, why)
+        if self.consecutive_failures == 1:  # once per streak, not at every poll
+            if not isinstance(error, OSError):  # a driver bug: say so loudly, keep going
+                _log.error("%s: poll failed with %s", self.name, why)
+            else:
+                _log.warning("%s: %s", self.name, why)
         if self.consecutive_failures >= self.offline_after:
             self.health.driver_status(False, why)
         if not self.health.ok and not self._resting:
@@ -286,8 +290,13 @@ def make_poller(
     clock: Clock,
     blackboard: Blackboard,
     health: DeviceHealth,
+    chain: XshutChain | None = None,
 ) -> Poller[Any]:
-    """The poller for a polled device of the config (touch, force, range, gesture)."""
+    """The poller for a polled device of the config (touch, force, range, gesture).
+
+    ``chain``: the XSHUT chain of a VL53L0X on one, which brings the chip back when it no
+    longer answers at its address.
+    """
     makers = {
         "touch": _touch,
         "force": _force,
@@ -297,7 +306,10 @@ def make_poller(
     maker = makers.get(device.role)
     if maker is None or device.rate_hz is None:
         raise ValueError(f"device {device.name!r} ({device.chip}) is not polled")
-    connect, read, rest = maker(device, handle, clock)
+    if device.role == "range":
+        connect, read, rest = _range(device, handle, clock, chain)
+    else:
+        connect, read, rest = maker(device, handle, clock)
     return Poller(
         device.name,
         rate_hz=device.rate_hz,
@@ -343,11 +355,28 @@ def _force(device: DeviceConfig, handle: DeviceHandle[Any], clock: Clock) -> Par
     return connect, read, [Staged(pad.key, 0.0) for pad in device.pads]
 
 
-def _range(device: DeviceConfig, handle: DeviceHandle[Any], clock: Clock) -> Parts:
+def _range(
+    device: DeviceConfig,
+    handle: DeviceHandle[Any],
+    clock: Clock,
+    chain: XshutChain | None = None,
+) -> Parts:
     key = device.keys["range"]
+    address = _address(device)
 
     def connect() -> VL53L0X:
-        return VL53L0X(ManagedI2C(handle), address=_address(device), clock=clock, **device.options)
+        try:
+            return VL53L0X(ManagedI2C(handle), address=address, clock=clock, **device.options)
+        except OSError:
+            # Not at its address: power-cycled (back at 0x29), or left in standby at start-up.
+            if chain is None or not chain.may_reboot(device.name):
+                raise
+        chain.reboot(device.name)
+        # Ahead of the polls, which the bus manager refuses while it has the chip offline.
+        bus = ManagedI2C(handle, priority=Priority.REQUEST)
+        driver = VL53L0X(bus, address=address, clock=clock, **device.options)
+        bus.priority = Priority.POLL
+        return driver
 
     def read(driver: VL53L0X) -> list[Staged]:
         distance_mm = driver.read_range_mm()

@@ -8,7 +8,9 @@ bus's worker and a job is done when its future is; inline they have run by the t
 method returns.
 
 - :class:`HardwareLeds`: every LED of the config's PCA9685 in one color; with ``seconds``
-  the LEDs go dark again when the hook (``leds(now_s)``, a scheduler hook) sees the time.
+  the LEDs go dark again when the hook (``leds(now_s)``, a scheduler hook) sees the time,
+  tried again until the chip took it. A rebuilt driver (after a failure: a replugged chip
+  starts dark) lights the color the LEDs should show.
 - :class:`HardwareServos`: joints in degrees on the Maestro; a move beyond a joint's limits
   is a failed job that says so, and nothing is sent. The job lasts as long as the move
   takes at its speed.
@@ -43,6 +45,8 @@ D = TypeVar("D")
 T = TypeVar("T")
 
 ON_REQUEST_SENSORS = ("temperature", "ultrasound")
+LED_OFF_RETRY_S = 0.5
+"""Seconds between two tries to turn the LEDs off when the chip did not take it."""
 
 
 class DriverSlot(Generic[D]):
@@ -152,7 +156,8 @@ class TimedFutureJob(FutureResultJob):
 class HardwareLeds:
     """The face LEDs on the config's PCA9685: :class:`~engine.services.interfaces.Leds`.
 
-    Also a scheduler hook: ``leds(now_s)`` turns the LEDs off when a ``seconds`` ran out.
+    Also a scheduler hook: ``leds(now_s)`` turns the LEDs off when a ``seconds`` ran out,
+    and tries again every :data:`LED_OFF_RETRY_S` until the chip took it.
     """
 
     def __init__(self, device: DeviceConfig, handle: DeviceHandle[Any], clock: Clock) -> None:
@@ -160,15 +165,22 @@ class HardwareLeds:
         self.clock = clock
         self._on = _OnDevice(device, handle, clock, self._make)
         self.color = "off"
-        self._off_at_s: float | None = None
+        """The color the LEDs should show (what the trees asked for last)."""
+        self._off_at_s: float | None = None  # kept until an "off" went through
+        self._off: Future[None] | None = None  # the "off" on its way to the chip
+        self._retry_at_s = float("-inf")
         self.pwm: PCA9685 | None = None
 
     def _make(self, bus: Any) -> RgbLeds:
+        """A new driver (the chip starts dark), showing the color the LEDs should show."""
         assert self.device.address is not None
         pwm = PCA9685(bus, address=self.device.address, clock=self.clock)
         pwm.set_frequency_hz(self.device.options["frequency_hz"])
         self.pwm = pwm
-        return RgbLeds(pwm, self.device.leds, common_anode=self.device.options["common_anode"])
+        leds = RgbLeds(pwm, self.device.leds, common_anode=self.device.options["common_anode"])
+        if self.color != "off":
+            leds.set_color(ALL, parse_color(self.color))
+        return leds
 
     @property
     def handle(self) -> DeviceHandle[Any]:
@@ -189,14 +201,27 @@ class HardwareLeds:
         future = self._on.submit(lambda leds: leds.set_color(ALL, rgb))
         self.color = color
         self._off_at_s = None if seconds is None else self.clock.now() + seconds
+        self._off = None  # an "off" still on its way is overtaken by this color
+        self._retry_at_s = float("-inf")
         return TimedFutureJob(future, self.clock, seconds or 0.0)
 
     def __call__(self, now_s: float) -> None:
-        """Scheduler hook: the LEDs go dark when their time is up."""
-        if self._off_at_s is not None and now_s + 1e-9 >= self._off_at_s:
-            self._off_at_s = None
+        """Scheduler hook: the LEDs go dark when their time is up, tried until they are."""
+        if self._off_at_s is None:
+            return
+        if self._off is None:
+            if now_s + 1e-9 < max(self._off_at_s, self._retry_at_s):
+                return
             self.color = "off"
-            self._on.submit(lambda leds: leds.off())
+            self._off = self._on.submit(lambda leds: leds.off())
+        if not self._off.done():
+            return  # on the bus worker; the next call looks again
+        failed = self._off.cancelled() or self._off.exception() is not None
+        self._off = None
+        if failed:  # still lit: keep the deadline, try again a little later
+            self._retry_at_s = now_s + LED_OFF_RETRY_S
+        else:
+            self._off_at_s = None
 
     def read_now(self) -> str:
         """What the PCA9685 says (for ``vest devices``): its PWM frequency."""

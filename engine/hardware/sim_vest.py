@@ -21,7 +21,7 @@ SRF02's echo. The drivers then read all of it at register level, exactly as on t
 Faults: :meth:`SimVest.unplug` and :meth:`SimVest.fault` (also the world events
 ``unplug`` ``{device, seconds}`` and ``fault`` ``{device, kind, seconds}``) make a device
 stop answering (I2C: NACK; SPI: MISO pulled high), answer garbage, or hold the whole I2C
-bus, for a while.
+bus, for a while. An unplugged chip has no power: a gesture made meanwhile is not seen.
 
 On a :class:`~engine.clock.VirtualClock` the chips and the drivers share a
 :class:`~engine.hardware.timing.BranchingClock` (:attr:`SimVest.clock`), so inline polls
@@ -78,6 +78,14 @@ class SpiSocket(SimSpiDevice):
 
     def inject(self, kind: str, seconds: float) -> None:
         self._fault = (kind, self._clock.now() + seconds)
+
+    @property
+    def fault(self) -> str | None:
+        """The fault still active now, if any."""
+        if self._fault is None:
+            return None
+        kind, until_s = self._fault
+        return kind if self._clock.now() < until_s else None
 
     def frame(self, mosi_bits: Sequence[int], *, mode: int, speed_hz: int) -> list[Bit]:
         if self._fault is not None:
@@ -260,6 +268,17 @@ class SimVest:
         bus, address = place
         bus.inject(kind, seconds, address)
 
+    def unplugged(self, device: str) -> bool:
+        """Whether ``device`` is unplugged now (an ``unplugged`` fault still active)."""
+        socket = self._sockets.get(device)
+        if socket is not None:
+            return socket.fault == "unplugged"
+        place = self._places.get(device)
+        if place is None:
+            return False
+        bus, address = place
+        return bus.fault_at(address) == "unplugged"
+
     # -- the world -------------------------------------------------------------------------
     def start(self) -> None:
         """Put the world's present state on the chips."""
@@ -299,6 +318,8 @@ class SimVest:
         try:
             if kind == "gesture":
                 for device in self.config.with_role("gesture"):
+                    if self.unplugged(device.name):
+                        continue  # a chip without power sees no hand
                     self.chips[device.name].perform(WAVE_AS if value == "wave" else value)
             elif kind == "unplug":
                 self.unplug(value["device"], value["seconds"])

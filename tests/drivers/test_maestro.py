@@ -10,11 +10,13 @@ from __future__ import annotations
 import errno
 import os
 from collections.abc import Iterator
+from pathlib import Path
 
 import pytest
 import serial
 
 from engine.clock import VirtualClock
+from engine.drivers.bus_manager import BusManager
 from engine.drivers.maestro import (
     Maestro,
     decode_errors,
@@ -359,3 +361,38 @@ def test_closing_the_emulator_removes_its_port(clock: VirtualClock) -> None:
     assert os.path.exists(name)
     emulator.close()
     assert not os.path.exists(name)
+
+
+def test_a_maestro_opened_by_name_carries_on_after_its_cable_was_pulled_and_plugged_back(
+    tmp_path: Path, clock: VirtualClock
+) -> None:
+    link = tmp_path / "ttyACM0"  # the port's name, as udev gives it
+    first = MaestroEmulator(clock)
+    link.symlink_to(first.port_name)
+    maestro = Maestro(str(link), clock=clock, timeout_s=0.5)
+    manager = BusManager(maestro, name=str(link), clock=clock, kind="serial", threaded=False)
+    servos = manager.claim("servos")
+    second: MaestroEmulator | None = None
+    try:
+        servos.call(lambda m: m.set_target_us(0, 1500))
+        assert servos.call(lambda m: m.get_position_us(0)) == 1500.0
+
+        first.close()  # the cable is pulled: the port goes away
+        link.unlink()
+        with pytest.raises(DeviceError, match="opened again at the next command"):
+            servos.call(lambda m: m.set_target_us(0, 1600))
+        with pytest.raises(DeviceError, match="no such file"):
+            servos.call(lambda m: m.set_target_us(0, 1600))
+
+        second = MaestroEmulator(clock)  # plugged back in, under the same name
+        link.symlink_to(second.port_name)
+        servos.call(lambda m: m.set_target_us(0, 1600))
+
+        assert servos.call(lambda m: m.get_position_us(0)) == 1600.0
+        assert second.targets_us()[0] == 1600.0
+    finally:
+        manager.close()
+        maestro.close()
+        first.close()
+        if second is not None:
+            second.close()

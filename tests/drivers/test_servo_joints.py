@@ -182,3 +182,17 @@ def test_a_joint_on_a_channel_the_maestro_lacks_is_refused(
     leg = Joint("leg", 17, -30, 30, 60)
     with pytest.raises(ValueError, match=r"channel 17 is outside the controller's 0..11"):
         ServoJoints(maestro, [leg], clock=clock)
+
+
+def test_a_pulse_too_short_to_tell_from_off_is_refused_and_the_servo_stays_driven(
+    maestro: Maestro, clock: VirtualClock
+) -> None:
+    tiny = Joint("neck_pan", 0, -60.0, 60.0, 120.0, min_us=0.1, max_us=2000.0)
+    joints = ServoJoints(maestro, [tiny], clock=clock)
+    joints.move("neck_pan", 0.0)
+    assert maestro.get_position_us(0) == 1000.0
+
+    with pytest.raises(ValueError, match=r"'neck_pan': angle -60.0 deg is a pulse of 0.1 us"):
+        joints.move("neck_pan", -60.0)
+
+    assert maestro.get_position_us(0) == 1000.0  # not switched off

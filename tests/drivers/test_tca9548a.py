@@ -136,3 +136,21 @@ def test_after_the_mux_was_reset_a_failed_read_selects_the_channel_again(
         bus0.read_byte_data(0x10, 0xFF)
     assert bus0.read_byte_data(0x10, 0xFF) == 0x01
     assert sim_mux.control == 0x01
+
+
+def test_a_mux_made_without_a_check_selects_its_channel_at_the_first_transfer(
+    clock, upstream, channels
+):
+    SimVL53L0X(clock, channels[2])
+    answers: list[bool] = []
+    mux = TCA9548A(
+        upstream, address=0x70, check=False, on_answer=lambda ok, why: answers.append(ok)
+    )
+    behind = mux.channel_bus(2)
+    with pytest.raises(OSError):  # the mux is not there yet: an ordinary bus error
+        behind.read_byte_data(0x29, 0xC0)
+
+    SimTCA9548A(0x70, channels, upstream=upstream)  # now it is
+
+    assert behind.read_byte_data(0x29, 0xC0) == 0xEE
+    assert answers == [False, True]

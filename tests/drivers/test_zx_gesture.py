@@ -130,3 +130,13 @@ def test_pure_decoding():
     assert gesture_name(0x04) is None  # no gesture has code 4
     assert decode_position(240, 0) == (240, 0)
     assert decode_position(255, 10) is None
+
+
+def test_a_gesture_the_chip_latched_before_the_driver_started_is_not_reported(bus, chip):
+    chip.perform("swipe_right")  # long ago: nobody was reading the sensor then
+
+    sensor = ZXGesture(bus)
+
+    assert sensor.read_gesture() is None
+    chip.perform("swipe_left")
+    assert sensor.read_gesture() == "swipe_left"

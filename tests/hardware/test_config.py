@@ -297,3 +297,96 @@ def test_a_config_without_devices_or_buses_says_what_it_needs(tmp_path):
         "robot.yaml:1:1: a robot config needs 'buses:' (e.g. i2c: {kind: i2c, number: 1})",
         "robot.yaml:1:1: a robot config needs 'devices:' (e.g. touch: {chip: mpr121})",
     ]
+
+
+def test_one_address_behind_two_muxes_of_one_bus_is_refused(tmp_path):
+    found = problems(
+        tmp_path,
+        """\
+        muxa: {chip: tca9548a, address: 0x71}
+        muxb: {chip: tca9548a, address: 0x72}
+        range_left: {chip: vl53l0x, side: left, mux: muxa, channel: 0}
+        range_right: {chip: vl53l0x, side: right, mux: muxb, channel: 0}
+        """,
+    )
+    assert found == [
+        "robot.yaml:9:3: I2C 0x29 is behind mux 'muxb' and, as 'range_left' (line 8), behind "
+        "mux 'muxa' on the same bus 'i2c': each mux keeps its channel selected, so both chips "
+        "would answer at once (put both behind 'muxa' on different channels, or give one "
+        "another address)"
+    ]
+
+
+@pytest.mark.parametrize("bad", [".nan", ".inf", "-.inf"])
+def test_a_calibration_point_that_is_not_a_finite_number_is_refused(tmp_path, bad):
+    found = problems(
+        tmp_path,
+        f"""\
+        force:
+          chip: ads1115
+          pads:
+            left: {{channel: 0, calibration: [[0.0, 0.0], [{bad}, 1.0], [3.0, 6.0]]}}
+        """,
+    )
+    assert len(found) == 1
+    assert found[0].startswith("robot.yaml:9:52: calibration point 2 is [")
+    assert found[0].endswith(
+        "volts and newtons must be finite numbers (pairs of [volts, newtons], e.g. "
+        "[[0.0, 0.0], [0.83, 0.2], [3.0, 6.0]])"
+    )
+
+
+def test_two_bus_entries_for_one_adapter_are_refused(tmp_path):
+    head = """\
+name: test
+buses:
+  front: {kind: i2c, number: 1}
+  back: {kind: i2c, number: 1}
+  spi: {kind: spi, number: 0}
+  spi_too: {kind: spi, number: 0, chip_select: 0}
+  spi_other: {kind: spi, number: 0, chip_select: 1}
+  servos: {kind: serial, port: /dev/ttyACM0}
+  servos_too: {kind: serial, port: /dev/ttyACM0}
+devices:
+"""
+    found = problems(tmp_path, "touch: {chip: mpr121, bus: front}\n", head=head)
+    assert found == [
+        "robot.yaml:4:9: bus 'back' is /dev/i2c-1, like bus 'front' (line 3): one adapter "
+        "needs one bus entry, or two owners would use it at once (remove 'back' and put its "
+        "devices on bus 'front')",
+        "robot.yaml:6:12: bus 'spi_too' is /dev/spidev0.0, like bus 'spi' (line 5): one "
+        "adapter needs one bus entry, or two owners would use it at once (remove 'spi_too' "
+        "and put its devices on bus 'spi')",
+        "robot.yaml:9:15: bus 'servos_too' is /dev/ttyACM0, like bus 'servos' (line 8): one "
+        "adapter needs one bus entry, or two owners would use it at once (remove "
+        "'servos_too' and put its devices on bus 'servos')",
+    ]
+
+
+@pytest.mark.parametrize(("field", "value"), [("min_us", "0.1"), ("max_us", "4500")])
+def test_a_pulse_limit_the_maestro_cannot_send_is_refused_saying_its_range(tmp_path, field, value):
+    limits = {"min_us": "1000", "max_us": "2000", field: value}
+    found = problems(
+        tmp_path,
+        f"""\
+        servos:
+          chip: maestro
+          joints:
+            neck: {{channel: 0, min_deg: -60, max_deg: 60, max_speed_dps: 90,
+                    min_us: {limits["min_us"]}, max_us: {limits["max_us"]}}}
+        """,
+    )
+    assert len(found) == 1
+    assert found[0].startswith("robot.yaml:10:")
+    expected = f"joint 'neck': {field} {value} us is outside the Maestro's pulse range 64..4000 us"
+    assert expected in found[0]
+
+
+@pytest.mark.parametrize("name", ["to/uch", "face leds", "5"])
+def test_a_device_name_that_is_not_an_identifier_is_refused(tmp_path, name):
+    found = problems(tmp_path, f'"{name}": {{chip: mpr121}}\n')
+    assert len(found) == 1
+    assert found[0].startswith(
+        f"robot.yaml:6:3: device name {name!r} is not an identifier: use letters, digits and _"
+    )
+    assert "/devices/<name>/ok" in found[0]

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import logging
 import threading
 from typing import Any
 
@@ -246,3 +247,35 @@ def test_pollers_on_threads_poll_by_themselves():
 
     assert not threads.running
     assert reads and board.last("/sensors/touch/any") is True
+
+
+def test_a_driver_bug_is_logged_once_per_failure_streak_not_at_every_poll(
+    bench: Bench, caplog: pytest.LogCaptureFixture
+):
+    broken = True
+
+    def read(driver: object) -> list[Staged]:
+        if broken:
+            raise ZeroDivisionError("division by zero")  # a bug, not a bus error
+        return [Staged("/sensors/touch/any", False)]
+
+    health = DeviceHealth("touch", bench.board)  # type: ignore[arg-type]
+    poller: Poller[object] = Poller(
+        "touch",
+        rate_hz=10.0,
+        clock=bench.clock,
+        blackboard=bench.board,  # type: ignore[arg-type]
+        health=health,
+        connect=object,
+        read=read,
+    )
+    with caplog.at_level(logging.INFO, logger="vest.pollers"):
+        bench.run(poller, 1.0)  # ten polls, all failing
+        broken = False
+        bench.run(poller, 0.5)
+        broken = True
+        bench.run(poller, 0.5)
+
+    errors = [record.getMessage() for record in caplog.records if record.levelno >= logging.ERROR]
+    assert errors == ["touch: poll failed with ZeroDivisionError: division by zero"] * 2
+    assert poller.failures == 15 and health.ok is False

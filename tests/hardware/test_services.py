@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import pytest
 
+from engine.drivers.sim.pca9685 import SimPCA9685
 from engine.errors import DeviceError, ServiceError
 
 from .conftest import SimRobot
@@ -139,3 +140,37 @@ def test_an_unknown_sensor_names_the_known_ones(sim_robot: SimRobot):
     job = sim_robot.services.sensors.read("humidity")
 
     assert str(job.error()) == "no sensor 'humidity' (known: temperature, ultrasound)"
+
+
+def test_leds_whose_time_ran_out_while_unplugged_go_dark_once_the_chip_is_back(
+    sim_robot: SimRobot,
+):
+    leds = sim_robot.hardware.leds
+    assert leds is not None
+    leds.set_color("blue", seconds=1.0)
+    sim_robot.vest.unplug("face_leds", 2.0)
+
+    sim_robot.run_for(1.5)  # the "off" at 1 s cannot reach the chip
+    assert blue_duty(sim_robot) == 1.0
+
+    sim_robot.run_for(1.5)  # back at 2 s
+
+    assert blue_duty(sim_robot) == 0.0
+    assert leds.color == "off"
+
+
+def test_a_new_face_board_shows_the_color_the_face_should_show(sim_robot: SimRobot):
+    leds = sim_robot.hardware.leds
+    assert leds is not None
+    assert leds.set_color("blue").done()
+    bus = sim_robot.vest.i2c["i2c"]
+
+    bus.detach(0x40)  # the face board is pulled...
+    with pytest.raises(DeviceError):
+        leds.read_now()
+    board = SimPCA9685(sim_robot.vest.clock, 0x40)  # ...and a new one, dark, plugged in
+    bus.attach(board)
+    leds.read_now()
+
+    _, _, blue = sim_robot.hardware.config.device("face_leds").leds["left_eye"]
+    assert board.duty(blue) == 1.0

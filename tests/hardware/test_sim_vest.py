@@ -13,6 +13,7 @@ import pytest
 from engine.blackboard.board import Blackboard
 from engine.blackboard.catalogue import default_catalogue
 from engine.clock import VirtualClock
+from engine.drivers import zx_gesture
 from engine.drivers.servo_joints import angle_to_us
 from engine.hardware.assembly import build_hardware
 from engine.hardware.config import RobotConfig, load_robot_config
@@ -234,3 +235,35 @@ def test_fault_events_must_name_a_device_the_simulation_can_fail(sim_config: Rob
         "demo.yaml:4:5: 'servos' (maestro) cannot be failed in the simulation "
         "(the simulated vest fails I2C and SPI devices)",
     ]
+
+
+def test_a_wave_at_the_unplugged_gesture_sensor_greets_nobody_later(sim_robot: SimRobot):
+    sim_robot.run_for(0.5)
+    sim_robot.vest.unplug("gesture", 3.0)
+    sim_robot.run_for(0.5)
+
+    sim_robot.world.happened("gesture", "wave")  # the chip has no power: it sees nothing
+    sim_robot.run_for(5.0)
+
+    assert sim_robot.key("/devices/gesture/ok") is True  # plugged back in
+    assert sim_robot.said == []
+    assert not sim_robot.blackboard.event_log("/sensors/gesture/last").events
+    sim_robot.world.happened("gesture", "wave")
+    sim_robot.run_for(0.3)
+    assert sim_robot.said == ["Hello"]
+
+
+def test_an_unplugged_gesture_sensor_latches_no_gesture_for_later(sim_config: RobotConfig):
+    clock = VirtualClock()
+    world = World()
+    vest = build_sim_vest(sim_config, world, clock)
+    try:
+        vest.unplug("gesture", 1.0)
+        world.happened("gesture", "wave")
+        clock.advance(1.5)  # plugged back in
+
+        status = vest.i2c["i2c"].read_byte_data(0x10, zx_gesture.STATUS)
+
+        assert status & zx_gesture.STATUS_GESTURES == 0
+    finally:
+        vest.close()

@@ -134,6 +134,11 @@ class SimI2CBus:
         with self._lock:
             self._faults[key] = _Fault(kind, self.clock.now() + seconds)
 
+    def fault_at(self, address: int) -> str | None:
+        """The fault injected at ``address`` that is still active, if any (not ``hold``)."""
+        with self._lock:
+            return self._active_fault(address)
+
     def clear_faults(self) -> None:
         with self._lock:
             self._faults.clear()
