@@ -19,23 +19,37 @@ A dialog file::
 from __future__ import annotations
 
 import itertools
+import math
+from dataclasses import dataclass
 from pathlib import Path
 
 from engine.blackboard.catalogue import KeyCatalogue
 from engine.dialogs.model import Dialog, DialogRule, normalize
 from engine.loader.problems import LoadError, Problems
-from engine.loader.yaml_source import YList, YMap, YScalar, YValue, describe, load_yaml
+from engine.loader.yaml_source import (
+    YList,
+    YMap,
+    YScalar,
+    YValue,
+    describe,
+    load_yaml,
+    resolved,
+)
 from engine.nodes.params import CheckContext, ParamProblem, did_you_mean
 from engine.nodes.templates import CompiledTemplate, compile_template
 
 ON_REQUEST_SENSORS = ("temperature", "ultrasound")
+MAX_PHRASE_EXPANSIONS = 200
+"""How many phrases one ``hear:`` phrase may expand to through its ``~concepts``."""
+MAX_DIALOG_EXPANSIONS = 2000
+"""How many phrases all of a dialog's ``hear:`` phrases may expand to together."""
 _TOP_KEYS = ("dialog", "description", "concepts", "rules", "fallback", "min_score")
 _RULE_KEYS = ("hear", "say", "read")
 
 
 def find_dialogs_folder(path: Path) -> Path | None:
     """The nearest ``dialogs/`` folder beside ``path`` or above it."""
-    for folder in [path.parent, *path.resolve().parents]:
+    for folder in [path.parent, *resolved(path).parents]:
         candidate = folder / "dialogs"
         if candidate.is_dir():
             return candidate
@@ -109,8 +123,9 @@ def check_dialog(
     elif not isinstance(raw_rules, YList):
         problems.add(raw_rules.mark, f"'rules' must be a list, got {describe(raw_rules)}")
     else:
+        budget = _Budget()
         for raw in raw_rules:
-            rule = _rule(raw, concepts, ctx, problems)
+            rule = _rule(raw, concepts, ctx, problems, budget)
             if rule is not None:
                 rules.append(rule)
     fallback = None
@@ -155,23 +170,43 @@ def _concepts(value: YValue | None, problems: Problems) -> dict[str, list[str]]:
     return concepts
 
 
-def _expand(phrase: str, concepts: dict[str, list[str]]) -> list[str] | str:
-    """Every phrase ``~concept`` words expand to, or an error message."""
+def _expand(phrase: str, concepts: dict[str, list[str]]) -> list[str] | tuple[str, str | None]:
+    """Every phrase ``~concept`` words expand to, or (message, hint) saying what is wrong."""
     options: list[list[str]] = []
     for word in phrase.split():
         if word.startswith("~"):
             synonyms = concepts.get(word[1:])
             if synonyms is None:
                 hint = did_you_mean(word[1:], list(concepts))
-                return f"unknown concept {word!r}" + (f"; {hint}" if hint else "")
+                return f"unknown concept {word!r}" + (f"; {hint}" if hint else ""), None
             options.append(synonyms)
         else:
             options.append([normalize(word)])
-    return [" ".join(filter(None, combo)) for combo in itertools.product(*options)]
+    count = math.prod(len(choices) for choices in options)
+    if count > MAX_PHRASE_EXPANSIONS:  # counted before expanding: 40^5 phrases would hang
+        return (
+            f"phrase expands to {count} phrases, more than {MAX_PHRASE_EXPANSIONS}",
+            "use fewer ~concepts in one phrase, or write several shorter phrases",
+        )
+    expanded = [" ".join(filter(None, combo)) for combo in itertools.product(*options)]
+    if not any(expanded):
+        return f"phrase {phrase!r} has no words", "write it with letters or digits"
+    return expanded
+
+
+@dataclass
+class _Budget:
+    """How many phrases a dialog's concepts may still expand to (-1: gone over)."""
+
+    left: int = MAX_DIALOG_EXPANSIONS
 
 
 def _rule(
-    raw: YValue, concepts: dict[str, list[str]], ctx: CheckContext, problems: Problems
+    raw: YValue,
+    concepts: dict[str, list[str]],
+    ctx: CheckContext,
+    problems: Problems,
+    budget: _Budget,
 ) -> DialogRule | None:
     if not isinstance(raw, YMap):
         problems.add(raw.mark, "each rule is a mapping with 'hear:' and 'say:'")
@@ -194,9 +229,19 @@ def _rule(
                 problems.add(item.mark, f"a phrase must be text, got {describe(item)}")
                 continue
             expanded = _expand(item.value, concepts)
-            if isinstance(expanded, str):
-                problems.add(item.mark, expanded)
+            if isinstance(expanded, tuple):
+                problems.add(item.mark, *expanded)
+            elif len(expanded) > budget.left:
+                if budget.left >= 0:  # said once, where the dialog goes over
+                    problems.add(
+                        item.mark,
+                        f"the dialog's phrases expand to more than {MAX_DIALOG_EXPANSIONS} "
+                        "phrases by here",
+                        "use fewer ~concepts, or split the dialog in two",
+                    )
+                budget.left = -1
             else:
+                budget.left -= len(expanded)
                 phrases.extend(p for p in expanded if p)
     say = raw.get("say")
     answer = None

@@ -1,14 +1,15 @@
 """Dialog rules and how a heard utterance is matched to one.
 
-Matching normalizes both sides (case, punctuation, contractions) and tolerates small
-recognition errors: an exact phrase scores 1.0, a phrase inside a longer utterance 0.95,
-otherwise the similarity of the two texts, accepted from ``min_score``.
+Matching normalizes both sides (case, punctuation, contractions; in any script) and
+tolerates small recognition errors: an exact phrase scores 1.0, a phrase inside a longer
+utterance 0.95, otherwise the similarity of the two texts, accepted from ``min_score``.
 """
 
 from __future__ import annotations
 
 import difflib
 import re
+import unicodedata
 from dataclasses import dataclass
 
 from engine.nodes.templates import CompiledTemplate
@@ -24,13 +25,23 @@ _CONTRACTIONS = {
     "favourite": "favorite",
     "colour": "color",
 }
-_NOT_WORD = re.compile(r"[^a-z0-9' ]+")
 _SPACES = re.compile(r"\s+")
+_WORD_CATEGORIES = ("L", "M", "N")
+"""Letters, marks and digits of any script (marks: the vowel signs of Devanagari, accents)."""
+
+
+def _word_character(char: str) -> bool:
+    return char == "'" or unicodedata.category(char)[0] in _WORD_CATEGORIES
 
 
 def normalize(text: str) -> str:
-    """Lower case, no punctuation, contractions spelled out, single spaces."""
-    words = _NOT_WORD.sub(" ", text.lower().replace("\u2019", "'")).split()
+    """Case folded, no punctuation, contractions spelled out, single spaces; in any script.
+
+    Accents are kept (``café`` stays ``café``); both sides of a match are normalized the
+    same way (Unicode NFKC), so a composed and a decomposed ``é`` are the same letter.
+    """
+    folded = unicodedata.normalize("NFKC", text).casefold().replace("\u2019", "'")
+    words = "".join(c if _word_character(c) else " " for c in folded).split()
     expanded = " ".join(_CONTRACTIONS.get(word, word) for word in words)
     return _SPACES.sub(" ", expanded.replace("'", "")).strip()
 

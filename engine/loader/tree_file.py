@@ -38,9 +38,18 @@ from engine.loader.substitution import (
     substitute,
     unresolved,
 )
-from engine.loader.yaml_source import YList, YMap, YScalar, YValue, describe, load_yaml, plain
+from engine.loader.yaml_source import (
+    YList,
+    YMap,
+    YScalar,
+    YValue,
+    describe,
+    load_yaml,
+    plain,
+    resolved,
+)
 from engine.nodes.context import TreeContext
-from engine.nodes.params import CheckContext, ParamProblem, did_you_mean
+from engine.nodes.params import CheckContext, Number, ParamProblem, did_you_mean
 from engine.nodes.registry import NodeRegistry
 from engine.nodes.spec import NodeType
 
@@ -115,9 +124,10 @@ class TreeLoader:
         """How messages name ``path``: relative to the working folder when inside it."""
         base = self.root_dir or Path.cwd()
         try:
-            return str(path.resolve().relative_to(base.resolve()))
+            shown = str(resolved(path).relative_to(resolved(base)))
         except ValueError:
-            return str(path)
+            shown = str(path)
+        return shown.replace("\0", "\\0")  # a NUL would cut the line a terminal shows
 
     def load(self, path: Path) -> TreeDefinition:
         """Validate the tree file at ``path``; LoadError listing every problem."""
@@ -141,7 +151,7 @@ class TreeLoader:
         params = self._params(document, problems, overrides=None, where="")
         rate_hz = self._rate(document, params, problems)
         description = document.get("description")
-        root = self._root(document, path, params, problems, [path.resolve()], seen)
+        root = self._root(document, path, params, problems, [resolved(path)], seen)
         problems.raise_if_any()
         assert root is not None
         text = plain(description) if description is not None else ""
@@ -211,20 +221,17 @@ class TreeLoader:
         raw = substitute(raw, params, problems)
         if unresolved(raw):
             return DEFAULT_RATE_HZ
-        value = raw.value if isinstance(raw, YScalar) else None
-        if isinstance(value, bool) or not isinstance(value, int | float):
-            problems.add(
-                raw.mark,
-                f"'rate_hz' must be a number, got {describe(raw)}",
-                "ticks per second, e.g. 10",
-            )
+        try:
+            value = Number(unit="Hz").convert(plain(raw), self.check_context)
+        except ParamProblem as problem:
+            problems.add(raw.mark, f"'rate_hz' {problem.message}", "ticks per second, e.g. 10")
             return DEFAULT_RATE_HZ
         if not 0 < value <= MAX_RATE_HZ:
             problems.add(
                 raw.mark, f"'rate_hz' must be above 0 and at most {MAX_RATE_HZ:g}, got {value:g}"
             )
             return DEFAULT_RATE_HZ
-        return float(value)
+        return value
 
     def _root(
         self,
@@ -409,7 +416,7 @@ class TreeLoader:
                 )
         file_value = body.get("file")
         assert isinstance(file_value, YScalar)
-        target = (path.parent / str(file_value.value)).resolve()
+        target = resolved(path.parent / str(file_value.value))
         if target in stack:
             chain = " -> ".join(self.shown(p) for p in [*stack, target])
             problems.add(

@@ -2,12 +2,15 @@
 
 PyYAML's composer gives nodes with marks; this module turns them into :class:`YMap`,
 :class:`YList` and :class:`YScalar` that keep a :class:`Mark` each. Only plain YAML is
-accepted: no Python tags, no duplicate keys, bounded size and alias expansion, UTF-8 only.
-Nothing here evaluates code.
+accepted: no Python tags, no duplicate keys, bounded size, nesting and alias expansion, no
+alias inside its own anchor, UTF-8 only. Nothing here evaluates code, and whatever a file
+holds, the answer is a value or a :class:`LoadError` with places, never another exception.
 """
 
 from __future__ import annotations
 
+import errno
+import os
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -19,6 +22,9 @@ from engine.loader.problems import LoadError, Mark, Problem
 
 MAX_FILE_BYTES = 1024 * 1024
 MAX_NODES = 100_000
+MAX_DEPTH = 100
+"""Values nested deeper than this are refused (a tree 50 composites deep is already far
+beyond what anyone writes; deeper ones would exhaust Python's stack)."""
 
 _STANDARD_TAGS = {
     "tag:yaml.org,2002:" + name
@@ -102,6 +108,51 @@ def _hint_for(problem: str) -> str | None:
     return None
 
 
+class _Refused(Exception):  # noqa: N818 - a problem found while composing, not a failure
+    def __init__(self, mark: Any, message: str, hint: str) -> None:
+        super().__init__(message)
+        self.mark = mark
+        self.message = message
+        self.hint = hint
+
+
+class _Composer(yaml.SafeLoader):
+    """PyYAML's safe loader that also refuses deep nesting and an alias inside its anchor
+    (``root: &x {Sequence: [*x]}``), with the place, before anything recurses on them."""
+
+    def __init__(self, text: str) -> None:
+        super().__init__(text)
+        self._depth = 0
+        self._open_anchors: set[str] = set()
+
+    def compose_node(self, parent: Any, index: Any) -> Any:
+        event = self.peek_event()
+        if isinstance(event, yaml.AliasEvent):
+            if event.anchor in self._open_anchors:
+                raise _Refused(
+                    event.start_mark,
+                    f"alias *{event.anchor} refers to itself: it is inside &{event.anchor}",
+                    "an alias repeats a value defined before it, never the value it is in",
+                )
+            return super().compose_node(parent, index)
+        self._depth += 1
+        if self._depth > MAX_DEPTH:
+            raise _Refused(
+                event.start_mark,
+                f"values are nested more than {MAX_DEPTH} levels deep here",
+                "nest less; a tree can move a part into its own file with Subtree",
+            )
+        anchor = event.anchor
+        if anchor is not None:
+            self._open_anchors.add(anchor)
+        try:
+            return super().compose_node(parent, index)
+        finally:
+            self._depth -= 1
+            if anchor is not None:
+                self._open_anchors.discard(anchor)
+
+
 class _Converter:
     def __init__(self, file: str) -> None:
         self.file = file
@@ -109,19 +160,29 @@ class _Converter:
         self.problems: list[Problem] = []
         self.constructor = yaml.SafeLoader("")
 
-    def convert(self, node: yaml.Node) -> YValue:
+    def convert(self, node: yaml.Node, depth: int = 1) -> YValue:
         self.count += 1
+        mark = _mark(self.file, node.start_mark)
         if self.count > MAX_NODES:
             raise LoadError(
                 [
                     Problem(
-                        _mark(self.file, node.start_mark),
+                        mark,
                         f"file expands to more than {MAX_NODES} values",
                         "remove deeply repeated aliases",
                     )
                 ]
             )
-        mark = _mark(self.file, node.start_mark)
+        if depth > MAX_DEPTH:  # aliases of nested values inside nested values
+            raise LoadError(
+                [
+                    Problem(
+                        mark,
+                        f"with its aliases, values are nested more than {MAX_DEPTH} levels deep",
+                        "use fewer aliases inside aliases",
+                    )
+                ]
+            )
         if node.tag not in _STANDARD_TAGS:
             tag = node.tag.replace("tag:yaml.org,2002:", "!!")
             self.problems.append(
@@ -131,16 +192,17 @@ class _Converter:
             )
             return YScalar(None, mark)
         if isinstance(node, yaml.ScalarNode):
+            if node.tag.endswith(":timestamp"):  # dates stay text (2024-13-45 is no date)
+                return YScalar(str(node.value), mark)
             try:
                 value = self.constructor.construct_object(node, deep=True)
-            except yaml.YAMLError as error:
+            except (yaml.YAMLError, ValueError, OverflowError) as error:
+                # e.g. an integer of more digits than Python converts
                 self.problems.append(Problem(mark, f"bad value: {error}"))
                 value = None
-            if node.tag.endswith(":timestamp"):
-                value = str(node.value)
             return YScalar(value, mark)
         if isinstance(node, yaml.SequenceNode):
-            return YList([self.convert(item) for item in node.value], mark)
+            return YList([self.convert(item, depth + 1) for item in node.value], mark)
         assert isinstance(node, yaml.MappingNode)
         entries: dict[str, YValue] = {}
         key_marks: dict[str, Mark] = {}
@@ -163,15 +225,34 @@ class _Converter:
                     )
                 )
                 continue
-            entries[key] = self.convert(value_node)
+            entries[key] = self.convert(value_node, depth + 1)
             key_marks[key] = key_mark
         return YMap(entries, mark, key_marks)
 
 
+_OS_HINTS = {
+    errno.ENOTDIR: "a part of the path is a file, not a folder",
+    errno.ENAMETOOLONG: "use a shorter file name",
+    errno.ELOOP: "a symbolic link on the way points back to itself",
+}
+
+
+def resolved(path: Path) -> Path:
+    """``path`` made absolute with links followed, or merely absolute when that is
+    impossible (a link loop, a NUL in the name): reading it then says why, with its place."""
+    try:
+        return path.resolve()
+    except (OSError, RuntimeError, ValueError):
+        return path.absolute()
+
+
 def read_text(path: Path, shown: str | None = None, *, max_bytes: int = MAX_FILE_BYTES) -> str:
-    """The file's text, or a LoadError: missing, unreadable, too big, not UTF-8."""
-    name = shown or str(path)
+    """The file's text, or a LoadError: missing, unreadable, too big, not UTF-8, or a path
+    that names no file (a file as a folder, too long, a link loop, a NUL character)."""
+    name = (shown or str(path)).replace("\0", "\\0")
     start = Mark(name, 1, 1)
+    if "\0" in str(path):  # the OS cannot even be asked about such a name
+        raise LoadError([Problem(start, "the file name contains a NUL character", "retype it")])
     try:
         size = path.stat().st_size
         if path.is_dir():
@@ -196,6 +277,11 @@ def read_text(path: Path, shown: str | None = None, *, max_bytes: int = MAX_FILE
         ) from None
     except IsADirectoryError:
         raise LoadError([Problem(start, "is a folder, not a file")]) from None
+    except OSError as error:
+        reason = os.strerror(error.errno) if error.errno else str(error)
+        raise LoadError(
+            [Problem(start, f"cannot read the file: {reason}", _OS_HINTS.get(error.errno or 0))]
+        ) from None
     try:
         return data.decode("utf-8")
     except UnicodeDecodeError as error:
@@ -215,8 +301,14 @@ def read_text(path: Path, shown: str | None = None, *, max_bytes: int = MAX_FILE
 
 def parse_yaml(text: str, name: str) -> YValue | None:
     """Parse one YAML document keeping places; None for an empty document."""
+    composer: _Composer | None = None
     try:
-        node = yaml.compose(text, Loader=yaml.SafeLoader)
+        composer = _Composer(text)  # checks the characters first (ReaderError)
+        node = composer.get_single_node()
+    except _Refused as refused:
+        raise LoadError(
+            [Problem(_mark(name, refused.mark), refused.message, refused.hint)]
+        ) from None
     except yaml.MarkedYAMLError as error:
         mark = error.problem_mark or error.context_mark
         where = _mark(name, mark) if mark is not None else Mark(name, 1, 1)
@@ -242,6 +334,17 @@ def parse_yaml(text: str, name: str) -> YValue | None:
         raise LoadError([Problem(Mark(name, 1, 1), f"YAML error: {error}")]) from None
     except yaml.YAMLError as error:
         raise LoadError([Problem(Mark(name, 1, 1), f"YAML error: {error}")]) from None
+    except (ValueError, OverflowError, RecursionError) as error:
+        # PyYAML's own slips: an escape like "\U0011FFFF" naming no character, ...
+        where = _mark(name, composer.get_mark()) if composer else Mark(name, 1, 1)
+        if "chr()" in str(error):
+            message, hint = "an escape here names no character", "check \\U and \\x escapes"
+        else:
+            message, hint = f"YAML cannot read this: {error}", None
+        raise LoadError([Problem(where, message, hint)]) from None
+    finally:
+        if composer is not None:
+            composer.dispose()
     if node is None:
         return None
     converter = _Converter(name)

@@ -121,7 +121,8 @@ class LookToward(Leaf):
     When the nearest reading is the left or right one, turns to +turn_deg (left) or
     -turn_deg (right); when it is the center one, or the joint already points there, or
     nothing is within max_mm, nothing moves. RUNNING while turning; SUCCESS when turned or
-    when there was nothing to do; FAILURE when the servo service failed.
+    when there was nothing to do; FAILURE when the servo service failed. Pre-empted while
+    turning, it stops the move and turns again the next time it runs.
     """
 
     params: ClassVar = (
@@ -169,6 +170,14 @@ class LookToward(Leaf):
         if status == Status.FAILURE:
             self.angle_deg = self.previous_deg  # not there: try again next tick
         return status
+
+    def terminate(self, new_status: Status) -> None:
+        """Pre-empted mid-turn: cancel the move and forget the angle it did not reach, so
+        the next round turns again."""
+        turning = self.job is not None and not self.job.done()
+        super().terminate(new_status)
+        if new_status == Status.INVALID and turning:
+            self.angle_deg = self.previous_deg
 
 
 class Wait(Leaf):

@@ -18,8 +18,9 @@ A developer writes a leaf in a few lines::
 and registers it: ``registry.add(IsWarm)``. Parameters are declared with types, defaults
 and docs; the loader validates YAML against them and ``vest nodes`` lists them.
 
-An exception inside any leaf makes that node FAILURE, is reported with the node's path,
-and the tree keeps ticking.
+An exception inside any leaf, or an ``update()`` that returns something other than a
+Status, makes that node FAILURE, is reported with the node's path, and the tree keeps
+ticking.
 """
 
 from __future__ import annotations
@@ -121,6 +122,10 @@ class Leaf(py_trees.behaviour.Behaviour):
             if self.status != Status.RUNNING:
                 self.initialise()
             new_status = self.update()
+            if not isinstance(new_status, Status):  # py_trees' own tick refuses these too
+                raise TypeError(
+                    f"{type(self).__name__}.update() returned {new_status!r}, not a Status"
+                )
             if new_status != Status.RUNNING:
                 self.stop(new_status)
         except Exception as error:

@@ -2,14 +2,44 @@
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from typing import Any, ClassVar
 
-from engine.blackboard.events import EventLog
-from engine.nodes.base import Condition
+from engine.blackboard.catalogue import VARIABLES_PREFIX, KeySpec
+from engine.blackboard.events import EVENT_LOG_LENGTH, EventLog
+from engine.nodes.base import Condition, node_path
 from engine.nodes.params import CheckContext, Integer, Key, ListOf, Number, Param, Scalar
 
 _COMPARISONS = ("equals", "not_equals", "above", "below", "between")
+_WORDS_FOR_BOOLEANS = ("true", "false", "yes", "no", "on", "off")
+_HOLDS = {"bool": "true/false", "number": "a number", "integer": "a whole number", "text": "text"}
+
+
+def _mismatch(key: str, spec: KeySpec, value: object) -> tuple[str, str] | None:
+    """(message, hint) when ``value`` can never equal a value of ``key``; None when it can."""
+    if isinstance(value, float) and math.isnan(value):
+        return f"nothing equals {value!r}, not even {key}", "compare with a number"
+    if spec.value_type is bool and not isinstance(value, bool):
+        word = str(value).strip().lower()
+        if word in _WORDS_FOR_BOOLEANS:
+            written = "true" if word in ("true", "yes", "on") else "false"
+            hint = f"write {written} without quotes"
+        else:
+            hint = "write true or false, without quotes"
+        return f"{key} holds true/false, never {value!r}", hint
+    if spec.value_type in (float, int) and (
+        isinstance(value, bool) or not isinstance(value, int | float)
+    ):
+        try:
+            hint = f"write {float(str(value)):g} without quotes"
+        except ValueError:
+            hint = "compare with a number, e.g. equals: 3"
+        return f"{key} holds a number, never {value!r}", hint
+    if spec.value_type is str and not isinstance(value, str):
+        shown = str(value).lower() if isinstance(value, bool) else str(value)
+        return f"{key} holds text, never {value!r}", f'put it in quotes: "{shown}"'
+    return None
 
 
 class Check(Condition):
@@ -69,6 +99,19 @@ class Check(Condition):
                     "add item: 0 for the first",
                 )
             )
+        variable = str(args.get("key", "")).startswith(VARIABLES_PREFIX)
+        if spec is not None and not variable:
+            if args.get("item") is not None and spec.value_type not in (list, object):
+                holds = _HOLDS.get(spec.type_name, "an object")
+                problems.append(
+                    ("item", f"{args['key']} holds {holds}, not a list", "remove item:")
+                )
+            if spec.value_type is not list:  # a list's items have no declared type
+                for name in ("equals", "not_equals"):
+                    value = args.get(name)
+                    mismatch = _mismatch(args["key"], spec, value) if value is not None else None
+                    if mismatch is not None:
+                        problems.append((name, *mismatch))
         return problems
 
     def __init__(self, *a: Any) -> None:
@@ -95,6 +138,9 @@ class Check(Condition):
     def check(self) -> bool:
         value = self.read(self._key)
         if value is not None and self._item is not None:
+            if not isinstance(value, list | tuple):  # a /vars/ key may hold anything
+                self.feedback_message = f"{self._key} holds {value!r}, not a list"
+                return False
             value = value[self._item] if self._item < len(value) else None
         if value is None:
             self.feedback_message = f"{self._key} has no value yet"
@@ -125,7 +171,8 @@ class OnEvent(Condition):
     Each tick it takes the oldest event this node has not handled yet. SUCCESS once per
     new event (matching ``equals`` / ``one_of`` when given), writing its value to
     ``save_as``; FAILURE when no new event arrived. Events from before the tree started
-    are not reacted to.
+    are not reacted to. A key keeps its last 32 events: when more arrive before this node
+    gets to them, the oldest are missed and a warning says how many.
     """
 
     params: ClassVar = (
@@ -153,7 +200,16 @@ class OnEvent(Condition):
         log = self.read(self.args.key)
         if not isinstance(log, EventLog) or log.last_seq <= self.handled_seq:
             return False
-        for event in log.after(self.handled_seq):
+        events = log.after(self.handled_seq)
+        missed = events[0].seq - self.handled_seq - 1 if events else 0
+        if missed > 0:
+            self.ctx.on_node_warning(
+                self.ctx.tree,
+                node_path(self),
+                f"missed {missed} event{'s' if missed != 1 else ''} on {self.args.key}: "
+                f"more than the {EVENT_LOG_LENGTH} a key keeps came before this node read them",
+            )
+        for event in events:
             self.handled_seq = event.seq
             if self._wanted is None or event.value in self._wanted:
                 if self.args.save_as is not None:

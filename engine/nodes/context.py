@@ -17,11 +17,19 @@ if TYPE_CHECKING:
 NodeErrorHandler = Callable[[str, str, BaseException], None]
 """Called as (tree name, node path, error) when a node raised and was made FAILURE."""
 
+NodeWarningHandler = Callable[[str, str, str], None]
+"""Called as (tree name, node path, message) when a node noticed something went amiss
+without failing (e.g. events it never saw because too many came at once)."""
+
 _log = logging.getLogger("vest.tree")
 
 
 def log_node_error(tree: str, path: str, error: BaseException) -> None:
     _log.error("%s: node %s failed: %s: %s", tree, path, type(error).__name__, error)
+
+
+def log_node_warning(tree: str, path: str, message: str) -> None:
+    _log.warning("%s: node %s: %s", tree, path, message)
 
 
 @dataclass
@@ -34,3 +42,4 @@ class TreeContext:
     actions: TreeActions
     dialogs: DialogLibrary | None = None
     on_node_error: NodeErrorHandler = field(default=log_node_error)
+    on_node_warning: NodeWarningHandler = field(default=log_node_warning)

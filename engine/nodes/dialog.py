@@ -5,22 +5,24 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any, ClassVar
 
-from py_trees.common import Status
+from py_trees.common import Access, Status
 
 from engine.dialogs.model import Dialog
+from engine.errors import ServiceError
 from engine.nodes.base import Leaf
 from engine.nodes.params import CheckContext, Key, Param, Text, did_you_mean
 from engine.nodes.templates import CompiledTemplate
-from engine.services.jobs import Job
+from engine.services.jobs import ImmediateJob, Job
 
 
 class Reply(Leaf):
     """Answer an utterance with the best-matching rule of a dialog (dialogs/NAME.yaml).
 
     When the rule says ``read: temperature`` (or ultrasound), the sensor is read first and
-    the answer is filled with the new value. RUNNING while reading and speaking; SUCCESS
-    when the answer was said; FAILURE when no rule matched and the dialog has no fallback,
-    or a sensor or the speech service failed.
+    the answer is filled with the new value; ``{fields}`` of other keys are filled with
+    their current value. RUNNING while reading and speaking; SUCCESS when the answer was
+    said; FAILURE when no rule matched and the dialog has no fallback, a field has no value
+    yet, or a sensor or the speech service failed.
     """
 
     params: ClassVar = (
@@ -51,6 +53,20 @@ class Reply(Leaf):
         self.job: Job | None = None
         self.answer: CompiledTemplate | None = None
         self.phase = "idle"
+        for key in dict.fromkeys(self._answer_keys()):  # whatever an answer may fill in
+            self.blackboard.register_key(key, access=Access.READ)
+
+    def _answer_keys(self) -> list[str]:
+        """Every blackboard key the dialog's answers and fallback name (none when the dialog
+        is not loaded: initialise() reports that)."""
+        dialogs = self.ctx.dialogs
+        dialog = dialogs.get(self.args.dialog) if dialogs is not None else None
+        if dialog is None:
+            return []
+        templates = [rule.answer for rule in dialog.rules]
+        if dialog.fallback is not None:
+            templates.append(dialog.fallback)
+        return [key for template in templates for key in template.keys]
 
     def dialog(self) -> Dialog:
         dialogs = self.ctx.dialogs
@@ -79,7 +95,12 @@ class Reply(Leaf):
 
     def _speak(self, template: CompiledTemplate) -> None:
         self.phase = "speaking"
-        self.job = self.ctx.actions.say(template.fill(self.read))
+        try:
+            text = template.fill(self.read)
+        except (KeyError, ValueError) as error:  # a field with no value, or a bad value
+            self.job = ImmediateJob(error=ServiceError(str(error).strip("'\"")))
+            return
+        self.job = self.ctx.actions.say(text)
 
     def update(self) -> Status:
         if self.job is None:

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import difflib
 import math
+import re
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, Literal
@@ -96,7 +97,13 @@ class Number(ParamType):
     def convert(self, value: Any, ctx: CheckContext) -> float:
         if isinstance(value, bool) or not isinstance(value, int | float):
             raise ParamProblem(f"must be a number, got {_shown(value)}", self._example())
-        number = float(value)
+        try:
+            number = float(value)
+        except OverflowError:
+            raise ParamProblem(
+                f"must be a number below 1e308, got one with {value.bit_length()} binary digits",
+                self._example(),
+            ) from None
         if not math.isfinite(number):
             raise ParamProblem(f"must be a finite number, got {number}", self._example())
         if self.minimum is not None and number < self.minimum:
@@ -187,6 +194,24 @@ class Choice(ParamType):
         return {"enum": list(self.options)}
 
 
+_KEY_CHARACTERS = re.compile(r"[A-Za-z0-9_/]+")
+
+
+def check_key_characters(key: str) -> None:
+    """Raise :class:`ParamProblem` when ``key`` has a character other than letters, digits,
+    ``_`` and ``/`` (py_trees would read a ``.`` as attribute access at every tick)."""
+    if _KEY_CHARACTERS.fullmatch(key) is None:
+        bad = next(char for char in key if not _KEY_CHARACTERS.fullmatch(char))
+        if bad == "*":
+            hint = "write one name in place of '*' (see `vest keys`)"
+        else:
+            hint = f"e.g. {re.sub(r'[^A-Za-z0-9_/]', '_', key)!r}"
+        raise ParamProblem(
+            f"blackboard key {key!r} has {bad!r}: keys use only letters, digits, '_' and '/'",
+            hint,
+        )
+
+
 @dataclass(frozen=True)
 class Key(ParamType):
     """A blackboard key from the catalogue.
@@ -210,13 +235,14 @@ class Key(ParamType):
                 f"blackboard keys start with '/', got {value!r}",
                 f"did you mean {'/' + value!r}?",
             )
+        check_key_characters(value)
         spec = ctx.catalogue.lookup(value)
         if spec is None:
             suggestion = ctx.catalogue.suggest(value)
             hint = (
                 f"did you mean {suggestion!r}?"
                 if suggestion
-                else "see `vest keys`; use /vars/NAME for a tree's own variable"
+                else "see `vest keys`; use /vars/NAME for a variable (shared by all trees)"
             )
             raise ParamProblem(f"unknown blackboard key {value!r}", hint)
         if spec.kind == "event" and "event" not in self.kinds:
@@ -224,13 +250,18 @@ class Key(ParamType):
                 f"{value!r} is an event key: its value stays after the event",
                 "use OnEvent to react once per event",
             )
-        if spec.kind == "state" and "state" not in self.kinds and not value.startswith("/vars/"):
+        if spec.kind == "state" and "state" not in self.kinds:
+            if value.startswith("/vars/"):  # a variable is a value, never a stream of events
+                raise ParamProblem(
+                    f"{value!r} is a tree variable, not an event key",
+                    "use Check to compare a /vars/ value each tick",
+                )
             raise ParamProblem(
                 f"{value!r} is not an event key", "use Check to compare a value each tick"
             )
         if self.access == "write" and not value.startswith("/vars/"):
             raise ParamProblem(
-                f"trees may only write their own variables, not {value!r}",
+                f"trees may only write variables (/vars/...), not {value!r}",
                 "write to /vars/NAME",
             )
         return value

@@ -31,14 +31,24 @@ class NodeRegistry:
     def add(self, node: type[Leaf] | NodeType, *, source: str = "vest") -> NodeType:
         """Register a leaf class or a NodeType; a name already taken is an error naming both."""
         node_type = node if isinstance(node, NodeType) else leaf_type(node, source=source)
+        self._check_free(node_type)
+        self._types[node_type.name] = node_type
+        return node_type
+
+    def add_all(self, node_types: list[NodeType]) -> None:
+        """Register all of ``node_types`` or, when one name is taken, none of them."""
+        for node_type in node_types:
+            self._check_free(node_type)
+        for node_type in node_types:
+            self._types[node_type.name] = node_type
+
+    def _check_free(self, node_type: NodeType) -> None:
         holder = self._types.get(node_type.name)
         if holder is not None:
             raise ValueError(
                 f"node type {node_type.name!r} from {node_type.source} is already "
                 f"registered by {holder.source}"
             )
-        self._types[node_type.name] = node_type
-        return node_type
 
     def get(self, name: str) -> NodeType | None:
         return self._types.get(name)
@@ -77,21 +87,35 @@ class NodeRegistry:
 
 
 def _call_register(register: Callable[..., object], registry: NodeRegistry, source: str) -> None:
-    before = set(registry.names)
-    register(_SourcedRegistry(registry, source))
-    if set(registry.names) == before:
+    """Run a plugin's register(); its node types join ``registry`` only if all of it worked."""
+    staging = _SourcedRegistry(registry, source)
+    register(staging)
+    if not staging.staged:
         raise ValueError("registered no node type")
+    registry.add_all(staging.staged)
 
 
 class _SourcedRegistry:
-    """What a plugin's register() receives: add() records the plugin as the source."""
+    """What a plugin's register() receives: add() records the plugin as the source and
+    stages the node type, so a plugin failing half-way leaves none of its node types behind."""
 
     def __init__(self, registry: NodeRegistry, source: str) -> None:
         self._registry = registry
         self._source = source
+        self.staged: list[NodeType] = []
 
     def add(self, node: type[Leaf] | NodeType, *, source: str | None = None) -> NodeType:
-        return self._registry.add(node, source=source or self._source)
+        node_type = (
+            node if isinstance(node, NodeType) else leaf_type(node, source=source or self._source)
+        )
+        self._registry._check_free(node_type)
+        for staged in self.staged:
+            if staged.name == node_type.name:
+                raise ValueError(
+                    f"node type {node_type.name!r} is registered twice by {staged.source}"
+                )
+        self.staged.append(node_type)
+        return node_type
 
 
 def builtin_registry() -> NodeRegistry:

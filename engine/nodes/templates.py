@@ -12,9 +12,18 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
-from engine.nodes.params import CheckContext, ParamProblem, ParamType, did_you_mean
+from engine.nodes.params import (
+    CheckContext,
+    ParamProblem,
+    ParamType,
+    check_key_characters,
+    did_you_mean,
+)
 
 _FORMATTER = string.Formatter()
+
+_SAMPLES: dict[type, Any] = {float: 1.5, int: 1, bool: True, str: "text"}
+"""A value of each key type, formatted with a field's spec at load time to check the spec."""
 
 
 @dataclass(frozen=True)
@@ -69,14 +78,35 @@ def compile_template(text: str, ctx: CheckContext) -> CompiledTemplate:
             continue
         if conversion or (spec and ("{" in spec)):
             raise ParamProblem(f"template field {{{field}}} is too complex", "use {key:.1f}")
-        parts.append((literal, _resolve(field, ctx), spec or ""))
+        key = _resolve(field, ctx)
+        if spec:
+            _check_spec(field, key, spec, ctx)
+        parts.append((literal, key, spec or ""))
     return CompiledTemplate(text, tuple(parts))
+
+
+def _check_spec(field: str, key: str, spec: str, ctx: CheckContext) -> None:
+    """A format spec that cannot format the key's kind of value is reported now, not at the
+    first tick that fills it (keys of any kind, like /vars/, are checked when filled)."""
+    key_spec = ctx.catalogue.lookup(key)
+    sample = _SAMPLES.get(key_spec.value_type) if key_spec is not None else None
+    if sample is None:
+        return
+    try:
+        format(sample, spec)
+    except (TypeError, ValueError) as error:
+        kind = key_spec.type_name if key_spec is not None else "value"
+        raise ParamProblem(
+            f"bad format {spec!r} in {{{field}:{spec}}} for a {kind}: {error}",
+            "e.g. {temperature_f:.0f} for a whole number, {temperature_f:.1f} for one decimal",
+        ) from None
 
 
 def _resolve(field: str, ctx: CheckContext) -> str:
     if not field:
         raise ParamProblem("empty template field {}", "name a key, e.g. {temperature_f}")
     if field.startswith("/"):
+        check_key_characters(field)
         if ctx.catalogue.lookup(field) is None:
             suggestion = ctx.catalogue.suggest(field)
             hint = f"did you mean {suggestion!r}?" if suggestion else None

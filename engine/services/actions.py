@@ -3,6 +3,8 @@
 :class:`TreeActions` is the one door from a tree's nodes to the services. Each call
 becomes an :class:`ActionRecord` (time, tree, action, args) handed to every listener of
 the :class:`ActionLog`: the timeline printer, the ``--json`` writer, the test harness.
+When the service later turns out to have failed the call, the log marks that record
+(``record.error``) and tells its ``failure_listeners``.
 """
 
 from __future__ import annotations
@@ -19,25 +21,47 @@ from engine.services.jobs import ImmediateJob, Job
 _log = logging.getLogger("vest.actions")
 
 
-@dataclass(frozen=True)
+@dataclass
 class ActionRecord:
-    """One service call: ``t`` in clock seconds, the tree, the action name and its arguments."""
+    """One service call: ``t`` in clock seconds, the tree, the action name and its arguments.
+
+    ``error`` is None while the call is under way or when it succeeded, and says why once
+    the service is seen to have failed it (the action was asked for but not done).
+    """
 
     t: float
     tree: str
     action: str
     args: dict[str, Any]
+    error: str | None = None
+
+    @property
+    def failed(self) -> bool:
+        return self.error is not None
 
     def to_json(self) -> dict[str, Any]:
-        return {"t": round(self.t, 3), "tree": self.tree, "action": self.action, "args": self.args}
+        shown = {"t": round(self.t, 3), "tree": self.tree, "action": self.action, "args": self.args}
+        if self.error is not None:
+            shown["error"] = self.error
+        return shown
+
+
+ActionListener = Callable[[ActionRecord], None]
+FailureListener = Callable[[ActionRecord, BaseException], None]
 
 
 @dataclass
 class ActionLog:
-    """Keeps every record and tells listeners as they come."""
+    """Keeps every record and tells listeners as they come.
+
+    ``listeners`` hear of each call when it is made; ``failure_listeners`` hear
+    ``(record, error)`` when a call's job is first seen failed (``record.error`` is set by
+    then). A cancelled call (its node was pre-empted) is not a failure.
+    """
 
     records: list[ActionRecord] = field(default_factory=list)
-    listeners: list[Callable[[ActionRecord], None]] = field(default_factory=list)
+    listeners: list[ActionListener] = field(default_factory=list)
+    failure_listeners: list[FailureListener] = field(default_factory=list)
 
     def add(self, record: ActionRecord) -> None:
         self.records.append(record)
@@ -47,12 +71,64 @@ class ActionLog:
             except Exception:  # a broken display must not stop the robot acting
                 _log.exception("action listener %r failed", listener)
 
+    def failed(self, record: ActionRecord, error: BaseException) -> None:
+        """The service could not do ``record``'s call: mark it and tell the listeners."""
+        record.error = str(error) or type(error).__name__
+        for listener in self.failure_listeners:
+            try:
+                listener(record, error)
+            except Exception:  # a broken display must not stop the robot acting
+                _log.exception("action failure listener %r failed", listener)
+
+    @property
+    def done(self) -> list[ActionRecord]:
+        """The records of calls not (yet) seen failed."""
+        return [record for record in self.records if record.error is None]
+
+
+class _WatchedJob:
+    """A service's job seen through the log: its first failure marks the record."""
+
+    def __init__(self, job: Job, record: ActionRecord, log: ActionLog) -> None:
+        self._job = job
+        self._record = record
+        self._log = log
+        self._settled = False
+
+    def _settle(self) -> None:
+        if self._settled or not self._job.done():
+            return
+        self._settled = True
+        error = self._job.error()
+        if error is not None:
+            self._log.failed(self._record, error)
+
+    def done(self) -> bool:
+        done = self._job.done()
+        if done:
+            self._settle()
+        return done
+
+    def error(self) -> BaseException | None:
+        self._settle()
+        return self._job.error()
+
+    def result(self) -> Any:
+        self._settle()
+        return self._job.result()
+
+    def cancel(self) -> None:
+        if not self._job.done():
+            self._settled = True  # pre-empted: stopped on purpose, not failed
+        self._job.cancel()
+
 
 class TreeActions:
     """The services as one tree sees them: every call recorded under the tree's name.
 
     A service that raises while accepting work gives a failed job instead, so a node
-    reports FAILURE rather than stopping the tick.
+    reports FAILURE rather than stopping the tick. The jobs returned mark their record in
+    the log when they are seen failed.
     """
 
     def __init__(self, services: Services, clock: Clock, tree: str, log: ActionLog) -> None:
@@ -62,11 +138,15 @@ class TreeActions:
         self.log = log
 
     def _call(self, action: str, args: dict[str, Any], start: Callable[[], Job]) -> Job:
-        self.log.add(ActionRecord(self.clock.now(), self.tree, action, args))
+        record = ActionRecord(self.clock.now(), self.tree, action, args)
+        self.log.add(record)
         try:
-            return start()
+            job = start()
         except Exception as error:  # a service refusing work is a failed action, not a crash
-            return ImmediateJob(error=error)
+            job = ImmediateJob(error=error)
+        watched = _WatchedJob(job, record, self.log)
+        watched.done()  # a call refused at once is marked failed at once
+        return watched
 
     def say(self, text: str, *, volume: float | None = None) -> Job:
         args: dict[str, Any] = {"text": text}

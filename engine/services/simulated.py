@@ -84,7 +84,31 @@ class SimulatedServos(_Recording):
         self.angles_deg[joint] = angle_deg
         speed = speed_dps or self.default_speed_dps
         seconds = abs(angle_deg - start) / speed if speed > 0 else 0.0
-        return TimedJob(self.clock, seconds)
+        return _ServoMove(self, joint, start, angle_deg, seconds)
+
+
+class _ServoMove(TimedJob):
+    """A move that, cancelled half-way, leaves the joint where it had got to."""
+
+    def __init__(
+        self, servos: SimulatedServos, joint: str, start_deg: float, end_deg: float, seconds: float
+    ) -> None:
+        super().__init__(servos.clock, seconds)
+        self._servos = servos
+        self._joint = joint
+        self._start_deg = start_deg
+        self._end_deg = end_deg
+        self._seconds = seconds
+
+    def cancel(self) -> None:
+        if self.done():
+            return
+        left_s = self.finishes_at_s - self._clock.now()
+        moved = 1.0 - left_s / self._seconds if self._seconds > 0 else 1.0
+        self._servos.angles_deg[self._joint] = (
+            self._start_deg + (self._end_deg - self._start_deg) * moved
+        )
+        super().cancel()
 
 
 class SimulatedSensors(_Recording):

@@ -10,6 +10,6 @@
         assert robot.said == ["I love hugs!"]
 """
 
-from engine.testing.harness import TreeHarness
+from engine.testing.harness import HarnessReplacedError, TreeHarness
 
-__all__ = ["TreeHarness"]
+__all__ = ["HarnessReplacedError", "TreeHarness"]

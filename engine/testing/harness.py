@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
+from typing import Any, ClassVar
 
 from py_trees.common import Status
 
@@ -12,6 +12,7 @@ from engine.blackboard.catalogue import KeyCatalogue, default_catalogue
 from engine.blackboard.events import EventLog
 from engine.clock import VirtualClock
 from engine.dialogs.library import DialogLibrary, find_dialogs_folder
+from engine.errors import VestError
 from engine.loader.substitution import load_profile
 from engine.loader.tree_file import TreeDefinition, TreeLoader
 from engine.nodes.context import TreeContext
@@ -22,12 +23,26 @@ from engine.services.interfaces import Services
 from engine.services.simulated import simulated_services
 
 
+class HarnessReplacedError(VestError, RuntimeError):
+    """A TreeHarness was used after a newer one took over py_trees' blackboard."""
+
+
 class TreeHarness:
     """One tree, a fresh blackboard, a virtual clock, recording services and a world.
 
     ``world`` answers on-request sensor reads (``world.temperature_c = 22.2``);
     ``services`` are the simulated services (``services.speech.fail_next = "why"``).
+
+    **One harness at a time.** py_trees keeps one blackboard per process, and every
+    harness uses it: creating a harness empties it, so a second harness resets the first
+    one's keys and the two would read each other's writes. Use one harness per test (or
+    finish with one before creating the next); an older harness raises
+    :class:`HarnessReplacedError` on its next ``tick``, ``advance`` or ``set``. To compare
+    two robots (say, two profiles), run one, note what it did, then create the other.
     """
+
+    _newest: ClassVar[int] = 0
+    """The number of the harness that owns py_trees' blackboard now (the latest created)."""
 
     def __init__(
         self,
@@ -38,6 +53,8 @@ class TreeHarness:
         clock: VirtualClock | None = None,
         services: Services | None = None,
     ) -> None:
+        TreeHarness._newest += 1
+        self._number = TreeHarness._newest
         self.definition = definition
         self.clock = clock or VirtualClock()
         self.blackboard = Blackboard(catalogue or default_catalogue(), self.clock)
@@ -47,6 +64,7 @@ class TreeHarness:
         self.services = services or simulated_services(self.clock, readers=self.senses.readers())
         self.log = ActionLog()
         self.node_errors: list[tuple[str, BaseException]] = []
+        self.node_warnings: list[tuple[str, str]] = []
         self.context = TreeContext(
             tree=definition.name,
             clock=self.clock,
@@ -54,6 +72,7 @@ class TreeHarness:
             actions=TreeActions(self.services, self.clock, definition.name, self.log),
             dialogs=dialogs,
             on_node_error=lambda tree, path, error: self.node_errors.append((path, error)),
+            on_node_warning=lambda tree, path, message: self.node_warnings.append((path, message)),
         )
         self.tree = definition.build(self.context)
         self.origin_s = self.clock.now()
@@ -83,8 +102,17 @@ class TreeHarness:
         return cls(loader.load(path), dialogs=dialogs, catalogue=catalogue)
 
     # -- the world ------------------------------------------------------------------------
+    def _check_current(self) -> None:
+        if self._number != TreeHarness._newest:
+            raise HarnessReplacedError(
+                f"this TreeHarness ({self.definition.name}) is used after another TreeHarness "
+                "was created: py_trees' blackboard is process-wide, and the newer harness "
+                "reset it; use one harness at a time"
+            )
+
     def set(self, key: str, value: Any) -> None:
         """Write ``key`` (an event key gets one new event), seen from the next tick on."""
+        self._check_current()
         if self._is_event(key):
             self.blackboard.stage_event(key, value)
         else:
@@ -113,6 +141,7 @@ class TreeHarness:
 
     def tick(self, n: int = 1) -> Status:
         """Tick ``n`` times, one tree period apart (as the scheduler would); the last status."""
+        self._check_current()
         for _ in range(n):
             self.blackboard.commit()
             self.tree.tick()
@@ -132,14 +161,21 @@ class TreeHarness:
 
     @property
     def actions(self) -> list[ActionRecord]:
-        """Every service call so far: time, tree, action (say, led, servo, ...), args."""
+        """Every service call so far, failed ones included: time, tree, action (say, led,
+        servo, ...), args, and ``error`` (None unless the service failed the call)."""
         return list(self.log.records)
 
+    @property
+    def failed_actions(self) -> list[ActionRecord]:
+        """The service calls the service failed (``record.error`` says why)."""
+        return [record for record in self.log.records if record.error is not None]
+
     def did(self, action: str) -> list[dict[str, Any]]:
-        """The arguments of every call of ``action`` (``"led"``, ``"servo"``, ...)."""
-        return [record.args for record in self.log.records if record.action == action]
+        """The arguments of every call of ``action`` (``"led"``, ``"servo"``, ...) that did not
+        fail (one still under way counts)."""
+        return [record.args for record in self.log.done if record.action == action]
 
     @property
     def said(self) -> list[str]:
-        """Every phrase the robot said, in order."""
+        """Every phrase the robot said (or is saying), in order; not those it failed to say."""
         return [args["text"] for args in self.did("say")]

@@ -96,4 +96,10 @@ def test_a_temperature_sensor_that_cannot_be_read_fails_the_answer(robot: TreeHa
     robot.services.sensors.fail_next = "MCP9808 not answering"
     robot.set("/speech/heard", "what is the temperature")
     assert robot.tick() == Status.FAILURE
-    assert robot.did("read") == [{"sensor": "temperature"}]
+    [failed] = robot.failed_actions
+    assert (failed.action, failed.args, failed.error) == (
+        "read",
+        {"sensor": "temperature"},
+        "MCP9808 not answering",
+    )
+    assert robot.did("read") == []

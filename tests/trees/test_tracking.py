@@ -90,4 +90,6 @@ def test_a_failed_turn_fails_the_tree_and_is_tried_again(robot: TreeHarness) -> 
     see(robot, left=250, center=600, right=900)
     assert robot.tick() == Status.FAILURE
     robot.advance(1.0)
-    assert robot.did("servo") == [LEFT, LEFT]
+    # the stalled turn is a failed call, not a turn; the retry is the turn
+    assert [record.args for record in robot.failed_actions] == [LEFT]
+    assert robot.did("servo") == [LEFT]

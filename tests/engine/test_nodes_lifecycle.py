@@ -1,0 +1,85 @@
+"""Leaf lifecycles: an update() without a status, and a turn cut short by a Timeout."""
+
+from __future__ import annotations
+
+import textwrap
+from pathlib import Path
+from typing import ClassVar
+
+import pytest
+from py_trees.common import Status
+
+from engine.nodes import Leaf
+from engine.nodes.registry import builtin_registry
+from engine.testing import TreeHarness
+
+LEFT = {"joint": "neck", "angle_deg": 30.0, "speed_dps": 10.0}
+
+
+def write(folder: Path, name: str, text: str) -> Path:
+    path = folder / name
+    path.write_text(textwrap.dedent(text), encoding="utf-8")
+    return path
+
+
+class Forgetful(Leaf):
+    """A developer's node whose update() forgets to return a status."""
+
+    params: ClassVar = ()
+
+    def update(self) -> Status:
+        self.feedback_message = "did my thing"  # and no return
+        return None  # type: ignore[return-value]
+
+
+def test_an_update_returning_no_status_fails_the_node_and_names_its_class(
+    tmp_path: Path,
+) -> None:
+    registry = builtin_registry()
+    registry.add(Forgetful)
+    tree = write(
+        tmp_path,
+        "forgetful.yaml",
+        """\
+        root:
+          Selector:
+            - Forgetful: {}
+            - Say: {text: "plan B"}
+        """,
+    )
+    robot = TreeHarness.from_file(tree, registry=registry)
+    # Forgetful: FAILURE (not None), so the Selector goes on: Say: SUCCESS -> SUCCESS
+    assert robot.tick() == Status.SUCCESS
+    forgetful = robot.tree.root.children[0]
+    assert forgetful.status == Status.FAILURE
+    [(path, error)] = robot.node_errors
+    assert path == "Selector/Forgetful"
+    assert str(error) == "Forgetful.update() returned None, not a Status"
+    assert robot.said == ["plan B"]
+
+
+def test_a_turn_cut_short_by_a_timeout_is_started_again_next_round(tmp_path: Path) -> None:
+    tree = write(
+        tmp_path,
+        "look.yaml",
+        """\
+        rate_hz: 10
+        root:
+          Timeout:
+            seconds: 0.2
+            child:
+              LookToward: {joint: neck, turn_deg: 30, speed_dps: 10}
+        """,
+    )
+    robot = TreeHarness.from_file(tree)
+    robot.set("/sensors/range/left_mm", 300.0)
+    robot.set("/sensors/range/center_mm", 800.0)
+    # a 30 deg turn at 10 deg/s takes 3 s: RUNNING, RUNNING, then the Timeout: FAILURE
+    assert [robot.tick().name for _ in range(3)] == ["RUNNING", "RUNNING", "FAILURE"]
+    look = robot.tree.root.children[0]
+    assert look.angle_deg == 0.0  # it never got there: the neck stopped 0.2 s into the turn
+    assert robot.services.servos.angles_deg["neck"] == pytest.approx(2.0)
+
+    # the next round: the neck is not yet left, so it turns again
+    assert robot.tick() == Status.RUNNING
+    assert robot.did("servo") == [LEFT, LEFT]

@@ -1,0 +1,176 @@
+"""A therapist's own dialog file: answers naming any sensor, phrases in any script, and
+concepts that would expand without end.
+
+Each test writes a dialog beside a tree like trees/dialog.yaml (OnEvent on
+/speech/heard -> Reply) and drives it with the TreeHarness.
+"""
+
+from __future__ import annotations
+
+import textwrap
+import time
+from pathlib import Path
+
+import pytest
+from py_trees.common import Status
+
+from engine.blackboard.catalogue import default_catalogue
+from engine.dialogs.library import load_dialog
+from engine.loader.problems import LoadError
+from engine.testing import TreeHarness
+
+TREE = """\
+name: dialog
+root:
+  Sequence:
+    - OnEvent: {key: /speech/heard, save_as: /vars/heard}
+    - Reply: {heard: /vars/heard}
+"""
+
+
+def write(folder: Path, name: str, text: str) -> Path:
+    path = folder / name
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(textwrap.dedent(text), encoding="utf-8")
+    return path
+
+
+def robot_with(folder: Path, dialog: str) -> TreeHarness:
+    write(folder, "dialogs/default.yaml", dialog)
+    return TreeHarness.from_file(write(folder, "trees/dialog.yaml", TREE))
+
+
+def dialog_problems(folder: Path, text: str) -> list[str]:
+    path = write(folder, "d.yaml", text)
+    with pytest.raises(LoadError) as caught:
+        load_dialog(path, default_catalogue(), "d.yaml")
+    return [str(problem) for problem in caught.value.problems]
+
+
+# -- answers filled from any blackboard key ----------------------------------------------
+FORCE_AND_DISTANCE = """\
+dialog: default
+rules:
+  - hear: ["how hard"]
+    say: "You pressed with {force_left_n:.0f} newtons"
+  - hear: ["how far"]
+    read: ultrasound
+    say: "Something is {ultrasound_cm:.0f} cm away"
+fallback: "I felt {/vars/mood}"
+"""
+
+
+def test_an_answer_may_name_a_sensor_the_rule_does_not_read(tmp_path: Path) -> None:
+    robot = robot_with(tmp_path, FORCE_AND_DISTANCE)
+    robot.set("/sensors/force/left_n", 6.0)
+    robot.set("/speech/heard", "how hard")
+    robot.tick()
+    assert robot.said == ["You pressed with 6 newtons"]
+    assert robot.node_errors == []
+
+
+def test_a_fallback_may_name_a_tree_variable(tmp_path: Path) -> None:
+    robot = robot_with(tmp_path, FORCE_AND_DISTANCE)
+    robot.set("/vars/mood", "happy")
+    robot.set("/speech/heard", "sing a song")
+    robot.tick()
+    assert robot.said == ["I felt happy"]
+
+
+def test_an_answer_whose_field_has_no_value_fails_in_words_not_with_an_error(
+    tmp_path: Path,
+) -> None:
+    robot = robot_with(tmp_path, FORCE_AND_DISTANCE)  # nothing in front: no distance
+    robot.set("/speech/heard", "how far")
+    # OnEvent: SUCCESS, Reply: FAILURE (reads, then cannot fill the answer) -> FAILURE
+    assert robot.tick() == Status.FAILURE
+    assert robot.said == []
+    assert robot.node_errors == []
+    reply = robot.tree.root.children[1]
+    assert reply.feedback_message == "could not answer: /sensors/ultrasound/cm has no value yet"
+
+
+# -- phrases in any script -------------------------------------------------------------------
+WORLD = """\
+dialog: default
+rules:
+  - hear: ["как тебя зовут"]
+    say: "Меня зовут Эйч Би Эс"
+  - hear: ["नमस्ते रोबोट"]
+    say: "नमस्ते"
+  - hear: ["¿Cómo estás?"]
+    say: "Muy bien"
+  - hear: ["你好"]
+    say: "你好!"
+"""
+
+
+@pytest.mark.parametrize(
+    ("heard", "answer"),
+    [
+        ("Как тебя зовут?", "Меня зовут Эйч Би Эс"),
+        ("नमस्ते, रोबोट!", "नमस्ते"),
+        ("cómo estás", "Muy bien"),
+        ("CÓMO ESTÁS", "Muy bien"),
+        ("你好", "你好!"),
+    ],
+)
+def test_phrases_in_any_script_are_heard(tmp_path: Path, heard: str, answer: str) -> None:
+    robot = robot_with(tmp_path, WORLD)
+    robot.set("/speech/heard", heard)
+    robot.tick()
+    assert robot.said == [answer]
+
+
+def test_a_phrase_of_punctuation_only_is_reported_where_it_is(tmp_path: Path) -> None:
+    assert dialog_problems(
+        tmp_path,
+        """\
+        dialog: d
+        rules:
+          - hear: ["hello", "!!!"]
+            say: Hi
+        """,
+    ) == ["d.yaml:3:21: phrase '!!!' has no words (write it with letters or digits)"]
+
+
+# -- concepts that multiply --------------------------------------------------------------------
+FORTY = ", ".join(f"x{i}" for i in range(40))
+
+
+def test_a_phrase_expanding_to_millions_is_refused_at_once(tmp_path: Path) -> None:
+    started = time.process_time()
+    problems = dialog_problems(
+        tmp_path,
+        f"""\
+        dialog: d
+        concepts:
+          a: [{FORTY}]
+        rules:
+          - hear: ["~a ~a ~a ~a ~a"]
+            say: ok
+        """,
+    )
+    assert problems == [
+        "d.yaml:5:12: phrase expands to 102400000 phrases, more than 200 "
+        "(use fewer ~concepts in one phrase, or write several shorter phrases)"
+    ]
+    assert time.process_time() - started < 5  # not 100 million phrases built first
+
+
+def test_a_dialog_whose_phrases_together_expand_too_far_is_refused_at_the_phrase(
+    tmp_path: Path,
+) -> None:
+    rules = "".join(f'  - hear: ["~a ~b {i}"]\n    say: ok\n' for i in range(20))
+    problems = dialog_problems(
+        tmp_path,
+        "dialog: d\nconcepts:\n"
+        f"  a: [{', '.join(f'a{i}' for i in range(10))}]\n"
+        f"  b: [{', '.join(f'b{i}' for i in range(15))}]\n"
+        f"rules:\n{rules}",
+    )
+    # 150 phrases per rule: the 14th rule passes 2000
+    assert problems == [
+        "d.yaml:32:12: the dialog's phrases expand to more than 2000 phrases by here "
+        "(use fewer ~concepts, or split the dialog in two)"
+    ]
