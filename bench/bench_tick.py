@@ -76,7 +76,7 @@ _STORAGE = py_trees.blackboard.Blackboard.storage
 FORCE_LEFT = "/sensors/force/left_n"
 FORCE_RIGHT = "/sensors/force/right_n"
 HEARD = "/speech/heard"
-HEARD_VAR = "/vars/heard"
+HEARD_VAR = "/vars/dialog_heard"
 SENSOR_KEYS = ("/sensors/temperature/c", "/sensors/temperature/f", "/sensors/ultrasound/cm")
 # what the hug tree's parameters say in trees/hug.yaml (checked against the file below)
 HUG_THRESHOLD_N = 3.0

@@ -188,3 +188,21 @@ def test_a_dialogs_folder_that_does_not_exist_is_named(capsys, monkeypatch):
     monkeypatch.chdir(ROOT)
     assert main(["run", "--fast", "--dialogs", "nodialogs"]) == 1
     assert "--dialogs nodialogs: no such folder" in capsys.readouterr().err
+
+
+def test_a_move_beyond_the_neck_s_limits_is_refused_shown_and_reported_failed(
+    tmp_path, capsys, monkeypatch
+):
+    monkeypatch.chdir(ROOT)
+    scenario = tmp_path / "bad_move.yaml"
+    scenario.write_text(
+        "duration_s: 3\nevents:\n"
+        "  - {at: 1.0, cloud: {type: move, args: {joint: neck, angle_deg: 170}}}\n"
+    )
+    actions = run_json(capsys, "--scenario", str(scenario))
+    refused = [a for a in actions if a["action"] == "servo" and "error" in a]
+    assert "outside its limits -60..60 deg" in refused[0]["error"]
+    report = next(a for a in actions if a["action"] == "report")
+    assert report["args"]["status"] == "failed"
+    assert main(["run", "--fast", "--scenario", str(scenario)]) == 0
+    assert "could not: turns neck to 170 deg" in capsys.readouterr().out

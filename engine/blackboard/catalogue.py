@@ -2,8 +2,8 @@
 
 The YAML loader checks every key a tree names against it (with "did you mean"), the docs
 list it, and the catalogue says which keys are *events* (reacted to once per event) rather
-than *state* (read every tick). Keys under ``/vars/`` are free for trees to use as their
-own variables; ``/devices/<name>/ok`` exists for every configured device.
+than *state* (read every tick). Keys under ``/vars/`` are variables that all trees of a
+robot share; ``/devices/<name>/ok`` exists for every configured device.
 """
 
 from __future__ import annotations
@@ -54,7 +54,12 @@ class KeySpec:
 
 
 VARIABLE_SPEC = KeySpec(
-    VARIABLES_PREFIX + "*", object, "", "trees", "a tree's own variable (any value)"
+    VARIABLES_PREFIX + "*",
+    object,
+    "",
+    "trees",
+    "a variable shared by every tree of the robot (any value; name it after the tree that "
+    "writes it)",
 )
 
 

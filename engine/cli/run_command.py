@@ -142,7 +142,7 @@ def main(args: argparse.Namespace) -> int:
         timeline = Timeline(sys.stdout, start_s=start_s, as_json=args.json)
         for name, why in hardware.startup_problems.items():
             print(f"warning: {name} did not start ({why}); it will be tried again", file=sys.stderr)
-        log = ActionLog(listeners=[timeline.action])
+        log = ActionLog(listeners=[timeline.action], failure_listeners=[timeline.failed])
         blackboard.watchers.append(
             lambda key, value: timeline.blackboard_write(key, value, clock.now())
         )

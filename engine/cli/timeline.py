@@ -89,6 +89,16 @@ class Timeline:
         else:
             self._line(record.t, record.tree, describe_action(record.action, record.args))
 
+    def failed(self, record: ActionRecord, error: BaseException) -> None:
+        """An action the service could not do: said so, after the line that announced it."""
+        if self.as_json:
+            shown = record.to_json()
+            shown["t"] = round(record.t - self.start_s, 3)
+            self._write(json.dumps(shown) + "\n")
+        else:
+            what = describe_action(record.action, record.args)
+            self._line(record.t, record.tree, f"could not: {what} ({record.error})")
+
     def _line(self, at_s: float, who: str, what: str) -> None:
         self._write(f"{at_s - self.start_s:8.2f}  {who:14} {what}\n")
 
