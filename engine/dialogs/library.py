@@ -25,7 +25,7 @@ from pathlib import Path
 
 from engine.blackboard.catalogue import KeyCatalogue
 from engine.dialogs.model import Dialog, DialogRule, normalize
-from engine.loader.problems import LoadError, Problems
+from engine.loader.problems import LoadError, Mark, Problems
 from engine.loader.yaml_source import (
     YList,
     YMap,
@@ -72,6 +72,14 @@ class DialogLibrary:
                 dialog = load_dialog(path, catalogue)
             except LoadError as error:
                 problems.extend(error.problems)
+                continue
+            holder = dialogs.get(dialog.name)
+            if holder is not None:
+                problems.add(
+                    Mark(str(path), 1, 1),
+                    f"two dialogs are named {dialog.name!r} (also {holder.source})",
+                    "rename one: trees name a dialog by its name",
+                )
                 continue
             dialogs[dialog.name] = dialog
         problems.raise_if_any()

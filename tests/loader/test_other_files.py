@@ -251,3 +251,18 @@ def test_a_profile_that_is_not_a_mapping_is_named(tmp_path: Path, text: str) -> 
     assert problems(tmp_path, load_profile, text) == [
         "file.yaml:1:1: a profile is a mapping with 'profile:' and 'params:'"
     ]
+
+
+def test_two_dialog_files_with_one_name_are_reported_with_both_files(tmp_path):
+    from engine.blackboard import default_catalogue
+    from engine.dialogs import DialogLibrary
+    from engine.loader.problems import LoadError
+
+    rule = 'rules:\n  - hear: ["hi"]\n    say: "Hello"\n'
+    (tmp_path / "a.yaml").write_text("dialog: default\n" + rule)
+    (tmp_path / "b.yaml").write_text("dialog: default\n" + rule)
+    with pytest.raises(LoadError) as error:
+        DialogLibrary.from_folder(tmp_path, default_catalogue())
+    assert str(error.value).startswith(
+        f"{tmp_path / 'b.yaml'}:1:1: two dialogs are named 'default' (also "
+    )
