@@ -17,7 +17,16 @@ class ConfigError(VestError, ValueError):
 
 
 class DeviceError(VestError, OSError):
-    """A device could not be reached or answered something it should not."""
+    """A device could not be reached or answered something it should not.
+
+    ``DeviceError(errno, message)`` keeps the errno for code, and reads as the message
+    alone (not Python's ``[Errno 121] ...``): the message already says it in words.
+    """
+
+    def __str__(self) -> str:
+        if self.errno is not None and self.strerror:
+            return str(self.strerror)
+        return super().__str__()
 
 
 class ServiceError(VestError, RuntimeError):

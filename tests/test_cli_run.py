@@ -206,3 +206,20 @@ def test_a_move_beyond_the_neck_s_limits_is_refused_shown_and_reported_failed(
     assert report["args"]["status"] == "failed"
     assert main(["run", "--fast", "--scenario", str(scenario)]) == 0
     assert "could not: turns neck to 170 deg" in capsys.readouterr().out
+
+
+def test_on_a_robot_without_its_buses_vest_run_exits_3_naming_the_missing_bus(capsys, monkeypatch):
+    monkeypatch.chdir(ROOT)
+    assert main(["run", "--hardware", "examples/robots/hbs2.yaml"]) == 3
+    err = capsys.readouterr().err
+    assert "cannot open I2C bus 'i2c' (/dev/i2c-1): no such device file" in err
+    assert "[Errno" not in err
+
+
+def test_a_real_robot_plays_no_scenario_unless_asked_and_runs_until_stopped():
+    from engine.cli.run_command import _scenario
+
+    on_the_robot = _scenario(None, simulated=False)
+    assert on_the_robot.events == ()
+    assert on_the_robot.duration_s == float("inf")
+    assert _scenario(None, simulated=True).events  # the demo on the simulated vest

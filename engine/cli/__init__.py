@@ -1,7 +1,8 @@
 """The ``vest`` command line.
 
 Exit codes: 0 success; 1 a file has problems (each printed as file:line:column); 2 the
-command line is wrong; 3 something needed is missing on this machine (e.g. Graphviz).
+command line is wrong; 3 something needed is missing on this machine (Graphviz, a bus, a
+port, a device file).
 """
 
 from __future__ import annotations
@@ -20,7 +21,7 @@ from engine.cli import (
     schema_command,
     validate_command,
 )
-from engine.errors import VestError
+from engine.errors import DeviceError, VestError
 from engine.loader.problems import LoadError
 
 EXIT_OK, EXIT_PROBLEMS, EXIT_USAGE, EXIT_MISSING = 0, 1, 2, 3
@@ -74,6 +75,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         count = len(error.problems)
         print(f"{count} problem{'s' if count != 1 else ''}", file=sys.stderr)
         return EXIT_PROBLEMS
+    except DeviceError as error:  # a bus, port or chip this machine does not have
+        print(f"vest {args.command}: {error}", file=sys.stderr)
+        return EXIT_MISSING
     except VestError as error:
         print(f"vest {args.command}: {error}", file=sys.stderr)
         return EXIT_PROBLEMS

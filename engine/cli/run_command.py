@@ -13,6 +13,7 @@ running tree); Ctrl-C or SIGTERM stops cleanly.
 from __future__ import annotations
 
 import argparse
+import math
 import signal
 import sys
 from collections.abc import Iterator
@@ -33,13 +34,14 @@ from engine.runtime.reload import TreeReloader
 from engine.runtime.robot import Robot, load_behaviors
 from engine.runtime.scheduler import Scheduler
 from engine.scenario.player import ScenarioPlayer
-from engine.scenario.scenario_file import load_scenario
+from engine.scenario.scenario_file import Scenario, load_scenario
 from engine.scenario.world import World
 from engine.services.actions import ActionLog
 from engine.services.simulated import simulated_services
 
 NAME = "run"
 DEFAULT_DIALOGS = Path("dialogs")
+DEFAULT_SCENARIO = Path("examples/scenarios/demo.yaml")
 HELP = "run the behaviors on a scenario (default: the demo)"
 
 
@@ -63,8 +65,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--scenario",
         type=Path,
-        default=Path("examples/scenarios/demo.yaml"),
-        help="scenario file (default: examples/scenarios/demo.yaml)",
+        default=None,
+        help="scenario file (default: examples/scenarios/demo.yaml on the simulated vest; "
+        "none on a real robot, which then runs until Ctrl-C)",
     )
     parser.add_argument(
         "--duration",
@@ -123,8 +126,8 @@ def main(args: argparse.Namespace) -> int:
     behaviors = load_behaviors(
         args.trees, dialogs_dir=dialogs, profile=resolve_profile(args.profile, args.trees)
     )
-    scenario = load_scenario(args.scenario)
     config = load_robot_config(args.hardware)
+    scenario = _scenario(args.scenario, simulated=config.simulated)
     problems = check_fault_events(scenario.events, config)
     if problems:
         raise LoadError(problems)
@@ -171,6 +174,16 @@ def main(args: argparse.Namespace) -> int:
         if vest is not None:
             vest.close()
     return 0
+
+
+def _scenario(path: Path | None, *, simulated: bool) -> Scenario:
+    """The named scenario; by default the demo on the simulated vest, and on a real robot
+    nothing scripted (the world is real) for as long as it runs."""
+    if path is not None:
+        return load_scenario(path)
+    if simulated:
+        return load_scenario(DEFAULT_SCENARIO)
+    return Scenario(duration_s=math.inf, events=(), path=Path("(no scenario)"))
 
 
 @contextmanager

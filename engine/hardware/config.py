@@ -172,7 +172,14 @@ CHIPS: dict[str, ChipSpec] = {
             default_address=VL53L0X_BOOT_ADDRESS,
             default_rate_hz=10.0,
             outputs={"range": ""},
-            options=(Param("timeout_s", Number(0.01, 1.0, "s"), 0.1, "longest measurement"),),
+            options=(
+                Param(
+                    "timeout_s",
+                    Number(0.05, 1.0, "s"),
+                    0.1,
+                    "longest measurement (one takes about 33 ms)",
+                ),
+            ),
             fields=("side", "xshut", "mux", "channel"),
         ),
         ChipSpec(
@@ -191,7 +198,7 @@ CHIPS: dict[str, ChipSpec] = {
             "Devantech SRF02 ultrasonic range, read on request",
             "i2c",
             "ultrasound",
-            addresses=tuple(range(0x70, 0x80)),
+            addresses=tuple(range(0x70, 0x78)),  # 0x78..0x7F are reserved on I2C
             default_address=0x70,
             outputs={"range": "/sensors/ultrasound/cm"},
         ),

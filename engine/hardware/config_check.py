@@ -17,6 +17,7 @@ from pathlib import Path
 from typing import Any
 
 from engine.blackboard.catalogue import KeyCatalogue
+from engine.drivers.mpr121 import check_thresholds
 from engine.drivers.servo_joints import MAESTRO_MAX_US, MAESTRO_MIN_US, Joint
 from engine.hardware.config import (
     BUS_KINDS,
@@ -398,6 +399,12 @@ class ConfigChecker:
                 ok = False
                 continue
             values[param.name] = _numeric_choice(param.name, converted)
+        if ok and spec.chip == "mpr121":
+            try:  # the driver refuses these; say so now rather than at start-up
+                check_thresholds(values["touch_threshold"], values["release_threshold"])
+            except ValueError as error:
+                self.problems.add(raw.mark, str(error), "release_threshold <= touch_threshold")
+                ok = False
         return values if ok else None
 
     def _keys(self, raw: YMap, spec: ChipSpec, side: str | None) -> dict[str, str] | None:
