@@ -227,7 +227,10 @@ class Maestro:
         clock: Clock | None = None,
         baudrate: int = 115200,
         timeout_s: float = 0.5,
+        connect: bool = True,
     ) -> None:
+        """``connect=False`` with a port name opens the port at the first command instead
+        of now (a Maestro that is not plugged in yet does not stop the robot starting)."""
         if not 0 <= device <= MAX_DEVICE_NUMBER:
             raise ValueError(f"Maestro device number {device} is outside 0..{MAX_DEVICE_NUMBER}")
         if protocol not in ("compact", "pololu"):
@@ -244,7 +247,9 @@ class Maestro:
         self._timeout_s = timeout_s
         self._port: SerialPort | None
         if isinstance(port, str):
-            self._port = _open_port(port, baudrate=baudrate, timeout_s=timeout_s)
+            self._port = (
+                _open_port(port, baudrate=baudrate, timeout_s=timeout_s) if connect else None
+            )
             self._owns_port = True
             self._port_name = port
         else:

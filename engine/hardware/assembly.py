@@ -563,14 +563,24 @@ class _Assembler:
 
     def _servos(self, device: DeviceConfig) -> None:
         bus = self.config.buses[device.bus]
-        maestro = Maestro(
-            self.provider.serial_port(bus),
-            device=device.options["device_number"],
-            protocol=device.options["protocol"],
-            channels=device.options["channels"],
-            clock=self.clock,
-            baudrate=bus.baudrate,
-        )
+        port = self.provider.serial_port(bus)
+        options = {
+            "device": device.options["device_number"],
+            "protocol": device.options["protocol"],
+            "channels": device.options["channels"],
+            "clock": self.clock,
+            "baudrate": bus.baudrate,
+        }
+        try:
+            maestro = Maestro(port, **options)
+        except DeviceError as error:
+            if not isinstance(port, str):
+                raise
+            # not plugged in yet: the robot starts without its servos, and the first move
+            # after the Maestro appears opens the port (moves meanwhile fail in words)
+            self._failed(device, error)
+            self.hw.health[device.name].driver_status(False, describe_exception(error))
+            maestro = Maestro(port, connect=False, **options)
         self.hw._owned.append(maestro)
         manager = self._manager(maestro, name=bus.path, kind="serial")
         self.hw.managers[bus.name] = manager

@@ -396,3 +396,22 @@ def test_a_maestro_opened_by_name_carries_on_after_its_cable_was_pulled_and_plug
         first.close()
         if second is not None:
             second.close()
+
+
+def test_a_maestro_not_plugged_in_at_start_up_is_opened_by_the_first_command_after_it_appears(
+    tmp_path: Path, clock: VirtualClock
+) -> None:
+    link = tmp_path / "ttyACM0"
+    maestro = Maestro(str(link), clock=clock, timeout_s=0.5, connect=False)  # nothing there
+    emulator: MaestroEmulator | None = None
+    try:
+        with pytest.raises(DeviceError, match="no such file"):
+            maestro.set_target_us(0, 1500)
+        emulator = MaestroEmulator(clock)  # plugged in later
+        link.symlink_to(emulator.port_name)
+        maestro.set_target_us(0, 1500)
+        assert maestro.get_position_us(0) == 1500.0
+    finally:
+        maestro.close()
+        if emulator is not None:
+            emulator.close()

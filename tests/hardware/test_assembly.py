@@ -395,3 +395,24 @@ def test_a_force_sensor_whose_poller_cannot_be_made_is_shown_not_ok(sim_config: 
     finally:
         hardware.close()
         vest.close()
+
+
+def test_a_maestro_missing_at_start_up_does_not_stop_the_robot_and_moves_fail_in_words(
+    sim_config: RobotConfig, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+):
+    clock = VirtualClock()
+    board = Blackboard(default_catalogue(), clock)
+    vest = build_sim_vest(sim_config, World(), clock)
+    missing = str(tmp_path / "ttyACM0")  # the USB cable is not plugged in
+    monkeypatch.setattr(vest, "serial_port", lambda bus: missing)
+    hardware = build_hardware(sim_config, clock, board, vest=vest)
+    try:
+        board.commit()
+        assert "no such file" in hardware.startup_problems["servos"]
+        assert board.get("/devices/servos/ok") is False
+        assert board.get("/devices/touch/ok") is True  # the rest of the vest works
+        job = hardware.servos.move("neck", 10.0)
+        assert job.done() and "no such file" in str(job.error())
+    finally:
+        hardware.close()
+        vest.close()
