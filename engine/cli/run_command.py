@@ -42,7 +42,7 @@ from engine.services.simulated import simulated_services
 NAME = "run"
 DEFAULT_DIALOGS = Path("dialogs")
 DEFAULT_SCENARIO = Path("examples/scenarios/demo.yaml")
-HELP = "run the behaviors on a scenario (default: the demo)"
+HELP = "run the behaviors (default: the demo scenario on the simulated vest)"
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

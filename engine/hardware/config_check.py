@@ -403,7 +403,8 @@ class ConfigChecker:
             try:  # the driver refuses these; say so now rather than at start-up
                 check_thresholds(values["touch_threshold"], values["release_threshold"])
             except ValueError as error:
-                self.problems.add(raw.mark, str(error), "release_threshold <= touch_threshold")
+                where = raw.get("release_threshold") or raw.get("touch_threshold") or raw
+                self.problems.add(where.mark, str(error), "release_threshold <= touch_threshold")
                 ok = False
         return values if ok else None
 
@@ -981,7 +982,7 @@ class _CrossChecks:
                 hint = "move it to 0x71..0x77"
                 if device.chip == "srf02":
                     hint = (
-                        "change the SRF02's address to 0x71..0x7F (0xE2..0xFE in Devantech's "
+                        "change the SRF02's address to 0x71..0x77 (0xE2..0xEE in Devantech's "
                         "8-bit numbering), e.g. 0x75"
                     )
                 self.c.problems.add(
