@@ -16,16 +16,6 @@ ADDRESS = 0x48
 
 
 @pytest.fixture
-def clock() -> VirtualClock:
-    return VirtualClock()
-
-
-@pytest.fixture
-def bus(clock: VirtualClock) -> SimI2CBus:
-    return SimI2CBus(clock)
-
-
-@pytest.fixture
 def chip(bus: SimI2CBus, clock: VirtualClock) -> SimADS1115:
     return bus.attach(SimADS1115(clock))  # type: ignore[return-value]
 

@@ -37,11 +37,6 @@ from engine.errors import DeviceError
 
 
 @pytest.fixture
-def clock() -> VirtualClock:
-    return VirtualClock()
-
-
-@pytest.fixture
 def emulator(clock: VirtualClock) -> Iterator[MaestroEmulator]:
     with MaestroEmulator(clock, limits_us=(500.0, 2500.0)) as emulator:
         yield emulator

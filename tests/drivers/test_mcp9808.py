@@ -37,16 +37,6 @@ class WordChip(SimI2CDevice):
 
 
 @pytest.fixture
-def clock() -> VirtualClock:
-    return VirtualClock()
-
-
-@pytest.fixture
-def bus(clock: VirtualClock) -> SimI2CBus:
-    return SimI2CBus(clock)
-
-
-@pytest.fixture
 def chip(bus: SimI2CBus, clock: VirtualClock) -> SimMCP9808:
     return bus.attach(SimMCP9808(clock))  # type: ignore[return-value]
 

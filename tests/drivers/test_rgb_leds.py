@@ -14,11 +14,6 @@ FACE = {"left_eye": (0, 1, 2), "right_eye": (3, 4, 5), "mouth": (6, 7, 8)}
 
 
 @pytest.fixture
-def clock() -> VirtualClock:
-    return VirtualClock()
-
-
-@pytest.fixture
 def chip(clock: VirtualClock) -> SimPCA9685:
     return SimPCA9685(clock)
 

@@ -25,11 +25,6 @@ ARM = Joint("arm_left", 1, 0.0, 90.0, 45.0, min_us=1100.0, max_us=1820.0, home_d
 
 
 @pytest.fixture
-def clock() -> VirtualClock:
-    return VirtualClock()
-
-
-@pytest.fixture
 def emulator(clock: VirtualClock) -> Iterator[MaestroEmulator]:
     with MaestroEmulator(clock, limits_us=(900.0, 2100.0)) as emulator:
         yield emulator

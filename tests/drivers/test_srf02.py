@@ -14,16 +14,6 @@ ADDRESS = 0x70
 
 
 @pytest.fixture
-def clock() -> VirtualClock:
-    return VirtualClock()
-
-
-@pytest.fixture
-def bus(clock: VirtualClock) -> SimI2CBus:
-    return SimI2CBus(clock)
-
-
-@pytest.fixture
 def chip(bus: SimI2CBus, clock: VirtualClock) -> SimSRF02:
     return bus.attach(SimSRF02(clock))  # type: ignore[return-value]
 

@@ -17,11 +17,6 @@ from engine.errors import DeviceError
 
 
 @pytest.fixture
-def clock() -> VirtualClock:
-    return VirtualClock()
-
-
-@pytest.fixture
 def upstream(clock: VirtualClock) -> SimI2CBus:
     return SimI2CBus(clock)
 

@@ -19,16 +19,6 @@ from engine.errors import DeviceError
 
 
 @pytest.fixture
-def clock() -> VirtualClock:
-    return VirtualClock()
-
-
-@pytest.fixture
-def bus(clock: VirtualClock) -> SimI2CBus:
-    return SimI2CBus(clock)
-
-
-@pytest.fixture
 def chip(clock: VirtualClock, bus: SimI2CBus) -> SimVL53L0X:
     return SimVL53L0X(clock, bus)
 
