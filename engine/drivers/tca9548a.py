@@ -22,11 +22,10 @@ strap the TCA9548A to 0x71..0x77 (pins A0..A2).
 from __future__ import annotations
 
 import threading
-from collections.abc import Callable, Sequence
+from collections.abc import Callable
 from typing import Any, Protocol
 
-from smbus2 import i2c_msg
-
+from engine.drivers.forwarding_bus import ForwardingI2C
 from engine.errors import DeviceError
 
 CHIP = "TCA9548A"
@@ -55,7 +54,7 @@ def channel_mask(channel: int) -> int:
     return 1 << channel
 
 
-class LockedBus:
+class LockedBus(ForwardingI2C):
     """An ``smbus2.SMBus``-compatible view of ``bus`` whose every call holds :attr:`lock`.
 
     Hand the same object to the bus manager of the upstream chips and to the
@@ -71,50 +70,9 @@ class LockedBus:
     def __repr__(self) -> str:
         return f"LockedBus({self.bus!r})"
 
-    def _call(self, method: str, *args: Any) -> Any:
+    def _forward(self, method: str, *args: Any) -> Any:
         with self.lock:
             return getattr(self.bus, method)(*args)
-
-    def write_quick(self, i2c_addr: int, force: bool | None = None) -> None:
-        self._call("write_quick", i2c_addr)
-
-    def read_byte(self, i2c_addr: int, force: bool | None = None) -> int:
-        return self._call("read_byte", i2c_addr)
-
-    def write_byte(self, i2c_addr: int, value: int, force: bool | None = None) -> None:
-        self._call("write_byte", i2c_addr, value)
-
-    def read_byte_data(self, i2c_addr: int, register: int, force: bool | None = None) -> int:
-        return self._call("read_byte_data", i2c_addr, register)
-
-    def write_byte_data(
-        self, i2c_addr: int, register: int, value: int, force: bool | None = None
-    ) -> None:
-        self._call("write_byte_data", i2c_addr, register, value)
-
-    def read_word_data(self, i2c_addr: int, register: int, force: bool | None = None) -> int:
-        return self._call("read_word_data", i2c_addr, register)
-
-    def write_word_data(
-        self, i2c_addr: int, register: int, value: int, force: bool | None = None
-    ) -> None:
-        self._call("write_word_data", i2c_addr, register, value)
-
-    def read_i2c_block_data(
-        self, i2c_addr: int, register: int, length: int, force: bool | None = None
-    ) -> list[int]:
-        return self._call("read_i2c_block_data", i2c_addr, register, length)
-
-    def write_i2c_block_data(
-        self, i2c_addr: int, register: int, data: Sequence[int], force: bool | None = None
-    ) -> None:
-        self._call("write_i2c_block_data", i2c_addr, register, data)
-
-    def i2c_rdwr(self, *i2c_msgs: i2c_msg) -> None:
-        self._call("i2c_rdwr", *i2c_msgs)
-
-    def close(self) -> None:
-        """Nothing to release: the adapter belongs to whoever opened it."""
 
 
 class TCA9548A:
@@ -226,7 +184,7 @@ class TCA9548A:
         return TCA9548AChannel(self, channel)
 
 
-class TCA9548AChannel:
+class TCA9548AChannel(ForwardingI2C):
     """One downstream channel of a :class:`TCA9548A`, with the ``smbus2.SMBus`` interface."""
 
     def __init__(self, mux: TCA9548A, channel: int) -> None:
@@ -236,7 +194,7 @@ class TCA9548AChannel:
     def __repr__(self) -> str:
         return f"{self.mux!r}.channel_bus({self.channel})"
 
-    def _call(self, method: str, *args: Any) -> Any:
+    def _forward(self, method: str, *args: Any) -> Any:
         with self.mux.lock:
             try:
                 self.mux.ensure_selected(self.channel)
@@ -244,47 +202,6 @@ class TCA9548AChannel:
             except OSError:
                 self.mux.forget_selection()  # a glitch may have reset or confused the mux
                 raise
-
-    def write_quick(self, i2c_addr: int, force: bool | None = None) -> None:
-        self._call("write_quick", i2c_addr)
-
-    def read_byte(self, i2c_addr: int, force: bool | None = None) -> int:
-        return self._call("read_byte", i2c_addr)
-
-    def write_byte(self, i2c_addr: int, value: int, force: bool | None = None) -> None:
-        self._call("write_byte", i2c_addr, value)
-
-    def read_byte_data(self, i2c_addr: int, register: int, force: bool | None = None) -> int:
-        return self._call("read_byte_data", i2c_addr, register)
-
-    def write_byte_data(
-        self, i2c_addr: int, register: int, value: int, force: bool | None = None
-    ) -> None:
-        self._call("write_byte_data", i2c_addr, register, value)
-
-    def read_word_data(self, i2c_addr: int, register: int, force: bool | None = None) -> int:
-        return self._call("read_word_data", i2c_addr, register)
-
-    def write_word_data(
-        self, i2c_addr: int, register: int, value: int, force: bool | None = None
-    ) -> None:
-        self._call("write_word_data", i2c_addr, register, value)
-
-    def read_i2c_block_data(
-        self, i2c_addr: int, register: int, length: int, force: bool | None = None
-    ) -> list[int]:
-        return self._call("read_i2c_block_data", i2c_addr, register, length)
-
-    def write_i2c_block_data(
-        self, i2c_addr: int, register: int, data: Sequence[int], force: bool | None = None
-    ) -> None:
-        self._call("write_i2c_block_data", i2c_addr, register, data)
-
-    def i2c_rdwr(self, *i2c_msgs: i2c_msg) -> None:
-        self._call("i2c_rdwr", *i2c_msgs)
-
-    def close(self) -> None:
-        """Nothing to release: the upstream bus belongs to whoever opened it."""
 
     def __enter__(self) -> TCA9548AChannel:
         return self

@@ -18,10 +18,9 @@ import threading
 from collections.abc import Callable, Sequence
 from typing import Any, TypeVar
 
-from smbus2 import i2c_msg
-
 from engine.blackboard.board import Blackboard
 from engine.drivers.bus_manager import DeviceHandle, Priority
+from engine.drivers.forwarding_bus import ForwardingI2C
 
 T = TypeVar("T")
 
@@ -29,7 +28,7 @@ DEFAULT_WAIT_S = 2.0
 """How long (real seconds) a driver waits for one access of a busy threaded bus."""
 
 
-class ManagedI2C:
+class ManagedI2C(ForwardingI2C):
     """An ``smbus2.SMBus``-compatible bus: each call is one transaction of ``handle``.
 
     ``priority`` is that of every access (:attr:`Priority.POLL` for pollers: refused while
@@ -54,44 +53,8 @@ class ManagedI2C:
     def _call(self, fn: Callable[[Any], T]) -> T:
         return self.handle.call(fn, priority=self.priority, timeout_s=self.wait_s)
 
-    def write_quick(self, i2c_addr: int, force: bool | None = None) -> None:
-        self._call(lambda bus: bus.write_quick(i2c_addr))
-
-    def read_byte(self, i2c_addr: int, force: bool | None = None) -> int:
-        return self._call(lambda bus: bus.read_byte(i2c_addr))
-
-    def write_byte(self, i2c_addr: int, value: int, force: bool | None = None) -> None:
-        self._call(lambda bus: bus.write_byte(i2c_addr, value))
-
-    def read_byte_data(self, i2c_addr: int, register: int, force: bool | None = None) -> int:
-        return self._call(lambda bus: bus.read_byte_data(i2c_addr, register))
-
-    def write_byte_data(
-        self, i2c_addr: int, register: int, value: int, force: bool | None = None
-    ) -> None:
-        self._call(lambda bus: bus.write_byte_data(i2c_addr, register, value))
-
-    def read_word_data(self, i2c_addr: int, register: int, force: bool | None = None) -> int:
-        return self._call(lambda bus: bus.read_word_data(i2c_addr, register))
-
-    def write_word_data(
-        self, i2c_addr: int, register: int, value: int, force: bool | None = None
-    ) -> None:
-        self._call(lambda bus: bus.write_word_data(i2c_addr, register, value))
-
-    def read_i2c_block_data(
-        self, i2c_addr: int, register: int, length: int, force: bool | None = None
-    ) -> list[int]:
-        return self._call(lambda bus: bus.read_i2c_block_data(i2c_addr, register, length))
-
-    def write_i2c_block_data(
-        self, i2c_addr: int, register: int, data: Sequence[int], force: bool | None = None
-    ) -> None:
-        values = list(data)
-        self._call(lambda bus: bus.write_i2c_block_data(i2c_addr, register, values))
-
-    def i2c_rdwr(self, *i2c_msgs: i2c_msg) -> None:
-        self._call(lambda bus: bus.i2c_rdwr(*i2c_msgs))
+    def _forward(self, method: str, *args: Any) -> Any:
+        return self._call(lambda bus: getattr(bus, method)(*args))
 
     def close(self) -> None:
         """Nothing to release: the bus belongs to its manager's owner."""

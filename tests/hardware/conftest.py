@@ -99,3 +99,17 @@ def sim_robot(sim_config: RobotConfig) -> Iterator[SimRobot]:
         yield robot
     finally:
         robot.close()
+
+
+# three range sensors, all at 0x29, each on its own channel of a TCA9548A
+MUXED = """\
+name: muxed
+simulated: true
+buses:
+  i2c: {kind: i2c, number: 1}
+devices:
+  mux: {chip: tca9548a, address: 0x71}
+  range_left: {chip: vl53l0x, side: left, mux: mux, channel: 0}
+  range_center: {chip: vl53l0x, side: center, mux: mux, channel: 3}
+  range_right: {chip: vl53l0x, side: right, mux: mux, channel: 7}
+"""

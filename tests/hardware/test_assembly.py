@@ -25,7 +25,7 @@ from engine.hardware.config import SIDES, BusConfig, RobotConfig, load_robot_con
 from engine.hardware.sim_vest import SimVest, build_sim_vest
 from engine.scenario.world import World
 
-from .conftest import ROOT, SimRobot
+from .conftest import MUXED, ROOT, SimRobot
 
 NO_SUCH_BUS = """\
 name: nowhere
@@ -302,17 +302,6 @@ def test_a_chip_brought_back_does_not_disturb_the_last_one_staying_at_0x29(tmp_p
 
 
 # -- a mux late at start-up ---------------------------------------------------------------------
-MUXED = """\
-name: muxed
-simulated: true
-buses:
-  i2c: {kind: i2c, number: 1}
-devices:
-  mux: {chip: tca9548a, address: 0x71}
-  range_left: {chip: vl53l0x, side: left, mux: mux, channel: 0}
-  range_center: {chip: vl53l0x, side: center, mux: mux, channel: 3}
-  range_right: {chip: vl53l0x, side: right, mux: mux, channel: 7}
-"""
 
 
 def test_sensors_behind_a_mux_that_was_late_at_start_up_read_once_it_answers(tmp_path):

@@ -22,7 +22,7 @@ from engine.loader.problems import Mark
 from engine.scenario.scenario_file import ScenarioEvent
 from engine.scenario.world import World
 
-from .conftest import ROOT, SimRobot
+from .conftest import MUXED, ROOT, SimRobot
 
 PINK = (1.0, 0.125, 0.375)
 
@@ -181,19 +181,6 @@ def test_the_same_devices_are_in_the_simulation_as_on_the_robot(sim_config: Robo
     assert [(d.name, d.chip, d.address) for d in robot] == [
         (d.name, d.chip, d.address) for d in sim_config
     ]
-
-
-MUXED = """\
-name: muxed
-simulated: true
-buses:
-  i2c: {kind: i2c, number: 1}
-devices:
-  mux: {chip: tca9548a, address: 0x71}
-  range_left: {chip: vl53l0x, side: left, mux: mux, channel: 0}
-  range_center: {chip: vl53l0x, side: center, mux: mux, channel: 3}
-  range_right: {chip: vl53l0x, side: right, mux: mux, channel: 7}
-"""
 
 
 def test_three_range_sensors_at_0x29_behind_a_multiplexer_each_see_their_side(tmp_path):

@@ -1,0 +1,62 @@
+"""The ``smbus2.SMBus`` interface, forwarded: the base of buses that wrap another bus.
+
+A wrapper (a bus under a lock, a multiplexer's channel, a bus-manager transaction)
+implements :meth:`ForwardingI2C._forward` once; every SMBus method goes through it by
+name with its arguments, so the interface is written in one place.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+from smbus2 import i2c_msg
+
+
+class ForwardingI2C:
+    """Every ``smbus2.SMBus`` call becomes ``self._forward(method_name, *args)``."""
+
+    def _forward(self, method: str, *args: Any) -> Any:
+        raise NotImplementedError(f"{type(self).__name__} must implement _forward()")
+
+    def write_quick(self, i2c_addr: int, force: bool | None = None) -> None:
+        self._forward("write_quick", i2c_addr)
+
+    def read_byte(self, i2c_addr: int, force: bool | None = None) -> int:
+        return self._forward("read_byte", i2c_addr)
+
+    def write_byte(self, i2c_addr: int, value: int, force: bool | None = None) -> None:
+        self._forward("write_byte", i2c_addr, value)
+
+    def read_byte_data(self, i2c_addr: int, register: int, force: bool | None = None) -> int:
+        return self._forward("read_byte_data", i2c_addr, register)
+
+    def write_byte_data(
+        self, i2c_addr: int, register: int, value: int, force: bool | None = None
+    ) -> None:
+        self._forward("write_byte_data", i2c_addr, register, value)
+
+    def read_word_data(self, i2c_addr: int, register: int, force: bool | None = None) -> int:
+        return self._forward("read_word_data", i2c_addr, register)
+
+    def write_word_data(
+        self, i2c_addr: int, register: int, value: int, force: bool | None = None
+    ) -> None:
+        self._forward("write_word_data", i2c_addr, register, value)
+
+    def read_i2c_block_data(
+        self, i2c_addr: int, register: int, length: int, force: bool | None = None
+    ) -> list[int]:
+        return self._forward("read_i2c_block_data", i2c_addr, register, length)
+
+    def write_i2c_block_data(
+        self, i2c_addr: int, register: int, data: Sequence[int], force: bool | None = None
+    ) -> None:
+        # a copy: the transaction may run later, on another thread
+        self._forward("write_i2c_block_data", i2c_addr, register, list(data))
+
+    def i2c_rdwr(self, *i2c_msgs: i2c_msg) -> None:
+        self._forward("i2c_rdwr", *i2c_msgs)
+
+    def close(self) -> None:
+        """Nothing to release: the wrapped bus belongs to whoever opened it."""
