@@ -17,7 +17,7 @@ import pytest
 
 from engine.blackboard.catalogue import default_catalogue
 from engine.cli import main
-from engine.loader.problems import LoadError
+from engine.files.problems import LoadError
 from engine.loader.tree_file import TreeLoader
 from engine.nodes import (
     ListOf,
@@ -30,9 +30,9 @@ from engine.nodes import (
     builtin_registry,
 )
 from engine.nodes.context import TreeContext
-from engine.nodes.params import CheckContext
 from engine.services import Job
 from engine.testing import TreeHarness
+from engine.values.params import CheckContext
 
 REPO = Path(__file__).resolve().parents[1]
 GUIDE = REPO / "docs" / "developer-guide.md"

@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 
-from engine.loader.problems import LoadError
+from engine.files.problems import LoadError
 from engine.nodes.docs import nodes_json, nodes_markdown
 from engine.nodes.registry import (
     ENTRY_POINT_GROUP,

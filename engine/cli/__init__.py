@@ -22,7 +22,7 @@ from engine.cli import (
     validate_command,
 )
 from engine.errors import DeviceError, VestError
-from engine.loader.problems import LoadError
+from engine.files.problems import LoadError
 
 EXIT_OK, EXIT_PROBLEMS, EXIT_USAGE, EXIT_MISSING = 0, 1, 2, 3
 

@@ -15,7 +15,7 @@ from engine.dialogs.library import DialogLibrary, find_dialogs_folder
 from engine.errors import ConfigError
 from engine.loader.tree_file import NodeDefinition, TreeDefinition, TreeLoader
 from engine.nodes.registry import default_registry
-from engine.nodes.templates import CompiledTemplate
+from engine.values.templates import CompiledTemplate
 
 NAME = "render"
 HELP = "draw a tree as ascii, dot, svg or png"

@@ -26,10 +26,10 @@ from engine.blackboard.catalogue import default_catalogue
 from engine.cli.timeline import Timeline
 from engine.clock import Clock, RealClock, VirtualClock
 from engine.errors import ConfigError
+from engine.files.problems import LoadError, Mark, Problem
 from engine.hardware.assembly import build_hardware
 from engine.hardware.config import load_robot_config
 from engine.hardware.sim_vest import UnwiredSenses, build_sim_vest, check_fault_events
-from engine.loader.problems import LoadError, Mark, Problem
 from engine.runtime.reload import TreeReloader
 from engine.runtime.robot import Robot, load_behaviors
 from engine.runtime.scheduler import Scheduler

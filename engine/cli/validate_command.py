@@ -11,15 +11,15 @@ from pathlib import Path
 
 from engine.blackboard.catalogue import KeyCatalogue, default_catalogue
 from engine.dialogs.library import DialogLibrary, check_dialog, find_dialogs_folder
+from engine.files.problems import LoadError, Mark, Problem, Problems
+from engine.files.yaml_source import YMap, YScalar, load_yaml
 from engine.hardware.config import check_robot_config
-from engine.loader.problems import LoadError, Mark, Problem, Problems
 from engine.loader.substitution import Profile, load_profile, undeclared_params
 from engine.loader.tree_file import TreeLoader
-from engine.loader.yaml_source import YMap, YScalar, load_yaml
-from engine.nodes.params import did_you_mean
 from engine.nodes.registry import NodeRegistry, default_registry
 from engine.runtime.robot import declared_beside, tree_files
 from engine.scenario.scenario_file import check_scenario
+from engine.values.params import did_you_mean
 
 NAME = "validate"
 HELP = "check trees, profiles, dialogs and scenarios"

@@ -25,8 +25,8 @@ from pathlib import Path
 
 from engine.blackboard.catalogue import KeyCatalogue
 from engine.dialogs.model import Dialog, DialogRule, normalize
-from engine.loader.problems import LoadError, Mark, Problems
-from engine.loader.yaml_source import (
+from engine.files.problems import LoadError, Mark, Problems
+from engine.files.yaml_source import (
     YList,
     YMap,
     YScalar,
@@ -35,8 +35,8 @@ from engine.loader.yaml_source import (
     load_yaml,
     resolved,
 )
-from engine.nodes.params import CheckContext, ParamProblem, did_you_mean
-from engine.nodes.templates import CompiledTemplate, compile_template
+from engine.values.params import CheckContext, ParamProblem, did_you_mean
+from engine.values.templates import CompiledTemplate, compile_template
 
 ON_REQUEST_SENSORS = ("temperature", "ultrasound")
 MAX_PHRASE_EXPANSIONS = 200
@@ -106,7 +106,7 @@ def check_dialog(
     document: YValue | None, file: str, catalogue: KeyCatalogue, *, default_name: str
 ) -> Dialog:
     """Validate a parsed dialog file whole; LoadError with every problem."""
-    from engine.loader.problems import Mark
+    from engine.files.problems import Mark
 
     problems = Problems()
     if not isinstance(document, YMap):
@@ -114,13 +114,7 @@ def check_dialog(
         problems.add(where, "a dialog file is a mapping with 'dialog:' and 'rules:'")
         problems.raise_if_any()
     assert isinstance(document, YMap)
-    for key, mark in document.key_marks.items():
-        if key not in _TOP_KEYS:
-            problems.add(
-                mark,
-                f"unknown dialog field {key!r}",
-                did_you_mean(key, _TOP_KEYS) or "fields: " + ", ".join(_TOP_KEYS),
-            )
+    problems.unknown_fields(document.key_marks, _TOP_KEYS, "dialog")
     ctx = CheckContext(catalogue)
     dialog_name = _text(document.get("dialog"), problems, "dialog") or default_name
     concepts = _concepts(document.get("concepts"), problems)
@@ -219,13 +213,7 @@ def _rule(
     if not isinstance(raw, YMap):
         problems.add(raw.mark, "each rule is a mapping with 'hear:' and 'say:'")
         return None
-    for key, mark in raw.key_marks.items():
-        if key not in _RULE_KEYS:
-            problems.add(
-                mark,
-                f"unknown rule field {key!r}",
-                did_you_mean(key, _RULE_KEYS) or "fields: hear, say, read",
-            )
+    problems.unknown_fields(raw.key_marks, _RULE_KEYS, "rule")
     hear = raw.get("hear")
     phrases: list[str] = []
     if hear is None:

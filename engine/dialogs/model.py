@@ -12,7 +12,7 @@ import re
 import unicodedata
 from dataclasses import dataclass
 
-from engine.nodes.templates import CompiledTemplate
+from engine.values.templates import CompiledTemplate
 
 _CONTRACTIONS = {
     "what's": "what is",

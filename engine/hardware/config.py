@@ -23,7 +23,7 @@ power-on address), ``rate_hz`` (polled chips only) and ``keys`` (what each of it
 feeds on the blackboard; sensible defaults). Chip options are the drivers' keyword options.
 
 :func:`load_robot_config` checks the whole file (the rules are in
-:mod:`engine.hardware.config_check`) and raises a :class:`~engine.loader.problems.LoadError`
+:mod:`engine.hardware.config_check`) and raises a :class:`~engine.files.problems.LoadError`
 listing every problem with its file:line:column, as the tree loader does.
 """
 
@@ -37,9 +37,9 @@ from typing import Any
 from engine.blackboard.catalogue import KeyCatalogue, default_catalogue
 from engine.drivers.servo_joints import Joint
 from engine.errors import ConfigError
-from engine.loader.problems import Mark
-from engine.loader.yaml_source import YValue, load_yaml
-from engine.nodes.params import (
+from engine.files.problems import Mark
+from engine.files.yaml_source import YValue, load_yaml
+from engine.values.params import (
     Boolean,
     Choice,
     Integer,
@@ -384,7 +384,7 @@ class RobotConfig:
 def load_robot_config(
     path: Path, shown: str | None = None, *, catalogue: KeyCatalogue | None = None
 ) -> RobotConfig:
-    """Read and check a robot config; :class:`~engine.loader.problems.LoadError` lists every
+    """Read and check a robot config; :class:`~engine.files.problems.LoadError` lists every
     problem with its file:line:column."""
     name = shown or str(path)
     return check_robot_config(load_yaml(path, name), name, path, catalogue=catalogue)

@@ -19,6 +19,8 @@ from typing import Any
 from engine.blackboard.catalogue import KeyCatalogue
 from engine.drivers.mpr121 import check_thresholds
 from engine.drivers.servo_joints import MAESTRO_MAX_US, MAESTRO_MIN_US, Joint
+from engine.files.problems import Mark, Problems
+from engine.files.yaml_source import YList, YMap, YScalar, YValue, describe, plain
 from engine.hardware.config import (
     BUS_KINDS,
     CHIPS,
@@ -35,9 +37,7 @@ from engine.hardware.config import (
     RobotConfig,
     hex_address,
 )
-from engine.loader.problems import Mark, Problems
-from engine.loader.yaml_source import YList, YMap, YScalar, YValue, describe, plain
-from engine.nodes.params import (
+from engine.values.params import (
     REQUIRED,
     Boolean,
     CheckContext,
@@ -100,13 +100,7 @@ class ConfigChecker:
             return None
 
     def unknown_fields(self, raw: YMap, known: tuple[str, ...] | list[str], what: str) -> None:
-        for key, mark in raw.key_marks.items():
-            if key not in known:
-                self.problems.add(
-                    mark,
-                    f"unknown {what} field {key!r}",
-                    did_you_mean(key, list(known)) or "fields: " + ", ".join(known),
-                )
+        self.problems.unknown_fields(raw.key_marks, known, what)
 
     def fields(self, raw: YMap, params: tuple[Param, ...], what: str) -> dict[str, Any] | None:
         """Convert the declared ``params`` of ``raw`` (unknown fields are checked apart)."""

@@ -51,11 +51,11 @@ from engine.drivers.sim.srf02 import SimSRF02
 from engine.drivers.sim.tca9548a import SimTCA9548A
 from engine.drivers.sim.vl53l0x import SimVL53L0X
 from engine.drivers.sim.zx_gesture import SimZXGesture
+from engine.files.problems import Problem
 from engine.hardware.config import BusConfig, DeviceConfig, RobotConfig
 from engine.hardware.timing import BranchingClock
-from engine.loader.problems import Problem
-from engine.nodes.params import did_you_mean
 from engine.scenario.world import EVENT_KEYS, World
+from engine.values.params import did_you_mean
 
 _log = logging.getLogger("vest.sim_vest")
 

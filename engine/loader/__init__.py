@@ -1,5 +1,3 @@
-"""Loading people's YAML files (trees, profiles, dialogs, scenarios, robot configs).
-
-Every file is parsed keeping each value's place, validated whole, and every problem is
-reported as ``file:line:column: message (hint)`` before anything is built.
+"""Loading tree files: includes, parameters and profiles substituted, every node checked
+against its declaration, and every problem reported with its place before anything is built.
 """

@@ -12,9 +12,9 @@ import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from engine.loader.problems import LoadError, Mark, Problem, Problems
-from engine.loader.yaml_source import YList, YMap, YScalar, YValue, describe, load_yaml
-from engine.nodes.params import did_you_mean
+from engine.files.problems import LoadError, Mark, Problem, Problems
+from engine.files.yaml_source import YList, YMap, YScalar, YValue, describe, load_yaml
+from engine.values.params import did_you_mean
 
 _REFERENCE = re.compile(r"\$\{([^}]*)\}")
 _NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
@@ -159,13 +159,7 @@ def load_profile(path: Path, shown: str | None = None) -> Profile:
     if not isinstance(document, YMap):
         where = document.mark if document is not None else Mark(name, 1, 1)
         raise LoadError([Problem(where, "a profile is a mapping with 'profile:' and 'params:'")])
-    for key, mark in document.key_marks.items():
-        if key not in _PROFILE_KEYS:
-            problems.add(
-                mark,
-                f"unknown profile field {key!r}",
-                did_you_mean(key, _PROFILE_KEYS) or "fields: profile, description, params",
-            )
+    problems.unknown_fields(document.key_marks, _PROFILE_KEYS, "profile")
     profile_name = path.stem
     raw_name = document.get("profile")
     if isinstance(raw_name, YScalar) and isinstance(raw_name.value, str):

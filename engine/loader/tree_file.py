@@ -29,16 +29,8 @@ import py_trees
 
 from engine.blackboard.catalogue import KeyCatalogue
 from engine.dialogs.library import DialogLibrary
-from engine.loader.problems import LoadError, Mark, Problems
-from engine.loader.substitution import (
-    ParamValue,
-    Profile,
-    check_override,
-    read_params,
-    substitute,
-    unresolved,
-)
-from engine.loader.yaml_source import (
+from engine.files.problems import LoadError, Mark, Problems
+from engine.files.yaml_source import (
     YList,
     YMap,
     YScalar,
@@ -48,10 +40,18 @@ from engine.loader.yaml_source import (
     plain,
     resolved,
 )
+from engine.loader.substitution import (
+    ParamValue,
+    Profile,
+    check_override,
+    read_params,
+    substitute,
+    unresolved,
+)
 from engine.nodes.context import TreeContext
-from engine.nodes.params import CheckContext, Number, ParamProblem, did_you_mean
 from engine.nodes.registry import NodeRegistry
 from engine.nodes.spec import NodeType
+from engine.values.params import CheckContext, Number, ParamProblem, did_you_mean
 
 TOP_KEYS = ("name", "description", "rate_hz", "params", "root")
 SUBTREE = "Subtree"
@@ -176,13 +176,7 @@ class TreeLoader:
                 "see docs/therapist-guide.md",
             )
             return None
-        for key, mark in document.key_marks.items():
-            if key not in TOP_KEYS:
-                problems.add(
-                    mark,
-                    f"unknown field {key!r}",
-                    did_you_mean(key, TOP_KEYS) or "fields: " + ", ".join(TOP_KEYS),
-                )
+        problems.unknown_fields(document.key_marks, TOP_KEYS)
         declared = document.get("params")
         if isinstance(declared, YMap):
             seen.declared.update(declared.entries)
@@ -407,13 +401,11 @@ class TreeLoader:
         if not isinstance(body, YMap) or not isinstance(body.get("file"), YScalar):
             problems.add(body.mark, "Subtree takes {file: path.yaml, params: {...}}")
             return None
-        for key, key_mark in body.key_marks.items():
-            if key not in ("file", "params", "name"):
-                problems.add(
-                    key_mark,
-                    f"unknown parameter {key!r} for Subtree",
-                    did_you_mean(key, ["file", "params", "name"]),
-                )
+        problems.unknown_fields(
+            body.key_marks,
+            ("file", "params", "name"),
+            message="unknown parameter {key!r} for Subtree",
+        )
         file_value = body.get("file")
         assert isinstance(file_value, YScalar)
         target = resolved(path.parent / str(file_value.value))

@@ -3,7 +3,9 @@
 from py_trees.common import Status
 
 from engine.nodes.base import Condition, Leaf, ServiceAction
-from engine.nodes.params import (
+from engine.nodes.registry import NodeRegistry, builtin_registry, default_registry
+from engine.nodes.spec import NodeType
+from engine.values.params import (
     AnyValue,
     Boolean,
     Choice,
@@ -15,9 +17,7 @@ from engine.nodes.params import (
     Scalar,
     Text,
 )
-from engine.nodes.registry import NodeRegistry, builtin_registry, default_registry
-from engine.nodes.spec import NodeType
-from engine.nodes.templates import Template
+from engine.values.templates import Template
 
 __all__ = [
     "AnyValue",

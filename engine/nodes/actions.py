@@ -14,7 +14,8 @@ from py_trees.common import Status
 from engine.colors import NAMED_COLORS, parse_color
 from engine.errors import ServiceError
 from engine.nodes.base import Leaf, ServiceAction
-from engine.nodes.params import (
+from engine.services.jobs import ImmediateJob, Job
+from engine.values.params import (
     AnyValue,
     CheckContext,
     Choice,
@@ -26,8 +27,7 @@ from engine.nodes.params import (
     Text,
     did_you_mean,
 )
-from engine.nodes.templates import Template
-from engine.services.jobs import ImmediateJob, Job
+from engine.values.templates import Template
 
 ON_REQUEST_SENSORS = ("temperature", "ultrasound")
 

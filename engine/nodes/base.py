@@ -33,8 +33,8 @@ import py_trees
 from py_trees.common import Access, Status
 
 from engine.nodes.context import TreeContext
-from engine.nodes.params import CheckContext, Param
 from engine.services.jobs import Job
+from engine.values.params import CheckContext, Param
 
 
 def node_path(node: py_trees.behaviour.Behaviour) -> str:

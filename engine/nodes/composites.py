@@ -9,8 +9,8 @@ import py_trees
 from py_trees.common import ParallelPolicy
 
 from engine.nodes.context import TreeContext
-from engine.nodes.params import Boolean, Choice, Param
 from engine.nodes.spec import NodeType
+from engine.values.params import Boolean, Choice, Param
 
 _MEMORY_SEQUENCE = Param(
     "memory",

@@ -9,7 +9,7 @@ from typing import Any, ClassVar
 from engine.blackboard.catalogue import VARIABLES_PREFIX, KeySpec
 from engine.blackboard.events import EVENT_LOG_LENGTH, EventLog
 from engine.nodes.base import Condition, node_path
-from engine.nodes.params import CheckContext, Integer, Key, ListOf, Number, Param, Scalar
+from engine.values.params import CheckContext, Integer, Key, ListOf, Number, Param, Scalar
 
 _COMPARISONS = ("equals", "not_equals", "above", "below", "between")
 _WORDS_FOR_BOOLEANS = ("true", "false", "yes", "no", "on", "off")

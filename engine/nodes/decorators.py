@@ -13,8 +13,8 @@ from py_trees.common import OneShotPolicy, Status
 
 from engine.clock import Clock
 from engine.nodes.context import TreeContext
-from engine.nodes.params import REQUIRED, Choice, Integer, Number, Param
 from engine.nodes.spec import NodeType
+from engine.values.params import REQUIRED, Choice, Integer, Number, Param
 
 
 class EngineTimeout(py_trees.decorators.Decorator):

@@ -10,9 +10,9 @@ from py_trees.common import Access, Status
 from engine.dialogs.model import Dialog
 from engine.errors import ServiceError
 from engine.nodes.base import Leaf
-from engine.nodes.params import CheckContext, Key, Param, Text, did_you_mean
-from engine.nodes.templates import CompiledTemplate
 from engine.services.jobs import ImmediateJob, Job
+from engine.values.params import CheckContext, Key, Param, Text, did_you_mean
+from engine.values.templates import CompiledTemplate
 
 
 class Reply(Leaf):

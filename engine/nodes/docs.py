@@ -4,10 +4,10 @@ from __future__ import annotations
 
 from typing import Any
 
-from engine.nodes.params import REQUIRED, Param
 from engine.nodes.registry import NodeRegistry
 from engine.nodes.spec import KINDS
-from engine.nodes.templates import CompiledTemplate
+from engine.values.params import REQUIRED, Param
+from engine.values.templates import CompiledTemplate
 
 _TITLES = {
     "composite": "Composites",

@@ -20,8 +20,8 @@ from engine.blackboard.events import EventLog
 from engine.colors import parse_color
 from engine.errors import ServiceError
 from engine.nodes.base import ServiceAction
-from engine.nodes.params import Key, Param
 from engine.services.jobs import ImmediateJob, Job
+from engine.values.params import Key, Param
 
 POLLED_READINGS: dict[str, tuple[str, ...]] = {
     "touch": ("/sensors/touch/pads", "/sensors/touch/any"),

@@ -17,8 +17,8 @@ from typing import TYPE_CHECKING, Any, Literal
 import py_trees
 
 from engine.nodes.context import TreeContext
-from engine.nodes.params import CheckContext, Key, ListOf, Param
-from engine.nodes.templates import CompiledTemplate
+from engine.values.params import CheckContext, Key, ListOf, Param
+from engine.values.templates import CompiledTemplate
 
 if TYPE_CHECKING:
     from engine.nodes.base import Leaf

@@ -12,7 +12,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 from engine.clock import Clock
-from engine.loader.problems import LoadError, Mark, Problem
+from engine.files.problems import LoadError, Mark, Problem
 from engine.loader.tree_file import TreeDefinition, TreeLoader
 from engine.runtime.scheduler import RunningTree
 

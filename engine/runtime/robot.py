@@ -9,10 +9,10 @@ from engine.blackboard.board import Blackboard
 from engine.blackboard.catalogue import KeyCatalogue, default_catalogue
 from engine.clock import Clock
 from engine.dialogs.library import DialogLibrary
-from engine.loader.problems import LoadError, Mark, Problems
+from engine.files.problems import LoadError, Mark, Problems
+from engine.files.yaml_source import YMap, load_yaml
 from engine.loader.substitution import Profile, load_profile, read_params, undeclared_params
 from engine.loader.tree_file import TreeDefinition, TreeLoader
-from engine.loader.yaml_source import YMap, load_yaml
 from engine.nodes.context import NodeErrorHandler, TreeContext, log_node_error
 from engine.nodes.registry import NodeRegistry, default_registry
 from engine.runtime.scheduler import RunningTree, Scheduler

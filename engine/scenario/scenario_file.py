@@ -20,9 +20,9 @@ from pathlib import Path
 from typing import Any
 
 from engine.blackboard.catalogue import default_catalogue
-from engine.loader.problems import Mark, Problems
-from engine.loader.yaml_source import YList, YMap, YValue, describe, load_yaml, plain
-from engine.nodes.params import (
+from engine.files.problems import Mark, Problems
+from engine.files.yaml_source import YList, YMap, YValue, describe, load_yaml, plain
+from engine.values.params import (
     REQUIRED,
     AnyValue,
     CheckContext,
@@ -155,13 +155,7 @@ def check_scenario(document: YValue | None, name: str, path: Path) -> Scenario:
         )
         problems.raise_if_any()
     assert isinstance(document, YMap)
-    for key, mark in document.key_marks.items():
-        if key not in ("duration_s", "events", "description"):
-            problems.add(
-                mark,
-                f"unknown scenario field {key!r}",
-                did_you_mean(key, ["duration_s", "events", "description"]),
-            )
+    problems.unknown_fields(document.key_marks, ("duration_s", "events", "description"), "scenario")
     ctx = CheckContext(default_catalogue())
     duration = 0.0
     raw_duration = document.get("duration_s")
@@ -260,18 +254,11 @@ def _fields(
             + f", got {describe(body)}",
         )
         return None
-    names = [p.name for p in params]
     values: dict[str, Any] = {}
-    ok = True
+    ok = problems.unknown_fields(body.key_marks, [p.name for p in params], kind)
     for key, value in body.items():
         param = next((p for p in params if p.name == key), None)
         if param is None:
-            problems.add(
-                body.key_marks[key],
-                f"unknown {kind} field {key!r}",
-                did_you_mean(key, names) or "fields: " + ", ".join(names),
-            )
-            ok = False
             continue
         converted = _convert(param.type, value, key, ctx, problems)
         ok = ok and converted is not None

@@ -7,8 +7,8 @@ from pathlib import Path
 
 import pytest
 
+from engine.files.problems import LoadError
 from engine.hardware.config import RobotConfig, load_robot_config
-from engine.loader.problems import LoadError
 
 from .conftest import ROOT
 

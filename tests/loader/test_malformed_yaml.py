@@ -18,7 +18,7 @@ import pytest
 
 from engine.blackboard.catalogue import default_catalogue
 from engine.cli import main
-from engine.loader.problems import LoadError
+from engine.files.problems import LoadError
 from engine.loader.tree_file import TreeLoader
 from engine.nodes.registry import default_registry
 

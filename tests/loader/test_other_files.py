@@ -11,7 +11,7 @@ import pytest
 
 from engine.blackboard.catalogue import default_catalogue
 from engine.dialogs.library import DialogLibrary, load_dialog
-from engine.loader.problems import LoadError
+from engine.files.problems import LoadError
 from engine.loader.substitution import load_profile
 from engine.scenario.scenario_file import load_scenario
 
@@ -256,7 +256,7 @@ def test_a_profile_that_is_not_a_mapping_is_named(tmp_path: Path, text: str) -> 
 def test_two_dialog_files_with_one_name_are_reported_with_both_files(tmp_path):
     from engine.blackboard import default_catalogue
     from engine.dialogs import DialogLibrary
-    from engine.loader.problems import LoadError
+    from engine.files.problems import LoadError
 
     rule = 'rules:\n  - hear: ["hi"]\n    say: "Hello"\n'
     (tmp_path / "a.yaml").write_text("dialog: default\n" + rule)

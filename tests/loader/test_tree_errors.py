@@ -14,7 +14,7 @@ from pathlib import Path
 import pytest
 
 from engine.blackboard.catalogue import default_catalogue
-from engine.loader.problems import LoadError
+from engine.files.problems import LoadError
 from engine.loader.substitution import Profile, load_profile
 from engine.loader.tree_file import TreeDefinition, TreeLoader
 from engine.nodes.registry import default_registry

@@ -16,7 +16,7 @@ from py_trees.common import Status
 
 from engine.blackboard.catalogue import default_catalogue
 from engine.dialogs.library import load_dialog
-from engine.loader.problems import LoadError
+from engine.files.problems import LoadError
 from engine.testing import TreeHarness
 
 TREE = """\

@@ -18,7 +18,7 @@ from typing import Any
 
 import yaml
 
-from engine.loader.problems import LoadError, Mark, Problem
+from engine.files.problems import LoadError, Mark, Problem
 
 MAX_FILE_BYTES = 1024 * 1024
 MAX_NODES = 100_000

@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 from engine.errors import ConfigError
+from engine.values.params import did_you_mean
 
 
 @dataclass(frozen=True, order=True)
@@ -40,6 +42,28 @@ class Problems:
 
     def add(self, mark: Mark, message: str, hint: str | None = None) -> None:
         self.items.append(Problem(mark, message, hint))
+
+    def unknown_fields(
+        self,
+        key_marks: Mapping[str, Mark],
+        known: Sequence[str],
+        what: str = "",
+        *,
+        message: str = "unknown {what}field {key!r}",
+    ) -> bool:
+        """Report each key of a mapping that is not one of ``known`` fields; True if none.
+
+        ``key_marks`` is a YAML mapping's keys with their places; ``what`` names the
+        mapping in the message ("unknown dialog field 'sya'"), or ``message`` words it
+        (``{key!r}`` is the unknown key). The hint is the nearest known field, or all.
+        """
+        clean = True
+        for key, mark in key_marks.items():
+            if key not in known:
+                clean = False
+                words = message.format(what=what + " " if what else "", key=key)
+                self.add(mark, words, did_you_mean(key, known) or "fields: " + ", ".join(known))
+        return clean
 
     def extend(self, other: Problems | list[Problem]) -> None:
         self.items.extend(other.items if isinstance(other, Problems) else other)

@@ -9,13 +9,21 @@ from __future__ import annotations
 import difflib
 import math
 import re
-from collections.abc import Sequence
+from collections.abc import Iterable
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any, Literal
+from typing import TYPE_CHECKING, Any, Literal, Protocol
 
 if TYPE_CHECKING:
     from engine.blackboard.catalogue import KeyCatalogue
-    from engine.dialogs.library import DialogLibrary
+
+
+class KnownDialogs(Protocol):
+    """What a check may ask of the loaded dialogs: their names (the library answers it)."""
+
+    @property
+    def names(self) -> list[str]: ...
+
+    def get(self, name: str) -> object | None: ...
 
 
 class ParamProblem(Exception):  # noqa: N818 - a problem report, not a failure
@@ -32,7 +40,7 @@ class CheckContext:
     """What parameter checks may consult at load time (never hardware)."""
 
     catalogue: KeyCatalogue
-    dialogs: DialogLibrary | None = None
+    dialogs: KnownDialogs | None = None
 
 
 def _shown(value: Any) -> str:
@@ -47,9 +55,10 @@ def _shown(value: Any) -> str:
     return repr(value)
 
 
-def did_you_mean(word: str, choices: Sequence[str]) -> str | None:
+def did_you_mean(word: str, choices: Iterable[str]) -> str | None:
     """``"did you mean 'x'?"`` for the choice closest to ``word``, or None."""
-    close = difflib.get_close_matches(word, list(choices), n=1, cutoff=0.6)
+    choices = list(choices)
+    close = difflib.get_close_matches(word, choices, n=1, cutoff=0.6)
     if not close:
         lowered = {c.lower(): c for c in choices}
         if word.lower() in lowered:

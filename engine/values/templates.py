@@ -12,7 +12,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
-from engine.nodes.params import (
+from engine.values.params import (
     CheckContext,
     ParamProblem,
     ParamType,
