@@ -32,6 +32,41 @@ class Clock(Protocol):
         """Cut short any sleep in progress, and every later one: the engine is shutting down."""
         ...
 
+    def event(self) -> ClockEvent:
+        """A new flag that :meth:`wait` can wait for (a thread's stop request, say)."""
+        ...
+
+    def wait(self, event: ClockEvent, timeout_s: float) -> bool:
+        """Wait until ``event`` is set or ``timeout_s`` of this clock's time has passed.
+
+        Returns True when the event is set (at once if it already is). Unlike :meth:`sleep`
+        it is not cut short by :meth:`wake`: a worker waits for its own event.
+        """
+        ...
+
+
+class ClockEvent:
+    """A flag set by one thread and waited for by another on a clock's time.
+
+    Made by :meth:`Clock.event`; setting it wakes a :meth:`Clock.wait` on it at once.
+    """
+
+    def __init__(self, condition: threading.Condition) -> None:
+        self._condition = condition
+        self._set = False
+
+    def set(self) -> None:
+        with self._condition:
+            self._set = True
+            self._condition.notify_all()
+
+    def clear(self) -> None:
+        with self._condition:
+            self._set = False
+
+    def is_set(self) -> bool:
+        return self._set
+
 
 class RealClock:
     """The machine's monotonic clock; sleeps can be woken early by :meth:`wake`."""
@@ -52,6 +87,19 @@ class RealClock:
     def wake(self) -> None:
         self._woken.set()
 
+    def event(self) -> ClockEvent:
+        return ClockEvent(threading.Condition())
+
+    def wait(self, event: ClockEvent, timeout_s: float) -> bool:
+        deadline = time.monotonic() + max(timeout_s, 0.0)
+        with event._condition:
+            while not event.is_set():
+                left = deadline - time.monotonic()
+                if left <= 0:
+                    return False
+                event._condition.wait(left)
+        return True
+
 
 class VirtualClock:
     """A clock that moves only when advanced; sleeping advances it.
@@ -62,7 +110,7 @@ class VirtualClock:
 
     def __init__(self, start_s: float = 0.0) -> None:
         self._now = start_s
-        self._lock = threading.Lock()
+        self._lock = threading.Condition()
 
     def now(self) -> float:
         return self._now
@@ -73,6 +121,7 @@ class VirtualClock:
             raise ValueError(f"a clock cannot go backwards: advance({seconds})")
         with self._lock:
             self._now += seconds
+            self._lock.notify_all()
 
     def sleep(self, seconds: float) -> None:
         if seconds > 0:
@@ -81,9 +130,24 @@ class VirtualClock:
     def sleep_until(self, deadline_s: float) -> None:
         with self._lock:
             self._now = max(self._now, deadline_s)
+            self._lock.notify_all()
 
     def wake(self) -> None:
         """Nothing sleeps for real on a virtual clock."""
+
+    def event(self) -> ClockEvent:
+        return ClockEvent(self._lock)
+
+    def wait(self, event: ClockEvent, timeout_s: float) -> bool:
+        """Block this thread until ``event`` is set or another thread advances the clock by
+        ``timeout_s``: a virtual clock drives threaded code as it drives the scheduler."""
+        if event._condition is not self._lock:
+            raise ValueError("wait on an event made by this clock (clock.event())")
+        with self._lock:
+            deadline = self._now + max(timeout_s, 0.0)
+            while not event.is_set() and self._now < deadline:
+                self._lock.wait()
+            return event.is_set()
 
 
 def stopwatch() -> float:

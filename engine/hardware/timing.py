@@ -20,7 +20,7 @@ import contextlib
 import threading
 from collections.abc import Iterator
 
-from engine.clock import Clock
+from engine.clock import Clock, ClockEvent
 
 
 class BranchingClock:
@@ -52,6 +52,13 @@ class BranchingClock:
 
     def wake(self) -> None:
         self.base.wake()
+
+    def event(self) -> ClockEvent:
+        return self.base.event()
+
+    def wait(self, event: ClockEvent, timeout_s: float) -> bool:
+        """Waits on the robot's time (a waiting thread is never inside a branch)."""
+        return self.base.wait(event, timeout_s)
 
     @property
     def in_branch(self) -> bool:

@@ -1,0 +1,68 @@
+"""Clocks: a worker thread waits on the injected clock, so a virtual clock drives it too."""
+
+from __future__ import annotations
+
+import threading
+
+import pytest
+
+from engine.clock import RealClock, VirtualClock
+
+
+def test_a_wait_on_a_set_event_returns_at_once() -> None:
+    clock = VirtualClock()
+    stop = clock.event()
+    stop.set()
+    assert clock.wait(stop, 10.0) is True
+    assert clock.now() == 0.0
+
+
+def test_a_zero_wait_reports_the_event_without_blocking() -> None:
+    clock = VirtualClock()
+    assert clock.wait(clock.event(), 0.0) is False
+
+
+def test_a_worker_waiting_on_a_virtual_clock_wakes_when_time_is_advanced() -> None:
+    clock = VirtualClock()
+    stop = clock.event()
+    results: list[bool] = []
+    worker = threading.Thread(target=lambda: results.append(clock.wait(stop, 1.0)))
+    worker.start()
+    clock.advance(0.5)  # not yet: the worker's timeout is one virtual second
+    clock.advance(0.5)
+    worker.join(timeout=5)
+    assert results == [False]  # timed out on virtual time, never on the wall clock
+
+
+def test_setting_the_event_wakes_a_worker_before_its_timeout() -> None:
+    clock = VirtualClock()
+    stop = clock.event()
+    results: list[bool] = []
+    worker = threading.Thread(target=lambda: results.append(clock.wait(stop, 3600.0)))
+    worker.start()
+    stop.set()
+    worker.join(timeout=5)
+    assert results == [True]
+    assert clock.now() == 0.0
+
+
+def test_a_cleared_event_can_be_waited_for_again() -> None:
+    clock = VirtualClock()
+    stop = clock.event()
+    stop.set()
+    stop.clear()
+    assert clock.wait(stop, 0.0) is False
+
+
+def test_waking_the_real_clock_does_not_cut_short_a_workers_own_wait() -> None:
+    clock = RealClock()
+    clock.wake()  # the engine is stopping: sleeps end, but a worker waits for its own event
+    stop = clock.event()
+    stop.set()
+    assert clock.wait(stop, 5.0) is True
+    assert clock.wait(clock.event(), 0.0) is False
+
+
+def test_an_event_of_another_clock_is_refused() -> None:
+    with pytest.raises(ValueError, match=r"clock\.event\(\)"):
+        VirtualClock().wait(RealClock().event(), 1.0)
