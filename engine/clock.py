@@ -111,6 +111,7 @@ class VirtualClock:
     def __init__(self, start_s: float = 0.0) -> None:
         self._now = start_s
         self._lock = threading.Condition()
+        self._waiting = 0
 
     def now(self) -> float:
         return self._now
@@ -145,9 +146,21 @@ class VirtualClock:
             raise ValueError("wait on an event made by this clock (clock.event())")
         with self._lock:
             deadline = self._now + max(timeout_s, 0.0)
-            while not event.is_set() and self._now < deadline:
-                self._lock.wait()
+            self._waiting += 1
+            self._lock.notify_all()
+            try:
+                while not event.is_set() and self._now < deadline:
+                    self._lock.wait()
+            finally:
+                self._waiting -= 1
             return event.is_set()
+
+    def until_waiting(self, threads: int = 1, *, limit_s: float = 10.0) -> bool:
+        """Block until ``threads`` threads are inside :meth:`wait` (a test's hand-off point:
+        advance the clock only once the worker waits). False if that took over ``limit_s``
+        real seconds, so a broken worker fails a test instead of hanging it."""
+        with self._lock:
+            return self._lock.wait_for(lambda: self._waiting >= threads, timeout=limit_s)
 
 
 def stopwatch() -> float:

@@ -28,6 +28,7 @@ def test_a_worker_waiting_on_a_virtual_clock_wakes_when_time_is_advanced() -> No
     results: list[bool] = []
     worker = threading.Thread(target=lambda: results.append(clock.wait(stop, 1.0)))
     worker.start()
+    assert clock.until_waiting(1)
     clock.advance(0.5)  # not yet: the worker's timeout is one virtual second
     clock.advance(0.5)
     worker.join(timeout=5)
@@ -40,6 +41,7 @@ def test_setting_the_event_wakes_a_worker_before_its_timeout() -> None:
     results: list[bool] = []
     worker = threading.Thread(target=lambda: results.append(clock.wait(stop, 3600.0)))
     worker.start()
+    assert clock.until_waiting(1)
     stop.set()
     worker.join(timeout=5)
     assert results == [True]
