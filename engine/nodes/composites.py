@@ -6,9 +6,9 @@ from types import SimpleNamespace
 from typing import Any
 
 import py_trees
-from py_trees.common import ParallelPolicy
 
 from engine.nodes.context import TreeContext
+from engine.nodes.parallel import Parallel
 from engine.nodes.spec import NodeType
 from engine.values.params import Boolean, Choice, Param
 
@@ -37,12 +37,7 @@ def _selector(name: str, args: SimpleNamespace, children: list[Any], ctx: TreeCo
 
 
 def _parallel(name: str, args: SimpleNamespace, children: list[Any], ctx: TreeContext) -> Any:
-    policy: ParallelPolicy.Base
-    if args.succeed_when == "all":
-        policy = ParallelPolicy.SuccessOnAll(synchronise=args.synchronise)
-    else:
-        policy = ParallelPolicy.SuccessOnOne()
-    return py_trees.composites.Parallel(name=name, policy=policy, children=children)
+    return Parallel(name, children, succeed_when=args.succeed_when, synchronise=args.synchronise)
 
 
 COMPOSITES = (
@@ -71,8 +66,10 @@ COMPOSITES = (
         "composite",
         """Tick every child each tick, side by side (speak while the LEDs light up).
 
-        SUCCESS when all children (or one, with succeed_when: one) succeeded; FAILURE as
-        soon as any child fails; RUNNING otherwise.""",
+        A child that fails never cuts the others short: the robot still says what it
+        meant to say when the LEDs are unplugged. SUCCESS when all children (or one, with
+        succeed_when: one) succeeded; FAILURE when every child has finished and one
+        failed (with succeed_when: one, when all failed); RUNNING otherwise.""",
         (
             Param(
                 "succeed_when",

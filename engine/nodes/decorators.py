@@ -9,6 +9,7 @@ from types import SimpleNamespace
 from typing import Any
 
 import py_trees
+from py_trees.behaviour import Behaviour
 from py_trees.common import OneShotPolicy, Status
 
 from engine.clock import Clock
@@ -38,7 +39,13 @@ class EngineTimeout(py_trees.decorators.Decorator):
 
 
 class Cooldown(py_trees.decorators.Decorator):
-    """After the child succeeds, FAILURE for ``seconds`` without ticking the child."""
+    """After the child acted, FAILURE for ``seconds`` without ticking the child.
+
+    The child acted when it succeeded, or when it failed after one of its actions ran
+    (the LEDs failed but the robot spoke): the robot rests either way, rather than
+    trying again on the next tick and stuttering. A child that failed before any action
+    ran (a check inside it said no) starts no rest.
+    """
 
     def __init__(self, name: str, child: Any, seconds: float, clock: Clock) -> None:
         super().__init__(name=name, child=child)
@@ -57,10 +64,21 @@ class Cooldown(py_trees.decorators.Decorator):
 
     def update(self) -> Status:
         status = self.decorated.status
-        if status == Status.SUCCESS:
+        if status == Status.SUCCESS or (
+            status == Status.FAILURE and _an_action_ran(self.decorated)
+        ):
             self.ready_at_s = self.clock.now() + self.seconds
         self.feedback_message = ""
         return status
+
+
+def _an_action_ran(node: Behaviour) -> bool:
+    """Whether an action leaf under ``node`` was ticked in the round that just ended (its
+    status is kept until the next round starts)."""
+    return any(
+        getattr(leaf, "kind", None) == "action" and leaf.status != Status.INVALID
+        for leaf in node.iterate()
+    )
 
 
 def _child(children: list[Any]) -> Any:

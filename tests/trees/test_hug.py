@@ -98,9 +98,25 @@ def test_the_adult_profile_needs_a_firmer_hug_and_answers_calmly(
     assert robot.said == ["Thank you for the hug."]
 
 
-def test_an_unplugged_speaker_fails_the_hug(robot: TreeHarness) -> None:
+def test_an_unplugged_speaker_fails_the_hug_after_the_face_has_lit(robot: TreeHarness) -> None:
     robot.services.speech.fail_next = "speaker unplugged"
     robot.set("/sensors/force/left_n", 6.0)
     robot.set("/sensors/force/right_n", 6.0)
-    assert robot.tick() == Status.FAILURE
-    assert robot.tree.root.tip().feedback_message == "could not act: speaker unplugged"
+    # RUNNING: the pink face still shows for its two seconds; then FAILURE, naming the speaker
+    assert robot.tick() == Status.RUNNING
+    assert robot.advance(2.0) == Status.FAILURE
+    [failed] = robot.failed_actions
+    assert (failed.action, failed.error) == ("say", "speaker unplugged")
+    assert robot.did("led") == [{"color": "pink", "seconds": 2.0}]
+
+
+def test_with_the_face_leds_unplugged_a_hug_is_still_answered_once_and_rests(
+    robot: TreeHarness,
+) -> None:
+    robot.services.leds.fail_next = "LEDs unplugged"
+    robot.set("/sensors/force/left_n", 6.0)
+    robot.set("/sensors/force/right_n", 6.0)
+    robot.advance(5.0)  # a long hug: the robot does not stutter its answer
+    assert robot.said == ["I love hugs!"]
+    # one try at the dark face, one answer, then the hug's rest
+    assert [(r.action, r.failed) for r in robot.actions] == [("led", True), ("say", False)]

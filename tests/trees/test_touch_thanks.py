@@ -84,11 +84,15 @@ def test_the_adult_profile_speaks_clearly(
     assert robot.did("say") == [{"text": "Thank you", "volume": 0.9}]
 
 
-def test_an_unplugged_speaker_fails_the_tree_and_it_thanks_once_it_is_back(
+def test_an_unplugged_speaker_fails_the_tree_which_rests_then_thanks_once_it_is_back(
     robot: TreeHarness,
 ) -> None:
     robot.services.speech.fail_next = "speaker unplugged"
     robot.set("/sensors/touch/any", True)
     assert robot.tick() == Status.FAILURE
     assert robot.tree.root.tip().feedback_message == "could not act: speaker unplugged"
-    assert robot.tick() == Status.SUCCESS
+    # no second try on the next tick (that is a stutter): the tree rests as after a thanks
+    assert robot.tick() == Status.FAILURE
+    assert [r.action for r in robot.actions] == ["say"]
+    robot.advance(3.0)  # the rest is over, the hand still rests, the speaker is back
+    assert robot.said == ["Thank you"]

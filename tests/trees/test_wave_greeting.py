@@ -84,4 +84,5 @@ def test_the_profile_chooses_the_greeting(
 def test_an_unplugged_speaker_fails_the_greeting(robot: TreeHarness) -> None:
     robot.services.speech.fail_next = "speaker unplugged"
     robot.set("/sensors/gesture/last", "wave")
-    assert robot.tick() == Status.FAILURE
+    assert robot.tick() == Status.RUNNING  # the green light still shows for its second
+    assert robot.advance(1.0) == Status.FAILURE
