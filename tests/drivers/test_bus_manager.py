@@ -561,11 +561,34 @@ def test_the_worker_reprobes_an_offline_device_that_nobody_polls(threaded_vest: 
     assert threaded_vest.statuses[-1] == ("tof_left", False)
     threaded_vest.status_changed.clear()
 
-    threaded_vest.clock.advance(2.5)
-    threaded_vest.manager.run_due_probes()  # the worker would notice by itself within 0.5 s
+    threaded_vest.clock.advance(2.5)  # the worker waits on this clock: advancing wakes it
 
     assert threaded_vest.status_changed.wait(WAIT_S)
     assert threaded_vest.statuses[-1] == ("tof_left", True)
+
+
+def test_the_threaded_worker_waits_for_a_reprobe_on_the_virtual_clock(
+    threaded_vest: Vest,
+) -> None:
+    left = threaded_vest.claim_left()
+    threaded_vest.bus.inject("nack", 1.0, TOF_LEFT)  # a loose connector for 1 s
+    for _ in range(3):
+        with pytest.raises(TransactionFailedError):
+            left.submit(read_level(TOF_LEFT)).result(WAIT_S)
+    assert threaded_vest.statuses[-1] == ("tof_left", False)  # re-probe due 2 s later
+    threaded_vest.status_changed.clear()
+
+    # The worker waits on the virtual clock; one second later nothing is due yet.
+    assert threaded_vest.clock.until_waiting(1)
+    threaded_vest.clock.advance(1.0)
+    assert threaded_vest.clock.until_waiting(1)
+    assert left.stats().probes == 0
+
+    # Past the re-probe's time the worker wakes by itself and finds the chip again.
+    threaded_vest.clock.advance(1.5)
+    assert threaded_vest.status_changed.wait(WAIT_S)
+    assert threaded_vest.statuses[-1] == ("tof_left", True)
+    assert left.stats().probes == 1
 
 
 def test_a_failing_status_callback_does_not_stop_the_bus(caplog: pytest.LogCaptureFixture) -> None:
