@@ -20,9 +20,10 @@ starting a conversion) and reads it back, which an ADS1115 echoes.
 from __future__ import annotations
 
 import math
-from typing import Any
 
 from engine.clock import Clock
+from engine.drivers.bus_protocols import I2CBus
+from engine.drivers.device_errors import not_found
 from engine.errors import DeviceError
 
 # Pointer register values.
@@ -93,12 +94,6 @@ def data_rate_code(data_rate_sps: int) -> int:
     return DATA_RATES_SPS.index(data_rate_sps)
 
 
-def _not_found(address: int, error: OSError) -> DeviceError:
-    """The bus error of a first contact, as a DeviceError that keeps its errno."""
-    message = f"ADS1115 not found at I2C 0x{address:02X}: {error.strerror or error}"
-    return DeviceError(error.errno, message) if error.errno is not None else DeviceError(message)
-
-
 class ADS1115:
     """An ADS1115 on an ``smbus2.SMBus``-compatible ``bus``, waiting on ``clock``.
 
@@ -109,7 +104,7 @@ class ADS1115:
 
     def __init__(
         self,
-        bus: Any,
+        bus: I2CBus,
         *,
         address: int = 0x48,
         gain: float = 1,
@@ -193,7 +188,7 @@ class ADS1115:
         except DeviceError:
             raise
         except OSError as error:
-            raise _not_found(self.address, error) from error
+            raise not_found("ADS1115", self.address, error) from error
         if echoed & ~OS_START != expected:
             raise DeviceError(
                 f"ADS1115 at I2C 0x{self.address:02X} failed its identity check: config "

@@ -1,5 +1,7 @@
 """The ``smbus2.SMBus`` interface, forwarded: the base of buses that wrap another bus.
 
+It implements :class:`~engine.drivers.bus_protocols.I2CBus`.
+
 A wrapper (a bus under a lock, a multiplexer's channel, a bus-manager transaction)
 implements :meth:`ForwardingI2C._forward` once; every SMBus method goes through it by
 name with its arguments, so the interface is written in one place.
@@ -23,13 +25,15 @@ class ForwardingI2C:
         self._forward("write_quick", i2c_addr)
 
     def read_byte(self, i2c_addr: int, force: bool | None = None) -> int:
-        return self._forward("read_byte", i2c_addr)
+        value: int = self._forward("read_byte", i2c_addr)
+        return value
 
     def write_byte(self, i2c_addr: int, value: int, force: bool | None = None) -> None:
         self._forward("write_byte", i2c_addr, value)
 
     def read_byte_data(self, i2c_addr: int, register: int, force: bool | None = None) -> int:
-        return self._forward("read_byte_data", i2c_addr, register)
+        value: int = self._forward("read_byte_data", i2c_addr, register)
+        return value
 
     def write_byte_data(
         self, i2c_addr: int, register: int, value: int, force: bool | None = None
@@ -37,7 +41,8 @@ class ForwardingI2C:
         self._forward("write_byte_data", i2c_addr, register, value)
 
     def read_word_data(self, i2c_addr: int, register: int, force: bool | None = None) -> int:
-        return self._forward("read_word_data", i2c_addr, register)
+        value: int = self._forward("read_word_data", i2c_addr, register)
+        return value
 
     def write_word_data(
         self, i2c_addr: int, register: int, value: int, force: bool | None = None
@@ -47,7 +52,8 @@ class ForwardingI2C:
     def read_i2c_block_data(
         self, i2c_addr: int, register: int, length: int, force: bool | None = None
     ) -> list[int]:
-        return self._forward("read_i2c_block_data", i2c_addr, register, length)
+        data: list[int] = self._forward("read_i2c_block_data", i2c_addr, register, length)
+        return data
 
     def write_i2c_block_data(
         self, i2c_addr: int, register: int, data: Sequence[int], force: bool | None = None

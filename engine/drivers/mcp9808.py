@@ -13,8 +13,9 @@ it was left in shutdown and sets the resolution; a finer resolution converts mor
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
 
+from engine.drivers.bus_protocols import I2CBus
+from engine.drivers.device_errors import not_found
 from engine.errors import DeviceError
 
 CONFIG = 0x01
@@ -102,16 +103,10 @@ def _resolution_entry(resolution_c: float) -> tuple[int, float]:
     return entry
 
 
-def _not_found(address: int, error: OSError) -> DeviceError:
-    """The bus error of a first contact, as a DeviceError that keeps its errno."""
-    message = f"MCP9808 not found at I2C 0x{address:02X}: {error.strerror or error}"
-    return DeviceError(error.errno, message) if error.errno is not None else DeviceError(message)
-
-
 class MCP9808:
     """An MCP9808 on an ``smbus2.SMBus``-compatible ``bus``."""
 
-    def __init__(self, bus: Any, *, address: int = 0x18, resolution_c: float = 0.0625) -> None:
+    def __init__(self, bus: I2CBus, *, address: int = 0x18, resolution_c: float = 0.0625) -> None:
         _resolution_entry(resolution_c)
         self._bus = bus
         self.address = address
@@ -173,7 +168,7 @@ class MCP9808:
         except DeviceError:
             raise
         except OSError as error:
-            raise _not_found(self.address, error) from error
+            raise not_found("MCP9808", self.address, error) from error
         if manufacturer != MANUFACTURER_ID_VALUE or device >> 8 != DEVICE_ID_VALUE:
             raise DeviceError(
                 f"MCP9808 at I2C 0x{self.address:02X} failed its identity check: "

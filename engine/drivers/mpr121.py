@@ -16,8 +16,8 @@ difference falls below the release threshold (hysteresis).
 
 from __future__ import annotations
 
-from typing import Any
-
+from engine.drivers.bus_protocols import I2CBus
+from engine.drivers.device_errors import not_found
 from engine.errors import DeviceError
 
 # Register map (data sheet Table 1).
@@ -72,12 +72,6 @@ def status_to_pads(status: int) -> list[bool]:
     return [bool(status >> pad & 1) for pad in range(PADS)]
 
 
-def _not_found(address: int, error: OSError) -> DeviceError:
-    """The bus error of a first contact, as a DeviceError that keeps its errno."""
-    message = f"MPR121 not found at I2C 0x{address:02X}: {error.strerror or error}"
-    return DeviceError(error.errno, message) if error.errno is not None else DeviceError(message)
-
-
 class MPR121:
     """An MPR121 on an ``smbus2.SMBus``-compatible ``bus``.
 
@@ -87,7 +81,7 @@ class MPR121:
 
     def __init__(
         self,
-        bus: Any,
+        bus: I2CBus,
         *,
         address: int = 0x5A,
         touch_threshold: int = 12,
@@ -118,7 +112,7 @@ class MPR121:
         except DeviceError:
             raise
         except OSError as error:
-            raise _not_found(self.address, error) from error
+            raise not_found("MPR121", self.address, error) from error
         if config2 != CONFIG2_AFTER_RESET:
             raise DeviceError(
                 f"MPR121 at I2C 0x{self.address:02X} failed its identity check: CONFIG2 "

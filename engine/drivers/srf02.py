@@ -20,9 +20,9 @@ block calls :meth:`start_ranging`, then :meth:`result_ready` on later ticks and
 
 from __future__ import annotations
 
-from typing import Any
-
 from engine.clock import Clock
+from engine.drivers.bus_protocols import I2CBus
+from engine.drivers.device_errors import not_found
 from engine.errors import DeviceError
 
 COMMAND = 0x00  # write: command; read: software revision (0xFF while ranging)
@@ -39,12 +39,6 @@ MAX_POLLS = 10
 MIN_RANGE_CM = 16  # the tuned minimum; a fresh chip starts at 28 cm
 
 
-def _not_found(address: int, error: OSError) -> DeviceError:
-    """The bus error of a first contact, as a DeviceError that keeps its errno."""
-    message = f"SRF02 not found at I2C 0x{address:02X}: {error.strerror or error}"
-    return DeviceError(error.errno, message) if error.errno is not None else DeviceError(message)
-
-
 class SRF02:
     """An SRF02 on an ``smbus2.SMBus``-compatible ``bus``, timed by ``clock``.
 
@@ -54,7 +48,7 @@ class SRF02:
 
     def __init__(
         self,
-        bus: Any,
+        bus: I2CBus,
         *,
         address: int = 0x70,
         clock: Clock,
@@ -144,7 +138,7 @@ class SRF02:
         except DeviceError:
             raise
         except OSError as error:
-            raise _not_found(self.address, error) from error
+            raise not_found("SRF02", self.address, error) from error
         if revision == BUSY or unused != UNUSED_VALUE:
             raise DeviceError(
                 f"SRF02 at I2C 0x{self.address:02X} failed its identity check: software "

@@ -174,13 +174,13 @@ class SimI2CBus:
             for address, is_read, payload in messages:
                 device, garbage = self._target(address)
                 if is_read:
-                    length = int(payload)  # type: ignore[arg-type]
+                    length = int(payload)
                     data = device.read(length)
                     if garbage:
                         data = bytes(self._random.randrange(256) for _ in range(length))
                     results.append(bytes(data))
                 else:
-                    device.write(bytes(payload))  # type: ignore[arg-type]
+                    device.write(bytes(payload))
         return results
 
     def _write(self, address: int, data: Iterable[int]) -> None:
