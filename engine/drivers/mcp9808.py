@@ -15,7 +15,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from engine.drivers.bus_protocols import I2CBus
-from engine.drivers.device_errors import not_found
+from engine.drivers.device_errors import ImplausibleReadingError, i2c_place, not_found
 from engine.errors import DeviceError
 
 CONFIG = 0x01
@@ -47,6 +47,8 @@ RESOLUTIONS_C: dict[float, tuple[int, float]] = {
     0.125: (0b10, 0.130),
     0.0625: (0b11, 0.250),
 }
+OPERATING_MIN_C = -40.0  # the chip's operating range: it reports nothing outside it
+OPERATING_MAX_C = 125.0
 LIMIT_MIN_C = -256.0
 LIMIT_MAX_C = 255.75
 
@@ -149,8 +151,21 @@ class MCP9808:
 
     # -- readings -----------------------------------------------------------------------
     def read_temperature_c(self) -> float:
-        """The latest conversion, degrees Celsius (negative below freezing)."""
-        return raw_to_celsius(self._read_word(T_AMBIENT))
+        """The latest conversion, degrees Celsius (negative below freezing).
+
+        Raises :class:`~engine.drivers.device_errors.ImplausibleReadingError` for a value
+        outside the chip's operating range (-40..125 degC): a garbled transfer, not air.
+        """
+        celsius = raw_to_celsius(self._read_word(T_AMBIENT))
+        if not OPERATING_MIN_C <= celsius <= OPERATING_MAX_C:
+            raise ImplausibleReadingError(
+                chip="MCP9808",
+                place=i2c_place(self.address),
+                what="temperature",
+                value=f"{celsius:g} degC",
+                plausible=f"{OPERATING_MIN_C:g}..{OPERATING_MAX_C:g} degC",
+            )
+        return celsius
 
     def read_temperature_f(self) -> float:
         """The latest conversion, degrees Fahrenheit."""

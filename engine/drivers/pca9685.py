@@ -17,7 +17,7 @@ import threading
 
 from engine.clock import Clock
 from engine.drivers.bus_protocols import I2CBus
-from engine.drivers.device_errors import device_error
+from engine.drivers.device_errors import ImplausibleReadingError, device_error, i2c_place
 from engine.errors import DeviceError
 
 CHIP = "PCA9685"
@@ -166,7 +166,16 @@ class PCA9685:
     def frequency_hz(self) -> float:
         """The PWM frequency in Hz, from the chip's PRE_SCALE register."""
         with self._lock:
-            return frequency_for(self._read(PRE_SCALE), self.oscillator_hz)
+            prescale = self._read(PRE_SCALE)
+        if prescale < PRESCALE_MIN:  # the chip holds at least 3 whatever is written
+            raise ImplausibleReadingError(
+                chip=CHIP,
+                place=i2c_place(self.address),
+                what="PRE_SCALE",
+                value=str(prescale),
+                plausible=f"{PRESCALE_MIN}..{PRESCALE_MAX}",
+            )
+        return frequency_for(prescale, self.oscillator_hz)
 
     def set_frequency_hz(self, frequency_hz: float) -> None:
         """Set the PWM frequency of every channel (24..1526 Hz with the 25 MHz oscillator).

@@ -22,7 +22,7 @@ from __future__ import annotations
 
 from engine.clock import Clock
 from engine.drivers.bus_protocols import I2CBus
-from engine.drivers.device_errors import not_found
+from engine.drivers.device_errors import ImplausibleReadingError, i2c_place, not_found
 from engine.errors import DeviceError
 
 COMMAND = 0x00  # write: command; read: software revision (0xFF while ranging)
@@ -37,6 +37,8 @@ RANGING_TIME_S = 0.066
 POLL_INTERVAL_S = 0.005
 MAX_POLLS = 10
 MIN_RANGE_CM = 16  # the tuned minimum; a fresh chip starts at 28 cm
+PLAUSIBLE_MIN_CM = 15  # below its minimum range the chip reports the minimum, never less
+MAX_RANGE_CM = 600  # the chip's 6 m; farther is "no echo", 0
 
 
 class SRF02:
@@ -99,14 +101,27 @@ class SRF02:
         return True
 
     def read_result_cm(self) -> int:
-        """The latest result in cm (0: nothing in range); ``DeviceError`` while ranging."""
+        """The latest result in cm (0: nothing in range); ``DeviceError`` while ranging.
+
+        A result the chip cannot report (between 1 and 14 cm, or beyond 600 cm) raises
+        :class:`~engine.drivers.device_errors.ImplausibleReadingError`.
+        """
         if not self.result_ready():
             raise DeviceError(
                 f"SRF02 at I2C 0x{self.address:02X} is still ranging; "
                 "wait for result_ready() before reading the result"
             )
         high, low = self._read(RANGE_HIGH, 2)
-        return high << 8 | low
+        range_cm = high << 8 | low
+        if range_cm != 0 and not PLAUSIBLE_MIN_CM <= range_cm <= MAX_RANGE_CM:
+            raise ImplausibleReadingError(
+                chip="SRF02",
+                place=i2c_place(self.address),
+                what="range",
+                value=f"{range_cm} cm",
+                plausible=f"0 for no echo, or {PLAUSIBLE_MIN_CM}..{MAX_RANGE_CM} cm",
+            )
+        return range_cm
 
     # -- blocking use -------------------------------------------------------------------
     def read_range_cm(self) -> int:

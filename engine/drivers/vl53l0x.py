@@ -33,7 +33,7 @@ from collections.abc import Callable
 
 from engine.clock import Clock
 from engine.drivers.bus_protocols import I2CBus
-from engine.drivers.device_errors import device_error
+from engine.drivers.device_errors import ImplausibleReadingError, device_error, i2c_place
 from engine.errors import DeviceError
 
 CHIP = "VL53L0X"
@@ -77,6 +77,7 @@ VHV_CALIBRATION_START = 0x40
 # Bits 6:3 of RESULT_RANGE_STATUS: the device's range status; 11 means a valid range.
 DEVICE_RANGE_STATUS_VALID = 11
 RANGE_OUT_OF_RANGE_MM = 8190  # the chip reports 8190 or 8191 when nothing is in range
+MAX_RANGE_MM = 2000  # the chip's reach (long-range mode); a valid range beyond it is garbled
 
 BOOT_TIME_S = 0.002  # after XSHUT rises; the datasheet's tBOOT is 1.2 ms max
 POLL_INTERVAL_S = 0.002
@@ -243,7 +244,9 @@ class VL53L0X:
         """One single-shot measurement: the distance in mm, or ``None`` if out of range.
 
         Takes the chip's timing budget (~33 ms) on the clock. Raises :class:`DeviceError`
-        when the chip does not finish within ``timeout_s``, and ``OSError`` on bus errors.
+        when the chip does not finish within ``timeout_s``, ``OSError`` on bus errors, and
+        :class:`~engine.drivers.device_errors.ImplausibleReadingError` for a valid range
+        beyond the chip's ~2 m.
         """
         with self._lock:
             self._enter_private_page()
@@ -259,7 +262,17 @@ class VL53L0X:
             )
             self._write(SYSTEM_INTERRUPT_CLEAR, 0x01)
         offset = RESULT_RANGE_MM_OFFSET
-        return decode_range(result[0], (result[offset] << 8) | result[offset + 1])
+        range_mm = (result[offset] << 8) | result[offset + 1]
+        distance_mm = decode_range(result[0], range_mm)
+        if distance_mm is not None and distance_mm > MAX_RANGE_MM:
+            raise ImplausibleReadingError(
+                chip=CHIP,
+                place=i2c_place(self._address),
+                what="range with a valid status",
+                value=f"{distance_mm} mm",
+                plausible=f"0..{MAX_RANGE_MM} mm, or {RANGE_OUT_OF_RANGE_MM} for nothing in range",
+            )
+        return distance_mm
 
     def set_address(self, new_address: int) -> None:
         """Move the chip to ``new_address`` (kept until power-off or XSHUT low)."""

@@ -18,7 +18,7 @@ from __future__ import annotations
 import threading
 
 from engine.drivers.bus_protocols import I2CBus
-from engine.drivers.device_errors import device_error
+from engine.drivers.device_errors import ImplausibleReadingError, device_error, i2c_place
 from engine.errors import DeviceError
 
 CHIP = "ZX gesture sensor"
@@ -108,7 +108,8 @@ class ZXGesture:
         """The gesture detected since the last call (each is reported once), or ``None``.
 
         One of ``swipe_right``, ``swipe_left``, ``swipe_up``, ``hover``, ``hover_left``,
-        ``hover_right``, ``hover_up``.
+        ``hover_right``, ``hover_up``; a code that is none of them raises
+        :class:`~engine.drivers.device_errors.ImplausibleReadingError` (no phantom gestures).
         """
         with self._lock:
             self._poll_status()
@@ -116,12 +117,23 @@ class ZXGesture:
                 return None
             self._pending &= ~STATUS_GESTURES
             code = self._bus.read_byte_data(self.address, GESTURE)
-        return gesture_name(code)
+        name = gesture_name(code)
+        if name is None:  # STATUS announced a gesture: the code must name one
+            raise ImplausibleReadingError(
+                chip=CHIP,
+                place=i2c_place(self.address),
+                what="gesture code",
+                value=f"0x{code:02X}",
+                plausible=", ".join(f"0x{known:02X}" for known in GESTURE_NAMES),
+            )
+        return name
 
     def read_position(self) -> tuple[int, int] | None:
         """The hand's (x, z) in sensor units 0..240 when the chip has a new coordinate.
 
         ``None`` when no new coordinate arrived since the last call (no hand in view).
+        A coordinate beyond 240 raises
+        :class:`~engine.drivers.device_errors.ImplausibleReadingError`.
         """
         with self._lock:
             self._poll_status()
@@ -130,4 +142,13 @@ class ZXGesture:
             self._pending &= ~STATUS_DAV
             x = self._bus.read_byte_data(self.address, XPOS)
             z = self._bus.read_byte_data(self.address, ZPOS)
-        return decode_position(x, z)
+        position = decode_position(x, z)
+        if position is None:
+            raise ImplausibleReadingError(
+                chip=CHIP,
+                place=i2c_place(self.address),
+                what="hand position (x, z)",
+                value=f"({x}, {z})",
+                plausible=f"0..{MAX_POSITION} each",
+            )
+        return position
