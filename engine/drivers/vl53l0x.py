@@ -77,6 +77,7 @@ VHV_CALIBRATION_START = 0x40
 # Bits 6:3 of RESULT_RANGE_STATUS: the device's range status; 11 means a valid range.
 DEVICE_RANGE_STATUS_VALID = 11
 RANGE_OUT_OF_RANGE_MM = 8190  # the chip reports 8190 or 8191 when nothing is in range
+RANGE_CODE_MAX = 8191  # the range field never holds more
 MAX_RANGE_MM = 2000  # the chip's reach (long-range mode); a valid range beyond it is garbled
 
 BOOT_TIME_S = 0.002  # after XSHUT rises; the datasheet's tBOOT is 1.2 ms max
@@ -246,7 +247,7 @@ class VL53L0X:
         Takes the chip's timing budget (~33 ms) on the clock. Raises :class:`DeviceError`
         when the chip does not finish within ``timeout_s``, ``OSError`` on bus errors, and
         :class:`~engine.drivers.device_errors.ImplausibleReadingError` for a valid range
-        beyond the chip's ~2 m.
+        beyond the chip's ~2 m, or a range field above 8191.
         """
         with self._lock:
             self._enter_private_page()
@@ -264,13 +265,15 @@ class VL53L0X:
         offset = RESULT_RANGE_MM_OFFSET
         range_mm = (result[offset] << 8) | result[offset + 1]
         distance_mm = decode_range(result[0], range_mm)
-        if distance_mm is not None and distance_mm > MAX_RANGE_MM:
+        if range_mm > RANGE_CODE_MAX or (distance_mm is not None and distance_mm > MAX_RANGE_MM):
+            valid = device_range_status(result[0]) == DEVICE_RANGE_STATUS_VALID
             raise ImplausibleReadingError(
                 chip=CHIP,
                 place=i2c_place(self._address),
-                what="range with a valid status",
-                value=f"{distance_mm} mm",
-                plausible=f"0..{MAX_RANGE_MM} mm, or {RANGE_OUT_OF_RANGE_MM} for nothing in range",
+                what="range with a valid status" if valid else "range",
+                value=f"{range_mm} mm",
+                plausible=f"0..{MAX_RANGE_MM} mm, or {RANGE_OUT_OF_RANGE_MM}..{RANGE_CODE_MAX} "
+                "for nothing in range",
             )
         return distance_mm
 

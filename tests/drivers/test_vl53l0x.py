@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from typing import Any
+
 import pytest
 
 from engine.clock import VirtualClock
@@ -173,3 +176,13 @@ def test_signal_rate_limit_is_q9_7():
         signal_rate_limit_to_register(-1)
     with pytest.raises(ValueError, match="512"):
         signal_rate_limit_to_register(512)
+
+
+def test_garbage_never_becomes_a_valid_distance_past_two_metres(
+    clock: VirtualClock, bus: SimI2CBus, chip: SimVL53L0X, read_garbage: Callable[..., Any]
+) -> None:
+    sensor = VL53L0X(bus, clock=clock)
+    readings = read_garbage(bus, 0x29, sensor.read_range_mm)
+    assert readings.refused
+    assert all(mm is None or 0 <= mm <= 2000 for mm in readings.believed)
+    assert any("VL53L0X at I2C 0x29: range with a valid status" in str(r) for r in readings.refused)
