@@ -4,7 +4,8 @@ A driver never opens a bus: it is handed an object with one of these interfaces,
 same driver runs on the robot's ``/dev/i2c-1`` (``smbus2.SMBus``), on a register-level
 model (:mod:`engine.drivers.sim`), behind a multiplexer channel or a bus manager's
 transaction (:class:`~engine.drivers.forwarding_bus.ForwardingI2C`), or on anyone else's
-compatible object. These are structural types (``typing.Protocol``): nothing inherits them.
+compatible object. These are structural types (``typing.Protocol``): nothing inherits them,
+and ``isinstance(bus, I2CBus)`` checks that the methods are there.
 
 - :class:`I2CBus`: the ``smbus2.SMBus`` methods. Registers are 8-bit addresses, values
   bytes (0..255); ``*_word_data`` are SMBus words, least significant byte first.
@@ -17,13 +18,14 @@ compatible object. These are structural types (``typing.Protocol``): nothing inh
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import Protocol
+from typing import Protocol, runtime_checkable
 
 from smbus2 import i2c_msg
 
 __all__ = ["I2CBus", "SerialPort", "SpiDevice"]
 
 
+@runtime_checkable
 class I2CBus(Protocol):
     """An ``smbus2.SMBus``-compatible I2C bus (``i2c_addr`` is the chip's 7-bit address)."""
 
@@ -58,6 +60,7 @@ class I2CBus(Protocol):
     def close(self) -> None: ...
 
 
+@runtime_checkable
 class SpiDevice(Protocol):
     """An ``spidev.SpiDev``-compatible SPI node, opened by its owner."""
 
@@ -73,6 +76,7 @@ class SpiDevice(Protocol):
     def writebytes(self, values: Sequence[int]) -> None: ...
 
 
+@runtime_checkable
 class SerialPort(Protocol):
     """The part of a pyserial ``serial.Serial`` a driver uses; ``timeout`` in seconds."""
 
