@@ -25,7 +25,14 @@ worker thread would make the order of events depend on the machine.
 
 Threaded, :meth:`BusManager.submit` never waits; :meth:`BusManager.call` waits for the
 answer, and when the bus is idle runs the transaction in the calling thread, saving the
-hand-off to the worker and back (tens of microseconds, most of the manager's cost).
+hand-off to the worker and back (tens of microseconds, most of the manager's cost). The
+worker waits on the injected clock, so a :class:`~engine.clock.VirtualClock` drives it too.
+
+This module is the queue and the worker. The parts: what one transaction does
+(:mod:`~engine.drivers.transaction_runner`), the retry and offline rules
+(:mod:`~engine.drivers.bus_policy`), the claims (:mod:`~engine.drivers.device_table`), the
+statistics (:mod:`~engine.drivers.device_stats`) and the drivers' handles
+(:mod:`~engine.drivers.device_handle`).
 """
 
 from __future__ import annotations

@@ -1,7 +1,5 @@
 """The ``smbus2.SMBus`` interface, forwarded: the base of buses that wrap another bus.
 
-It implements :class:`~engine.drivers.bus_protocols.I2CBus`.
-
 A wrapper (a bus under a lock, a multiplexer's channel, a bus-manager transaction)
 implements :meth:`ForwardingI2C._forward` once; every SMBus method goes through it by
 name with its arguments, so the interface is written in one place.
@@ -14,9 +12,15 @@ from typing import Any
 
 from smbus2 import i2c_msg
 
+from engine.drivers.bus_protocols import I2CBus
 
-class ForwardingI2C:
-    """Every ``smbus2.SMBus`` call becomes ``self._forward(method_name, *args)``."""
+
+class ForwardingI2C(I2CBus):
+    """Every ``smbus2.SMBus`` call becomes ``self._forward(method_name, *args)``.
+
+    It declares :class:`~engine.drivers.bus_protocols.I2CBus`, so the type checker holds
+    every method to that one interface.
+    """
 
     def _forward(self, method: str, *args: Any) -> Any:
         raise NotImplementedError(f"{type(self).__name__} must implement _forward()")

@@ -27,6 +27,7 @@ from engine.errors import DeviceError
 
 __all__ = ["Job", "TransactionRunner", "fail_future"]
 
+# The manager's logger: its messages keep the name they had before the split.
 _log = logging.getLogger("engine.drivers.bus_manager")
 
 BusT = TypeVar("BusT")
