@@ -21,6 +21,7 @@ from dataclasses import dataclass
 from smbus2 import i2c_msg
 
 from engine.clock import Clock
+from engine.drivers.bus_protocols import I2CBus
 
 I2C_M_RD = 0x0001
 
@@ -74,7 +75,7 @@ class _Fault:
     until_s: float
 
 
-class SimI2CBus:
+class SimI2CBus(I2CBus):
     """An ``smbus2.SMBus``-compatible bus whose chips are Python models.
 
     ``bus_number`` is only used in messages. Thread-safe: one transfer at a time.
