@@ -8,8 +8,7 @@ from typing import Any
 import pytest
 
 from engine.clock import VirtualClock
-from engine.drivers.ads1115 import ADS1115, raw_to_volts
-from engine.drivers.device_errors import ImplausibleReadingError
+from engine.drivers.ads1115 import ADS1115, lowest_single_ended_code, raw_to_volts
 from engine.drivers.force_calibration import ForceCalibration
 from engine.drivers.sim.ads1115 import SimADS1115
 from engine.drivers.sim.fsr import fsr406_volts
@@ -272,10 +271,8 @@ def test_garbage_never_becomes_a_force(
     assert "ADS1115 at I2C 0x48: config register" in str(readings.refused[0])
 
 
-def test_a_single_ended_code_far_below_ground_is_refused(
-    chip: SimADS1115, bus: SimI2CBus, clock: VirtualClock
-) -> None:
-    adc = ADS1115(bus, clock=clock)  # +/-4.096 V: -0.3 V is code -2400
-    assert adc._checked_code(-2400) == -2400
-    with pytest.raises(ImplausibleReadingError, match=r"code -2401 .*-2400\.\.32767"):
-        adc._checked_code(-2401)
+def test_a_single_ended_input_cannot_read_below_its_absolute_maximum_under_ground() -> None:
+    # -0.3 V is the inputs' absolute maximum below GND: lower codes are refused.
+    assert lowest_single_ended_code(4.096) == -2400
+    assert lowest_single_ended_code(6.144) == -1600
+    assert lowest_single_ended_code(0.256) == -32768  # -0.3 V is beyond full scale: any code
