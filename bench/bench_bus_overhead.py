@@ -43,7 +43,8 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # run from a checkout
 
 from engine.clock import RealClock, stopwatch
-from engine.drivers.bus_manager import BusManager, percentile
+from engine.drivers.bus_manager import BusManager
+from engine.drivers.device_stats import percentile
 from engine.drivers.sim.i2c_bus import RegisterFile, SimI2CBus, SimI2CDevice
 
 TARGET_MEDIAN_ADDED_US = 50.0

@@ -20,9 +20,10 @@ starting a conversion) and reads it back, which an ADS1115 echoes.
 from __future__ import annotations
 
 import math
-from typing import Any
 
 from engine.clock import Clock
+from engine.drivers.bus_protocols import I2CBus
+from engine.drivers.device_errors import ImplausibleReadingError, i2c_place, not_found
 from engine.errors import DeviceError
 
 # Pointer register values.
@@ -55,6 +56,7 @@ OSCILLATOR_TOLERANCE = 0.10  # the internal oscillator is within 10 %
 MAX_POLLS = 10
 CODE_MIN = -0x8000
 CODE_MAX = 0x7FFF
+INPUT_MIN_V = -0.3  # absolute maximum below GND: a single-ended input never reads lower
 
 
 def raw_to_volts(raw: int, full_scale_v: float) -> float:
@@ -70,6 +72,12 @@ def word_to_code(msb: int, lsb: int) -> int:
     """The two's complement code of the conversion register's two bytes (MSB first)."""
     word = msb << 8 | lsb
     return word - 0x10000 if word & 0x8000 else word
+
+
+def lowest_single_ended_code(full_scale_v: float) -> int:
+    """The most negative code a single-ended input can give at ``full_scale_v`` volts:
+    that of -0.3 V (the inputs' absolute maximum below GND), or -32768 if that is beyond."""
+    return max(CODE_MIN, math.floor(INPUT_MIN_V * 32768 / full_scale_v))
 
 
 def pga_code(gain: float) -> int:
@@ -93,12 +101,6 @@ def data_rate_code(data_rate_sps: int) -> int:
     return DATA_RATES_SPS.index(data_rate_sps)
 
 
-def _not_found(address: int, error: OSError) -> DeviceError:
-    """The bus error of a first contact, as a DeviceError that keeps its errno."""
-    message = f"ADS1115 not found at I2C 0x{address:02X}: {error.strerror or error}"
-    return DeviceError(error.errno, message) if error.errno is not None else DeviceError(message)
-
-
 class ADS1115:
     """An ADS1115 on an ``smbus2.SMBus``-compatible ``bus``, waiting on ``clock``.
 
@@ -109,7 +111,7 @@ class ADS1115:
 
     def __init__(
         self,
-        bus: Any,
+        bus: I2CBus,
         *,
         address: int = 0x48,
         gain: float = 1,
@@ -154,16 +156,22 @@ class ADS1115:
 
     # -- readings -----------------------------------------------------------------------
     def read_raw(self, channel: int) -> int:
-        """One single-shot conversion of AIN``channel`` (0..3) against GND, as its code."""
+        """One single-shot conversion of AIN``channel`` (0..3) against GND, as its code.
+
+        Raises :class:`~engine.drivers.device_errors.ImplausibleReadingError` when the
+        config register does not echo what was written or the code is far below GND.
+        """
         if not 0 <= channel <= 3:
             raise ValueError(f"ADS1115 channel {channel} is outside 0..3")
         self._write_register(CONFIG, OS_START | self._config(channel))
         self._clock.sleep(self.conversion_time_s)
         poll_interval_s = OSCILLATOR_TOLERANCE / self.data_rate_sps
         for _ in range(MAX_POLLS):
-            if self._read_register(CONFIG) & OS_START:
+            config = self._read_register(CONFIG)
+            self._check_config(config, channel)
+            if config & OS_START:
                 msb, lsb = self._read_bytes(CONVERSION)
-                return word_to_code(msb, lsb)
+                return self._checked_code(word_to_code(msb, lsb))
             self._clock.sleep(poll_interval_s)
         raise DeviceError(
             f"ADS1115 at I2C 0x{self.address:02X}: conversion on AIN{channel} not done "
@@ -176,6 +184,31 @@ class ADS1115:
         return raw_to_volts(self.read_raw(channel), self.full_scale_v)
 
     # -- helpers ------------------------------------------------------------------------
+    def _check_config(self, config: int, channel: int) -> None:
+        """The config register echoes what was written (OS aside); anything else is garbled."""
+        expected = self._config(channel)
+        if config & ~OS_START != expected:
+            raise ImplausibleReadingError(
+                chip="ADS1115",
+                place=i2c_place(self.address),
+                what="config register",
+                value=f"0x{config:04X}",
+                plausible=f"0x{expected:04X} as written, with or without OS (0x8000)",
+            )
+
+    def _checked_code(self, code: int) -> int:
+        """``code`` unless a single-ended input cannot give it (far below GND)."""
+        lowest = lowest_single_ended_code(self.full_scale_v)
+        if code < lowest:
+            raise ImplausibleReadingError(
+                chip="ADS1115",
+                place=i2c_place(self.address),
+                what="single-ended conversion code",
+                value=str(code),
+                plausible=f"{lowest}..{CODE_MAX} at +/-{self.full_scale_v:g} V full scale",
+            )
+        return code
+
     def _config(self, channel: int) -> int:
         return (
             (MUX_SINGLE_ENDED | channel) << MUX_SHIFT
@@ -193,7 +226,7 @@ class ADS1115:
         except DeviceError:
             raise
         except OSError as error:
-            raise _not_found(self.address, error) from error
+            raise not_found("ADS1115", self.address, error) from error
         if echoed & ~OS_START != expected:
             raise DeviceError(
                 f"ADS1115 at I2C 0x{self.address:02X} failed its identity check: config "

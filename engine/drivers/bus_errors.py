@@ -7,24 +7,18 @@ looking at a loose cable, not at a stack trace.
 
 from __future__ import annotations
 
-import errno as errno_codes
-import os
-
+from engine.drivers.device_errors import describe_exception, errno_in_words
 from engine.errors import ConfigError, DeviceError
 
-
-def errno_in_words(code: int) -> str:
-    """``121`` -> ``'Remote I/O error (EREMOTEIO, errno 121)'``."""
-    name = errno_codes.errorcode.get(code, "unknown")
-    return f"{os.strerror(code)} ({name}, errno {code})"
-
-
-def describe_exception(exc: BaseException) -> str:
-    """A one-line text for statistics and messages: errno in words, or type and message."""
-    code = getattr(exc, "errno", None)
-    if isinstance(exc, OSError) and isinstance(code, int) and not isinstance(exc, DeviceError):
-        return errno_in_words(code)
-    return f"{type(exc).__name__}: {exc}"
+# The bus managers' messages use these; their home is engine.drivers.device_errors.
+__all__ = [
+    "AddressConflictError",
+    "BusClosedError",
+    "DeviceOfflineError",
+    "TransactionFailedError",
+    "describe_exception",
+    "errno_in_words",
+]
 
 
 class AddressConflictError(ConfigError):

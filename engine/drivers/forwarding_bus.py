@@ -12,9 +12,15 @@ from typing import Any
 
 from smbus2 import i2c_msg
 
+from engine.drivers.bus_protocols import I2CBus
 
-class ForwardingI2C:
-    """Every ``smbus2.SMBus`` call becomes ``self._forward(method_name, *args)``."""
+
+class ForwardingI2C(I2CBus):
+    """Every ``smbus2.SMBus`` call becomes ``self._forward(method_name, *args)``.
+
+    It declares :class:`~engine.drivers.bus_protocols.I2CBus`, so the type checker holds
+    every method to that one interface.
+    """
 
     def _forward(self, method: str, *args: Any) -> Any:
         raise NotImplementedError(f"{type(self).__name__} must implement _forward()")
@@ -23,13 +29,15 @@ class ForwardingI2C:
         self._forward("write_quick", i2c_addr)
 
     def read_byte(self, i2c_addr: int, force: bool | None = None) -> int:
-        return self._forward("read_byte", i2c_addr)
+        value: int = self._forward("read_byte", i2c_addr)
+        return value
 
     def write_byte(self, i2c_addr: int, value: int, force: bool | None = None) -> None:
         self._forward("write_byte", i2c_addr, value)
 
     def read_byte_data(self, i2c_addr: int, register: int, force: bool | None = None) -> int:
-        return self._forward("read_byte_data", i2c_addr, register)
+        value: int = self._forward("read_byte_data", i2c_addr, register)
+        return value
 
     def write_byte_data(
         self, i2c_addr: int, register: int, value: int, force: bool | None = None
@@ -37,7 +45,8 @@ class ForwardingI2C:
         self._forward("write_byte_data", i2c_addr, register, value)
 
     def read_word_data(self, i2c_addr: int, register: int, force: bool | None = None) -> int:
-        return self._forward("read_word_data", i2c_addr, register)
+        value: int = self._forward("read_word_data", i2c_addr, register)
+        return value
 
     def write_word_data(
         self, i2c_addr: int, register: int, value: int, force: bool | None = None
@@ -47,7 +56,8 @@ class ForwardingI2C:
     def read_i2c_block_data(
         self, i2c_addr: int, register: int, length: int, force: bool | None = None
     ) -> list[int]:
-        return self._forward("read_i2c_block_data", i2c_addr, register, length)
+        data: list[int] = self._forward("read_i2c_block_data", i2c_addr, register, length)
+        return data
 
     def write_i2c_block_data(
         self, i2c_addr: int, register: int, data: Sequence[int], force: bool | None = None

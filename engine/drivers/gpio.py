@@ -19,6 +19,7 @@ import struct
 from pathlib import Path
 from typing import Protocol
 
+from engine.drivers.device_errors import errno_in_words
 from engine.errors import DeviceError
 
 
@@ -106,7 +107,7 @@ def pack_line_values(high: bool) -> bytearray:
     return bytearray(struct.pack(LINE_VALUES_FORMAT, int(high), 1))
 
 
-_ERRNO_WORDS = {
+_GPIO_ADVICE = {
     errno.ENOENT: "no such GPIO chip",
     errno.EACCES: "no permission (is the user in the gpio group?)",
     errno.EPERM: "no permission (is the user in the gpio group?)",
@@ -161,7 +162,7 @@ class GpioOutputLine:
         self._high = initial_high
 
     def _error(self, action: str, err: OSError) -> DeviceError:
-        words = _ERRNO_WORDS.get(err.errno or 0, os.strerror(err.errno or 0))
+        words = errno_in_words(err.errno, _GPIO_ADVICE)
         return DeviceError(
             err.errno, f"GPIO {self.path} line {self.offset}: {action} the line: {words}"
         )

@@ -4,197 +4,59 @@ Over USB the Maestro shows up as two serial ports; commands go to the first one,
 "Command Port" (usually ``/dev/ttyACM0``), where the baud rate does not matter. The same
 commands work on the TTL serial line.
 
-The protocol (Maestro user's guide, sections 5.c and 5.e) is a command byte with its most
-significant bit set followed by data bytes with it cleared, so every 14-bit value travels
-as two 7-bit bytes, low bits first. The *compact* protocol sends the command byte itself;
-the *Pololu* protocol sends ``0xAA``, the device number and the command byte with its MSB
-cleared, so several Pololu controllers can share one line. Replies are plain bytes, 16-bit
-values little-endian.
-
-Pulse widths travel in quarter-microseconds (a target of 6000 is 1500 us; 0 stops the
-pulses). Speed is in (0.25 us)/(10 ms), acceleration in (0.25 us)/(10 ms)/(80 ms), for the
-default 20 ms servo period; 0 means unlimited for both.
-
-The encoding is kept in pure functions (``encode_*``, ``decode_*``) testable without a
-port; :class:`Maestro` only moves bytes.
+The bytes of each command and reply are built and read by the pure functions of
+:mod:`engine.drivers.maestro_protocol`; :class:`Maestro` only moves them over the port,
+and notices a Maestro that does not answer: every query has the port's read timeout, and
+one that times out raises a :class:`~engine.errors.DeviceError` naming the port.
 """
 
 from __future__ import annotations
 
 import contextlib
 import errno
-import os
 import termios
 import threading
 from types import TracebackType
-from typing import Literal, Protocol, Self
+from typing import Literal, Self
 
 import serial
 
-from engine.clock import Clock, RealClock
+from engine.clock import Clock
+from engine.drivers.bus_protocols import SerialPort
+from engine.drivers.device_errors import errno_in_words
+from engine.drivers.maestro_protocol import (
+    DEFAULT_DEVICE_NUMBER,
+    MAX_DEVICE_NUMBER,
+    QUARTER_US_PER_US,
+    decode_errors,
+    decode_u16,
+    encode_get_errors,
+    encode_get_moving_state,
+    encode_get_position,
+    encode_go_home,
+    encode_pololu,
+    encode_set_acceleration,
+    encode_set_speed,
+    encode_set_target,
+    us_to_quarter_us,
+)
 from engine.errors import DeviceError
 
-# Command bytes (compact protocol).
-CMD_SET_TARGET = 0x84
-CMD_SET_SPEED = 0x87
-CMD_SET_ACCELERATION = 0x89
-CMD_GET_POSITION = 0x90
-CMD_GET_MOVING_STATE = 0x93
-CMD_GET_ERRORS = 0xA1
-CMD_GO_HOME = 0xA2
-POLOLU_PROTOCOL_START = 0xAA
-"""First byte of a Pololu-protocol packet (also the baud-rate indication byte)."""
-
-DEFAULT_DEVICE_NUMBER = 12
-MAX_DEVICE_NUMBER = 127
-MAX_14_BIT = 0x3FFF
-MAX_ACCELERATION = 255
-QUARTER_US_PER_US = 4
-
-# Error register (user's guide section 4.e): read and cleared by Get Errors.
-ERROR_SERIAL_SIGNAL = 1 << 0
-ERROR_SERIAL_OVERRUN = 1 << 1
-ERROR_SERIAL_BUFFER_FULL = 1 << 2
-ERROR_SERIAL_CRC = 1 << 3
-ERROR_SERIAL_PROTOCOL = 1 << 4
-ERROR_SERIAL_TIMEOUT = 1 << 5
-ERROR_SCRIPT_STACK = 1 << 6
-ERROR_SCRIPT_CALL_STACK = 1 << 7
-ERROR_SCRIPT_PROGRAM_COUNTER = 1 << 8
-
-ERROR_NAMES: dict[int, str] = {
-    ERROR_SERIAL_SIGNAL: "serial signal error",
-    ERROR_SERIAL_OVERRUN: "serial overrun error",
-    ERROR_SERIAL_BUFFER_FULL: "serial buffer full",
-    ERROR_SERIAL_CRC: "serial CRC error",
-    ERROR_SERIAL_PROTOCOL: "serial protocol error",
-    ERROR_SERIAL_TIMEOUT: "serial timeout",
-    ERROR_SCRIPT_STACK: "script stack error",
-    ERROR_SCRIPT_CALL_STACK: "script call stack error",
-    ERROR_SCRIPT_PROGRAM_COUNTER: "script program counter error",
+_PORT_ADVICE = {
+    errno.ENOENT: "no such file: is the Maestro plugged in? (its command port is often "
+    "/dev/ttyACM0)",
+    errno.EACCES: "permission denied: add yourself to the dialout group",
+    errno.EPERM: "permission denied: add yourself to the dialout group",
+    errno.EBUSY: "busy: another program has it open",
+    errno.EAGAIN: "busy: another program has it open",
+    errno.ENXIO: "no such device: was the Maestro unplugged?",
+    errno.ENODEV: "no such device: was the Maestro unplugged?",
 }
-"""Bit mask -> name of each error the Maestro reports, in bit order."""
-
-
-class SerialPort(Protocol):
-    """The part of ``serial.Serial`` the driver uses; ``timeout`` is in seconds."""
-
-    timeout: float | None
-
-    def write(self, data: bytes, /) -> int | None: ...
-
-    def read(self, size: int = 1, /) -> bytes: ...
-
-    def flush(self) -> None: ...
-
-    def reset_input_buffer(self) -> None: ...
-
-    def close(self) -> None: ...
-
-
-# --- pure encoding -------------------------------------------------------------------------
-
-
-def _check_data_byte(what: str, value: int) -> None:
-    if not 0 <= value <= 0x7F:
-        raise ValueError(f"{what} {value} does not fit a 7-bit data byte (0..127)")
-
-
-def _encode_14_bit(what: str, value: int) -> bytes:
-    if not 0 <= value <= MAX_14_BIT:
-        raise ValueError(f"{what} {value} is outside 0..{MAX_14_BIT} (14 bits)")
-    return bytes((value & 0x7F, (value >> 7) & 0x7F))
-
-
-def us_to_quarter_us(pulse_us: float) -> int:
-    """A pulse width in microseconds as the Maestro's integer quarter-microseconds."""
-    quarter_us = round(pulse_us * QUARTER_US_PER_US)
-    if not 0 <= quarter_us <= MAX_14_BIT:
-        raise ValueError(
-            f"pulse width {pulse_us} us is outside 0..{MAX_14_BIT / QUARTER_US_PER_US} us"
-        )
-    return quarter_us
-
-
-def encode_set_target(channel: int, quarter_us: int) -> bytes:
-    """Set Target: ``channel`` moves to ``quarter_us`` (0.25 us units; 0 stops its pulses)."""
-    _check_data_byte("channel", channel)
-    return bytes((CMD_SET_TARGET, channel)) + _encode_14_bit("target", quarter_us)
-
-
-def encode_set_speed(channel: int, speed: int) -> bytes:
-    """Set Speed: limit in (0.25 us)/(10 ms); 0 is unlimited."""
-    _check_data_byte("channel", channel)
-    return bytes((CMD_SET_SPEED, channel)) + _encode_14_bit("speed", speed)
-
-
-def encode_set_acceleration(channel: int, acceleration: int) -> bytes:
-    """Set Acceleration: limit in (0.25 us)/(10 ms)/(80 ms), 0..255; 0 is unlimited."""
-    _check_data_byte("channel", channel)
-    if not 0 <= acceleration <= MAX_ACCELERATION:
-        raise ValueError(f"acceleration {acceleration} is outside 0..{MAX_ACCELERATION}")
-    return bytes((CMD_SET_ACCELERATION, channel)) + _encode_14_bit("acceleration", acceleration)
-
-
-def encode_get_position(channel: int) -> bytes:
-    """Get Position: the reply is the pulse width being sent, 2 bytes little-endian (0.25 us)."""
-    _check_data_byte("channel", channel)
-    return bytes((CMD_GET_POSITION, channel))
-
-
-def encode_get_moving_state() -> bytes:
-    """Get Moving State: the reply is 0x01 while a speed- or acceleration-limited servo moves."""
-    return bytes((CMD_GET_MOVING_STATE,))
-
-
-def encode_get_errors() -> bytes:
-    """Get Errors: the reply is the error register, 2 bytes little-endian; reading clears it."""
-    return bytes((CMD_GET_ERRORS,))
-
-
-def encode_go_home() -> bytes:
-    """Go Home: every channel goes to its configured home (off, unchanged, or a position)."""
-    return bytes((CMD_GO_HOME,))
-
-
-def encode_pololu(device: int, packet: bytes) -> bytes:
-    """A compact-protocol ``packet`` rewritten for the Pololu protocol and ``device``."""
-    _check_data_byte("device number", device)
-    if not packet or not packet[0] & 0x80:
-        raise ValueError(f"packet {packet.hex(' ')} does not start with a command byte")
-    return bytes((POLOLU_PROTOCOL_START, device, packet[0] & 0x7F)) + packet[1:]
-
-
-def decode_u16(reply: bytes) -> int:
-    """A 2-byte little-endian reply as an integer."""
-    if len(reply) != 2:
-        raise ValueError(f"expected a 2-byte reply, got {reply.hex(' ') or 'nothing'}")
-    return reply[0] | (reply[1] << 8)
-
-
-def decode_errors(register: int) -> list[str]:
-    """The error register as names, lowest bit first; unknown bits are named by number."""
-    names = []
-    for bit in range(16):
-        mask = 1 << bit
-        if register & mask:
-            names.append(ERROR_NAMES.get(mask, f"unknown error bit {bit}"))
-    return names
 
 
 def describe_port_error(code: int | None) -> str:
     """Words for an errno from opening or using a serial port, with what to do about it."""
-    if code == errno.ENOENT:
-        return "no such file: is the Maestro plugged in? (its command port is often /dev/ttyACM0)"
-    if code in (errno.EACCES, errno.EPERM):
-        return "permission denied: add yourself to the dialout group"
-    if code in (errno.EBUSY, errno.EAGAIN, errno.EWOULDBLOCK):
-        return "busy: another program has it open"
-    if code in (errno.ENXIO, errno.ENODEV):
-        return "no such device: was the Maestro unplugged?"
-    if code is None:
-        return "unknown error"
-    return os.strerror(code).lower()
+    return errno_in_words(code, _PORT_ADVICE)
 
 
 # --- the device ----------------------------------------------------------------------------
@@ -210,7 +72,7 @@ class Maestro:
     carries on; until then each command fails with a :class:`DeviceError` saying why.
     ``device`` is the Pololu-protocol
     device number (0..127), used when ``protocol="pololu"``; ``channels`` is 12 for a Mini
-    Maestro 12. ``clock`` is only needed by :meth:`wait_until_stopped`. ``baudrate`` and
+    Maestro 12. ``clock`` paces :meth:`wait_until_stopped`. ``baudrate`` and
     ``timeout_s`` apply only when the port is opened here; a borrowed port must have a
     timeout so that a silent Maestro cannot hang a read.
 
@@ -224,7 +86,7 @@ class Maestro:
         device: int = DEFAULT_DEVICE_NUMBER,
         protocol: Literal["compact", "pololu"] = "compact",
         channels: int = 12,
-        clock: Clock | None = None,
+        clock: Clock,
         baudrate: int = 115200,
         timeout_s: float = 0.5,
         connect: bool = True,
@@ -240,7 +102,7 @@ class Maestro:
         self.device = device
         self.protocol = protocol
         self.channels = channels
-        self._clock = clock if clock is not None else RealClock()
+        self._clock = clock
         self._lock = threading.Lock()
         self._closed = False
         self._baudrate = baudrate

@@ -16,8 +16,7 @@ Code = 1024 * VIN / VREF, so volts = code * VREF / 1024.
 
 from __future__ import annotations
 
-from typing import Any
-
+from engine.drivers.bus_protocols import SpiDevice
 from engine.errors import DeviceError
 
 CHANNELS = 8
@@ -53,7 +52,9 @@ class MCP3008:
     chip's limit at any supply (1.35 MHz at 2.7 V, 3.6 MHz at 5 V).
     """
 
-    def __init__(self, spi: Any, *, vref_v: float = 3.3, max_speed_hz: int = 1_000_000) -> None:
+    def __init__(
+        self, spi: SpiDevice, *, vref_v: float = 3.3, max_speed_hz: int = 1_000_000
+    ) -> None:
         if not 0.25 <= vref_v <= 5.5:
             raise ValueError(f"MCP3008 VREF {vref_v} V is outside 0.25..5.5 V")
         if not MIN_CLOCK_HZ <= max_speed_hz <= MAX_CLOCK_AT_5V_HZ:

@@ -13,8 +13,9 @@ it was left in shutdown and sets the resolution; a finer resolution converts mor
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
 
+from engine.drivers.bus_protocols import I2CBus
+from engine.drivers.device_errors import ImplausibleReadingError, i2c_place, not_found
 from engine.errors import DeviceError
 
 CONFIG = 0x01
@@ -46,6 +47,8 @@ RESOLUTIONS_C: dict[float, tuple[int, float]] = {
     0.125: (0b10, 0.130),
     0.0625: (0b11, 0.250),
 }
+OPERATING_MIN_C = -40.0  # the chip's operating range: it reports nothing outside it
+OPERATING_MAX_C = 125.0
 LIMIT_MIN_C = -256.0
 LIMIT_MAX_C = 255.75
 
@@ -102,16 +105,10 @@ def _resolution_entry(resolution_c: float) -> tuple[int, float]:
     return entry
 
 
-def _not_found(address: int, error: OSError) -> DeviceError:
-    """The bus error of a first contact, as a DeviceError that keeps its errno."""
-    message = f"MCP9808 not found at I2C 0x{address:02X}: {error.strerror or error}"
-    return DeviceError(error.errno, message) if error.errno is not None else DeviceError(message)
-
-
 class MCP9808:
     """An MCP9808 on an ``smbus2.SMBus``-compatible ``bus``."""
 
-    def __init__(self, bus: Any, *, address: int = 0x18, resolution_c: float = 0.0625) -> None:
+    def __init__(self, bus: I2CBus, *, address: int = 0x18, resolution_c: float = 0.0625) -> None:
         _resolution_entry(resolution_c)
         self._bus = bus
         self.address = address
@@ -154,8 +151,21 @@ class MCP9808:
 
     # -- readings -----------------------------------------------------------------------
     def read_temperature_c(self) -> float:
-        """The latest conversion, degrees Celsius (negative below freezing)."""
-        return raw_to_celsius(self._read_word(T_AMBIENT))
+        """The latest conversion, degrees Celsius (negative below freezing).
+
+        Raises :class:`~engine.drivers.device_errors.ImplausibleReadingError` for a value
+        outside the chip's operating range (-40..125 degC): a garbled transfer, not air.
+        """
+        celsius = raw_to_celsius(self._read_word(T_AMBIENT))
+        if not OPERATING_MIN_C <= celsius <= OPERATING_MAX_C:
+            raise ImplausibleReadingError(
+                chip="MCP9808",
+                place=i2c_place(self.address),
+                what="temperature",
+                value=f"{celsius:g} degC",
+                plausible=f"{OPERATING_MIN_C:g}..{OPERATING_MAX_C:g} degC",
+            )
+        return celsius
 
     def read_temperature_f(self) -> float:
         """The latest conversion, degrees Fahrenheit."""
@@ -173,7 +183,7 @@ class MCP9808:
         except DeviceError:
             raise
         except OSError as error:
-            raise _not_found(self.address, error) from error
+            raise not_found("MCP9808", self.address, error) from error
         if manufacturer != MANUFACTURER_ID_VALUE or device >> 8 != DEVICE_ID_VALUE:
             raise DeviceError(
                 f"MCP9808 at I2C 0x{self.address:02X} failed its identity check: "

@@ -16,8 +16,8 @@ difference falls below the release threshold (hysteresis).
 
 from __future__ import annotations
 
-from typing import Any
-
+from engine.drivers.bus_protocols import I2CBus
+from engine.drivers.device_errors import ImplausibleReadingError, i2c_place, not_found
 from engine.errors import DeviceError
 
 # Register map (data sheet Table 1).
@@ -47,6 +47,9 @@ CONFIG2_HALF_US_1MS = 0x20  # 0.5 us charge time, 4 second-filter samples, 1 ms 
 
 PADS = 12
 STATUS_PAD_MASK = (1 << PADS) - 1
+# Above the pads: ELEPROX (off: proximity is not enabled), two reserved bits and OVCF
+# (over-current on REXT, which stops the chip). None of them can be set while it runs here.
+STATUS_NOT_PADS_MASK = 0xFFFF & ~STATUS_PAD_MASK
 
 
 def _check_threshold(name: str, value: int) -> None:
@@ -72,12 +75,6 @@ def status_to_pads(status: int) -> list[bool]:
     return [bool(status >> pad & 1) for pad in range(PADS)]
 
 
-def _not_found(address: int, error: OSError) -> DeviceError:
-    """The bus error of a first contact, as a DeviceError that keeps its errno."""
-    message = f"MPR121 not found at I2C 0x{address:02X}: {error.strerror or error}"
-    return DeviceError(error.errno, message) if error.errno is not None else DeviceError(message)
-
-
 class MPR121:
     """An MPR121 on an ``smbus2.SMBus``-compatible ``bus``.
 
@@ -87,7 +84,7 @@ class MPR121:
 
     def __init__(
         self,
-        bus: Any,
+        bus: I2CBus,
         *,
         address: int = 0x5A,
         touch_threshold: int = 12,
@@ -118,7 +115,7 @@ class MPR121:
         except DeviceError:
             raise
         except OSError as error:
-            raise _not_found(self.address, error) from error
+            raise not_found("MPR121", self.address, error) from error
         if config2 != CONFIG2_AFTER_RESET:
             raise DeviceError(
                 f"MPR121 at I2C 0x{self.address:02X} failed its identity check: CONFIG2 "
@@ -134,9 +131,22 @@ class MPR121:
         self._write(ECR, ECR_RUN_12_PADS)
 
     def touched(self) -> list[bool]:
-        """Which of the 12 pads are touched now, pad 0 first."""
+        """Which of the 12 pads are touched now, pad 0 first.
+
+        A status with a bit set above the pads (proximity, reserved, over-current) raises
+        :class:`~engine.drivers.device_errors.ImplausibleReadingError`.
+        """
         low, high = self._read(TOUCH_STATUS_L, 2)
-        return status_to_pads((low | high << 8) & STATUS_PAD_MASK)
+        status = low | high << 8
+        if status & STATUS_NOT_PADS_MASK:
+            raise ImplausibleReadingError(
+                chip="MPR121",
+                place=i2c_place(self.address),
+                what="touch status",
+                value=f"0x{status:04X}",
+                plausible="bits 12..15 clear: proximity off, no over-current",
+            )
+        return status_to_pads(status)
 
     def set_thresholds(self, touch: int, release: int) -> None:
         """Set the touch and release thresholds (counts) of every pad.

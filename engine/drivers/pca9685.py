@@ -14,10 +14,10 @@ identity register; construction checks that it answers and that PRE_SCALE holds 
 from __future__ import annotations
 
 import threading
-from collections.abc import Sequence
-from typing import Protocol
 
 from engine.clock import Clock
+from engine.drivers.bus_protocols import I2CBus
+from engine.drivers.device_errors import ImplausibleReadingError, device_error, i2c_place
 from engine.errors import DeviceError
 
 CHIP = "PCA9685"
@@ -50,22 +50,6 @@ FULL = 0x1000  # bit 4 of the _H register, as a bit of the 16-bit ON / OFF value
 PRESCALE_MIN = 3
 PRESCALE_MAX = 255
 OSCILLATOR_WAKE_S = 500e-6
-
-
-def _device_error(message: str, cause: OSError | None = None) -> DeviceError:
-    """A DeviceError that keeps the errno of the bus error behind it, if it had one."""
-    code = cause.errno if cause is not None else None
-    return DeviceError(code, message) if isinstance(code, int) else DeviceError(message)
-
-
-class SMBusLike(Protocol):
-    def read_byte_data(self, i2c_addr: int, register: int) -> int: ...
-
-    def write_byte_data(self, i2c_addr: int, register: int, value: int) -> None: ...
-
-    def read_i2c_block_data(self, i2c_addr: int, register: int, length: int) -> list[int]: ...
-
-    def write_i2c_block_data(self, i2c_addr: int, register: int, data: Sequence[int]) -> None: ...
 
 
 # -- pure conversions ---------------------------------------------------------------------------
@@ -134,7 +118,7 @@ class PCA9685:
 
     def __init__(
         self,
-        bus: SMBusLike,
+        bus: I2CBus,
         *,
         address: int = 0x40,
         clock: Clock,
@@ -154,7 +138,7 @@ class PCA9685:
         try:
             prescale = bus.read_byte_data(address, PRE_SCALE)
         except OSError as err:
-            raise _device_error(f"{where} did not answer: {err.strerror or err}", err) from err
+            raise device_error(f"{where} did not answer: {err.strerror or err}", err) from err
         if prescale < PRESCALE_MIN:
             raise DeviceError(
                 f"{where}: PRE_SCALE reads {prescale}, below the chip's hardware minimum "
@@ -182,7 +166,16 @@ class PCA9685:
     def frequency_hz(self) -> float:
         """The PWM frequency in Hz, from the chip's PRE_SCALE register."""
         with self._lock:
-            return frequency_for(self._read(PRE_SCALE), self.oscillator_hz)
+            prescale = self._read(PRE_SCALE)
+        if prescale < PRESCALE_MIN:  # the chip holds at least 3 whatever is written
+            raise ImplausibleReadingError(
+                chip=CHIP,
+                place=i2c_place(self.address),
+                what="PRE_SCALE",
+                value=str(prescale),
+                plausible=f"{PRESCALE_MIN}..{PRESCALE_MAX}",
+            )
+        return frequency_for(prescale, self.oscillator_hz)
 
     def set_frequency_hz(self, frequency_hz: float) -> None:
         """Set the PWM frequency of every channel (24..1526 Hz with the 25 MHz oscillator).

@@ -18,7 +18,7 @@ from dataclasses import dataclass, fields
 from typing import Any, Protocol
 
 from engine.clock import Clock
-from engine.drivers.maestro import us_to_quarter_us
+from engine.drivers.maestro_protocol import us_to_quarter_us
 from engine.errors import ConfigError, DeviceError, ServiceError
 
 MAESTRO_SPEED_UNIT_US_PER_S = 0.25 / 0.010
@@ -201,7 +201,9 @@ class ServoJoints:
         ``speed_dps`` defaults to the joint's limit. Raises ValueError (naming the joint, the
         value and the limit) for an angle outside the joint's range or a speed above its
         limit, and for a pulse too short to tell from "off" (0); nothing is sent then.
-        Returns at once; see :meth:`is_moving`.
+        Raises DeviceError when the controller does not answer the query that confirms the
+        move (within its port's read timeout). Does not wait for the joint to arrive; see
+        :meth:`is_moving`.
         """
         joint = self.joint(joint_name)
         if not joint.min_deg <= angle_deg <= joint.max_deg:
@@ -225,6 +227,10 @@ class ServoJoints:
             )
         self._maestro.set_speed(joint.channel, units)
         self._maestro.set_target_us(joint.channel, pulse_us)
+        # Commands get no reply; a query does. Its answer proves the controller heard the
+        # move, and a controller that is silent (powered off, another program's port) fails
+        # the move here, after the port's read timeout, instead of never.
+        self._maestro.get_position_us(joint.channel)
 
     def position_deg(self, joint_name: str) -> float:
         """The angle in degrees the controller is driving ``joint_name`` to right now.

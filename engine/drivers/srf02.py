@@ -20,9 +20,9 @@ block calls :meth:`start_ranging`, then :meth:`result_ready` on later ticks and
 
 from __future__ import annotations
 
-from typing import Any
-
 from engine.clock import Clock
+from engine.drivers.bus_protocols import I2CBus
+from engine.drivers.device_errors import ImplausibleReadingError, i2c_place, not_found
 from engine.errors import DeviceError
 
 COMMAND = 0x00  # write: command; read: software revision (0xFF while ranging)
@@ -37,12 +37,8 @@ RANGING_TIME_S = 0.066
 POLL_INTERVAL_S = 0.005
 MAX_POLLS = 10
 MIN_RANGE_CM = 16  # the tuned minimum; a fresh chip starts at 28 cm
-
-
-def _not_found(address: int, error: OSError) -> DeviceError:
-    """The bus error of a first contact, as a DeviceError that keeps its errno."""
-    message = f"SRF02 not found at I2C 0x{address:02X}: {error.strerror or error}"
-    return DeviceError(error.errno, message) if error.errno is not None else DeviceError(message)
+PLAUSIBLE_MIN_CM = 15  # below its minimum range the chip reports the minimum, never less
+MAX_RANGE_CM = 600  # the chip's 6 m; farther is "no echo", 0
 
 
 class SRF02:
@@ -54,7 +50,7 @@ class SRF02:
 
     def __init__(
         self,
-        bus: Any,
+        bus: I2CBus,
         *,
         address: int = 0x70,
         clock: Clock,
@@ -105,14 +101,27 @@ class SRF02:
         return True
 
     def read_result_cm(self) -> int:
-        """The latest result in cm (0: nothing in range); ``DeviceError`` while ranging."""
+        """The latest result in cm (0: nothing in range); ``DeviceError`` while ranging.
+
+        A result the chip cannot report (between 1 and 14 cm, or beyond 600 cm) raises
+        :class:`~engine.drivers.device_errors.ImplausibleReadingError`.
+        """
         if not self.result_ready():
             raise DeviceError(
                 f"SRF02 at I2C 0x{self.address:02X} is still ranging; "
                 "wait for result_ready() before reading the result"
             )
         high, low = self._read(RANGE_HIGH, 2)
-        return high << 8 | low
+        range_cm = high << 8 | low
+        if range_cm != 0 and not PLAUSIBLE_MIN_CM <= range_cm <= MAX_RANGE_CM:
+            raise ImplausibleReadingError(
+                chip="SRF02",
+                place=i2c_place(self.address),
+                what="range",
+                value=f"{range_cm} cm",
+                plausible=f"0 for no echo, or {PLAUSIBLE_MIN_CM}..{MAX_RANGE_CM} cm",
+            )
+        return range_cm
 
     # -- blocking use -------------------------------------------------------------------
     def read_range_cm(self) -> int:
@@ -144,7 +153,7 @@ class SRF02:
         except DeviceError:
             raise
         except OSError as error:
-            raise _not_found(self.address, error) from error
+            raise not_found("SRF02", self.address, error) from error
         if revision == BUSY or unused != UNUSED_VALUE:
             raise DeviceError(
                 f"SRF02 at I2C 0x{self.address:02X} failed its identity check: software "

@@ -23,28 +23,15 @@ from __future__ import annotations
 
 import threading
 from collections.abc import Callable
-from typing import Any, Protocol
+from typing import Any
 
+from engine.drivers.bus_protocols import I2CBus
+from engine.drivers.device_errors import device_error
 from engine.drivers.forwarding_bus import ForwardingI2C
-from engine.errors import DeviceError
 
 CHIP = "TCA9548A"
 CHANNELS = 8
 ADDRESSES = range(0x70, 0x78)
-
-
-def _device_error(message: str, cause: OSError | None = None) -> DeviceError:
-    """A DeviceError that keeps the errno of the bus error behind it, if it had one."""
-    code = cause.errno if cause is not None else None
-    return DeviceError(code, message) if isinstance(code, int) else DeviceError(message)
-
-
-class SMBusLike(Protocol):
-    """The part of ``smbus2.SMBus`` the multiplexer itself uses."""
-
-    def read_byte(self, i2c_addr: int) -> int: ...
-
-    def write_byte(self, i2c_addr: int, value: int) -> None: ...
 
 
 def channel_mask(channel: int) -> int:
@@ -63,7 +50,7 @@ class LockedBus(ForwardingI2C):
     it across its selection and transfer.
     """
 
-    def __init__(self, bus: Any, *, lock: threading.RLock | None = None) -> None:
+    def __init__(self, bus: I2CBus, *, lock: threading.RLock | None = None) -> None:
         self.bus = bus
         self.lock = lock if lock is not None else threading.RLock()
 
@@ -94,7 +81,7 @@ class TCA9548A:
 
     def __init__(
         self,
-        bus: Any,
+        bus: I2CBus,
         *,
         address: int = 0x70,
         lock: threading.RLock | None = None,
@@ -117,7 +104,7 @@ class TCA9548A:
                 self.selected()
             except OSError as err:
                 where = f"{CHIP} at 0x{address:02X}"
-                raise _device_error(f"{where} did not answer: {err.strerror or err}", err) from err
+                raise device_error(f"{where} did not answer: {err.strerror or err}", err) from err
 
     def __repr__(self) -> str:
         return f"TCA9548A(address=0x{self.address:02X})"

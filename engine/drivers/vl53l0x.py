@@ -1,8 +1,9 @@
 """ST VL53L0X time-of-flight distance sensor (I2C, default address 0x29).
 
 The vest carries three of them (left, centre, right). All three boot at 0x29, so each must
-be moved to its own address before the next one is switched on: :func:`bring_up_chain`
-does that with their XSHUT lines; a TCA9548A multiplexer (:mod:`engine.drivers.tca9548a`)
+be moved to its own address before the next one is switched on:
+:class:`~engine.hardware.xshut.XshutChain` does that with their XSHUT lines and
+:meth:`VL53L0X.set_address`; a TCA9548A multiplexer (:mod:`engine.drivers.tca9548a`)
 is the other way, each sensor keeping 0x29 on its own channel.
 
 The initialisation follows the order of ST's API as Pololu's library distils it, keeping
@@ -28,11 +29,11 @@ than with the full ST sequence. Port those steps if millimetre accuracy ever mat
 from __future__ import annotations
 
 import threading
-from collections.abc import Callable, Sequence
-from typing import Protocol
+from collections.abc import Callable
 
 from engine.clock import Clock
-from engine.drivers.gpio import OutputLine
+from engine.drivers.bus_protocols import I2CBus
+from engine.drivers.device_errors import ImplausibleReadingError, device_error, i2c_place
 from engine.errors import DeviceError
 
 CHIP = "VL53L0X"
@@ -76,27 +77,11 @@ VHV_CALIBRATION_START = 0x40
 # Bits 6:3 of RESULT_RANGE_STATUS: the device's range status; 11 means a valid range.
 DEVICE_RANGE_STATUS_VALID = 11
 RANGE_OUT_OF_RANGE_MM = 8190  # the chip reports 8190 or 8191 when nothing is in range
+RANGE_CODE_MAX = 8191  # the range field never holds more
+MAX_RANGE_MM = 2000  # the chip's reach (long-range mode); a valid range beyond it is garbled
 
 BOOT_TIME_S = 0.002  # after XSHUT rises; the datasheet's tBOOT is 1.2 ms max
 POLL_INTERVAL_S = 0.002
-
-
-class SMBusLike(Protocol):
-    """The part of ``smbus2.SMBus`` this driver uses."""
-
-    def read_byte_data(self, i2c_addr: int, register: int) -> int: ...
-
-    def write_byte_data(self, i2c_addr: int, register: int, value: int) -> None: ...
-
-    def read_i2c_block_data(self, i2c_addr: int, register: int, length: int) -> list[int]: ...
-
-    def write_i2c_block_data(self, i2c_addr: int, register: int, data: Sequence[int]) -> None: ...
-
-
-def _device_error(message: str, cause: OSError | None = None) -> DeviceError:
-    """A DeviceError that keeps the errno of the bus error behind it, if it had one."""
-    code = cause.errno if cause is not None else None
-    return DeviceError(code, message) if isinstance(code, int) else DeviceError(message)
 
 
 # -- pure conversions -------------------------------------------------------------------------
@@ -137,7 +122,7 @@ class VL53L0X:
 
     def __init__(
         self,
-        bus: SMBusLike,
+        bus: I2CBus,
         *,
         address: int = DEFAULT_ADDRESS,
         clock: Clock,
@@ -184,7 +169,7 @@ class VL53L0X:
                 self._bus.read_i2c_block_data(self._address, IDENTIFICATION_MODEL_ID, 3)
             )
         except OSError as err:
-            raise _device_error(
+            raise device_error(
                 f"{self._where()} did not answer: {err.strerror or err}", err
             ) from err
         if identity != IDENTITY:
@@ -260,7 +245,9 @@ class VL53L0X:
         """One single-shot measurement: the distance in mm, or ``None`` if out of range.
 
         Takes the chip's timing budget (~33 ms) on the clock. Raises :class:`DeviceError`
-        when the chip does not finish within ``timeout_s``, and ``OSError`` on bus errors.
+        when the chip does not finish within ``timeout_s``, ``OSError`` on bus errors, and
+        :class:`~engine.drivers.device_errors.ImplausibleReadingError` for a valid range
+        beyond the chip's ~2 m, or a range field above 8191.
         """
         with self._lock:
             self._enter_private_page()
@@ -276,7 +263,19 @@ class VL53L0X:
             )
             self._write(SYSTEM_INTERRUPT_CLEAR, 0x01)
         offset = RESULT_RANGE_MM_OFFSET
-        return decode_range(result[0], (result[offset] << 8) | result[offset + 1])
+        range_mm = (result[offset] << 8) | result[offset + 1]
+        distance_mm = decode_range(result[0], range_mm)
+        if range_mm > RANGE_CODE_MAX or (distance_mm is not None and distance_mm > MAX_RANGE_MM):
+            valid = device_range_status(result[0]) == DEVICE_RANGE_STATUS_VALID
+            raise ImplausibleReadingError(
+                chip=CHIP,
+                place=i2c_place(self._address),
+                what="range with a valid status" if valid else "range",
+                value=f"{range_mm} mm",
+                plausible=f"0..{MAX_RANGE_MM} mm, or {RANGE_OUT_OF_RANGE_MM}..{RANGE_CODE_MAX} "
+                "for nothing in range",
+            )
+        return distance_mm
 
     def set_address(self, new_address: int) -> None:
         """Move the chip to ``new_address`` (kept until power-off or XSHUT low)."""
@@ -287,58 +286,8 @@ class VL53L0X:
             try:
                 self._read(IDENTIFICATION_MODEL_ID)
             except OSError as err:
-                raise _device_error(
+                raise device_error(
                     f"{CHIP} moved from 0x{old:02X} but does not answer at "
                     f"0x{new_address:02X}: {err.strerror or err}",
                     err,
                 ) from err
-
-
-def bring_up_chain(
-    bus: SMBusLike,
-    xshut_lines: Sequence[OutputLine],
-    addresses: Sequence[int],
-    *,
-    clock: Clock,
-    timeout_s: float = 0.1,
-) -> list[VL53L0X]:
-    """Give each VL53L0X on one bus its own address, using their XSHUT lines.
-
-    All lines go low (every chip in hardware standby, forgetting any earlier address);
-    then one at a time: its line high, wait for boot, initialise it at 0x29 and move it to
-    its address. Returns the sensors in the order of ``xshut_lines``. 0x29 itself may only
-    be the last address, since every later chip boots there.
-    """
-    if len(xshut_lines) != len(addresses):
-        raise ValueError(
-            f"{len(xshut_lines)} XSHUT lines but {len(addresses)} addresses for the "
-            f"{CHIP} chain: give one address per line"
-        )
-    for address in addresses:
-        check_address(address)
-    if len(set(addresses)) != len(addresses):
-        shown = ", ".join(f"0x{a:02X}" for a in addresses)
-        raise ValueError(f"{CHIP} chain addresses must differ, got {shown}")
-    if DEFAULT_ADDRESS in addresses[:-1]:
-        raise ValueError(
-            f"{CHIP} chain: 0x{DEFAULT_ADDRESS:02X} can only be the last address, since "
-            f"every chip switched on after it boots there"
-        )
-    for line in xshut_lines:
-        line.set(False)
-    sensors: list[VL53L0X] = []
-    for position, (line, address) in enumerate(zip(xshut_lines, addresses, strict=True)):
-        line.set(True)
-        clock.sleep(BOOT_TIME_S)
-        try:
-            sensor = VL53L0X(bus, address=DEFAULT_ADDRESS, clock=clock, timeout_s=timeout_s)
-            if address != DEFAULT_ADDRESS:
-                sensor.set_address(address)
-        except DeviceError as err:
-            raise _device_error(
-                f"{CHIP} #{position + 1} of the XSHUT chain (for 0x{address:02X}): "
-                f"{err.strerror or err}",
-                err,
-            ) from err
-        sensors.append(sensor)
-    return sensors

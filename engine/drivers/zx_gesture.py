@@ -16,8 +16,9 @@ tree; this driver reports what the chip reports.
 from __future__ import annotations
 
 import threading
-from typing import Protocol
 
+from engine.drivers.bus_protocols import I2CBus
+from engine.drivers.device_errors import ImplausibleReadingError, device_error, i2c_place
 from engine.errors import DeviceError
 
 CHIP = "ZX gesture sensor"
@@ -60,18 +61,6 @@ GESTURE_NAMES = {
 }
 
 
-def _device_error(message: str, cause: OSError | None = None) -> DeviceError:
-    """A DeviceError that keeps the errno of the bus error behind it, if it had one."""
-    code = cause.errno if cause is not None else None
-    return DeviceError(code, message) if isinstance(code, int) else DeviceError(message)
-
-
-class SMBusLike(Protocol):
-    def read_byte_data(self, i2c_addr: int, register: int) -> int: ...
-
-    def write_byte_data(self, i2c_addr: int, register: int, value: int) -> None: ...
-
-
 def gesture_name(code: int) -> str | None:
     """The engine's name for a GESTURE register value, or ``None`` for no/unknown gesture."""
     return GESTURE_NAMES.get(code)
@@ -87,7 +76,7 @@ def decode_position(x: int, z: int) -> tuple[int, int] | None:
 class ZXGesture:
     """A ZX sensor, polled (its DR pin is not used). Thread-safe."""
 
-    def __init__(self, bus: SMBusLike, *, address: int = 0x10) -> None:
+    def __init__(self, bus: I2CBus, *, address: int = 0x10) -> None:
         if address not in ADDRESSES:
             raise ValueError(f"{CHIP} address must be 0x10 or 0x11, got 0x{address:02X}")
         self._bus = bus
@@ -99,7 +88,7 @@ class ZXGesture:
             model = bus.read_byte_data(address, MODEL)
             version = bus.read_byte_data(address, REGVER)
         except OSError as err:
-            raise _device_error(f"{where} did not answer: {err.strerror or err}", err) from err
+            raise device_error(f"{where} did not answer: {err.strerror or err}", err) from err
         if model != MODEL_ID or version != REGISTER_MAP_VERSION:
             raise DeviceError(
                 f"{where}: model 0x{model:02X}, register map 0x{version:02X}; expected "
@@ -119,7 +108,8 @@ class ZXGesture:
         """The gesture detected since the last call (each is reported once), or ``None``.
 
         One of ``swipe_right``, ``swipe_left``, ``swipe_up``, ``hover``, ``hover_left``,
-        ``hover_right``, ``hover_up``.
+        ``hover_right``, ``hover_up``; a code that is none of them raises
+        :class:`~engine.drivers.device_errors.ImplausibleReadingError` (no phantom gestures).
         """
         with self._lock:
             self._poll_status()
@@ -127,12 +117,23 @@ class ZXGesture:
                 return None
             self._pending &= ~STATUS_GESTURES
             code = self._bus.read_byte_data(self.address, GESTURE)
-        return gesture_name(code)
+        name = gesture_name(code)
+        if name is None:  # STATUS announced a gesture: the code must name one
+            raise ImplausibleReadingError(
+                chip=CHIP,
+                place=i2c_place(self.address),
+                what="gesture code",
+                value=f"0x{code:02X}",
+                plausible=", ".join(f"0x{known:02X}" for known in GESTURE_NAMES),
+            )
+        return name
 
     def read_position(self) -> tuple[int, int] | None:
         """The hand's (x, z) in sensor units 0..240 when the chip has a new coordinate.
 
         ``None`` when no new coordinate arrived since the last call (no hand in view).
+        A coordinate beyond 240 raises
+        :class:`~engine.drivers.device_errors.ImplausibleReadingError`.
         """
         with self._lock:
             self._poll_status()
@@ -141,4 +142,13 @@ class ZXGesture:
             self._pending &= ~STATUS_DAV
             x = self._bus.read_byte_data(self.address, XPOS)
             z = self._bus.read_byte_data(self.address, ZPOS)
-        return decode_position(x, z)
+        position = decode_position(x, z)
+        if position is None:
+            raise ImplausibleReadingError(
+                chip=CHIP,
+                place=i2c_place(self.address),
+                what="hand position (x, z)",
+                value=f"({x}, {z})",
+                plausible=f"0..{MAX_POSITION} each",
+            )
+        return position

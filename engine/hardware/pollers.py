@@ -44,6 +44,7 @@ from engine.clock import Clock
 from engine.drivers.ads1115 import ADS1115
 from engine.drivers.bus_errors import describe_exception
 from engine.drivers.bus_manager import DeviceHandle, Priority
+from engine.drivers.device_errors import ImplausibleReadingError
 from engine.drivers.force_calibration import ForceCalibration
 from engine.drivers.mcp3008 import MCP3008
 from engine.drivers.mpr121 import MPR121, PADS
@@ -310,6 +311,14 @@ def make_poller(
         connect, read, rest = _range(device, handle, clock, chain)
     else:
         connect, read, rest = maker(device, handle, clock)
+
+    def read_counted(driver: Any) -> Sequence[Staged]:
+        try:
+            return read(driver)
+        except ImplausibleReadingError as error:  # found after the bus transactions
+            handle.note_implausible(error)
+            raise
+
     return Poller(
         device.name,
         rate_hz=device.rate_hz,
@@ -317,7 +326,7 @@ def make_poller(
         blackboard=blackboard,
         health=health,
         connect=connect,
-        read=read,
+        read=read_counted,
         rest=rest,
     )
 

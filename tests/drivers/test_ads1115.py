@@ -2,10 +2,13 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from typing import Any
+
 import pytest
 
 from engine.clock import VirtualClock
-from engine.drivers.ads1115 import ADS1115, raw_to_volts
+from engine.drivers.ads1115 import ADS1115, lowest_single_ended_code, raw_to_volts
 from engine.drivers.force_calibration import ForceCalibration
 from engine.drivers.sim.ads1115 import SimADS1115
 from engine.drivers.sim.fsr import fsr406_volts
@@ -256,3 +259,20 @@ def test_fsr406_volts_follow_the_divider_and_refuse_nonsense() -> None:
         fsr406_volts(-1.0)
     with pytest.raises(ValueError, match="divider"):
         fsr406_volts(1.0, divider_ohm=0)
+
+
+def test_garbage_never_becomes_a_force(
+    chip: SimADS1115, bus: SimI2CBus, clock: VirtualClock, read_garbage: Callable[..., Any]
+) -> None:
+    # Random bytes cannot echo the config register that was written: every one refused.
+    adc = ADS1115(bus, clock=clock)
+    readings = read_garbage(bus, 0x48, lambda: adc.read_volts(0), times=50)
+    assert readings.believed == []
+    assert "ADS1115 at I2C 0x48: config register" in str(readings.refused[0])
+
+
+def test_a_single_ended_input_cannot_read_below_its_absolute_maximum_under_ground() -> None:
+    # -0.3 V is the inputs' absolute maximum below GND: lower codes are refused.
+    assert lowest_single_ended_code(4.096) == -2400
+    assert lowest_single_ended_code(6.144) == -1600
+    assert lowest_single_ended_code(0.256) == -32768  # -0.3 V is beyond full scale: any code

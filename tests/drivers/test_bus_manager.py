@@ -30,6 +30,7 @@ from engine.drivers.bus_manager import (
     Priority,
     percentile,
 )
+from engine.drivers.device_errors import ImplausibleReadingError
 from engine.drivers.sim.i2c_bus import RegisterFile, SimI2CBus, SimI2CDevice
 from engine.errors import ConfigError, DeviceError
 
@@ -561,11 +562,34 @@ def test_the_worker_reprobes_an_offline_device_that_nobody_polls(threaded_vest: 
     assert threaded_vest.statuses[-1] == ("tof_left", False)
     threaded_vest.status_changed.clear()
 
-    threaded_vest.clock.advance(2.5)
-    threaded_vest.manager.run_due_probes()  # the worker would notice by itself within 0.5 s
+    threaded_vest.clock.advance(2.5)  # the worker waits on this clock: advancing wakes it
 
     assert threaded_vest.status_changed.wait(WAIT_S)
     assert threaded_vest.statuses[-1] == ("tof_left", True)
+
+
+def test_the_threaded_worker_waits_for_a_reprobe_on_the_virtual_clock(
+    threaded_vest: Vest,
+) -> None:
+    left = threaded_vest.claim_left()
+    threaded_vest.bus.inject("nack", 1.0, TOF_LEFT)  # a loose connector for 1 s
+    for _ in range(3):
+        with pytest.raises(TransactionFailedError):
+            left.submit(read_level(TOF_LEFT)).result(WAIT_S)
+    assert threaded_vest.statuses[-1] == ("tof_left", False)  # re-probe due 2 s later
+    threaded_vest.status_changed.clear()
+
+    # The worker waits on the virtual clock; one second later nothing is due yet.
+    assert threaded_vest.clock.until_waiting(1)
+    threaded_vest.clock.advance(1.0)
+    assert threaded_vest.clock.until_waiting(1)
+    assert left.stats().probes == 0
+
+    # Past the re-probe's time the worker wakes by itself and finds the chip again.
+    threaded_vest.clock.advance(1.5)
+    assert threaded_vest.status_changed.wait(WAIT_S)
+    assert threaded_vest.statuses[-1] == ("tof_left", True)
+    assert left.stats().probes == 1
 
 
 def test_a_failing_status_callback_does_not_stop_the_bus(caplog: pytest.LogCaptureFixture) -> None:
@@ -715,3 +739,42 @@ def test_options_out_of_range_are_refused_with_the_value() -> None:
         BusManager(SimI2CBus(clock), name="1", clock=clock, threaded=False, retries=-1)
     with pytest.raises(ValueError, match="got 0"):
         BusManager(SimI2CBus(clock), name="1", clock=clock, threaded=False, offline_after=0)
+
+
+# -- implausible readings ------------------------------------------------------------------
+def test_a_reading_the_driver_refuses_is_counted_as_implausible_and_never_returned(
+    vest: Vest,
+) -> None:
+    left = vest.claim_left()
+    vest.left_chip.level = 0xFFFF  # beyond anything this chip can measure
+
+    def read_checked(bus: SimI2CBus) -> int:
+        level = read_level(TOF_LEFT)(bus)
+        if level > 4000:
+            raise ImplausibleReadingError(
+                chip="probe chip",
+                place="I2C 0x29",
+                what="level",
+                value=str(level),
+                plausible="0..4000",
+            )
+        return level
+
+    with pytest.raises(ImplausibleReadingError, match="level 65535"):
+        left.submit(read_checked).result()
+    stats = left.stats()
+    assert (stats.implausible, stats.errors) == (1, 1)
+    assert stats.last_error is not None and "level 65535" in stats.last_error
+
+
+def test_a_poller_reports_a_refused_reading_found_after_its_transactions(vest: Vest) -> None:
+    left = vest.claim_left()
+    assert left.submit(read_level(TOF_LEFT)).result() == 0
+    left.note_implausible(
+        ImplausibleReadingError(
+            chip="probe chip", place="I2C 0x29", what="level", value="9999", plausible="0..4000"
+        )
+    )
+    stats = left.stats()
+    assert (stats.transactions, stats.errors, stats.implausible) == (1, 1, 1)
+    assert left.online

@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import errno
 import os
+import pty
+import tty
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -17,11 +19,10 @@ import serial
 
 from engine.clock import VirtualClock
 from engine.drivers.bus_manager import BusManager
-from engine.drivers.maestro import (
-    Maestro,
+from engine.drivers.maestro import Maestro, describe_port_error
+from engine.drivers.maestro_protocol import (
     decode_errors,
     decode_u16,
-    describe_port_error,
     encode_get_errors,
     encode_get_moving_state,
     encode_get_position,
@@ -32,6 +33,7 @@ from engine.drivers.maestro import (
     encode_set_target,
     us_to_quarter_us,
 )
+from engine.drivers.servo_joints import Joint, ServoJoints
 from engine.drivers.sim.maestro_emulator import MaestroEmulator
 from engine.errors import DeviceError
 
@@ -185,7 +187,7 @@ def test_go_home_eases_to_the_configured_home(clock: VirtualClock) -> None:
     with (
         MaestroEmulator(clock, home={0: 1500.0, 1: "ignore"}) as emulator,
         serial.Serial(emulator.port_name, timeout=0.5) as port,
-        Maestro(port) as maestro,
+        Maestro(port, clock=clock) as maestro,
     ):
         assert maestro.get_position_us(0) == 1500.0  # a home position is where it starts
         maestro.set_target_us(0, 1800)
@@ -204,7 +206,7 @@ def test_targets_beyond_the_channel_limits_stop_at_the_limit(clock: VirtualClock
     with (
         MaestroEmulator(clock) as emulator,
         serial.Serial(emulator.port_name, timeout=0.5) as port,
-        Maestro(port) as maestro,
+        Maestro(port, clock=clock) as maestro,
     ):
         maestro.set_target_us(0, 2400)
         assert maestro.get_position_us(0) == 2000.0
@@ -250,7 +252,7 @@ def test_serial_timeout_sends_servos_home(clock: VirtualClock) -> None:
     with (
         MaestroEmulator(clock, home={0: 1500.0}, serial_timeout_s=1.0) as emulator,
         serial.Serial(emulator.port_name, timeout=0.5) as port,
-        Maestro(port) as maestro,
+        Maestro(port, clock=clock) as maestro,
     ):
         maestro.set_target_us(0, 1800)
         clock.advance(0.9)
@@ -291,27 +293,29 @@ def test_commands_for_another_device_number_are_ignored(
 
 
 def test_a_maestro_that_never_answers_times_out_naming_the_port(
-    port: serial.Serial, emulator: MaestroEmulator
+    port: serial.Serial, emulator: MaestroEmulator, clock: VirtualClock
 ) -> None:
     port.timeout = 0.05
-    other = Maestro(port, device=13, protocol="pololu")
+    other = Maestro(port, device=13, protocol="pololu", clock=clock)
     with pytest.raises(DeviceError, match=emulator.port_name) as raised:
         other.get_position_us(0)
     assert "no reply to Get Position" in str(raised.value)
     assert raised.value.errno == errno.ETIMEDOUT
 
 
-def test_a_borrowed_port_without_timeout_is_refused(emulator: MaestroEmulator) -> None:
+def test_a_borrowed_port_without_timeout_is_refused(
+    emulator: MaestroEmulator, clock: VirtualClock
+) -> None:
     with (
         serial.Serial(emulator.port_name, timeout=None) as port,
         pytest.raises(ValueError, match="timeout"),
     ):
-        Maestro(port)
+        Maestro(port, clock=clock)
 
 
-def test_device_numbers_are_7_bit(port: serial.Serial) -> None:
+def test_device_numbers_are_7_bit(port: serial.Serial, clock: VirtualClock) -> None:
     with pytest.raises(ValueError, match="128"):
-        Maestro(port, device=128, protocol="pololu")
+        Maestro(port, device=128, protocol="pololu", clock=clock)
 
 
 # --- who owns the port ------------------------------------------------------------------
@@ -334,18 +338,23 @@ def test_a_borrowed_port_stays_open(port: serial.Serial, clock: VirtualClock) ->
     with Maestro(port, clock=clock) as maestro:
         maestro.set_target_us(0, 1500)
     assert port.is_open
-    assert Maestro(port).get_position_us(0) == 1500.0
+    assert Maestro(port, clock=clock).get_position_us(0) == 1500.0
 
 
-def test_a_port_opened_by_name_is_not_shared(emulator: MaestroEmulator) -> None:
-    with Maestro(emulator.port_name), pytest.raises(DeviceError, match="busy") as raised:
-        Maestro(emulator.port_name)
+def test_a_port_opened_by_name_is_not_shared(
+    emulator: MaestroEmulator, clock: VirtualClock
+) -> None:
+    with (
+        Maestro(emulator.port_name, clock=clock),
+        pytest.raises(DeviceError, match="busy") as raised,
+    ):
+        Maestro(emulator.port_name, clock=clock)
     assert emulator.port_name in str(raised.value)
 
 
 def test_a_missing_port_names_the_path_and_says_no_such_file() -> None:
     with pytest.raises(DeviceError, match="/dev/ttyNOMAESTRO") as raised:
-        Maestro("/dev/ttyNOMAESTRO")
+        Maestro("/dev/ttyNOMAESTRO", clock=VirtualClock())
     assert "no such file" in str(raised.value)
     assert raised.value.errno == errno.ENOENT
 
@@ -410,3 +419,58 @@ def test_a_maestro_not_plugged_in_at_start_up_is_opened_by_the_first_command_aft
         maestro.close()
         if emulator is not None:
             emulator.close()
+
+
+# --- a Maestro that never answers ---------------------------------------------------------
+
+
+@pytest.fixture
+def silent_port() -> Iterator[serial.Serial]:
+    """A serial port that takes every byte and never answers: a pseudo-terminal whose other
+    end nobody serves (a Maestro without power behind its USB adapter, a wrong port)."""
+    controller, terminal = pty.openpty()
+    tty.setraw(terminal)
+    try:
+        with serial.Serial(os.ttyname(terminal), timeout=0.05) as port:
+            yield port
+    finally:
+        os.close(terminal)
+        os.close(controller)
+
+
+def test_a_silent_maestro_takes_commands_but_its_queries_time_out_naming_the_port(
+    silent_port: serial.Serial, clock: VirtualClock
+) -> None:
+    maestro = Maestro(silent_port, clock=clock)
+    maestro.set_target_us(0, 1500)  # a command has no reply: nothing to notice yet
+    with pytest.raises(DeviceError, match="no reply to Get Position") as raised:
+        maestro.get_position_us(0)
+    assert silent_port.name in str(raised.value)
+    assert raised.value.errno == errno.ETIMEDOUT
+    with pytest.raises(DeviceError, match="no reply to Get Errors"):
+        maestro.get_errors()
+
+
+def test_moves_to_a_silent_maestro_fail_and_it_goes_offline(
+    silent_port: serial.Serial, clock: VirtualClock
+) -> None:
+    maestro = Maestro(silent_port, clock=clock)
+    statuses: list[tuple[str, bool]] = []
+    manager = BusManager(
+        maestro,
+        name=silent_port.name,
+        clock=clock,
+        kind="serial",
+        threaded=False,
+        on_status=lambda device, ok: statuses.append((device, ok)),
+    )
+    servos = manager.claim("servos")
+    joints = ServoJoints(maestro, [Joint("neck_pan", 0, -60.0, 60.0, 120.0)], clock=clock)
+
+    for angle_deg in (10.0, 20.0, 30.0):
+        with pytest.raises(DeviceError, match="no reply to Get Position"):
+            servos.call(lambda _: joints.move("neck_pan", angle_deg))  # noqa: B023
+
+    assert not servos.online
+    assert statuses == [("servos", True), ("servos", False)]
+    assert servos.stats().errors == 3

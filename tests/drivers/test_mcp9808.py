@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from typing import Any
+
 import pytest
 
 from engine.clock import VirtualClock
@@ -196,3 +199,17 @@ def test_pure_conversions() -> None:
     assert celsius_to_limit_word(40.1) == 0x0280
     with pytest.raises(ValueError, match="limit"):
         celsius_to_limit_word(300.0)
+
+
+def test_garbage_never_becomes_a_temperature_outside_the_chips_range(
+    chip: SimMCP9808, bus: SimI2CBus, read_garbage: Callable[..., Any]
+) -> None:
+    # "The temperature is -102 degrees" must never be said: the chip works at -40..125 C.
+    sensor = MCP9808(bus)
+    readings = read_garbage(bus, ADDRESS, sensor.read_temperature_c)
+    assert readings.refused
+    assert all(-40.0 <= celsius <= 125.0 for celsius in readings.believed)
+    refusal = readings.refused[0]
+    assert isinstance(refusal, DeviceError) and isinstance(refusal, ValueError)
+    assert "MCP9808 at I2C 0x18: temperature" in str(refusal)
+    assert "-40..125 degC" in str(refusal)

@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from typing import Any
+
 import pytest
 
 from engine.clock import VirtualClock
@@ -171,3 +174,14 @@ def test_pad_outside_0_to_11_is_a_value_error(bus: SimI2CBus, chip: SimMPR121) -
         pads.filtered_data(12)
     with pytest.raises(ValueError, match="pad 12"):
         chip.touch(12)
+
+
+def test_garbage_never_becomes_phantom_touches(
+    chip: SimMPR121, bus: SimI2CBus, read_garbage: Callable[..., Any]
+) -> None:
+    pads = MPR121(bus)
+    readings = read_garbage(bus, 0x5A, pads.touched)
+    # a status with proximity, reserved or over-current bits set is refused; only the
+    # rare garbage that looks like a plain touch status can pass
+    assert len(readings.refused) > 0.8 * 200
+    assert "MPR121 at I2C 0x5A: touch status" in str(readings.refused[0])

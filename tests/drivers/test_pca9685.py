@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
+from typing import Any
 
 import pytest
 
@@ -195,3 +197,14 @@ def test_duty_counts_round_trip():
         assert counts_to_duty(*duty_to_counts(fraction)) == pytest.approx(fraction, abs=1 / 8192)
     assert counts_to_duty(0x1000, 0x1000) == 0.0  # full off wins over full on
     assert counts_to_duty(4000, 100) == pytest.approx(196 / 4096)  # on late, off after wrap
+
+
+def test_garbage_never_becomes_a_frequency_the_chip_cannot_run_at(
+    bus: SimI2CBus, clock: VirtualClock, read_garbage: Callable[..., Any]
+) -> None:
+    bus.attach(SimPCA9685(clock))
+    pwm = PCA9685(bus, clock=clock)
+    readings = read_garbage(bus, 0x40, lambda: pwm.frequency_hz, times=500)
+    assert readings.refused
+    assert all(hz <= 25e6 / (4096 * 4) for hz in readings.believed)
+    assert "PCA9685 at I2C 0x40: PRE_SCALE" in str(readings.refused[0])

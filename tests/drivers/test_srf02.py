@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from typing import Any
+
 import pytest
 
 from engine.clock import VirtualClock
@@ -165,3 +168,14 @@ def test_missing_chip_raises_device_error_naming_chip_and_address(
 ) -> None:
     with pytest.raises(DeviceError, match=r"SRF02 not found at I2C 0x71"):
         SRF02(bus, address=0x71, clock=clock)
+
+
+def test_garbage_never_becomes_a_range_the_chip_cannot_report(
+    chip: SimSRF02, bus: SimI2CBus, read_garbage: Callable[..., Any]
+) -> None:
+    # "8146 cm away" must never be said: the SRF02 reports 0 (no echo) or 15..600 cm.
+    ranger = SRF02(bus, clock=bus.clock)
+    readings = read_garbage(bus, 0x70, ranger.read_range_cm)
+    assert readings.refused
+    assert all(cm == 0 or 15 <= cm <= 600 for cm in readings.believed)
+    assert "SRF02 at I2C 0x70: range" in str(readings.refused[0])

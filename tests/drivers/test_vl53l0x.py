@@ -2,15 +2,16 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from typing import Any
+
 import pytest
 
 from engine.clock import VirtualClock
-from engine.drivers.sim.gpio import SimOutputLine
 from engine.drivers.sim.i2c_bus import SimI2CBus, SimI2CDevice
 from engine.drivers.sim.vl53l0x import SimVL53L0X
 from engine.drivers.vl53l0x import (
     VL53L0X,
-    bring_up_chain,
     decode_range,
     device_range_status,
     signal_rate_limit_to_register,
@@ -158,49 +159,6 @@ def test_xshut_low_silences_the_chip_and_forgets_its_address(clock, bus, chip):
     assert bus.read_byte_data(0x29, 0xC0) == 0xEE
 
 
-def test_three_sensors_brought_up_through_xshut_each_read_their_own_distance(clock, bus):
-    chips = [SimVL53L0X(clock, bus, xshut_high=False) for _ in range(3)]
-    lines = [SimOutputLine(chip.set_xshut) for chip in chips]
-    for chip, distance in zip(chips, (150, 450, 900), strict=True):
-        chip.distance_mm = distance
-
-    left, centre, right = bring_up_chain(bus, lines, [0x30, 0x31, 0x32], clock=clock)
-
-    assert bus.addresses == [0x30, 0x31, 0x32]
-    assert [s.address for s in (left, centre, right)] == [0x30, 0x31, 0x32]
-    assert [s.read_range_mm() for s in (left, centre, right)] == [150, 450, 900]
-
-
-def test_the_chain_comes_up_again_after_a_restart(clock, bus):
-    chips = [SimVL53L0X(clock, bus, xshut_high=False) for _ in range(3)]
-    lines = [SimOutputLine(chip.set_xshut) for chip in chips]
-    bring_up_chain(bus, lines, [0x30, 0x31, 0x32], clock=clock)
-    chips[1].distance_mm = 321
-
-    # The engine restarts: the chips still sit at their new addresses until XSHUT drops.
-    sensors = bring_up_chain(bus, lines, [0x30, 0x31, 0x32], clock=clock)
-
-    assert bus.addresses == [0x30, 0x31, 0x32]
-    assert sensors[1].read_range_mm() == 321
-
-
-def test_a_dead_sensor_in_the_chain_is_named_by_position(clock, bus):
-    chips = [SimVL53L0X(clock, bus, xshut_high=False) for _ in range(2)]
-    lines = [SimOutputLine(chips[0].set_xshut), SimOutputLine(lambda high: None)]
-    with pytest.raises(DeviceError, match=r"#2 of the XSHUT chain \(for 0x31\)"):
-        bring_up_chain(bus, lines, [0x30, 0x31], clock=clock)
-
-
-def test_the_chain_needs_one_distinct_address_per_line(clock, bus):
-    lines = [SimOutputLine(lambda high: None) for _ in range(2)]
-    with pytest.raises(ValueError, match="2 XSHUT lines but 3 addresses"):
-        bring_up_chain(bus, lines, [0x30, 0x31, 0x32], clock=clock)
-    with pytest.raises(ValueError, match="must differ"):
-        bring_up_chain(bus, lines, [0x30, 0x30], clock=clock)
-    with pytest.raises(ValueError, match="only be the last"):
-        bring_up_chain(bus, lines, [0x29, 0x30], clock=clock)
-
-
 # -- pure conversions ---------------------------------------------------------------------------
 def test_range_decoding():
     valid = 11 << 3
@@ -218,3 +176,13 @@ def test_signal_rate_limit_is_q9_7():
         signal_rate_limit_to_register(-1)
     with pytest.raises(ValueError, match="512"):
         signal_rate_limit_to_register(512)
+
+
+def test_garbage_never_becomes_a_valid_distance_past_two_metres(
+    clock: VirtualClock, bus: SimI2CBus, chip: SimVL53L0X, read_garbage: Callable[..., Any]
+) -> None:
+    sensor = VL53L0X(bus, clock=clock)
+    readings = read_garbage(bus, 0x29, sensor.read_range_mm)
+    assert readings.refused
+    assert all(mm is None or 0 <= mm <= 2000 for mm in readings.believed)
+    assert any("VL53L0X at I2C 0x29: range with a valid status" in str(r) for r in readings.refused)

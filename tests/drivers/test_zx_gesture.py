@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from typing import Any
+
 import pytest
 
 from engine.clock import VirtualClock
@@ -130,3 +133,21 @@ def test_a_gesture_the_chip_latched_before_the_driver_started_is_not_reported(bu
     assert sensor.read_gesture() is None
     chip.perform("swipe_left")
     assert sensor.read_gesture() == "swipe_left"
+
+
+def test_garbage_never_becomes_a_phantom_gesture(
+    bus: SimI2CBus, sensor: ZXGesture, read_garbage: Callable[..., Any]
+) -> None:
+    readings = read_garbage(bus, 0x10, sensor.read_gesture)
+    assert readings.refused
+    known = {"swipe_right", "swipe_left", "swipe_up", "hover", "hover_left", "hover_right"}
+    assert all(g is None or g in known | {"hover_up"} for g in readings.believed)
+    assert "ZX gesture sensor at I2C 0x10: gesture code" in str(readings.refused[0])
+
+
+def test_garbage_never_becomes_a_hand_position_beyond_240(
+    bus: SimI2CBus, sensor: ZXGesture, read_garbage: Callable[..., Any]
+) -> None:
+    readings = read_garbage(bus, 0x10, sensor.read_position)
+    assert readings.refused
+    assert all(p is None or max(p) <= 240 for p in readings.believed)

@@ -21,6 +21,7 @@ from dataclasses import dataclass
 from smbus2 import i2c_msg
 
 from engine.clock import Clock
+from engine.drivers.bus_protocols import I2CBus
 
 I2C_M_RD = 0x0001
 
@@ -74,7 +75,7 @@ class _Fault:
     until_s: float
 
 
-class SimI2CBus:
+class SimI2CBus(I2CBus):
     """An ``smbus2.SMBus``-compatible bus whose chips are Python models.
 
     ``bus_number`` is only used in messages. Thread-safe: one transfer at a time.
@@ -174,13 +175,13 @@ class SimI2CBus:
             for address, is_read, payload in messages:
                 device, garbage = self._target(address)
                 if is_read:
-                    length = int(payload)  # type: ignore[arg-type]
+                    length = int(payload)
                     data = device.read(length)
                     if garbage:
                         data = bytes(self._random.randrange(256) for _ in range(length))
                     results.append(bytes(data))
                 else:
-                    device.write(bytes(payload))  # type: ignore[arg-type]
+                    device.write(bytes(payload))
         return results
 
     def _write(self, address: int, data: Iterable[int]) -> None:

@@ -39,7 +39,7 @@ from types import TracebackType
 from typing import Literal, Self
 
 from engine.clock import Clock
-from engine.drivers.maestro import (
+from engine.drivers.maestro_protocol import (
     CMD_GET_ERRORS,
     CMD_GET_MOVING_STATE,
     CMD_GET_POSITION,

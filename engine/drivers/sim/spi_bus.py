@@ -24,6 +24,8 @@ import os
 import random
 from collections.abc import Sequence
 
+from engine.drivers.bus_protocols import SpiDevice
+
 Bit = int | None
 
 
@@ -43,7 +45,7 @@ def _reverse_bits(byte: int) -> int:
     return int(f"{byte:08b}"[::-1], 2)
 
 
-class SimSpiDev:
+class SimSpiDev(SpiDevice):
     """An ``spidev.SpiDev``-compatible node with ``chip`` behind its chip select.
 
     Like ``spidev.SpiDev(bus, device)``, giving ``bus`` and ``device`` opens the node at
