@@ -7,22 +7,21 @@ chip models that the real drivers read. --hardware CONFIG names a robot config; 
 --fast runs on a virtual clock as fast as the machine allows; --json prints one JSON
 object per robot action: {"t": seconds, "tree": name, "action": ..., "args": {...}}.
 In real time, a changed tree file is reloaded between ticks (an invalid change keeps the
-running tree); Ctrl-C or SIGTERM stops cleanly.
+running tree); Ctrl-C or SIGTERM stops cleanly at any moment, start-up included. The
+timeline never stops the robot: if it cannot be written (a full disk), that is said once
+on stderr, the run goes on, and it exits 1.
 """
 
 from __future__ import annotations
 
 import argparse
 import math
-import signal
 import sys
-from collections.abc import Iterator
-from contextlib import contextmanager
 from pathlib import Path
-from types import FrameType
 
 from engine.blackboard.board import Blackboard
 from engine.blackboard.catalogue import default_catalogue
+from engine.cli.output import tell
 from engine.cli.timeline import Timeline
 from engine.clock import Clock, RealClock, VirtualClock
 from engine.errors import ConfigError
@@ -32,7 +31,6 @@ from engine.hardware.config import load_robot_config
 from engine.hardware.sim_vest import UnwiredSenses, build_sim_vest, check_fault_events
 from engine.runtime.reload import TreeReloader
 from engine.runtime.robot import Robot, load_behaviors
-from engine.runtime.scheduler import Scheduler
 from engine.scenario.player import ScenarioPlayer
 from engine.scenario.scenario_file import Scenario, load_scenario
 from engine.scenario.world import World
@@ -144,7 +142,7 @@ def main(args: argparse.Namespace) -> int:
         start_s = clock.now()  # after start-up, which takes simulated time too
         timeline = Timeline(sys.stdout, start_s=start_s, as_json=args.json)
         for name, why in hardware.startup_problems.items():
-            print(f"warning: {name} did not start ({why}); it will be tried again", file=sys.stderr)
+            tell(f"warning: {name} did not start ({why}); it will be tried again")
         log = ActionLog(listeners=[timeline.action], failure_listeners=[timeline.failed])
         blackboard.watchers.append(
             lambda key, value: timeline.blackboard_write(key, value, clock.now())
@@ -163,17 +161,18 @@ def main(args: argparse.Namespace) -> int:
         if not args.fast:
             robot.scheduler.hooks.append(TreeReloader(behaviors.loader, robot.trees, clock))
         duration = args.duration if args.duration is not None else scenario.duration_s
-        with _stopped_by_signals(robot.scheduler):
-            timeline.start()
-            first_tick_s = clock.now()
-            hardware.start(origin_s=first_tick_s)  # readings staged just before each tick
-            robot.scheduler.run(until_s=start_s + duration, start_s=first_tick_s)
+        # a signal that came during start-up stops the run before its first tick
+        args.stop_signals.on_stop(robot.scheduler.stop)
+        timeline.start()
+        first_tick_s = clock.now()
+        hardware.start(origin_s=first_tick_s)  # readings staged just before each tick
+        robot.scheduler.run(until_s=start_s + duration, start_s=first_tick_s)
         timeline.summary(robot.trees)
     finally:
         hardware.close()
         if vest is not None:
             vest.close()
-    return 0
+    return 0 if timeline.write_error is None else 1  # the robot ran; its timeline was lost
 
 
 def _scenario(path: Path | None, *, simulated: bool) -> Scenario:
@@ -184,18 +183,3 @@ def _scenario(path: Path | None, *, simulated: bool) -> Scenario:
     if simulated:
         return load_scenario(DEFAULT_SCENARIO)
     return Scenario(duration_s=math.inf, events=(), path=Path("(no scenario)"))
-
-
-@contextmanager
-def _stopped_by_signals(scheduler: Scheduler) -> Iterator[None]:
-    """Ctrl-C and SIGTERM ask the scheduler to stop after the current tick."""
-
-    def stop(signum: int, frame: FrameType | None) -> None:
-        scheduler.stop()
-
-    previous = {sig: signal.signal(sig, stop) for sig in (signal.SIGINT, signal.SIGTERM)}
-    try:
-        yield
-    finally:
-        for sig, handler in previous.items():
-            signal.signal(sig, handler)
