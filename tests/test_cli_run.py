@@ -217,7 +217,7 @@ def test_on_a_robot_without_its_buses_vest_run_exits_3_naming_the_missing_bus(ca
 
 
 def test_a_real_robot_plays_no_scenario_unless_asked_and_runs_until_stopped():
-    from engine.cli.run_command import _scenario
+    from engine.cli.run_inputs import default_scenario as _scenario
 
     on_the_robot = _scenario(None, simulated=False)
     assert on_the_robot.events == ()

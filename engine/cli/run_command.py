@@ -15,31 +15,26 @@ on stderr, the run goes on, and it exits 1.
 from __future__ import annotations
 
 import argparse
-import math
 import sys
 from pathlib import Path
 
 from engine.blackboard.board import Blackboard
 from engine.blackboard.catalogue import default_catalogue
 from engine.cli.output import tell
+from engine.cli.run_inputs import DEFAULT_HARDWARE, load_run_inputs
 from engine.cli.timeline import Timeline
 from engine.clock import Clock, RealClock, VirtualClock
 from engine.errors import ConfigError
-from engine.files.problems import LoadError, Mark, Problem
 from engine.hardware.assembly import build_hardware
-from engine.hardware.config import load_robot_config
-from engine.hardware.sim_vest import UnwiredSenses, build_sim_vest, check_fault_events
+from engine.hardware.sim_vest import UnwiredSenses, build_sim_vest
 from engine.runtime.reload import TreeReloader
-from engine.runtime.robot import Robot, load_behaviors
+from engine.runtime.robot import Robot
 from engine.scenario.player import ScenarioPlayer
-from engine.scenario.scenario_file import Scenario, load_scenario
 from engine.scenario.world import World
 from engine.services.actions import ActionLog
 from engine.services.simulated import simulated_services
 
 NAME = "run"
-DEFAULT_DIALOGS = Path("dialogs")
-DEFAULT_SCENARIO = Path("examples/scenarios/demo.yaml")
 HELP = "run the behaviors (default: the demo scenario on the simulated vest)"
 
 
@@ -53,7 +48,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="tree files or folders (default: trees/)",
     )
     parser.add_argument(
-        "--dialogs", type=Path, default=DEFAULT_DIALOGS, help="dialogs folder (default: dialogs/)"
+        "--dialogs", type=Path, default=None, help="dialogs folder (default: dialogs/)"
     )
     parser.add_argument(
         "--profile",
@@ -81,7 +76,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--hardware",
         type=Path,
-        default=Path("examples/robots/sim.yaml"),
+        default=DEFAULT_HARDWARE,
         metavar="CONFIG",
         help="robot config (default: examples/robots/sim.yaml, the simulated vest)",
     )
@@ -97,38 +92,16 @@ def _positive_seconds(text: str) -> float:
     return value
 
 
-def resolve_profile(value: str | None, trees: list[Path]) -> Path | None:
-    if value is None:
-        return None
-    path = Path(value)
-    if path.suffix in (".yaml", ".yml") or path.exists():
-        return path
-    for folder in trees:
-        candidate = (folder if folder.is_dir() else folder.parent) / "profiles" / f"{value}.yaml"
-        if candidate.exists():
-            return candidate
-    raise LoadError(
-        [Problem(Mark(value, 1, 1), "no such profile", "give a file or a name in trees/profiles/")]
-    )
-
-
 def main(args: argparse.Namespace) -> int:
-    for path in args.trees:
-        if not path.exists():
-            raise ConfigError(
-                f"{path}: no such file or folder (run from the project folder or pass --trees)"
-            )
-    dialogs = args.dialogs if args.dialogs.is_dir() else None
-    if dialogs is None and args.dialogs != DEFAULT_DIALOGS:
-        raise ConfigError(f"--dialogs {args.dialogs}: no such folder")
-    behaviors = load_behaviors(
-        args.trees, dialogs_dir=dialogs, profile=resolve_profile(args.profile, args.trees)
+    # the same checks as `vest validate`: every problem of every file, before anything starts
+    inputs = load_run_inputs(
+        args.trees,
+        dialogs=args.dialogs,
+        profile=args.profile,
+        hardware=args.hardware,
+        scenario=args.scenario,
     )
-    config = load_robot_config(args.hardware)
-    scenario = _scenario(args.scenario, simulated=config.simulated)
-    problems = check_fault_events(scenario.events, config)
-    if problems:
-        raise LoadError(problems)
+    behaviors, config, scenario = inputs.behaviors, inputs.config, inputs.scenario
     if args.fast and not config.simulated:
         raise ConfigError(f"{args.hardware}: --fast needs a simulated vest (simulated: true)")
     clock: Clock = VirtualClock() if args.fast else RealClock()
@@ -173,13 +146,3 @@ def main(args: argparse.Namespace) -> int:
         if vest is not None:
             vest.close()
     return 0 if timeline.write_error is None else 1  # the robot ran; its timeline was lost
-
-
-def _scenario(path: Path | None, *, simulated: bool) -> Scenario:
-    """The named scenario; by default the demo on the simulated vest, and on a real robot
-    nothing scripted (the world is real) for as long as it runs."""
-    if path is not None:
-        return load_scenario(path)
-    if simulated:
-        return load_scenario(DEFAULT_SCENARIO)
-    return Scenario(duration_s=math.inf, events=(), path=Path("(no scenario)"))

@@ -2,6 +2,9 @@
 
 Give files or folders (searched recursively for *.yaml). Prints "ok" when everything is
 valid; otherwise every problem as file:line:column: message (hint), and exits 1.
+The checks are those ``vest run`` makes before it starts: trees are checked against the
+robot config (--hardware, default examples/robots/sim.yaml: its devices, its 12 touch
+pads), the dialogs of a folder together (two with one name), scenarios against the robot.
 """
 
 from __future__ import annotations
@@ -9,16 +12,25 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from engine.blackboard.catalogue import KeyCatalogue, default_catalogue
+from engine.cli.run_inputs import (
+    DEFAULT_DIALOGS,
+    DEFAULT_HARDWARE,
+    check_items,
+    check_scenario_events,
+    dialogs_folder,
+    list_lengths,
+    load_config,
+    robot_catalogue,
+)
 from engine.dialogs.library import DialogLibrary, check_dialog, find_dialogs_folder
 from engine.files.problems import LoadError, Mark, Problem, Problems
 from engine.files.yaml_source import YMap, YScalar, load_yaml
-from engine.hardware.config import check_robot_config
+from engine.hardware.config import RobotConfig
 from engine.loader.substitution import Profile, load_profile, undeclared_params
 from engine.loader.tree_file import TreeLoader
 from engine.nodes.registry import NodeRegistry, default_registry
 from engine.runtime.robot import declared_beside, tree_files
-from engine.scenario.scenario_file import check_scenario
+from engine.scenario.scenario_file import load_scenario
 from engine.values.params import did_you_mean
 
 NAME = "validate"
@@ -32,6 +44,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         type=Path,
         default=None,
         help="dialogs folder (default: the nearest dialogs/ above each file)",
+    )
+    parser.add_argument(
+        "--hardware",
+        type=Path,
+        default=None,
+        metavar="CONFIG",
+        help=f"robot config the trees and scenarios run on (default: {DEFAULT_HARDWARE} "
+        "when there is one)",
     )
 
 
@@ -68,26 +88,44 @@ def kind_of(document: object) -> str | None:
 
 
 class Validator:
+    """Checks files one by one with the checks ``vest run`` makes (engine.cli.run_inputs)."""
+
     def __init__(
-        self, registry: NodeRegistry, catalogue: KeyCatalogue, dialogs_dir: Path | None
+        self,
+        registry: NodeRegistry,
+        config: RobotConfig | None,
+        dialogs_dir: Path | None,
+        problems: Problems | None = None,
     ) -> None:
         self.registry = registry
-        self.catalogue = catalogue
+        self.config = config
+        self.catalogue = robot_catalogue(config)
+        self.lengths = list_lengths(config)
         self.dialogs_dir = dialogs_dir
-        self.problems = Problems()
+        self.problems = problems if problems is not None else Problems()
         self._dialogs: dict[Path, DialogLibrary | None] = {}
 
     def dialogs_for(self, path: Path) -> DialogLibrary | None:
+        """The dialogs a tree at ``path`` uses, or None when there are none to check
+        against (none found, or they have problems of their own, told once)."""
         folder = self.dialogs_dir or find_dialogs_folder(path)
-        if folder is None:
-            return None
-        if folder not in self._dialogs:
+        return self.dialog_library(folder) if folder is not None else None
+
+    def dialog_library(self, folder: Path) -> DialogLibrary | None:
+        """The folder's dialogs loaded as ``vest run`` loads them (so two dialogs with one
+        name are found), once per folder however it is named."""
+        key = folder.resolve()
+        if key not in self._dialogs:
             try:
-                self._dialogs[folder] = DialogLibrary.from_folder(folder, self.catalogue)
+                self._dialogs[key] = DialogLibrary.from_folder(folder, self.catalogue)
             except LoadError as error:
                 self.problems.extend(error.problems)
-                self._dialogs[folder] = None
-        return self._dialogs[folder]
+                self._dialogs[key] = None
+        return self._dialogs[key]
+
+    def is_dialogs_folder(self, folder: Path) -> bool:
+        given = self.dialogs_dir is not None and folder.resolve() == self.dialogs_dir.resolve()
+        return given or folder.name == DEFAULT_DIALOGS.name
 
     def loader_for(self, path: Path, profile: Profile | None = None) -> TreeLoader:
         return TreeLoader(
@@ -103,15 +141,19 @@ class Validator:
         kind = kind_of(document)
         try:
             if kind == "tree":
-                self.loader_for(path).load(path)
+                self.problems.extend(check_items(self.loader_for(path).load(path), self.lengths))
             elif kind == "profile":
                 self.check_profile(path)
-            elif kind == "dialog":
+            elif kind == "dialog" and self.is_dialogs_folder(path.parent):
+                self.dialog_library(path.parent)
+            elif kind == "dialog":  # a dialog kept elsewhere is checked on its own
                 check_dialog(document, str(path), self.catalogue, default_name=path.stem)
             elif kind == "scenario":
-                check_scenario(document, str(path), path)
+                scenario = load_scenario(path)
+                if self.config is not None:
+                    self.problems.extend(check_scenario_events(scenario.events, self.config))
             elif kind == "robot config":
-                check_robot_config(document, str(path), path, catalogue=self.catalogue)
+                load_config(path, self.problems)
             else:
                 where = document.mark if document is not None else Mark(str(path), 1, 1)
                 self.problems.add(
@@ -160,7 +202,11 @@ class Validator:
 
 def main(args: argparse.Namespace) -> int:
     files = yaml_files(args.paths)
-    validator = Validator(default_registry(), default_catalogue(), args.dialogs)
+    problems = Problems()
+    hardware = args.hardware or (DEFAULT_HARDWARE if DEFAULT_HARDWARE.is_file() else None)
+    config = load_config(hardware, problems) if hardware is not None else None
+    dialogs = dialogs_folder(args.dialogs) if args.dialogs is not None else None
+    validator = Validator(default_registry(), config, dialogs, problems)
     for path in args.paths:
         if not path.exists():
             validator.problems.add(Mark(str(path), 1, 1), "no such file or folder")
@@ -168,7 +214,8 @@ def main(args: argparse.Namespace) -> int:
         validator.check(path)
     validator.check_tree_names(files)
     if validator.problems:
-        raise LoadError(validator.problems.items)
+        # a file met twice (a dialog beside its tree, the robot config named) is told once
+        raise LoadError(list(dict.fromkeys(validator.problems.items)))
     if not files:
         raise LoadError([Problem(Mark(str(args.paths[0]), 1, 1), "no YAML files found")])
     print(f"ok: {len(files)} file{'s' if len(files) != 1 else ''}")
