@@ -112,7 +112,7 @@ def test_spoken_text_with_a_newline_and_a_terminal_escape_stays_on_its_own_line(
 def test_ordinary_text_in_any_script_is_shown_as_written() -> None:
     for text in ("I love hugs!", "café, नमस्ते, 你好", "non\u00a0breaking space"):
         assert shown(text) == text
-    assert shown("a\tb\\c\u2028d") == "a\\tb\\\\c\\u2028d"
+    assert shown("a\tb\\c\u2028d") == "a\\tb\\c\\u2028d"  # a backslash stays as written
 
 
 def test_json_lines_are_strict_json_with_null_for_numbers_that_are_not_finite() -> None:

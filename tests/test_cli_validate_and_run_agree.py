@@ -179,3 +179,15 @@ def test_a_profile_name_that_does_not_exist_is_told_with_the_nearest(capsys, mon
         assert capsys.readouterr().err == (
             f"vest {command[0]}: --profile chlid: no such profile (did you mean 'child'?)\n"
         )
+
+
+def test_validate_checks_the_trees_with_a_profile_given_by_name_or_path(
+    tmp_path, capsys, monkeypatch
+):
+    monkeypatch.chdir(ROOT)
+    assert main(["validate", "trees/", "--profile", "child"]) == 0
+    capsys.readouterr()
+    profile = write(tmp_path / "kid.yaml", "profile: kid\nparams:\n  hug_treshold_n: 2.0\n")
+    [line] = problems_told(capsys, "validate", "trees/", "--profile", str(profile))
+    assert line.startswith(f"{profile}:3:19: no tree in the trees given declares parameter")
+    assert "(did you mean 'hug_threshold_n'?)" in line

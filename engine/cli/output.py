@@ -21,20 +21,16 @@ _UNSAFE_CATEGORIES = frozenset({"Cc", "Zl", "Zp"})
 
 
 def shown(text: str) -> str:
-    """``text`` with control characters, line separators and backslashes escaped the way
-    Python's repr writes them (``\\x1b``, ``\\n``, ``\\u2028``, ``\\\\``); other text,
-    accents and every script included, is unchanged."""
-    if text.isprintable() and "\\" not in text:
+    """``text`` with control characters and line separators escaped the way Python's repr
+    writes them (``\\x1b``, ``\\n``, ``\\u2028``); other text, accents and every script
+    included, is unchanged. Backslashes are kept as written: a human timeline stays
+    readable, and a real newline or escape can never come through."""
+    if text.isprintable():
         return text  # the common case, without a walk over each character
-    parts: list[str] = []
-    for char in text:
-        if char == "\\":
-            parts.append("\\\\")
-        elif unicodedata.category(char) in _UNSAFE_CATEGORIES:
-            parts.append(repr(char)[1:-1])
-        else:
-            parts.append(char)
-    return "".join(parts)
+    return "".join(
+        repr(char)[1:-1] if unicodedata.category(char) in _UNSAFE_CATEGORIES else char
+        for char in text
+    )
 
 
 def finite_json(value: Any) -> Any:

@@ -20,6 +20,7 @@ from engine.cli.run_inputs import (
     dialogs_folder,
     list_lengths,
     load_config,
+    resolve_profile,
     robot_catalogue,
 )
 from engine.dialogs.library import DialogLibrary, check_dialog, find_dialogs_folder
@@ -44,6 +45,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         type=Path,
         default=None,
         help="dialogs folder (default: the nearest dialogs/ above each file)",
+    )
+    parser.add_argument(
+        "--profile",
+        default=None,
+        help="check the trees with this profile: a file, or a name in trees/profiles/ "
+        "(child, adult), as vest run takes it",
     )
     parser.add_argument(
         "--hardware",
@@ -104,6 +111,10 @@ class Validator:
         self.dialogs_dir = dialogs_dir
         self.problems = problems if problems is not None else Problems()
         self._dialogs: dict[Path, DialogLibrary | None] = {}
+        self.profile: Profile | None = None
+        """The profile trees are checked with (``--profile``), as ``vest run`` applies it."""
+        self.declared: set[str] = set()
+        """Parameters the trees checked so far declare."""
 
     def dialogs_for(self, path: Path) -> DialogLibrary | None:
         """The dialogs a tree at ``path`` uses, or None when there are none to check
@@ -128,8 +139,12 @@ class Validator:
         return given or folder.name == DEFAULT_DIALOGS.name
 
     def loader_for(self, path: Path, profile: Profile | None = None) -> TreeLoader:
+        """A loader for the tree at ``path`` with ``profile`` (default: the one given)."""
         return TreeLoader(
-            self.registry, self.catalogue, dialogs=self.dialogs_for(path), profile=profile
+            self.registry,
+            self.catalogue,
+            dialogs=self.dialogs_for(path),
+            profile=profile or self.profile,
         )
 
     def check(self, path: Path) -> None:
@@ -141,7 +156,9 @@ class Validator:
         kind = kind_of(document)
         try:
             if kind == "tree":
-                self.problems.extend(check_items(self.loader_for(path).load(path), self.lengths))
+                definition = self.loader_for(path).load(path)
+                self.declared |= definition.declared_params
+                self.problems.extend(check_items(definition, self.lengths))
             elif kind == "profile":
                 self.check_profile(path)
             elif kind == "dialog" and self.is_dialogs_folder(path.parent):
@@ -207,12 +224,27 @@ def main(args: argparse.Namespace) -> int:
     config = load_config(hardware, problems) if hardware is not None else None
     dialogs = dialogs_folder(args.dialogs) if args.dialogs is not None else None
     validator = Validator(default_registry(), config, dialogs, problems)
+    profile = resolve_profile(args.profile, args.paths)
+    if profile is not None:
+        try:
+            validator.profile = load_profile(profile)
+        except LoadError as error:
+            problems.extend(error.problems)
     for path in args.paths:
         if not path.exists():
             validator.problems.add(Mark(str(path), 1, 1), "no such file or folder")
     for path in files:
         validator.check(path)
     validator.check_tree_names(files)
+    if validator.profile is not None and profile is not None and validator.declared:
+        # as vest run: the profile sets only parameters the trees (or those beside it)
+        # declare; told once the trees load (a tree that failed has declared nothing)
+        where = (
+            f"{profile.parent.parent}/" if profile.parent.name == "profiles" else "the trees given"
+        )
+        declared = validator.declared | declared_beside(profile)
+        if not problems:
+            problems.extend(undeclared_params(validator.profile, declared, where))
     if validator.problems:
         # a file met twice (a dialog beside its tree, the robot config named) is told once
         raise LoadError(list(dict.fromkeys(validator.problems.items)))
