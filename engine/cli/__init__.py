@@ -1,8 +1,10 @@
 """The ``vest`` command line.
 
-Exit codes: 0 success; 1 a file has problems (each printed as file:line:column); 2 the
-command line is wrong; 3 something needed is missing on this machine (Graphviz, a bus, a
-port, a device file).
+Exit codes: 0 success; 1 a file has problems (each printed as file:line:column), or the
+output could not be written (one line on stderr, never a traceback); 2 the command line is
+wrong; 3 something needed is missing on this machine (Graphviz, a bus, a port, a device
+file); 130 a command other than ``vest run`` was stopped by Ctrl-C or SIGTERM (``vest run``
+stops cleanly, with its statistics, and exits as it would have).
 """
 
 from __future__ import annotations
@@ -13,11 +15,13 @@ import argparse
 import logging
 import sys
 from collections.abc import Sequence
+from typing import TYPE_CHECKING
 
 from engine.cli.output import WatchedOutput, discard, reason, tell
 from engine.cli.stop_signals import StopSignals
-from engine.errors import DeviceError, VestError
-from engine.files.problems import LoadError
+
+if TYPE_CHECKING:
+    from engine.errors import VestError
 
 EXIT_OK, EXIT_PROBLEMS, EXIT_USAGE, EXIT_MISSING = 0, 1, 2, 3
 EXIT_INTERRUPTED = 130
@@ -88,6 +92,8 @@ def _command(argv: Sequence[str] | None, signals: StopSignals) -> int:
 
 
 def _handled(argv: Sequence[str] | None, signals: StopSignals, out: WatchedOutput) -> int:
+    from engine.errors import VestError  # after the signal handlers: nothing before them
+
     command = "vest"
     try:
         parser = build_parser()
@@ -126,6 +132,9 @@ def _handled(argv: Sequence[str] | None, signals: StopSignals, out: WatchedOutpu
 
 def _refused(command: str, error: VestError) -> int:
     """Tell what was wrong with the input or the machine; the exit code says which."""
+    from engine.errors import DeviceError
+    from engine.files.problems import LoadError
+
     if isinstance(error, LoadError):
         count = len(error.problems)
         tell(f"{error}\n{count} problem{'s' if count != 1 else ''}")
