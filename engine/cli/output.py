@@ -63,6 +63,7 @@ class WatchedOutput:
     def __init__(self, stream: Any) -> None:
         self.stream = stream
         self.error: OSError | None = None
+        self._below: WatchedOutput | None = None
 
     def write(self, data: Any) -> Any:
         try:
@@ -81,16 +82,14 @@ class WatchedOutput:
     @property
     def buffer(self) -> WatchedOutput:
         """The binary stream below, watched the same way (``render --format svg``)."""
-        below = WatchedOutput(self.stream.buffer)
-        below.error = self.error
-        self._below = below
-        return below
+        if self._below is None:
+            self._below = WatchedOutput(self.stream.buffer)
+        return self._below
 
     @property
     def failed(self) -> OSError | None:
         """The first error writing gave, text or binary."""
-        below: WatchedOutput | None = getattr(self, "_below", None)
-        return self.error or (below.error if below is not None else None)
+        return self.error or (self._below.error if self._below is not None else None)
 
     def __getattr__(self, name: str) -> Any:  # fileno, isatty, encoding...
         return getattr(self.stream, name)

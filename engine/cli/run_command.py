@@ -20,7 +20,7 @@ from pathlib import Path
 
 from engine.blackboard.board import Blackboard
 from engine.blackboard.catalogue import default_catalogue
-from engine.cli.output import tell
+from engine.cli.output import shown, tell
 from engine.cli.run_inputs import DEFAULT_HARDWARE, load_run_inputs
 from engine.cli.timeline import Timeline
 from engine.clock import Clock, RealClock, VirtualClock
@@ -115,7 +115,7 @@ def main(args: argparse.Namespace) -> int:
         start_s = clock.now()  # after start-up, which takes simulated time too
         timeline = Timeline(sys.stdout, start_s=start_s, as_json=args.json)
         for name, why in hardware.startup_problems.items():
-            tell(f"warning: {name} did not start ({why}); it will be tried again")
+            tell(f"warning: {shown(name)} did not start ({shown(why)}); it will be tried again")
         log = ActionLog(listeners=[timeline.action], failure_listeners=[timeline.failed])
         blackboard.watchers.append(
             lambda key, value: timeline.blackboard_write(key, value, clock.now())
