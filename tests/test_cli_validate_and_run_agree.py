@@ -191,3 +191,22 @@ def test_validate_checks_the_trees_with_a_profile_given_by_name_or_path(
     [line] = problems_told(capsys, "validate", "trees/", "--profile", str(profile))
     assert line.startswith(f"{profile}:3:19: no tree in the trees given declares parameter")
     assert "(did you mean 'hug_threshold_n'?)" in line
+
+
+def test_a_tree_answering_from_dialogs_that_are_not_there_is_refused_by_both(
+    tmp_path, capsys, monkeypatch
+):
+    monkeypatch.chdir(tmp_path)  # no dialogs/ here nor above the tree
+    trees = tmp_path / "trees"
+    write(
+        trees / "talk.yaml",
+        """\
+        name: talk
+        root:
+          Reply: {heard: /vars/heard}
+        """,
+    )
+    robot = ("--hardware", str(ROOT / "examples/robots/sim.yaml"))
+    scenario = ("--scenario", str(ROOT / "examples/scenarios/demo.yaml"))
+    [line] = both_refuse(capsys, trees, *robot, *scenario)
+    assert line == "trees/talk.yaml:3:3: no dialog named 'default' (add dialogs/NAME.yaml)"

@@ -117,10 +117,10 @@ class Validator:
         """Parameters the trees checked so far declare."""
 
     def dialogs_for(self, path: Path) -> DialogLibrary | None:
-        """The dialogs a tree at ``path`` uses, or None when there are none to check
-        against (none found, or they have problems of their own, told once)."""
+        """The dialogs a tree at ``path`` uses (none when there is no dialogs folder, as in
+        ``vest run``), or None when they have problems of their own (told once)."""
         folder = self.dialogs_dir or find_dialogs_folder(path)
-        return self.dialog_library(folder) if folder is not None else None
+        return self.dialog_library(folder) if folder is not None else DialogLibrary()
 
     def dialog_library(self, folder: Path) -> DialogLibrary | None:
         """The folder's dialogs loaded as ``vest run`` loads them (so two dialogs with one
