@@ -41,10 +41,9 @@ class Blackboard:
         self.watchers: list[Watcher] = []
         """Called as (key, value) for every committed write (debug views, the timeline).
 
-        A watcher that raises is logged the first time and counted in
-        :attr:`watcher_errors`; the commit goes on for the other writes and watchers."""
-        self.watcher_errors: dict[Watcher, int] = {}
-        """How many times each watcher has raised."""
+        A watcher that raises is logged the first time and counted (:meth:`watcher_failures`);
+        the commit goes on for the other writes and watchers."""
+        self._watcher_failures: dict[int, int] = {}  # by id(): a watcher may be unhashable
 
     # -- producers (any thread) ---------------------------------------------------------
     def stage(self, key: str, value: Any) -> None:
@@ -77,16 +76,21 @@ class Blackboard:
         try:
             watcher(key, value)
         except Exception as error:
-            count = self.watcher_errors.get(watcher, 0) + 1
-            self.watcher_errors[watcher] = count
+            count = self._watcher_failures.get(id(watcher), 0) + 1
+            self._watcher_failures[id(watcher)] = count
             if count == 1:
                 _log.error(
-                    "blackboard watcher %r failed on %s: %s: %s (further failures are counted)",
+                    "blackboard watcher %r failed on %s: %s: %s (failure 1; later ones are "
+                    "counted, not logged)",
                     watcher,
                     key,
                     type(error).__name__,
                     error,
                 )
+
+    def watcher_failures(self, watcher: Watcher) -> int:
+        """How many times ``watcher`` has raised while told of a commit."""
+        return self._watcher_failures.get(id(watcher), 0)
 
     def set(self, key: str, value: Any) -> None:
         """Write now (a tree node during its tick, or a test). Event keys get an event."""

@@ -30,7 +30,7 @@ def test_a_failing_watcher_is_logged_once_counted_and_the_commit_goes_on(
     assert board.event_log("/sensors/gesture/last").last_seq == 1
     assert board.get("/sensors/touch/any") is False
     assert seen == ["/sensors/gesture/last", "/sensors/touch/any", "/sensors/touch/any"]
-    assert board.watcher_errors == {full_disk: 3}
+    assert board.watcher_failures(full_disk) == 3
     failures = [r for r in caplog.records if "watcher" in r.getMessage()]
     assert len(failures) == 1
     assert "No space left on device" in failures[0].getMessage()
