@@ -217,9 +217,58 @@ def test_on_a_robot_without_its_buses_vest_run_exits_3_naming_the_missing_bus(ca
 
 
 def test_a_real_robot_plays_no_scenario_unless_asked_and_runs_until_stopped():
-    from engine.cli.run_command import _scenario
+    from engine.cli.run_inputs import default_scenario as _scenario
 
     on_the_robot = _scenario(None, simulated=False)
     assert on_the_robot.events == ()
     assert on_the_robot.duration_s == float("inf")
     assert _scenario(None, simulated=True).events  # the demo on the simulated vest
+
+
+def _with_signals_held(*signals: signal.Signals):
+    """Start the child with ``signals`` blocked: one sent at once stays pending until vest
+    handles signals itself, so the test hits vest's very first moment without sleeping."""
+
+    def hold() -> None:
+        signal.pthread_sigmask(signal.SIG_BLOCK, set(signals))
+
+    return hold
+
+
+@pytest.mark.parametrize("stop", [signal.SIGINT, signal.SIGTERM], ids=["ctrl-c", "sigterm"])
+def test_a_signal_at_once_after_start_ends_the_run_cleanly_with_its_statistics(stop):
+    process = subprocess.Popen(
+        [*VEST, "run", "--duration", "60"],
+        cwd=ROOT,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        preexec_fn=_with_signals_held(signal.SIGINT, signal.SIGTERM),
+    )
+    try:
+        process.send_signal(stop)  # before the engine is even imported
+        out, err = process.communicate(timeout=60)
+    finally:
+        process.kill()
+    assert process.returncode == 0, err
+    assert "tick p99" in out
+    assert "Traceback" not in err
+
+
+def test_ctrl_c_stops_another_command_in_one_line():
+    process = subprocess.Popen(
+        [*VEST, "validate", "trees/"],
+        cwd=ROOT,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        preexec_fn=_with_signals_held(signal.SIGINT),
+    )
+    try:
+        process.send_signal(signal.SIGINT)
+        out, err = process.communicate(timeout=60)
+    finally:
+        process.kill()
+    assert process.returncode == 130
+    assert err.splitlines() == ["vest validate: interrupted"]
+    assert out == ""

@@ -9,6 +9,7 @@ read through py_trees blackboard clients and write during their tick with :meth:
 
 from __future__ import annotations
 
+import logging
 import threading
 from collections.abc import Callable
 from typing import Any
@@ -20,6 +21,9 @@ from engine.blackboard.events import EventLog
 from engine.clock import Clock
 
 _STORAGE = py_trees.blackboard.Blackboard.storage
+_log = logging.getLogger(__name__)
+
+Watcher = Callable[[str, Any], None]
 
 
 class Blackboard:
@@ -34,8 +38,12 @@ class Blackboard:
         self._pending: list[tuple[str, Any, bool]] = []
         self._lock = threading.Lock()
         self._updated_s: dict[str, float] = {}
-        self.watchers: list[Callable[[str, Any], None]] = []
-        """Called as (key, value) for every committed write (debug views, the timeline)."""
+        self.watchers: list[Watcher] = []
+        """Called as (key, value) for every committed write (debug views, the timeline).
+
+        A watcher that raises is logged the first time and counted (:meth:`watcher_failures`);
+        the commit goes on for the other writes and watchers."""
+        self._watcher_failures: dict[int, int] = {}  # by id(): a watcher may be unhashable
 
     # -- producers (any thread) ---------------------------------------------------------
     def stage(self, key: str, value: Any) -> None:
@@ -59,8 +67,30 @@ class Blackboard:
             else:
                 self._write(key, value)
             for watcher in self.watchers:
-                watcher(key, value)
+                self._tell(watcher, key, value)
         return len(pending)
+
+    def _tell(self, watcher: Watcher, key: str, value: Any) -> None:
+        """Tell one watcher of a write; a watcher (a view, the timeline) that fails must
+        not lose the writes after it nor stop the robot, so it is logged once and counted."""
+        try:
+            watcher(key, value)
+        except Exception as error:
+            count = self._watcher_failures.get(id(watcher), 0) + 1
+            self._watcher_failures[id(watcher)] = count
+            if count == 1:
+                _log.error(
+                    "blackboard watcher %r failed on %s: %s: %s (failure 1; later ones are "
+                    "counted, not logged)",
+                    watcher,
+                    key,
+                    type(error).__name__,
+                    error,
+                )
+
+    def watcher_failures(self, watcher: Watcher) -> int:
+        """How many times ``watcher`` has raised while told of a commit."""
+        return self._watcher_failures.get(id(watcher), 0)
 
     def set(self, key: str, value: Any) -> None:
         """Write now (a tree node during its tick, or a test). Event keys get an event."""

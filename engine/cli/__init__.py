@@ -1,36 +1,48 @@
 """The ``vest`` command line.
 
-Exit codes: 0 success; 1 a file has problems (each printed as file:line:column); 2 the
-command line is wrong; 3 something needed is missing on this machine (Graphviz, a bus, a
-port, a device file).
+Exit codes: 0 success; 1 a file has problems (each printed as file:line:column), or the
+output could not be written (one line on stderr, never a traceback); 2 the command line is
+wrong; 3 something needed is missing on this machine (Graphviz, a bus, a port, a device
+file); 130 a command other than ``vest run`` was stopped by Ctrl-C or SIGTERM (``vest run``
+stops cleanly, with its statistics, and exits as it would have).
 """
 
 from __future__ import annotations
 
+# Only light imports here: SIGINT and SIGTERM are handled before the commands (and the
+# engine they import) are loaded, which takes a second or more on a small board.
 import argparse
 import logging
 import sys
 from collections.abc import Sequence
+from typing import TYPE_CHECKING
 
-from engine.cli import (
-    devices_command,
-    keys_command,
-    nodes_command,
-    render_command,
-    run_command,
-    schema_command,
-    validate_command,
-)
-from engine.errors import DeviceError, VestError
-from engine.files.problems import LoadError
+from engine.cli.output import WatchedOutput, discard, reason, tell
+from engine.cli.stop_signals import StopSignals
+
+if TYPE_CHECKING:
+    from engine.errors import VestError
 
 EXIT_OK, EXIT_PROBLEMS, EXIT_USAGE, EXIT_MISSING = 0, 1, 2, 3
+EXIT_INTERRUPTED = 130
+"""A command other than ``vest run`` stopped by Ctrl-C or SIGTERM (the shell's 128 + 2)."""
 
-EPILOG = """exit codes: 0 ok; 1 a file has problems (listed as file:line:column);
-2 wrong command line; 3 something needed is missing on this machine"""
+EPILOG = """exit codes: 0 ok; 1 a file has problems (listed as file:line:column), or the
+output could not be written; 2 wrong command line; 3 something needed is missing on this
+machine"""
 
 
 def build_parser() -> argparse.ArgumentParser:
+    from engine.cli import (
+        devices_command,
+        keys_command,
+        nodes_command,
+        render_command,
+        run_command,
+        schema_command,
+        validate_command,
+    )
+
     parser = argparse.ArgumentParser(
         prog="vest",
         description="Behavior-tree social interaction engine for robots wearing a sensor vest.",
@@ -60,26 +72,74 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    parser = build_parser()
-    args = parser.parse_args(argv)
-    if args.command is None:
-        parser.print_help()
-        return EXIT_USAGE
-    logging.basicConfig(
-        level=logging.WARNING, format="%(levelname)s %(name)s: %(message)s", stream=sys.stderr
-    )
+    """Run one command; returns its exit code (see :data:`EPILOG`)."""
+    signals = StopSignals()
+    signals.install()
     try:
-        return int(args.handler(args))
-    except LoadError as error:
-        print(error, file=sys.stderr)
-        count = len(error.problems)
-        print(f"{count} problem{'s' if count != 1 else ''}", file=sys.stderr)
-        return EXIT_PROBLEMS
-    except DeviceError as error:  # a bus, port or chip this machine does not have
-        print(f"vest {args.command}: {error}", file=sys.stderr)
-        return EXIT_MISSING
-    except VestError as error:
-        print(f"vest {args.command}: {error}", file=sys.stderr)
-        return EXIT_PROBLEMS
-    except BrokenPipeError:  # e.g. `vest run --json | head`
+        return _command(argv, signals)
+    finally:
+        signals.restore()
+
+
+def _command(argv: Sequence[str] | None, signals: StopSignals) -> int:
+    real_stdout = sys.stdout
+    out = WatchedOutput(real_stdout)
+    sys.stdout = out  # a TextIO in all but its name (Any-typed where it matters)
+    try:
+        return _handled(argv, signals, out)
+    finally:
+        sys.stdout = real_stdout
+
+
+def _handled(argv: Sequence[str] | None, signals: StopSignals, out: WatchedOutput) -> int:
+    from engine.errors import VestError  # after the signal handlers: nothing before them
+
+    command = "vest"
+    try:
+        parser = build_parser()
+        args = parser.parse_args(argv)
+        if args.command is None:
+            parser.print_help()
+            sys.stdout.flush()
+            return EXIT_USAGE
+        command = f"vest {args.command}"
+        args.stop_signals = signals
+        logging.basicConfig(
+            level=logging.WARNING, format="%(levelname)s %(name)s: %(message)s", stream=sys.stderr
+        )
+        if args.command != "run":  # the run stops itself cleanly; the others stop where they are
+            signals.interrupt()
+        code = int(args.handler(args))
+        sys.stdout.flush()  # a failing output is seen here, not in Python's flush at exit
+        return code
+    except KeyboardInterrupt:
+        tell(f"{command}: interrupted")
+        return EXIT_INTERRUPTED
+    except BrokenPipeError:  # e.g. `vest nodes | head`: the reader has what it wanted
+        discard(out.stream)
         return EXIT_OK
+    except OSError as error:
+        if isinstance(error, VestError):
+            return _refused(command, error)
+        if out.failed is None:
+            raise  # not the output: a bug, shown as one
+        discard(out.stream)
+        tell(f"{command}: cannot write the output ({reason(out.failed)})")
+        return EXIT_PROBLEMS
+    except VestError as error:
+        return _refused(command, error)
+
+
+def _refused(command: str, error: VestError) -> int:
+    """Tell what was wrong with the input or the machine; the exit code says which."""
+    from engine.errors import DeviceError
+    from engine.files.problems import LoadError
+
+    if isinstance(error, LoadError):
+        count = len(error.problems)
+        tell(f"{error}\n{count} problem{'s' if count != 1 else ''}")
+        return EXIT_PROBLEMS
+    tell(f"{command}: {error}")
+    if isinstance(error, DeviceError):  # a bus, port or chip this machine does not have
+        return EXIT_MISSING
+    return EXIT_PROBLEMS

@@ -40,7 +40,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         default=None,
         help="file to write (default: standard output; required for png)",
     )
-    parser.add_argument("--profile", type=Path, default=None, help="profile to apply")
+    parser.add_argument(
+        "--profile",
+        default=None,
+        help="a profile file, or a name in trees/profiles/ (child, adult)",
+    )
 
 
 def label(node: NodeDefinition) -> str:
@@ -101,12 +105,14 @@ def dot_source(definition: TreeDefinition) -> str:
 
 
 def main(args: argparse.Namespace) -> int:
+    from engine.cli.run_inputs import resolve_profile
     from engine.loader.substitution import load_profile
 
     catalogue = default_catalogue()
     folder = find_dialogs_folder(args.tree)
     dialogs = DialogLibrary.from_folder(folder, catalogue) if folder else None
-    profile = load_profile(args.profile) if args.profile else None
+    profile_path = resolve_profile(args.profile, [args.tree])  # by name or path, as vest run
+    profile = load_profile(profile_path) if profile_path else None
     loader = TreeLoader(default_registry(), catalogue, dialogs=dialogs, profile=profile)
     definition = loader.load(args.tree)
     if args.format in ("ascii", "dot"):

@@ -7,41 +7,34 @@ chip models that the real drivers read. --hardware CONFIG names a robot config; 
 --fast runs on a virtual clock as fast as the machine allows; --json prints one JSON
 object per robot action: {"t": seconds, "tree": name, "action": ..., "args": {...}}.
 In real time, a changed tree file is reloaded between ticks (an invalid change keeps the
-running tree); Ctrl-C or SIGTERM stops cleanly.
+running tree); Ctrl-C or SIGTERM stops cleanly at any moment, start-up included. The
+timeline never stops the robot: if it cannot be written (a full disk), that is said once
+on stderr, the run goes on, and it exits 1.
 """
 
 from __future__ import annotations
 
 import argparse
-import math
-import signal
 import sys
-from collections.abc import Iterator
-from contextlib import contextmanager
 from pathlib import Path
-from types import FrameType
 
 from engine.blackboard.board import Blackboard
 from engine.blackboard.catalogue import default_catalogue
+from engine.cli.output import shown, tell
+from engine.cli.run_inputs import DEFAULT_HARDWARE, load_run_inputs
 from engine.cli.timeline import Timeline
 from engine.clock import Clock, RealClock, VirtualClock
 from engine.errors import ConfigError
-from engine.files.problems import LoadError, Mark, Problem
 from engine.hardware.assembly import build_hardware
-from engine.hardware.config import load_robot_config
-from engine.hardware.sim_vest import UnwiredSenses, build_sim_vest, check_fault_events
+from engine.hardware.sim_vest import UnwiredSenses, build_sim_vest
 from engine.runtime.reload import TreeReloader
-from engine.runtime.robot import Robot, load_behaviors
-from engine.runtime.scheduler import Scheduler
+from engine.runtime.robot import Robot
 from engine.scenario.player import ScenarioPlayer
-from engine.scenario.scenario_file import Scenario, load_scenario
 from engine.scenario.world import World
 from engine.services.actions import ActionLog
 from engine.services.simulated import simulated_services
 
 NAME = "run"
-DEFAULT_DIALOGS = Path("dialogs")
-DEFAULT_SCENARIO = Path("examples/scenarios/demo.yaml")
 HELP = "run the behaviors (default: the demo scenario on the simulated vest)"
 
 
@@ -55,7 +48,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="tree files or folders (default: trees/)",
     )
     parser.add_argument(
-        "--dialogs", type=Path, default=DEFAULT_DIALOGS, help="dialogs folder (default: dialogs/)"
+        "--dialogs", type=Path, default=None, help="dialogs folder (default: dialogs/)"
     )
     parser.add_argument(
         "--profile",
@@ -83,7 +76,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--hardware",
         type=Path,
-        default=Path("examples/robots/sim.yaml"),
+        default=DEFAULT_HARDWARE,
         metavar="CONFIG",
         help="robot config (default: examples/robots/sim.yaml, the simulated vest)",
     )
@@ -99,38 +92,16 @@ def _positive_seconds(text: str) -> float:
     return value
 
 
-def resolve_profile(value: str | None, trees: list[Path]) -> Path | None:
-    if value is None:
-        return None
-    path = Path(value)
-    if path.suffix in (".yaml", ".yml") or path.exists():
-        return path
-    for folder in trees:
-        candidate = (folder if folder.is_dir() else folder.parent) / "profiles" / f"{value}.yaml"
-        if candidate.exists():
-            return candidate
-    raise LoadError(
-        [Problem(Mark(value, 1, 1), "no such profile", "give a file or a name in trees/profiles/")]
-    )
-
-
 def main(args: argparse.Namespace) -> int:
-    for path in args.trees:
-        if not path.exists():
-            raise ConfigError(
-                f"{path}: no such file or folder (run from the project folder or pass --trees)"
-            )
-    dialogs = args.dialogs if args.dialogs.is_dir() else None
-    if dialogs is None and args.dialogs != DEFAULT_DIALOGS:
-        raise ConfigError(f"--dialogs {args.dialogs}: no such folder")
-    behaviors = load_behaviors(
-        args.trees, dialogs_dir=dialogs, profile=resolve_profile(args.profile, args.trees)
+    # the same checks as `vest validate`: every problem of every file, before anything starts
+    inputs = load_run_inputs(
+        args.trees,
+        dialogs=args.dialogs,
+        profile=args.profile,
+        hardware=args.hardware,
+        scenario=args.scenario,
     )
-    config = load_robot_config(args.hardware)
-    scenario = _scenario(args.scenario, simulated=config.simulated)
-    problems = check_fault_events(scenario.events, config)
-    if problems:
-        raise LoadError(problems)
+    behaviors, config, scenario = inputs.behaviors, inputs.config, inputs.scenario
     if args.fast and not config.simulated:
         raise ConfigError(f"{args.hardware}: --fast needs a simulated vest (simulated: true)")
     clock: Clock = VirtualClock() if args.fast else RealClock()
@@ -144,7 +115,7 @@ def main(args: argparse.Namespace) -> int:
         start_s = clock.now()  # after start-up, which takes simulated time too
         timeline = Timeline(sys.stdout, start_s=start_s, as_json=args.json)
         for name, why in hardware.startup_problems.items():
-            print(f"warning: {name} did not start ({why}); it will be tried again", file=sys.stderr)
+            tell(f"warning: {shown(name)} did not start ({shown(why)}); it will be tried again")
         log = ActionLog(listeners=[timeline.action], failure_listeners=[timeline.failed])
         blackboard.watchers.append(
             lambda key, value: timeline.blackboard_write(key, value, clock.now())
@@ -163,39 +134,15 @@ def main(args: argparse.Namespace) -> int:
         if not args.fast:
             robot.scheduler.hooks.append(TreeReloader(behaviors.loader, robot.trees, clock))
         duration = args.duration if args.duration is not None else scenario.duration_s
-        with _stopped_by_signals(robot.scheduler):
-            timeline.start()
-            first_tick_s = clock.now()
-            hardware.start(origin_s=first_tick_s)  # readings staged just before each tick
-            robot.scheduler.run(until_s=start_s + duration, start_s=first_tick_s)
+        # a signal that came during start-up stops the run before its first tick
+        args.stop_signals.on_stop(robot.scheduler.stop)
+        timeline.start()
+        first_tick_s = clock.now()
+        hardware.start(origin_s=first_tick_s)  # readings staged just before each tick
+        robot.scheduler.run(until_s=start_s + duration, start_s=first_tick_s)
         timeline.summary(robot.trees)
     finally:
         hardware.close()
         if vest is not None:
             vest.close()
-    return 0
-
-
-def _scenario(path: Path | None, *, simulated: bool) -> Scenario:
-    """The named scenario; by default the demo on the simulated vest, and on a real robot
-    nothing scripted (the world is real) for as long as it runs."""
-    if path is not None:
-        return load_scenario(path)
-    if simulated:
-        return load_scenario(DEFAULT_SCENARIO)
-    return Scenario(duration_s=math.inf, events=(), path=Path("(no scenario)"))
-
-
-@contextmanager
-def _stopped_by_signals(scheduler: Scheduler) -> Iterator[None]:
-    """Ctrl-C and SIGTERM ask the scheduler to stop after the current tick."""
-
-    def stop(signum: int, frame: FrameType | None) -> None:
-        scheduler.stop()
-
-    previous = {sig: signal.signal(sig, stop) for sig in (signal.SIGINT, signal.SIGTERM)}
-    try:
-        yield
-    finally:
-        for sig, handler in previous.items():
-            signal.signal(sig, handler)
+    return 0 if timeline.write_error is None else 1  # the robot ran; its timeline was lost

@@ -1,12 +1,19 @@
-"""The run's timeline: what happened around the robot and what it did, as readable lines."""
+"""The run's timeline: what happened around the robot and what it did, as readable lines.
+
+The timeline is the robot's own output and never stops the robot: a reader that goes
+away (``| head``) ends the run quietly, any other write error (a full disk) is told once
+on stderr and the run goes on without its timeline. Text people wrote is shown with
+control characters escaped (:func:`engine.cli.output.shown`); ``--json`` lines are strict
+JSON: a NaN or infinite number is written as null.
+"""
 
 from __future__ import annotations
 
 import json
-import os
 from collections.abc import Callable
 from typing import Any, TextIO
 
+from engine.cli.output import discard, finite_json, reason, shown, tell
 from engine.runtime.scheduler import RunningTree
 from engine.scenario.scenario_file import ScenarioEvent
 from engine.services.actions import ActionRecord
@@ -45,6 +52,8 @@ class Timeline:
         self.as_json = as_json
         self.on_closed = on_closed
         self.closed = False
+        self.write_error: OSError | None = None
+        """Why the timeline stopped being written, when a write failed (not a closed pipe)."""
         self._device_ok: dict[str, bool] = {}
 
     def start(self) -> None:
@@ -53,7 +62,8 @@ class Timeline:
             self._write(f"{'t (s)':>8}  {'who':14} what\n")
 
     def _write(self, text: str) -> None:
-        """Write and flush; a reader that went away (``| head``) ends the run quietly."""
+        """Write and flush; a reader that went away (``| head``) ends the run quietly, a
+        failing output (a full disk) is told once on stderr and the robot carries on."""
         if self.closed:
             return
         try:
@@ -61,10 +71,24 @@ class Timeline:
             self.out.flush()
         except BrokenPipeError:
             self.closed = True
-            # nothing more can reach the reader; keep Python's exit flush from complaining
-            os.dup2(os.open(os.devnull, os.O_WRONLY), self.out.fileno())
+            discard(self.out)  # nothing more can reach the reader; keep the exit flush quiet
             if self.on_closed is not None:
                 self.on_closed()
+        except OSError as error:
+            self.closed = True
+            self.write_error = error
+            discard(self.out)
+            tell(
+                f"vest run: cannot write the timeline ({reason(error)}); "
+                "the robot carries on without it"
+            )
+
+    def _json_line(self, record: ActionRecord) -> None:
+        shown_record = record.to_json()
+        shown_record["t"] = round(record.t - self.start_s, 3)
+        # a value JSON has no form for (an object in a result) is shown as its text
+        line = json.dumps(finite_json(shown_record), allow_nan=False, default=str)
+        self._write(line + "\n")
 
     def world(self, at_s: float, event: ScenarioEvent) -> None:
         if not self.as_json:
@@ -83,24 +107,20 @@ class Timeline:
 
     def action(self, record: ActionRecord) -> None:
         if self.as_json:
-            shown = record.to_json()
-            shown["t"] = round(record.t - self.start_s, 3)
-            self._write(json.dumps(shown) + "\n")
+            self._json_line(record)
         else:
             self._line(record.t, record.tree, describe_action(record.action, record.args))
 
     def failed(self, record: ActionRecord, error: BaseException) -> None:
         """An action the service could not do: said so, after the line that announced it."""
         if self.as_json:
-            shown = record.to_json()
-            shown["t"] = round(record.t - self.start_s, 3)
-            self._write(json.dumps(shown) + "\n")
+            self._json_line(record)
         else:
             what = describe_action(record.action, record.args)
             self._line(record.t, record.tree, f"could not: {what} ({record.error})")
 
     def _line(self, at_s: float, who: str, what: str) -> None:
-        self._write(f"{at_s - self.start_s:8.2f}  {who:14} {what}\n")
+        self._write(f"{at_s - self.start_s:8.2f}  {shown(who):14} {shown(what)}\n")
 
     def summary(self, trees: list[RunningTree]) -> None:
         if self.as_json:
@@ -112,7 +132,7 @@ class Timeline:
         for tree in trees:
             s = tree.stats.summary()
             self._write(
-                f"{tree.name:14} {tree.definition.rate_hz:5g}/s {s['ticks']:6d} "
+                f"{shown(tree.name):14} {tree.definition.rate_hz:5g}/s {s['ticks']:6d} "
                 f"{s['duration_p50_ms']:7.3f}ms {s['duration_p99_ms']:7.3f}ms "
                 f"{s['lateness_p99_ms']:7.2f}ms {s['skipped']:7d}\n"
             )

@@ -2,6 +2,9 @@
 
 Give files or folders (searched recursively for *.yaml). Prints "ok" when everything is
 valid; otherwise every problem as file:line:column: message (hint), and exits 1.
+The checks are those ``vest run`` makes before it starts: trees are checked against the
+robot config (--hardware, default examples/robots/sim.yaml: its devices, its 12 touch
+pads), the dialogs of a folder together (two with one name), scenarios against the robot.
 """
 
 from __future__ import annotations
@@ -9,16 +12,26 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from engine.blackboard.catalogue import KeyCatalogue, default_catalogue
+from engine.cli.run_inputs import (
+    DEFAULT_DIALOGS,
+    DEFAULT_HARDWARE,
+    check_items,
+    check_scenario_events,
+    dialogs_folder,
+    list_lengths,
+    load_config,
+    resolve_profile,
+    robot_catalogue,
+)
 from engine.dialogs.library import DialogLibrary, check_dialog, find_dialogs_folder
 from engine.files.problems import LoadError, Mark, Problem, Problems
 from engine.files.yaml_source import YMap, YScalar, load_yaml
-from engine.hardware.config import check_robot_config
+from engine.hardware.config import RobotConfig
 from engine.loader.substitution import Profile, load_profile, undeclared_params
 from engine.loader.tree_file import TreeLoader
 from engine.nodes.registry import NodeRegistry, default_registry
 from engine.runtime.robot import declared_beside, tree_files
-from engine.scenario.scenario_file import check_scenario
+from engine.scenario.scenario_file import load_scenario
 from engine.values.params import did_you_mean
 
 NAME = "validate"
@@ -32,6 +45,20 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         type=Path,
         default=None,
         help="dialogs folder (default: the nearest dialogs/ above each file)",
+    )
+    parser.add_argument(
+        "--profile",
+        default=None,
+        help="check the trees with this profile: a file, or a name in trees/profiles/ "
+        "(child, adult), as vest run takes it",
+    )
+    parser.add_argument(
+        "--hardware",
+        type=Path,
+        default=None,
+        metavar="CONFIG",
+        help=f"robot config the trees and scenarios run on (default: {DEFAULT_HARDWARE} "
+        "when there is one)",
     )
 
 
@@ -68,30 +95,56 @@ def kind_of(document: object) -> str | None:
 
 
 class Validator:
+    """Checks files one by one with the checks ``vest run`` makes (engine.cli.run_inputs)."""
+
     def __init__(
-        self, registry: NodeRegistry, catalogue: KeyCatalogue, dialogs_dir: Path | None
+        self,
+        registry: NodeRegistry,
+        config: RobotConfig | None,
+        dialogs_dir: Path | None,
+        problems: Problems | None = None,
     ) -> None:
         self.registry = registry
-        self.catalogue = catalogue
+        self.config = config
+        self.catalogue = robot_catalogue(config)
+        self.lengths = list_lengths(config)
         self.dialogs_dir = dialogs_dir
-        self.problems = Problems()
+        self.problems = problems if problems is not None else Problems()
         self._dialogs: dict[Path, DialogLibrary | None] = {}
+        self.profile: Profile | None = None
+        """The profile trees are checked with (``--profile``), as ``vest run`` applies it."""
+        self.declared: set[str] = set()
+        """Parameters the trees checked so far declare."""
 
     def dialogs_for(self, path: Path) -> DialogLibrary | None:
+        """The dialogs a tree at ``path`` uses (none when there is no dialogs folder, as in
+        ``vest run``), or None when they have problems of their own (told once)."""
         folder = self.dialogs_dir or find_dialogs_folder(path)
-        if folder is None:
-            return None
-        if folder not in self._dialogs:
+        return self.dialog_library(folder) if folder is not None else DialogLibrary()
+
+    def dialog_library(self, folder: Path) -> DialogLibrary | None:
+        """The folder's dialogs loaded as ``vest run`` loads them (so two dialogs with one
+        name are found), once per folder however it is named."""
+        key = folder.resolve()
+        if key not in self._dialogs:
             try:
-                self._dialogs[folder] = DialogLibrary.from_folder(folder, self.catalogue)
+                self._dialogs[key] = DialogLibrary.from_folder(folder, self.catalogue)
             except LoadError as error:
                 self.problems.extend(error.problems)
-                self._dialogs[folder] = None
-        return self._dialogs[folder]
+                self._dialogs[key] = None
+        return self._dialogs[key]
+
+    def is_dialogs_folder(self, folder: Path) -> bool:
+        given = self.dialogs_dir is not None and folder.resolve() == self.dialogs_dir.resolve()
+        return given or folder.name == DEFAULT_DIALOGS.name
 
     def loader_for(self, path: Path, profile: Profile | None = None) -> TreeLoader:
+        """A loader for the tree at ``path`` with ``profile`` (default: the one given)."""
         return TreeLoader(
-            self.registry, self.catalogue, dialogs=self.dialogs_for(path), profile=profile
+            self.registry,
+            self.catalogue,
+            dialogs=self.dialogs_for(path),
+            profile=profile or self.profile,
         )
 
     def check(self, path: Path) -> None:
@@ -103,15 +156,21 @@ class Validator:
         kind = kind_of(document)
         try:
             if kind == "tree":
-                self.loader_for(path).load(path)
+                definition = self.loader_for(path).load(path)
+                self.declared |= definition.declared_params
+                self.problems.extend(check_items(definition, self.lengths))
             elif kind == "profile":
                 self.check_profile(path)
-            elif kind == "dialog":
+            elif kind == "dialog" and self.is_dialogs_folder(path.parent):
+                self.dialog_library(path.parent)
+            elif kind == "dialog":  # a dialog kept elsewhere is checked on its own
                 check_dialog(document, str(path), self.catalogue, default_name=path.stem)
             elif kind == "scenario":
-                check_scenario(document, str(path), path)
+                scenario = load_scenario(path)
+                if self.config is not None:
+                    self.problems.extend(check_scenario_events(scenario.events, self.config))
             elif kind == "robot config":
-                check_robot_config(document, str(path), path, catalogue=self.catalogue)
+                load_config(path, self.problems)
             else:
                 where = document.mark if document is not None else Mark(str(path), 1, 1)
                 self.problems.add(
@@ -160,15 +219,35 @@ class Validator:
 
 def main(args: argparse.Namespace) -> int:
     files = yaml_files(args.paths)
-    validator = Validator(default_registry(), default_catalogue(), args.dialogs)
+    problems = Problems()
+    hardware = args.hardware or (DEFAULT_HARDWARE if DEFAULT_HARDWARE.is_file() else None)
+    config = load_config(hardware, problems) if hardware is not None else None
+    dialogs = dialogs_folder(args.dialogs) if args.dialogs is not None else None
+    validator = Validator(default_registry(), config, dialogs, problems)
+    profile = resolve_profile(args.profile, args.paths)
+    if profile is not None:
+        try:
+            validator.profile = load_profile(profile)
+        except LoadError as error:
+            problems.extend(error.problems)
     for path in args.paths:
         if not path.exists():
             validator.problems.add(Mark(str(path), 1, 1), "no such file or folder")
     for path in files:
         validator.check(path)
     validator.check_tree_names(files)
+    if validator.profile is not None and profile is not None and validator.declared:
+        # as vest run: the profile sets only parameters the trees (or those beside it)
+        # declare; told once the trees load (a tree that failed has declared nothing)
+        where = (
+            f"{profile.parent.parent}/" if profile.parent.name == "profiles" else "the trees given"
+        )
+        declared = validator.declared | declared_beside(profile)
+        if not problems:
+            problems.extend(undeclared_params(validator.profile, declared, where))
     if validator.problems:
-        raise LoadError(validator.problems.items)
+        # a file met twice (a dialog beside its tree, the robot config named) is told once
+        raise LoadError(list(dict.fromkeys(validator.problems.items)))
     if not files:
         raise LoadError([Problem(Mark(str(args.paths[0]), 1, 1), "no YAML files found")])
     print(f"ok: {len(files)} file{'s' if len(files) != 1 else ''}")

@@ -48,8 +48,10 @@ _RULE_KEYS = ("hear", "say", "read")
 
 
 def find_dialogs_folder(path: Path) -> Path | None:
-    """The nearest ``dialogs/`` folder beside ``path`` or above it."""
-    for folder in [path.parent, *resolved(path).parents]:
+    """The nearest ``dialogs/`` folder beside ``path`` or above it, named as ``path`` is
+    (relative for a relative path, so problems show ``dialogs/x.yaml`` as a person wrote it)
+    until the path runs out of parents, absolute above that."""
+    for folder in [*path.parents, *resolved(path).parents]:
         candidate = folder / "dialogs"
         if candidate.is_dir():
             return candidate

@@ -72,18 +72,20 @@ def load_behaviors(
     catalogue = catalogue or default_catalogue()
     problems = Problems()
     dialogs = DialogLibrary()
+    checked_dialogs: DialogLibrary | None = dialogs
     if dialogs_dir is not None:
         try:
-            dialogs = DialogLibrary.from_folder(dialogs_dir, catalogue)
+            dialogs = checked_dialogs = DialogLibrary.from_folder(dialogs_dir, catalogue)
         except LoadError as error:
             problems.extend(error.problems)
+            checked_dialogs = None  # its own problems say why; no tree is blamed for it
     loaded_profile: Profile | None = None
     if profile is not None:
         try:
             loaded_profile = load_profile(profile)
         except LoadError as error:
             problems.extend(error.problems)
-    loader = TreeLoader(registry, catalogue, dialogs=dialogs, profile=loaded_profile)
+    loader = TreeLoader(registry, catalogue, dialogs=checked_dialogs, profile=loaded_profile)
     definitions: list[TreeDefinition] = []
     for path in tree_files(trees):
         try:
@@ -109,8 +111,8 @@ def load_behaviors(
             )
         names[definition.name] = definition.path
     if not definitions and not problems:
-        where = Mark(str(trees[0]) if trees else ".", 1, 1)
-        problems.add(where, "no tree files (*.yaml) found", "name a tree file or a folder of them")
+        place = Mark(str(trees[0]) if trees else ".", 1, 1)
+        problems.add(place, "no tree files (*.yaml) found", "name a tree file or a folder of them")
     problems.raise_if_any()
     return Behaviors(definitions, dialogs, loader)
 

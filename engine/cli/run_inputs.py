@@ -1,0 +1,225 @@
+"""What ``vest run`` reads before the robot starts, checked as one: one set of checks.
+
+Trees (with their subtrees and profile), the dialogs they use, the robot config and the
+scenario are checked together, so a tree is checked against the robot it runs on: a key
+``/devices/NAME/ok`` must name a configured device, ``item:`` must be inside the list the
+robot's chip writes (the MPR121's 12 pads), a scenario may fail only devices the robot
+has and send only remote commands the robot knows. ``vest run`` refuses to start on any
+problem; ``vest validate`` runs these same functions and lists the same problems.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Iterator, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+from engine.blackboard.catalogue import KeyCatalogue, KeySpec, default_catalogue
+from engine.drivers import mpr121
+from engine.errors import ConfigError
+from engine.files.problems import LoadError, Problem, Problems
+from engine.hardware.config import RobotConfig, load_robot_config
+from engine.hardware.sim_vest import check_fault_events
+from engine.loader.tree_file import NodeDefinition, TreeDefinition
+from engine.nodes.remote import COMMAND_TYPES
+from engine.runtime.robot import Behaviors, load_behaviors
+from engine.scenario.scenario_file import Scenario, ScenarioEvent, load_scenario
+from engine.values.params import did_you_mean
+
+DEFAULT_DIALOGS = Path("dialogs")
+DEFAULT_HARDWARE = Path("examples/robots/sim.yaml")
+DEFAULT_SCENARIO = Path("examples/scenarios/demo.yaml")
+_DEVICE_OK = "/devices/*/ok"
+
+
+def resolve_profile(value: str | Path | None, trees: Sequence[Path]) -> Path | None:
+    """A profile given by file or by name: ``child`` is ``profiles/child.yaml`` in the
+    folder of the trees (or a folder above it, for a subtree in ``parts/``).
+
+    Every command takes a profile this way; ConfigError when there is no such profile.
+    """
+    if value is None:
+        return None
+    path = Path(value)
+    if path.suffix in (".yaml", ".yml") or path.exists():
+        return path
+    known: list[str] = []
+    for tree in trees:
+        folder = tree if tree.is_dir() else tree.parent
+        for above in (folder, *folder.parents):
+            candidate = above / "profiles" / f"{value}.yaml"
+            if candidate.exists():
+                return candidate
+            known += [p.stem for p in sorted((above / "profiles").glob("*.yaml"))]
+    names = list(dict.fromkeys(known))
+    hint = did_you_mean(str(value), names) or (
+        "give a profile file, or a name of " + ", ".join(names)
+        if names
+        else "give a profile file, or a name in trees/profiles/"
+    )
+    raise ConfigError(f"--profile {value}: no such profile ({hint})")
+
+
+def dialogs_folder(given: Path | None) -> Path | None:
+    """The dialogs folder: the one given with ``--dialogs`` (ConfigError when it is not
+    a folder), else ``dialogs/`` when there is one."""
+    if given is None:
+        return DEFAULT_DIALOGS if DEFAULT_DIALOGS.is_dir() else None
+    if not given.is_dir():
+        raise ConfigError(f"--dialogs {given}: no such folder")
+    return given
+
+
+def robot_catalogue(config: RobotConfig | None) -> KeyCatalogue:
+    """The key catalogue of one robot: ``/devices/NAME/ok`` for each of its devices only
+    (the default catalogue, without a robot, accepts any NAME)."""
+    catalogue = default_catalogue()
+    if config is None:
+        return catalogue
+    pattern = catalogue.lookup("/devices/x/ok")
+    specs = [spec for spec in catalogue if spec.name != _DEVICE_OK]
+    if pattern is not None:
+        specs += [
+            KeySpec(
+                f"/devices/{name}/ok", pattern.value_type, "", pattern.writer, pattern.description
+            )
+            for name in config.devices
+        ]
+    return KeyCatalogue(specs)
+
+
+def list_lengths(config: RobotConfig | None) -> dict[str, int]:
+    """How many items each list key holds on this robot (a touch chip's pads)."""
+    devices = config.devices.values() if config is not None else ()
+    lengths = {
+        d.keys["pads"]: mpr121.PADS for d in devices if d.chip == "mpr121" and "pads" in d.keys
+    }
+    if config is None:  # without a robot, the vest's own MPR121
+        lengths["/sensors/touch/pads"] = mpr121.PADS
+    return lengths
+
+
+def check_items(definition: TreeDefinition, lengths: dict[str, int]) -> list[Problem]:
+    """``item:`` beyond the list it picks from (``item: 12`` of 12 pads) would never be
+    true: each such node, at its place."""
+    problems: list[Problem] = []
+    for node in _nodes(definition.root):
+        key, item = node.args.get("key"), node.args.get("item")
+        length = lengths.get(key) if isinstance(key, str) else None
+        if length is not None and isinstance(item, int) and not 0 <= item < length:
+            problems.append(
+                Problem(
+                    node.mark,
+                    f"item {item} is not in {key}, which holds {length} items",
+                    f"use an item from 0 to {length - 1}",
+                )
+            )
+    return problems
+
+
+def _nodes(node: NodeDefinition) -> Iterator[NodeDefinition]:
+    yield node
+    for child in node.children:
+        yield from _nodes(child)
+
+
+def check_scenario_events(events: Iterable[ScenarioEvent], config: RobotConfig) -> list[Problem]:
+    """The scenario's faults name devices of ``config``; its remote commands are of a type
+    the robot carries out."""
+    problems = check_fault_events(events, config)
+    for event in events:
+        if event.kind == "cloud" and event.value["type"] not in COMMAND_TYPES:
+            kind = event.value["type"]
+            problems.append(
+                Problem(
+                    event.mark,
+                    f"no remote command type {kind!r}",
+                    did_you_mean(kind, COMMAND_TYPES) or "types: " + ", ".join(COMMAND_TYPES),
+                )
+            )
+    return problems
+
+
+def load_config(path: Path, problems: Problems) -> RobotConfig | None:
+    """The robot config, or None with its problems added."""
+    try:
+        return load_robot_config(path)
+    except LoadError as error:
+        problems.extend(error.problems)
+        return None
+
+
+def load_checked_behaviors(
+    trees: list[Path],
+    *,
+    dialogs: Path | None,
+    profile: Path | None,
+    config: RobotConfig | None,
+    problems: Problems,
+) -> Behaviors | None:
+    """Trees, dialogs and profile checked against the robot; None with problems added."""
+    try:
+        behaviors = load_behaviors(
+            trees, dialogs_dir=dialogs, profile=profile, catalogue=robot_catalogue(config)
+        )
+    except LoadError as error:
+        problems.extend(error.problems)
+        return None
+    lengths = list_lengths(config)
+    for definition in behaviors.trees:
+        problems.extend(check_items(definition, lengths))
+    return behaviors
+
+
+@dataclass
+class RunInputs:
+    """Everything a run reads, checked."""
+
+    behaviors: Behaviors
+    config: RobotConfig
+    scenario: Scenario
+
+
+def load_run_inputs(
+    trees: list[Path],
+    *,
+    dialogs: Path | None,
+    profile: str | None,
+    hardware: Path,
+    scenario: Path | None,
+) -> RunInputs:
+    """What ``vest run`` checks at start-up; LoadError listing every problem of every file,
+    ConfigError for a file or folder that is not there."""
+    for path in trees:
+        if not path.exists():
+            raise ConfigError(
+                f"{path}: no such file or folder (run from the project folder or pass --trees)"
+            )
+    folder = dialogs_folder(dialogs)
+    profile_path = resolve_profile(profile, trees)
+    problems = Problems()
+    config = load_config(hardware, problems)
+    behaviors = load_checked_behaviors(
+        trees, dialogs=folder, profile=profile_path, config=config, problems=problems
+    )
+    loaded: Scenario | None = None
+    if config is not None:
+        try:
+            loaded = default_scenario(scenario, simulated=config.simulated)
+        except LoadError as error:
+            problems.extend(error.problems)
+        if loaded is not None:
+            problems.extend(check_scenario_events(loaded.events, config))
+    problems.raise_if_any()
+    assert behaviors is not None and config is not None and loaded is not None
+    return RunInputs(behaviors, config, loaded)
+
+
+def default_scenario(path: Path | None, *, simulated: bool) -> Scenario:
+    """The named scenario; by default the demo on the simulated vest, and on a real robot
+    nothing scripted (the world is real) for as long as it runs."""
+    if path is not None:
+        return load_scenario(path)
+    if simulated:
+        return load_scenario(DEFAULT_SCENARIO)
+    return Scenario(duration_s=float("inf"), events=(), path=Path("(no scenario)"))
