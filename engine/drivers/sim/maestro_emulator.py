@@ -34,7 +34,6 @@ import select
 import threading
 import tty
 from collections.abc import Mapping
-from dataclasses import dataclass
 from types import TracebackType
 from typing import Literal, Self
 
@@ -55,6 +54,7 @@ from engine.drivers.maestro_protocol import (
     POLOLU_PROTOCOL_START,
     QUARTER_US_PER_US,
 )
+from engine.drivers.sim.servo_channel import ServoChannel
 
 TICK_S = 0.010
 """The Maestro updates servo positions every 10 ms (at the default 20 ms period)."""
@@ -101,66 +101,6 @@ def _ticks(time_s: float) -> int:
 
 def _data(value_low: int, value_high: int) -> int:
     return value_low | (value_high << 7)
-
-
-@dataclass
-class _Channel:
-    """One servo channel; positions and targets in quarter-microseconds."""
-
-    min_qus: int
-    max_qus: int
-    home: int | Literal["off", "ignore"]
-    target: int = 0
-    position: float = 0.0
-    velocity: float = 0.0  # quarter-us per tick, signed
-    speed: int = 0
-    acceleration: int = 0
-
-    def set_target(self, quarter_us: int) -> None:
-        if quarter_us == 0:
-            self.target, self.position, self.velocity = 0, 0.0, 0.0
-            return
-        self.target = min(max(quarter_us, self.min_qus), self.max_qus)
-        # An off servo's whereabouts are unknown, so it goes straight to a new target.
-        if self.position == 0 or (self.speed == 0 and self.acceleration == 0):
-            self.position, self.velocity = float(self.target), 0.0
-
-    def go_home(self) -> None:
-        if self.home == "off":
-            self.set_target(0)
-        elif isinstance(self.home, int):  # "ignore" leaves the channel as it is
-            self.set_target(self.home)
-
-    @property
-    def moving(self) -> bool:
-        return round(self.position) != self.target
-
-    def step(self, ticks: int) -> None:
-        """Advance ``ticks`` 10 ms updates."""
-        if ticks <= 0 or (self.position == self.target and self.velocity == 0.0):
-            return
-        if self.acceleration == 0:
-            self.velocity = 0.0
-            distance = self.target - self.position
-            if self.speed == 0 or abs(distance) <= self.speed * ticks:
-                self.position = float(self.target)
-            else:
-                self.position += math.copysign(self.speed * ticks, distance)
-            return
-        accel = self.acceleration / 8  # per 10 ms tick: the unit is per 80 ms
-        top_speed = self.speed if self.speed else math.inf
-        for _ in range(ticks):
-            distance = self.target - self.position
-            if distance == 0 and self.velocity == 0.0:
-                return
-            # Fastest speed from which it can still stop at the target.
-            braking = math.sqrt(2 * accel * abs(distance))
-            wanted = math.copysign(min(top_speed, braking), distance)
-            self.velocity = min(max(wanted, self.velocity - accel), self.velocity + accel)
-            self.position += self.velocity
-            toward = distance * self.velocity > 0
-            if toward and (self.target - self.position) * distance <= 0:
-                self.position, self.velocity = float(self.target), 0.0
 
 
 class MaestroEmulator:
@@ -221,7 +161,7 @@ class MaestroEmulator:
         channel: int,
         limits_us: tuple[float, float] | Mapping[int, tuple[float, float]],
         home: HomeSetting,
-    ) -> _Channel:
+    ) -> ServoChannel:
         if isinstance(limits_us, Mapping):
             low_us, high_us = limits_us.get(channel, DEFAULT_LIMITS_US)
         else:
@@ -230,7 +170,7 @@ class MaestroEmulator:
             raise ValueError(f"channel {channel} limits {low_us}..{high_us} us are not ordered")
         low, high = round(low_us * QUARTER_US_PER_US), round(high_us * QUARTER_US_PER_US)
         if home in ("off", "ignore"):
-            return _Channel(low, high, home)
+            return ServoChannel(low, high, home)
         if isinstance(home, str) or not low_us <= home <= high_us:
             raise ValueError(
                 f"channel {channel} home {home!r} is neither 'off', 'ignore' nor a pulse "
@@ -238,7 +178,7 @@ class MaestroEmulator:
             )
         home_qus = round(home * QUARTER_US_PER_US)
         # At startup a servo with a home position starts there, without easing in.
-        return _Channel(low, high, home_qus, target=home_qus, position=float(home_qus))
+        return ServoChannel(low, high, home_qus, target=home_qus, position=float(home_qus))
 
     # -- what tests look at -----------------------------------------------------------------
 
@@ -398,7 +338,7 @@ class MaestroEmulator:
         self._timed_out = False
         return reply
 
-    def _channel(self, number: int) -> _Channel | None:
+    def _channel(self, number: int) -> ServoChannel | None:
         if number < len(self._channels):
             return self._channels[number]
         self._raise_error(ERROR_SERIAL_PROTOCOL)
