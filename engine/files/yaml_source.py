@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import errno
 import os
+import stat
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -246,29 +247,63 @@ def resolved(path: Path) -> Path:
         return path.absolute()
 
 
+class _NotRegular(Exception):  # noqa: N818 - a refusal, reported as a problem
+    def __init__(self, what: str, hint: str) -> None:
+        super().__init__(what)
+        self.what = what
+        self.hint = hint
+
+
+_KINDS = (
+    (stat.S_ISDIR, "is a folder, not a file", "name a .yaml file in it"),
+    (stat.S_ISFIFO, "is not a regular file (a FIFO)", "name a .yaml file"),
+    (stat.S_ISCHR, "is not a regular file (a character device)", "name a .yaml file"),
+    (stat.S_ISBLK, "is not a regular file (a block device)", "name a .yaml file"),
+    (stat.S_ISSOCK, "is not a regular file (a socket)", "name a .yaml file"),
+)
+
+
+def _read_at_most(path: Path, max_bytes: int) -> bytes:
+    """At most ``max_bytes + 1`` bytes of a regular file (links followed).
+
+    Opened without blocking, so a FIFO named as a tree can never hang the robot, and
+    checked on the open file itself, so nothing can swap it between check and read;
+    the size is what is read, never what ``stat`` claims (a /proc file says 0 bytes).
+    """
+    fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | os.O_CLOEXEC)
+    try:
+        mode = os.fstat(fd).st_mode
+        if not stat.S_ISREG(mode):
+            what, hint = next(
+                ((w, h) for test, w, h in _KINDS if test(mode)),
+                ("is not a regular file", "name a .yaml file"),
+            )
+            raise _NotRegular(what, hint)
+        chunks: list[bytes] = []
+        left = max_bytes + 1
+        while left > 0:
+            chunk = os.read(fd, min(left, 1 << 16))
+            if not chunk:
+                break
+            chunks.append(chunk)
+            left -= len(chunk)
+        return b"".join(chunks)
+    finally:
+        os.close(fd)
+
+
 def read_text(path: Path, shown: str | None = None, *, max_bytes: int = MAX_FILE_BYTES) -> str:
-    """The file's text, or a LoadError: missing, unreadable, too big, not UTF-8, or a path
-    that names no file (a file as a folder, too long, a link loop, a NUL character)."""
+    """The file's text, or a LoadError: missing, unreadable, too big, not UTF-8, not a
+    regular file (a folder, a FIFO, a device), or a path that names no file (a file as a
+    folder, too long, a link loop, a NUL character). Every person's file is read here."""
     name = (shown or str(path)).replace("\0", "\\0")
     start = Mark(name, 1, 1)
     if "\0" in str(path):  # the OS cannot even be asked about such a name
         raise LoadError([Problem(start, "the file name contains a NUL character", "retype it")])
     try:
-        size = path.stat().st_size
-        if path.is_dir():
-            raise LoadError([Problem(start, "is a folder, not a file")])
-        if size > max_bytes:
-            raise LoadError(
-                [
-                    Problem(
-                        start,
-                        f"file is {size / 1024:.0f} KiB, more than the "
-                        f"{max_bytes // 1024} KiB a vest YAML file may be",
-                        "split it into subtrees",
-                    )
-                ]
-            )
-        data = path.read_bytes()
+        data = _read_at_most(path, max_bytes)
+    except _NotRegular as refused:
+        raise LoadError([Problem(start, refused.what, refused.hint)]) from None
     except FileNotFoundError:
         raise LoadError([Problem(start, "file not found", "check the path")]) from None
     except PermissionError:
@@ -282,6 +317,16 @@ def read_text(path: Path, shown: str | None = None, *, max_bytes: int = MAX_FILE
         raise LoadError(
             [Problem(start, f"cannot read the file: {reason}", _OS_HINTS.get(error.errno or 0))]
         ) from None
+    if len(data) > max_bytes:
+        raise LoadError(
+            [
+                Problem(
+                    start,
+                    f"file is more than the {max_bytes // 1024} KiB a vest YAML file may be",
+                    "split it into subtrees",
+                )
+            ]
+        )
     try:
         return data.decode("utf-8")
     except UnicodeDecodeError as error:
