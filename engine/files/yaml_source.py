@@ -248,14 +248,14 @@ def resolved(path: Path) -> Path:
 
 
 class _NotRegular(Exception):  # noqa: N818 - a refusal, reported as a problem
-    def __init__(self, what: str, hint: str) -> None:
+    def __init__(self, what: str, hint: str | None) -> None:
         super().__init__(what)
         self.what = what
         self.hint = hint
 
 
 _KINDS = (
-    (stat.S_ISDIR, "is a folder, not a file", "name a .yaml file in it"),
+    (stat.S_ISDIR, "is a folder, not a file", None),
     (stat.S_ISFIFO, "is not a regular file (a FIFO)", "name a .yaml file"),
     (stat.S_ISCHR, "is not a regular file (a character device)", "name a .yaml file"),
     (stat.S_ISBLK, "is not a regular file (a block device)", "name a .yaml file"),
