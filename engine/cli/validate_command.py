@@ -24,11 +24,12 @@ from engine.cli.run_inputs import (
     robot_catalogue,
 )
 from engine.dialogs.library import DialogLibrary, check_dialog, find_dialogs_folder
+from engine.files.parsed_files import ParsedFiles
 from engine.files.problems import LoadError, Mark, Problem, Problems
-from engine.files.yaml_source import YMap, YScalar, load_yaml
+from engine.files.yaml_source import YMap, YScalar
 from engine.hardware.config import RobotConfig
 from engine.loader.substitution import Profile, load_profile, undeclared_params
-from engine.loader.tree_file import TreeLoader
+from engine.loader.tree_file import TreeLoader, shown_path
 from engine.nodes.registry import NodeRegistry, default_registry
 from engine.runtime.robot import declared_beside, tree_files
 from engine.scenario.scenario_file import load_scenario
@@ -115,6 +116,8 @@ class Validator:
         """The profile trees are checked with (``--profile``), as ``vest run`` applies it."""
         self.declared: set[str] = set()
         """Parameters the trees checked so far declare."""
+        self.files = ParsedFiles()
+        """Each file is parsed once, however many checks look at it."""
 
     def dialogs_for(self, path: Path) -> DialogLibrary | None:
         """The dialogs a tree at ``path`` uses (none when there is no dialogs folder, as in
@@ -145,11 +148,12 @@ class Validator:
             self.catalogue,
             dialogs=self.dialogs_for(path),
             profile=profile or self.profile,
+            files=self.files,
         )
 
     def check(self, path: Path) -> None:
         try:
-            document = load_yaml(path)
+            document = self.files.load(path, shown_path(path))
         except LoadError as error:
             self.problems.extend(error.problems)
             return
@@ -199,7 +203,7 @@ class Validator:
         seen: dict[tuple[Path, str], Path] = {}
         for path in files:
             try:
-                document = load_yaml(path)
+                document = self.files.load(path, shown_path(path))
             except LoadError:
                 continue
             if kind_of(document) != "tree" or path.parent.name in ("parts", "profiles"):

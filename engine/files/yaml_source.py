@@ -12,85 +12,45 @@ from __future__ import annotations
 import errno
 import os
 import stat
-from collections.abc import Iterator
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import yaml
 
 from engine.files.problems import LoadError, Mark, Problem
+from engine.files.yaml_events import STANDARD_TAGS, NeedsCarefulReading, compose_fast
+from engine.files.yaml_values import (
+    LONE_SURROGATE,
+    YList,
+    YMap,
+    YScalar,
+    YValue,
+    describe,
+    plain,
+    scalar_value,
+)
+
+__all__ = [
+    "MAX_DEPTH",
+    "MAX_FILE_BYTES",
+    "MAX_NODES",
+    "YList",
+    "YMap",
+    "YScalar",
+    "YValue",
+    "describe",
+    "load_yaml",
+    "parse_yaml",
+    "plain",
+    "read_text",
+    "resolved",
+]
 
 MAX_FILE_BYTES = 1024 * 1024
 MAX_NODES = 100_000
 MAX_DEPTH = 100
 """Values nested deeper than this are refused (a tree 50 composites deep is already far
 beyond what anyone writes; deeper ones would exhaust Python's stack)."""
-
-_STANDARD_TAGS = {
-    "tag:yaml.org,2002:" + name
-    for name in ("str", "int", "float", "bool", "null", "map", "seq", "timestamp")
-}
-
-
-@dataclass
-class YScalar:
-    value: Any
-    mark: Mark
-
-
-@dataclass
-class YList:
-    items: list[YValue]
-    mark: Mark
-
-    def __iter__(self) -> Iterator[YValue]:
-        return iter(self.items)
-
-    def __len__(self) -> int:
-        return len(self.items)
-
-
-@dataclass
-class YMap:
-    """A mapping whose keys are text; ``key_marks`` has the place of each key."""
-
-    entries: dict[str, YValue]
-    mark: Mark
-    key_marks: dict[str, Mark] = field(default_factory=dict)
-
-    def get(self, key: str) -> YValue | None:
-        return self.entries.get(key)
-
-    def __contains__(self, key: str) -> bool:
-        return key in self.entries
-
-    def items(self) -> Iterator[tuple[str, YValue]]:
-        return iter(self.entries.items())
-
-    def __len__(self) -> int:
-        return len(self.entries)
-
-
-YValue = YScalar | YList | YMap
-
-
-def plain(value: YValue) -> Any:
-    """The Python value without places (dicts, lists, scalars)."""
-    if isinstance(value, YScalar):
-        return value.value
-    if isinstance(value, YList):
-        return [plain(item) for item in value.items]
-    return {key: plain(item) for key, item in value.entries.items()}
-
-
-def describe(value: YValue) -> str:
-    """How a value reads in a message: ``'three'``, ``a list``, ``a mapping``."""
-    if isinstance(value, YMap):
-        return "a mapping"
-    if isinstance(value, YList):
-        return "a list"
-    return "nothing" if value.value is None else repr(value.value)
 
 
 def _mark(file: str, yaml_mark: Any) -> Mark:
@@ -161,6 +121,17 @@ class _Converter:
         self.problems: list[Problem] = []
         self.constructor = yaml.SafeLoader("")
 
+    def refuse_surrogates(self, text: str, mark: Mark) -> None:
+        found = LONE_SURROGATE.search(text)
+        if found:
+            self.problems.append(
+                Problem(
+                    mark,
+                    f"\\u{ord(found.group()):04X} is half of a character pair, not a character",
+                    "remove the escape, or write the character itself",
+                )
+            )
+
     def convert(self, node: yaml.Node, depth: int = 1) -> YValue:
         self.count += 1
         mark = _mark(self.file, node.start_mark)
@@ -184,7 +155,7 @@ class _Converter:
                     )
                 ]
             )
-        if node.tag not in _STANDARD_TAGS:
+        if node.tag not in STANDARD_TAGS:
             tag = node.tag.replace("tag:yaml.org,2002:", "!!")
             self.problems.append(
                 Problem(
@@ -193,10 +164,9 @@ class _Converter:
             )
             return YScalar(None, mark)
         if isinstance(node, yaml.ScalarNode):
-            if node.tag.endswith(":timestamp"):  # dates stay text (2024-13-45 is no date)
-                return YScalar(str(node.value), mark)
+            self.refuse_surrogates(node.value, mark)
             try:
-                value = self.constructor.construct_object(node, deep=True)
+                value = scalar_value(self.constructor, node.tag, node.value, node.style)
             except (yaml.YAMLError, ValueError, OverflowError) as error:
                 # e.g. an integer of more digits than Python converts
                 self.problems.append(Problem(mark, f"bad value: {error}"))
@@ -217,6 +187,7 @@ class _Converter:
                 )
                 continue
             key = str(key_node.value)
+            self.refuse_surrogates(key, key_mark)
             if key in entries:
                 self.problems.append(
                     Problem(
@@ -345,7 +316,15 @@ def read_text(path: Path, shown: str | None = None, *, max_bytes: int = MAX_FILE
 
 
 def parse_yaml(text: str, name: str) -> YValue | None:
-    """Parse one YAML document keeping places; None for an empty document."""
+    """Parse one YAML document keeping places; None for an empty document.
+
+    libyaml reads a good file fast (:mod:`engine.files.yaml_events`); a file it cannot
+    read plainly is read again here, slowly and carefully, to word every problem.
+    """
+    try:
+        return compose_fast(text, name, max_nodes=MAX_NODES, max_depth=MAX_DEPTH)  # type: ignore[no-any-return]
+    except NeedsCarefulReading:
+        pass
     composer: _Composer | None = None
     try:
         composer = _Composer(text)  # checks the characters first (ReaderError)

@@ -29,6 +29,7 @@ import py_trees
 
 from engine.blackboard.catalogue import KeyCatalogue
 from engine.dialogs.library import DialogLibrary
+from engine.files.parsed_files import ParsedFiles
 from engine.files.problems import LoadError, Mark, Problems
 from engine.files.yaml_source import (
     YList,
@@ -36,7 +37,6 @@ from engine.files.yaml_source import (
     YScalar,
     YValue,
     describe,
-    load_yaml,
     plain,
     resolved,
 )
@@ -101,6 +101,15 @@ class _Seen:
     declared: set[str] = field(default_factory=set)
 
 
+def shown_path(path: Path, base: Path | None = None) -> str:
+    """How messages name ``path``: relative to ``base`` (the working folder) when inside."""
+    try:
+        shown = str(resolved(path).relative_to(resolved(base or Path.cwd())))
+    except ValueError:
+        shown = str(path)
+    return shown.replace("\0", "\\0")  # a NUL would cut the line a terminal shows
+
+
 class TreeLoader:
     """Validates tree files against a registry, a key catalogue, dialogs and a profile."""
 
@@ -112,8 +121,10 @@ class TreeLoader:
         dialogs: DialogLibrary | None = None,
         profile: Profile | None = None,
         root_dir: Path | None = None,
+        files: ParsedFiles | None = None,
     ) -> None:
         self.registry = registry
+        self.files = files or ParsedFiles()
         self.catalogue = catalogue
         self.dialogs = dialogs
         self.profile = profile
@@ -122,12 +133,7 @@ class TreeLoader:
 
     def shown(self, path: Path) -> str:
         """How messages name ``path``: relative to the working folder when inside it."""
-        base = self.root_dir or Path.cwd()
-        try:
-            shown = str(resolved(path).relative_to(resolved(base)))
-        except ValueError:
-            shown = str(path)
-        return shown.replace("\0", "\\0")  # a NUL would cut the line a terminal shows
+        return shown_path(path, self.root_dir)
 
     def load(self, path: Path) -> TreeDefinition:
         """Validate the tree file at ``path``; LoadError listing every problem."""
@@ -163,7 +169,7 @@ class TreeLoader:
     def _read(self, path: Path, problems: Problems, seen: _Seen) -> YMap | None:
         shown = self.shown(path)
         try:
-            document = load_yaml(path, shown)
+            document = self.files.load(path, shown)
         except LoadError as error:
             problems.extend(error.problems)
             return None
