@@ -87,7 +87,7 @@ class _Composer(yaml.SafeLoader):
         self._open_anchors: set[str] = set()
 
     def compose_node(self, parent: Any, index: Any) -> Any:
-        event = self.peek_event()
+        event = self.peek_event()  # type: ignore[no-untyped-call]
         if isinstance(event, yaml.AliasEvent):
             if event.anchor in self._open_anchors:
                 raise _Refused(
@@ -322,7 +322,7 @@ def parse_yaml(text: str, name: str) -> YValue | None:
     read plainly is read again here, slowly and carefully, to word every problem.
     """
     try:
-        return compose_fast(text, name, max_nodes=MAX_NODES, max_depth=MAX_DEPTH)  # type: ignore[no-any-return]
+        return compose_fast(text, name, max_nodes=MAX_NODES, max_depth=MAX_DEPTH)
     except NeedsCarefulReading:
         pass
     composer: _Composer | None = None
