@@ -51,12 +51,11 @@ from engine.loader.substitution import (
 from engine.nodes.context import TreeContext
 from engine.nodes.registry import NodeRegistry
 from engine.nodes.spec import NodeType
-from engine.values.params import CheckContext, Number, ParamProblem, did_you_mean
+from engine.values.params import RATE_HZ, CheckContext, ParamProblem, did_you_mean
 
 TOP_KEYS = ("name", "description", "rate_hz", "params", "root")
 SUBTREE = "Subtree"
 DEFAULT_RATE_HZ = 10.0
-MAX_RATE_HZ = 1000.0
 
 
 @dataclass
@@ -222,16 +221,14 @@ class TreeLoader:
         if unresolved(raw):
             return DEFAULT_RATE_HZ
         try:
-            value = Number(unit="Hz").convert(plain(raw), self.check_context)
+            return RATE_HZ.convert(plain(raw), self.check_context)
         except ParamProblem as problem:
-            problems.add(raw.mark, f"'rate_hz' {problem.message}", "ticks per second, e.g. 10")
-            return DEFAULT_RATE_HZ
-        if not 0 < value <= MAX_RATE_HZ:
             problems.add(
-                raw.mark, f"'rate_hz' must be above 0 and at most {MAX_RATE_HZ:g}, got {value:g}"
+                raw.mark,
+                f"'rate_hz' {problem.message}",
+                f"ticks per second, from {RATE_HZ.minimum:g} to {RATE_HZ.maximum:g}, e.g. 10",
             )
             return DEFAULT_RATE_HZ
-        return value
 
     def _root(
         self,

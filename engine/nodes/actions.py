@@ -16,6 +16,9 @@ from engine.errors import ServiceError
 from engine.nodes.base import Leaf, ServiceAction
 from engine.services.jobs import ImmediateJob, Job
 from engine.values.params import (
+    DISTANCE_MM,
+    SECONDS,
+    SPEED_DPS,
     AnyValue,
     CheckContext,
     Choice,
@@ -81,7 +84,7 @@ class SetLed(ServiceAction):
         Param("color", Color(), doc="a color name (pink, blue, off, ...) or #RRGGBB"),
         Param(
             "seconds",
-            Number(minimum=0.0, unit="s"),
+            SECONDS,
             None,
             "how long to keep it lit; empty: until another SetLed",
         ),
@@ -103,7 +106,7 @@ class MoveServo(ServiceAction):
         Param("angle_deg", Number(-180.0, 180.0, "deg"), doc="target angle in degrees"),
         Param(
             "speed_dps",
-            Number(minimum=0.0, unit="deg/s"),
+            SPEED_DPS,
             None,
             "degrees per second; empty: the joint's own maximum",
         ),
@@ -128,8 +131,8 @@ class LookToward(Leaf):
     params: ClassVar = (
         Param("joint", Text(), "neck", "the joint to turn"),
         Param("turn_deg", Number(0.0, 90.0, "deg"), 30.0, "how far to turn; left is positive"),
-        Param("max_mm", Number(minimum=0.0, unit="mm"), 1200.0, "ignore anything farther"),
-        Param("speed_dps", Number(minimum=0.0, unit="deg/s"), None, "turn speed"),
+        Param("max_mm", DISTANCE_MM, 1200.0, "ignore anything farther"),
+        Param("speed_dps", SPEED_DPS, None, "turn speed"),
         Param("left", Key(), "/sensors/range/left_mm", "left distance key"),
         Param("center", Key(), "/sensors/range/center_mm", "center distance key"),
         Param("right", Key(), "/sensors/range/right_mm", "right distance key"),
@@ -186,7 +189,7 @@ class Wait(Leaf):
     RUNNING until ``seconds`` have passed since it started; then SUCCESS.
     """
 
-    params: ClassVar = (Param("seconds", Number(minimum=0.0, unit="s"), doc="how long"),)
+    params: ClassVar = (Param("seconds", SECONDS, doc="how long"),)
 
     def initialise(self) -> None:
         self.until_s = self.now() + self.args.seconds

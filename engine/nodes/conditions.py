@@ -9,7 +9,16 @@ from typing import Any, ClassVar
 from engine.blackboard.catalogue import VARIABLES_PREFIX, KeySpec
 from engine.blackboard.events import EVENT_LOG_LENGTH, EventLog
 from engine.nodes.base import Condition, node_path
-from engine.values.params import CheckContext, Integer, Key, ListOf, Number, Param, Scalar
+from engine.values.params import (
+    SECONDS,
+    CheckContext,
+    Integer,
+    Key,
+    ListOf,
+    Number,
+    Param,
+    Scalar,
+)
 
 _COMPARISONS = ("equals", "not_equals", "above", "below", "between")
 _WORDS_FOR_BOOLEANS = ("true", "false", "yes", "no", "on", "off")
@@ -157,7 +166,7 @@ class Fresh(Condition):
 
     params: ClassVar = (
         Param("key", Key(kinds=("state", "event")), doc="the blackboard key"),
-        Param("within_s", Number(minimum=0.0, unit="s"), doc="how recent, in seconds"),
+        Param("within_s", SECONDS, doc="how recent, in seconds"),
     )
 
     def check(self) -> bool:

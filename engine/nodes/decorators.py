@@ -15,7 +15,7 @@ from py_trees.common import OneShotPolicy, Status
 from engine.clock import Clock
 from engine.nodes.context import TreeContext
 from engine.nodes.spec import NodeType
-from engine.values.params import REQUIRED, Choice, Integer, Number, Param
+from engine.values.params import REQUIRED, SECONDS, Choice, Integer, Param
 
 
 class EngineTimeout(py_trees.decorators.Decorator):
@@ -118,8 +118,6 @@ def _one_shot(name: str, args: SimpleNamespace, children: list[Any], ctx: TreeCo
     return py_trees.decorators.OneShot(name=name, child=_child(children), policy=policy)
 
 
-_SECONDS = Number(minimum=0.0, unit="s")
-
 DECORATORS = (
     NodeType(
         "Inverter",
@@ -166,7 +164,7 @@ DECORATORS = (
 
         The child's status while it is in time; FAILURE (and the child stopped) when it is
         still RUNNING after ``seconds``.""",
-        (Param("seconds", _SECONDS, REQUIRED, "time allowed, in seconds"),),
+        (Param("seconds", SECONDS, REQUIRED, "time allowed, in seconds"),),
         _timeout,
     ),
     NodeType(
@@ -175,7 +173,7 @@ DECORATORS = (
         """After the child succeeds, rest for ``seconds`` so a behavior does not repeat itself.
 
         The child's status; FAILURE without ticking the child while cooling down.""",
-        (Param("seconds", _SECONDS, REQUIRED, "rest time after a success, in seconds"),),
+        (Param("seconds", SECONDS, REQUIRED, "rest time after a success, in seconds"),),
         _cooldown,
     ),
     NodeType(

@@ -18,9 +18,11 @@ import py_trees
 
 from engine.blackboard.board import Blackboard
 from engine.clock import Clock, stopwatch
+from engine.errors import ConfigError
 from engine.loader.tree_file import TreeDefinition
 from engine.nodes.context import TreeContext
 from engine.runtime.stats import TickStats
+from engine.values.params import RATE_HZ
 
 _log = logging.getLogger("vest.scheduler")
 
@@ -97,7 +99,17 @@ class Scheduler:
         self.hook_errors = 0
 
     def add(self, tree: RunningTree) -> RunningTree:
-        """Schedule ``tree``; trees added before the run share one origin for their deadlines."""
+        """Schedule ``tree``; trees added before the run share one origin for their deadlines.
+
+        A rate the loader would refuse (a tree built in code) is refused here too, so every
+        deadline is finite: 5e-324 Hz is a period of inf and a deadline of NaN.
+        """
+        rate_hz = tree.definition.rate_hz
+        if not (RATE_HZ.minimum or 0.0) <= rate_hz <= (RATE_HZ.maximum or math.inf):
+            raise ConfigError(
+                f"tree {tree.name!r}: rate_hz must be {RATE_HZ.minimum:g}..{RATE_HZ.maximum:g},"
+                f" got {rate_hz!r}"
+            )
         started = any(t.stats.ticks for t in self.trees)
         tree.origin_s = self.clock.now() if started or not self.trees else self.trees[0].origin_s
         tree.period_index = 0

@@ -24,6 +24,7 @@ from engine.files.problems import Mark, Problems
 from engine.files.yaml_source import YList, YMap, YValue, describe, load_yaml, plain
 from engine.values.params import (
     REQUIRED,
+    SECONDS,
     AnyValue,
     CheckContext,
     Choice,
@@ -205,7 +206,7 @@ def _event(raw: YValue, ctx: CheckContext, problems: Problems, index: int) -> Sc
     if at is None:
         problems.add(raw.mark, "event has no 'at:'", "seconds from the start, e.g. at: 1.5")
     else:
-        at_s = _convert(Number(0.0, unit="s"), at, "at", ctx, problems)
+        at_s = _convert(SECONDS, at, "at", ctx, problems)
     if len(kinds) != 1:
         problems.add(
             raw.mark,

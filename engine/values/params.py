@@ -353,3 +353,13 @@ class Param:
     @property
     def required(self) -> bool:
         return self.default is REQUIRED
+
+
+SECONDS = Number(0.0, 86_400.0, "s")
+"""A duration or a rest: up to a day (a longer one is a typo, and would never end a test)."""
+RATE_HZ = Number(0.1, 1000.0, "Hz")
+"""How often something ticks or polls: from once in ten seconds to a thousand times a second."""
+SPEED_DPS = Number(0.0, 10_000.0, "deg/s")
+"""A turning speed (each joint's own limit applies too)."""
+DISTANCE_MM = Number(0.0, 100_000.0, "mm")
+"""A distance up to 100 m."""

@@ -7,6 +7,7 @@ checked when the tree loads and never evaluate code.
 
 from __future__ import annotations
 
+import re
 import string
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -85,9 +86,23 @@ def compile_template(text: str, ctx: CheckContext) -> CompiledTemplate:
     return CompiledTemplate(text, tuple(parts))
 
 
+MAX_FORMAT_NUMBER = 100
+"""The widest width and the longest precision a format spec may ask for: a spec like
+``{key:>900000000}`` would take gigabytes at the tick that fills it."""
+
+_NUMBERS = re.compile(r"\d+")
+
+
 def _check_spec(field: str, key: str, spec: str, ctx: CheckContext) -> None:
     """A format spec that cannot format the key's kind of value is reported now, not at the
     first tick that fills it (keys of any kind, like /vars/, are checked when filled)."""
+    for number in _NUMBERS.findall(spec):
+        if len(number) > 3 or int(number) > MAX_FORMAT_NUMBER:
+            raise ParamProblem(
+                f"format {{{field}:{spec}}} asks for {number[:12]}"
+                f"{'...' if len(number) > 12 else ''} characters",
+                f"widths and precisions go up to {MAX_FORMAT_NUMBER}, e.g. {{{field}:.1f}}",
+            )
     key_spec = ctx.catalogue.lookup(key)
     sample = _SAMPLES.get(key_spec.value_type) if key_spec is not None else None
     if sample is None:

@@ -1,12 +1,15 @@
 """The scheduler: each tree at its own rate, drift-free, and a failing leaf never stops it."""
 
+import dataclasses
 import textwrap
 from pathlib import Path
 
+import pytest
 from py_trees.common import Status
 
 from engine.blackboard import Blackboard, default_catalogue
 from engine.clock import VirtualClock
+from engine.errors import ConfigError
 from engine.nodes import Condition, Param, Text, builtin_registry
 from engine.runtime.robot import Robot, load_behaviors
 from engine.services.simulated import simulated_services
@@ -150,3 +153,12 @@ def test_a_failing_hook_is_counted_and_the_trees_keep_ticking(tmp_path):
     robot.scheduler.run(until_s=0.2)
     assert robot.scheduler.hook_errors == 3
     assert robot.trees[0].stats.ticks == 3
+
+
+def test_a_tree_built_in_code_with_an_absurd_rate_is_refused_before_it_can_spin(tmp_path):
+    write(tmp_path, "calm.yaml", "rate_hz: 10\nroot:\n  Wait: {seconds: 1}\n")
+    robot, _ = make_robot(tmp_path)
+    [running] = robot.trees
+    running.definition = dataclasses.replace(running.definition, rate_hz=5e-324)
+    with pytest.raises(ConfigError, match=r"rate_hz must be 0.1..1000, got 5e-324"):
+        robot.scheduler.add(running)

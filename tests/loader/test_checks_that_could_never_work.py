@@ -191,10 +191,23 @@ def test_a_template_format_that_cannot_format_the_value_is_refused_at_load(
     assert problem.startswith(f"tree.yaml:2:15: {expected}")
 
 
-@pytest.mark.parametrize("text", ["{temperature_f:.0f}", "{temperature_f:>6.1f}", "{/vars/x:.2f}"])
-def test_a_template_format_that_suits_the_value_loads(tmp_path: Path, text: str) -> None:
+@pytest.mark.parametrize(
+    ("text", "said"),
+    [
+        ("{temperature_f:.0f}", "It is 72"),
+        ("{temperature_f:>6.1f}", "It is   71.9"),
+        ("{/vars/x:.2f}", "It is 1.50"),
+    ],
+)
+def test_a_template_format_that_suits_the_value_loads_and_fills(
+    tmp_path: Path, text: str, said: str
+) -> None:
     path = write(tmp_path, "tree.yaml", f'root:\n  Say: {{text: "It is {text}"}}\n')
-    TreeLoader(default_registry(), default_catalogue(), root_dir=tmp_path).load(path)
+    robot = TreeHarness.from_file(path)
+    robot.set("/sensors/temperature/f", 71.94)
+    robot.set("/vars/x", 1.5)
+    robot.tick()
+    assert robot.said == [said]
 
 
 def test_a_dialog_answer_with_a_bad_format_is_refused_at_its_place(tmp_path: Path) -> None:

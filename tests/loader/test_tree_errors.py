@@ -442,9 +442,11 @@ def test_every_problem_of_a_file_is_reported_together(tmp_path: Path) -> None:
 @pytest.mark.parametrize(
     ("rate", "expected"),
     [
-        ("0", "'rate_hz' must be above 0 and at most 1000, got 0"),
-        ("-5", "'rate_hz' must be above 0 and at most 1000, got -5"),
-        ("5000", "'rate_hz' must be above 0 and at most 1000, got 5000"),
+        ("0", "'rate_hz' must be at least 0.1, got 0"),
+        ("-5", "'rate_hz' must be at least 0.1, got -5"),
+        ("5.0e-324", "'rate_hz' must be at least 0.1, got 4.94066e-324"),  # a period of inf
+        ("5000", "'rate_hz' must be at most 1000, got 5000"),
+        (".inf", "'rate_hz' must be a finite number, got inf"),
         ("fast", "'rate_hz' must be a number, got 'fast'"),
     ],
 )
