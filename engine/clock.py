@@ -112,6 +112,7 @@ class VirtualClock:
         self._now = start_s
         self._lock = threading.Condition()
         self._waiting = 0
+        self._entered = 0
 
     def now(self) -> float:
         return self._now
@@ -147,6 +148,7 @@ class VirtualClock:
         with self._lock:
             deadline = self._now + max(timeout_s, 0.0)
             self._waiting += 1
+            self._entered += 1
             self._lock.notify_all()
             try:
                 while not event.is_set() and self._now < deadline:
@@ -155,12 +157,16 @@ class VirtualClock:
                 self._waiting -= 1
             return event.is_set()
 
-    def until_waiting(self, threads: int = 1, *, limit_s: float = 10.0) -> bool:
-        """Block until ``threads`` threads are inside :meth:`wait` (a test's hand-off point:
-        advance the clock only once the worker waits). False if that took over ``limit_s``
-        real seconds, so a broken worker fails a test instead of hanging it."""
+    def until_waiting(self, threads: int = 1, *, entered: int = 0, limit_s: float = 10.0) -> bool:
+        """Block until ``threads`` threads are inside :meth:`wait`, and waits have been
+        entered ``entered`` times in all (a test's hand-off point: advance the clock only
+        once the worker waits; after an advance, ``entered`` says the worker finished its
+        round and waits again). False if that took over ``limit_s`` real seconds, so a
+        broken worker fails a test instead of hanging it."""
         with self._lock:
-            return self._lock.wait_for(lambda: self._waiting >= threads, timeout=limit_s)
+            return self._lock.wait_for(
+                lambda: self._waiting >= threads and self._entered >= entered, timeout=limit_s
+            )
 
 
 def stopwatch() -> float:

@@ -111,6 +111,7 @@ def main(args: argparse.Namespace) -> int:
     vest = build_sim_vest(config, world, clock) if config.simulated else None
     world.listeners.append(UnwiredSenses(blackboard))  # speech and cloud have no devices yet
     hardware = build_hardware(config, clock, blackboard, vest=vest)
+    reloader: TreeReloader | None = None
     try:
         start_s = clock.now()  # after start-up, which takes simulated time too
         timeline = Timeline(sys.stdout, start_s=start_s, as_json=args.json)
@@ -131,8 +132,10 @@ def main(args: argparse.Namespace) -> int:
             ScenarioPlayer(scenario, world, start_s=start_s, on_event=timeline.world)
         )
         robot.scheduler.hooks.extend(hardware.hooks)
-        if not args.fast:
-            robot.scheduler.hooks.append(TreeReloader(behaviors.loader, robot.trees, clock))
+        if not args.fast:  # reload work runs beside the scheduler, swaps between ticks
+            reloader = TreeReloader(behaviors.loader, robot.trees, clock)
+            robot.scheduler.hooks.append(reloader)
+            reloader.start()
         duration = args.duration if args.duration is not None else scenario.duration_s
         # a signal that came during start-up stops the run before its first tick
         args.stop_signals.on_stop(robot.scheduler.stop)
@@ -142,6 +145,8 @@ def main(args: argparse.Namespace) -> int:
         robot.scheduler.run(until_s=start_s + duration, start_s=first_tick_s)
         timeline.summary(robot.trees)
     finally:
+        if reloader is not None:
+            reloader.stop()
         hardware.close()
         if vest is not None:
             vest.close()

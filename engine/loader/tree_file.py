@@ -98,6 +98,8 @@ class _Seen:
 
     files: list[Path] = field(default_factory=list)
     declared: set[str] = field(default_factory=set)
+    tried: list[Path] = field(default_factory=list)
+    """Every file the load tried to read, found or not."""
 
 
 def shown_path(path: Path, base: Path | None = None) -> str:
@@ -136,8 +138,19 @@ class TreeLoader:
 
     def load(self, path: Path) -> TreeDefinition:
         """Validate the tree file at ``path``; LoadError listing every problem."""
-        problems = Problems()
+        return self._load(path, _Seen())
+
+    def load_watching(self, path: Path) -> tuple[TreeDefinition | LoadError, list[Path]]:
+        """The tree (or why not) and every file the load read or tried to read: what hot
+        reload watches, including a subtree a refused edit names that does not exist yet."""
         seen = _Seen()
+        try:
+            return self._load(path, seen), seen.tried
+        except LoadError as error:
+            return error, seen.tried
+
+    def _load(self, path: Path, seen: _Seen) -> TreeDefinition:
+        problems = Problems()
         document = self._read(path, problems, seen)
         if document is None:
             problems.raise_if_any()
@@ -167,6 +180,7 @@ class TreeLoader:
     # -- file level -----------------------------------------------------------------------
     def _read(self, path: Path, problems: Problems, seen: _Seen) -> YMap | None:
         shown = self.shown(path)
+        seen.tried.append(path)
         try:
             document = self.files.load(path, shown)
         except LoadError as error:

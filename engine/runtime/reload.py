@@ -1,15 +1,26 @@
 """Hot reload: a changed tree file is validated and swapped in between ticks.
 
 An invalid change keeps the running tree and reports every problem once; fixing the file
-reloads it. Files are compared by modification time and size, checked every
-``check_every_s`` seconds of the engine clock.
+reloads it. Files are compared by modification time and size every ``check_every_s``
+seconds of the engine clock. Only the files a tree uses are watched, and while an edit is
+refused, the files that edit tried to read (a subtree it names may not exist yet).
+
+The tick is sacred: on the robot, :meth:`TreeReloader.start` runs the slow part (stat,
+read, parse, validate, build) on a thread of its own, and the scheduler hook only swaps
+a tree that is ready, between ticks. Without a thread (tests, ``--fast``), the hook does
+both itself, at its checks, so a run on a virtual clock stays deterministic.
 """
 
 from __future__ import annotations
 
 import logging
+import queue
+import threading
 from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
+
+import py_trees
 
 from engine.clock import Clock
 from engine.files.problems import LoadError, Mark, Problem
@@ -19,19 +30,28 @@ from engine.runtime.scheduler import RunningTree
 _log = logging.getLogger("vest.reload")
 
 Stamp = tuple[int, int] | None
-MAX_WATCHED = 500
 
 
 def _stamp(path: Path) -> Stamp:
     try:
         info = path.stat()
-    except OSError:
+    except (OSError, ValueError):
         return None
     return (info.st_mtime_ns, info.st_size)
 
 
+@dataclass
+class _Prepared:
+    """A reload made ready beside the scheduler: the new tree, built, or why not."""
+
+    tree: RunningTree
+    definition: TreeDefinition | None
+    built: py_trees.trees.BehaviourTree | None
+    problem: LoadError | None
+
+
 class TreeReloader:
-    """A scheduler hook that reloads changed tree files."""
+    """A scheduler hook that reloads changed tree files (see the module's doc)."""
 
     def __init__(
         self,
@@ -44,83 +64,118 @@ class TreeReloader:
     ) -> None:
         self.loader = loader
         self.trees = trees
+        self.clock = clock
         self.check_every_s = check_every_s
         self.on_reload = on_reload or _log_reload
         self._next_check_s = clock.now() + check_every_s
         self._stamps: dict[Path, dict[Path, Stamp]] = {
-            tree.definition.path: self._stamps_of(tree.definition) for tree in trees
+            tree.definition.path: _stamps(tree.definition.files or [tree.definition.path])
+            for tree in trees
         }
+        self._ready: queue.SimpleQueue[_Prepared] = queue.SimpleQueue()
+        self._stop = clock.event()
+        self._worker: threading.Thread | None = None
 
-    @staticmethod
-    def _stamps_of(definition: TreeDefinition) -> dict[Path, Stamp]:
-        return {path: _stamp(path) for path in definition.files or [definition.path]}
-
+    # -- the scheduler's side -------------------------------------------------------------
     def __call__(self, now_s: float) -> None:
+        if self._worker is not None:
+            self._swap_ready()
+            return
         if now_s < self._next_check_s:
             return
         self._next_check_s = now_s + self.check_every_s
         self.check()
 
     def check(self) -> list[str]:
-        """Reload every tree whose files changed; returns the names reloaded."""
-        reloaded = []
+        """Reload every tree whose files changed, here and now; returns the names reloaded."""
+        for prepared in self._prepare_changed():
+            self._ready.put(prepared)
+        return self._swap_ready()
+
+    def _swap_ready(self) -> list[str]:
+        reloaded: list[str] = []
+        while True:
+            try:
+                prepared = self._ready.get_nowait()
+            except queue.Empty:
+                return reloaded
+            problem = prepared.problem
+            if problem is None and prepared.definition and prepared.built:
+                try:
+                    prepared.tree.swap(prepared.definition, prepared.built)
+                    reloaded.append(prepared.tree.name)
+                except Exception as error:  # whatever went wrong, the running robot goes on
+                    problem = _crashed(self.loader.shown(prepared.tree.definition.path), error)
+            self.on_reload(prepared.tree.name, problem)
+
+    # -- the worker's side ------------------------------------------------------------------
+    def start(self) -> None:
+        """Check and prepare reloads on a thread of their own until :meth:`stop`."""
+        if self._worker is None:
+            self._stop.clear()
+            self._worker = threading.Thread(target=self._watch, name="vest-reload", daemon=True)
+            self._worker.start()
+
+    def stop(self) -> None:
+        """End the worker (a reload it was preparing is dropped)."""
+        self._stop.set()
+        if self._worker is not None:
+            self._worker.join()
+            self._worker = None
+
+    def _watch(self) -> None:
+        while not self.clock.wait(self._stop, self.check_every_s):
+            for prepared in self._prepare_changed():
+                self._ready.put(prepared)
+
+    def _prepare_changed(self) -> list[_Prepared]:
+        prepared = []
         for tree in self.trees:
             path = tree.definition.path
-            old = self._stamps[path]
-            current = {file: _stamp(file) for file in old}
-            if current == old:
+            watched = self._stamps[path]
+            current = {file: _stamp(file) for file in watched}
+            if current == watched:
                 continue
-            # the refused version is remembered (reported once, not at every check), and
-            # while it is refused every YAML file near it is watched: the fix may be in a
-            # subtree the running version did not include
-            self._stamps[path] = {**current, **_stamps_near(path)}
-            problem = self._reload(tree)
-            self.on_reload(tree.name, problem)
-            if problem is None:
-                self._stamps[path] = self._stamps_of(tree.definition)
-                reloaded.append(tree.name)
-        return reloaded
+            ready, used = self._prepare(tree)
+            # a refused version is remembered (reported once, not at every check); its
+            # files are watched too: the fix may be in a subtree the running one lacks
+            self._stamps[path] = {**current, **_stamps(used)} if ready.problem else _stamps(used)
+            prepared.append(ready)
+        return prepared
 
-    def _reload(self, tree: RunningTree) -> LoadError | None:
-        """Swap in the changed file, or say why the running tree is kept."""
-        shown = self.loader.shown(tree.definition.path)
+    def _prepare(self, tree: RunningTree) -> tuple[_Prepared, list[Path]]:
+        """Load and build the changed file, or say why the running tree is kept."""
+        path = tree.definition.path
+        used = [path]
         try:
-            definition = self.loader.load(tree.definition.path)
-            if definition.name != tree.name:
-                return LoadError(
-                    [
-                        Problem(
-                            definition.root.mark,
-                            f"the tree is renamed "
-                            f"{tree.name!r} -> {definition.name!r} while running",
-                            "restart vest run to rename a tree",
-                        )
-                    ]
+            loaded, used = self.loader.load_watching(path)
+            if isinstance(loaded, LoadError):
+                return _Prepared(tree, None, None, loaded), used
+            if loaded.name != tree.name:
+                renamed = Problem(
+                    loaded.root.mark,
+                    f"the tree is renamed {tree.name!r} -> {loaded.name!r} while running",
+                    "restart vest run to rename a tree",
                 )
-            tree.replace(definition)
-        except LoadError as error:
-            return error
+                return _Prepared(tree, None, None, LoadError([renamed])), used
+            return _Prepared(tree, loaded, loaded.build(tree.context), None), used
         except Exception as error:  # whatever went wrong, the running robot goes on
-            _log.exception("reloading %s failed", shown)
-            return LoadError(
-                [Problem(Mark(shown, 1, 1), f"could not reload: {type(error).__name__}: {error}")]
-            )
-        return None
+            return _Prepared(tree, None, None, _crashed(self.loader.shown(path), error)), used
 
 
-def _stamps_near(tree_file: Path) -> dict[Path, Stamp]:
-    """Every YAML file in the tree file's folder and below (bounded)."""
-    found: dict[Path, Stamp] = {}
-    try:
-        for file in sorted(tree_file.parent.rglob("*.yaml"))[:MAX_WATCHED]:
-            found[file] = _stamp(file)
-    except OSError:
-        pass
-    return found
+def _stamps(files: list[Path]) -> dict[Path, Stamp]:
+    return {file: _stamp(file) for file in files}
+
+
+def _crashed(shown: str, error: Exception) -> LoadError:
+    _log.error("reloading %s failed", shown, exc_info=error)
+    return LoadError(
+        [Problem(Mark(shown, 1, 1), f"could not reload: {type(error).__name__}: {error}")]
+    )
 
 
 def _log_reload(name: str, error: LoadError | None) -> None:
     if error is None:
-        _log.warning("reloaded %s", name)
+        _log.info("reloaded %s", name)
     else:
         _log.error("kept the running %s; the changed file has problems:\n%s", name, error)

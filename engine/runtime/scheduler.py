@@ -61,7 +61,11 @@ class RunningTree:
 
         The new tree is built first: if building fails, the running tree is untouched.
         """
-        new_tree = definition.build(self.context)
+        self.swap(definition, definition.build(self.context))
+
+    def swap(self, definition: TreeDefinition, new_tree: py_trees.trees.BehaviourTree) -> None:
+        """Swap in ``new_tree``, built from ``definition`` (beside the scheduler, for hot
+        reload), halting the running one cleanly; call between ticks."""
         old_root = self.tree.root
         self.halt()
         for node in old_root.iterate():  # the old nodes' blackboard clients go with them

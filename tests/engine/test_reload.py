@@ -110,3 +110,45 @@ def test_a_reload_that_crashes_while_building_keeps_the_running_tree(tmp_path, m
     robot.scheduler.run(until_s=1.5)
     assert set(said(robot)) == {"Hello"}
     assert "could not reload: RuntimeError: disk on fire" in str(reports[0][1])
+
+
+def test_on_its_own_thread_the_reloader_prepares_beside_the_ticks_and_swaps_between_them(
+    tmp_path,
+):
+    robot, tree_file, reports = start(tmp_path)
+    clock = robot.scheduler.clock
+    [reloader] = [hook for hook in robot.scheduler.hooks if isinstance(hook, TreeReloader)]
+    reloader.start()
+    try:
+        assert clock.until_waiting(1)  # the worker waits for its next check
+        edit(tree_file, GREETER.replace("PHRASE", "From the worker"), 1)
+        clock.advance(1.0)  # the worker's check is due: it loads and builds the new tree
+        assert clock.until_waiting(1, entered=2)  # ... and waits again: the new tree is ready
+        assert robot.trees[0].definition.root.children[1].args["text"].source == "Hello"
+        reloader(clock.now())  # the scheduler's hook swaps it in between ticks
+    finally:
+        reloader.stop()
+    assert reports == [("greeter", None)]
+    robot.scheduler.run(until_s=clock.now() + 0.1)
+    assert said(robot)[-1] == "From the worker"
+
+
+def test_only_the_files_a_tree_uses_are_watched_never_its_whole_folder(tmp_path):
+    robot, tree_file, _ = start(tmp_path)
+    for i in range(50):  # a busy folder: none of these is read at a check
+        (tmp_path / f"unrelated_{i}.yaml").write_text("not: a tree\n")
+    [reloader] = [hook for hook in robot.scheduler.hooks if isinstance(hook, TreeReloader)]
+    edit(tree_file, GREETER.replace("Say", "Sya"), 1)
+    reloader.check()
+    assert sorted(p.name for p in reloader._stamps[tree_file]) == ["greeter.yaml"]
+
+
+def test_creating_the_subtree_a_refused_edit_named_reloads_the_tree(tmp_path):
+    robot, tree_file, reports = start(tmp_path)
+    edit(tree_file, GREETER.replace('- Say: {text: "PHRASE"}', "- Subtree: {file: new.yaml}"), 1)
+    robot.scheduler.run(until_s=1.5)
+    assert "cannot include 'new.yaml'" in str(reports[-1][1])  # refused: no such file yet
+    edit(tmp_path / "new.yaml", 'root:\n  Say: {text: "Brand new"}\n', 2)
+    robot.scheduler.run(until_s=3.5)
+    assert reports[-1] == ("greeter", None)
+    assert said(robot)[-1] == "Brand new"
