@@ -21,8 +21,12 @@ LONE_SURROGATE = re.compile("[\ud800-\udfff]")
 
 @dataclass
 class YScalar:
+    """One value and its place; ``via`` names the ``${parameter}`` it was written through
+    and where that parameter's value was set (a tree's ``params:`` or a profile)."""
+
     value: Any
     mark: Mark
+    via: tuple[str, Mark] | None = None
 
 
 @dataclass

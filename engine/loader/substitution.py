@@ -112,11 +112,12 @@ def substitute(value: YValue, params: dict[str, ParamValue], problems: Problems)
         return value
     whole = _REFERENCE.fullmatch(text)
     if whole:
-        found = _lookup(whole.group(1), value.mark, params, problems)
+        name = whole.group(1).strip()
+        found = _lookup(name, value.mark, params, problems)
         if found is None:
             return YScalar(UNRESOLVED, value.mark)
         if isinstance(found, YScalar):
-            return YScalar(found.value, value.mark)
+            return YScalar(found.value, value.mark, (name, params[name].source))
         return found
 
     def replace(match: re.Match[str]) -> str:

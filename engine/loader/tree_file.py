@@ -353,7 +353,16 @@ class TreeLoader:
                 message = problem.message
                 if message.startswith(("must", "needs", "takes", "item")):
                     message = f"{key!r} {message}"
-                problems.add(value.mark, message, problem.hint)
+                if isinstance(value, YScalar) and value.via is not None:
+                    # the fix is where the value was written, not where it is used
+                    parameter, written = value.via
+                    message = (
+                        f"parameter {parameter!r} is used as {node_type.name}.{key} "
+                        f"({value.mark}): {message}"
+                    )
+                    problems.add(written, message, problem.hint)
+                else:
+                    problems.add(value.mark, message, problem.hint)
                 ok = False
         for param in node_type.params:
             if param.name in args or param.name in given:

@@ -475,3 +475,41 @@ def test_an_unknown_top_level_field_suggests_the_nearest(tmp_path: Path) -> None
           Say: {text: hi}
         """,
     ) == ["tree.yaml:2:1: unknown field 'rate' (did you mean 'rate_hz'?)"]
+
+
+def test_a_parameter_of_the_wrong_type_is_shown_where_it_was_written_and_named(
+    tmp_path: Path,
+) -> None:
+    assert problems_of(
+        tmp_path,
+        """\
+        params:
+          force_n: three
+        root:
+          Check: {key: /sensors/force/left_n, above: "${force_n}"}
+        """,
+    ) == [
+        "tree.yaml:2:12: parameter 'force_n' is used as Check.above (tree.yaml:4:46): "
+        "'above' must be a number, got 'three' (write digits, e.g. 3.0)"
+    ]
+
+
+def test_a_profile_value_of_the_wrong_type_is_shown_in_the_profile(tmp_path: Path) -> None:
+    profile_file = write(tmp_path, "kid.yaml", "profile: kid\nparams:\n  force_n: lots\n")
+    tree = write(
+        tmp_path,
+        "tree.yaml",
+        'params:\n  force_n: three\nroot:\n  Say: {text: hi, volume: "${force_n}"}\n',
+    )
+    loader = TreeLoader(
+        default_registry(),
+        default_catalogue(),
+        root_dir=tmp_path,
+        profile=load_profile(profile_file, "kid.yaml"),
+    )
+    with pytest.raises(LoadError) as caught:
+        loader.load(tree)
+    assert [str(p) for p in caught.value.problems] == [
+        "kid.yaml:3:12: parameter 'force_n' is used as Say.volume (tree.yaml:4:27): "
+        "'volume' must be a number, got 'lots' (write digits, e.g. 3.0)"
+    ]
