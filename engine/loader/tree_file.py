@@ -373,9 +373,9 @@ class TreeLoader:
             else:
                 args[param.name] = param.default
         if ok and node_type.check is not None:
-            for param_name, message, hint in node_type.check(args, self.check_context):
+            for param_name, why, advice in node_type.check(args, self.check_context):
                 where = given[param_name].mark if param_name in given else mark
-                problems.add(where, message, hint)
+                problems.add(where, why, advice)
                 ok = False
         return (args if ok else None), name, children_raw
 

@@ -110,7 +110,8 @@ class Number(ParamType):
             number = float(value)
         except OverflowError:
             raise ParamProblem(
-                f"must be a number below 1e308, got one with {value.bit_length()} binary digits",
+                f"must be a number below 1e308, got one with {int(value).bit_length()} binary"
+                " digits",
                 self._example(),
             ) from None
         if not math.isfinite(number):
