@@ -33,6 +33,8 @@ from engine.values.params import (
 from engine.values.templates import Template
 
 ON_REQUEST_SENSORS = ("temperature", "ultrasound")
+MAX_SAID_CHARS = 1000
+"""The longest phrase one Say speaks (about a minute of speech)."""
 
 
 class Color(ParamType):
@@ -61,7 +63,11 @@ class Say(ServiceAction):
     """
 
     params: ClassVar = (
-        Param("text", Template(), doc="what to say; {key} fields are filled from the blackboard"),
+        Param(
+            "text",
+            Template(max_chars=MAX_SAID_CHARS),
+            doc="what to say; {key} fields are filled from the blackboard",
+        ),
         Param("volume", Number(0.0, 1.0), None, "0..1; empty: the robot's default volume"),
     )
 

@@ -17,11 +17,12 @@ from typing import Any, ClassVar
 from py_trees.common import Status
 
 from engine.blackboard.events import EventLog
-from engine.colors import parse_color
 from engine.errors import ServiceError
-from engine.nodes.base import ServiceAction
+from engine.nodes.actions import MoveServo, Say, SetLed
+from engine.nodes.base import Leaf, ServiceAction
 from engine.services.jobs import ImmediateJob, Job
-from engine.values.params import Key, Param
+from engine.values.params import SECONDS, CheckContext, Key, Param, ParamProblem, did_you_mean
+from engine.values.templates import Template
 
 POLLED_READINGS: dict[str, tuple[str, ...]] = {
     "touch": ("/sensors/touch/pads", "/sensors/touch/any"),
@@ -39,36 +40,64 @@ class CommandError(ServiceError):
     """A remote command is malformed; the message says what to send instead."""
 
 
-def _number(args: Mapping[str, Any], name: str, *, required: bool = True) -> float | None:
-    value = args.get(name)
-    if value is None and not required:
-        return None
-    if isinstance(value, bool) or not isinstance(value, int | float):
-        raise CommandError(f"'{name}' must be a number, got {value!r}")
-    return float(value)
+ACTION_NODES: dict[str, type[Leaf]] = {"say": Say, "led": SetLed, "move": MoveServo}
+"""The node whose declaration checks each acting command's arguments: one set of rules
+for a tree's parameters and an operator's arguments."""
 
 
-def _text(args: Mapping[str, Any], name: str) -> str:
-    value = args.get(name)
-    if not isinstance(value, str) or not value:
-        raise CommandError(f"'{name}' must be non-empty text, got {value!r}")
-    return value
+def checked_args(command_type: str, args: Mapping[str, Any], ctx: CheckContext) -> dict[str, Any]:
+    """``args`` converted by the parameters ``ACTION_NODES[command_type]`` declares.
+
+    Raises CommandError naming the argument, the value and what is expected: unknown
+    names, missing required ones, wrong types, NaN, inf, numbers past their bounds, text
+    past its length. Text is taken as written (an operator's braces are no template).
+    """
+    declared = {param.name: param for param in ACTION_NODES[command_type].params}
+    for name in args:
+        if name not in declared:
+            hint = did_you_mean(str(name), list(declared)) or "arguments: " + ", ".join(declared)
+            raise CommandError(f"unknown argument {name!r} for {command_type} ({hint})")
+    values: dict[str, Any] = {}
+    for name, param in declared.items():
+        raw = args.get(name)
+        if raw is None:
+            if param.required:
+                raise CommandError(f"{command_type} needs {name!r}: {param.doc}")
+            values[name] = param.default
+            continue
+        if isinstance(param.type, Template) and isinstance(raw, str):
+            raw = raw.replace("{", "{{").replace("}", "}}")
+        try:
+            values[name] = param.type.convert(raw, ctx)
+        except ParamProblem as problem:
+            hint = f" ({problem.hint})" if problem.hint else ""
+            raise CommandError(f"{name!r} {problem.message}{hint}") from None
+    return values
 
 
 class CarryOut(ServiceAction):
     """Carry out a remote command (say, led, move, read).
 
     RUNNING while the service works; SUCCESS when done, with the result saved to
-    ``save_result_as``; FAILURE when the command is malformed or the service failed, with
-    ``{"error": why}`` saved there instead.
+    ``save_result_as``; FAILURE when the command is malformed, the service failed or the
+    command took longer than ``timeout_s``, with ``{"error": why}`` saved there instead.
+    Arguments are checked by the declarations of Say, SetLed and MoveServo. The result
+    saved always belongs to this command (it is cleared when the command starts).
     """
 
     params: ClassVar = (
         Param("command", Key(), doc="the /vars/ key holding the command"),
         Param("save_result_as", Key(access="write"), None, "a /vars/ key for the result"),
+        Param("timeout_s", SECONDS, 60.0, "FAILURE when a command takes longer, in seconds"),
     )
     reads: ClassVar = tuple(key for keys in POLLED_READINGS.values() for key in keys)
     writes: ClassVar = tuple(sorted(ON_REQUEST_KEYS))
+
+    def initialise(self) -> None:
+        if self.args.save_result_as:
+            self.write(self.args.save_result_as, None)
+        self.started_s = self.now()
+        super().initialise()
 
     def start(self) -> Job:
         command = self.read(self.args.command)
@@ -78,11 +107,11 @@ class CarryOut(ServiceAction):
             kind = command.get("type")
             args = command.get("args") or {}
             if not isinstance(args, Mapping):
-                raise CommandError(f"'args' must be a mapping, got {args!r}")
-            handler = self._handlers().get(str(kind))
+                raise CommandError(f"'args' must be a mapping, got {_shown(args)}")
+            handler = self._handlers().get(kind) if isinstance(kind, str) else None
             if handler is None:
                 raise CommandError(
-                    f"unknown command type {kind!r} (known: {', '.join(COMMAND_TYPES)})"
+                    f"unknown command type {_shown(kind)} (known: {', '.join(COMMAND_TYPES)})"
                 )
             return handler(args)
         except CommandError as error:
@@ -91,33 +120,35 @@ class CarryOut(ServiceAction):
     def _handlers(self) -> dict[str, Callable[[Mapping[str, Any]], Job]]:
         return {"say": self._say, "led": self._led, "move": self._move, "read": self._read}
 
+    def _check(self, kind: str, args: Mapping[str, Any]) -> dict[str, Any]:
+        return checked_args(kind, args, CheckContext(self.ctx.blackboard.catalogue))
+
     def _say(self, args: Mapping[str, Any]) -> Job:
-        volume = _number(args, "volume", required=False)
-        return self.ctx.actions.say(_text(args, "text"), volume=volume)
+        values = self._check("say", args)
+        return self.ctx.actions.say(values["text"].fill(self.read), volume=values["volume"])
 
     def _led(self, args: Mapping[str, Any]) -> Job:
-        color = _text(args, "color")
-        try:
-            parse_color(color)
-        except ValueError as error:
-            raise CommandError(str(error)) from None
-        return self.ctx.actions.set_led(color, seconds=_number(args, "seconds", required=False))
+        values = self._check("led", args)
+        return self.ctx.actions.set_led(values["color"], seconds=values["seconds"])
 
     def _move(self, args: Mapping[str, Any]) -> Job:
-        angle = _number(args, "angle_deg")
-        assert angle is not None
+        values = self._check("move", args)
         return self.ctx.actions.move_servo(
-            _text(args, "joint"), angle, speed_dps=_number(args, "speed_dps", required=False)
+            values["joint"], values["angle_deg"], speed_dps=values["speed_dps"]
         )
 
     def _read(self, args: Mapping[str, Any]) -> Job:
-        sensor = _text(args, "sensor")
+        sensor = args.get("sensor")
+        if not isinstance(sensor, str) or not sensor:
+            raise CommandError(f"'sensor' must be non-empty text, got {_shown(sensor)}")
+        if set(args) - {"sensor"}:
+            raise CommandError(f"read takes only 'sensor', got {', '.join(map(str, args))}")
         if sensor in ("temperature", "ultrasound"):
             return self.ctx.actions.read_sensor(sensor)
         keys = POLLED_READINGS.get(sensor)
         if keys is None:
             known = ", ".join(("temperature", "ultrasound", *POLLED_READINGS))
-            raise CommandError(f"unknown sensor {sensor!r} (known: {known})")
+            raise CommandError(f"unknown sensor {_shown(sensor)} (known: {known})")
         values = {key: self.read(key) for key in keys}
         for key, value in values.items():
             if isinstance(value, EventLog):
@@ -136,9 +167,20 @@ class CarryOut(ServiceAction):
 
     def update(self) -> Status:
         status = super().update()
+        if status == Status.RUNNING and self.now() - self.started_s > self.args.timeout_s:
+            if self.job is not None:
+                self.job.cancel()
+            self.feedback_message = f"timed out after {self.args.timeout_s:g} s"
+            status = Status.FAILURE
         if status == Status.FAILURE and self.args.save_result_as:
             self.write(self.args.save_result_as, {"error": self.feedback_message})
         return status
+
+
+def _shown(value: Any) -> str:
+    """A value as an operator reads it in an error: short, and never a wall of text."""
+    text = repr(value)
+    return text if len(text) <= 60 else text[:57] + "..."
 
 
 REMOTE_NODES = (CarryOut,)

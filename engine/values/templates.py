@@ -44,8 +44,8 @@ class CompiledTemplate:
         Raises KeyError naming the key when it has no value yet, ValueError when the value
         does not suit the format spec.
         """
-        if not self.keys:
-            return self.source
+        if not self.keys:  # the literal text, with {{ and }} written as { and }
+            return "".join(literal for literal, _, _ in self.parts)
         pieces = []
         for literal, key, spec in self.parts:
             pieces.append(literal)
@@ -142,10 +142,25 @@ class Template(ParamType):
 
     name = "text with {fields}"
 
+    def __init__(self, *, max_chars: int | None = None) -> None:
+        self.max_chars = max_chars
+
     def json_schema(self) -> dict[str, Any]:
-        return {"type": ["string", "number"]}
+        schema: dict[str, Any] = {"type": ["string", "number"]}
+        if self.max_chars is not None:
+            schema["maxLength"] = self.max_chars
+        return schema
+
+    def describe(self) -> str:
+        return self.name + (f", up to {self.max_chars} characters" if self.max_chars else "")
 
     def convert(self, value: Any, ctx: CheckContext) -> CompiledTemplate:
         if isinstance(value, bool) or value is None or isinstance(value, dict | list):
             raise ParamProblem("must be text", "put the text in quotes")
-        return compile_template(str(value), ctx)
+        text = str(value)
+        if self.max_chars is not None and len(text) > self.max_chars:
+            raise ParamProblem(
+                f"is {len(text)} characters long, more than {self.max_chars}",
+                "say it in several shorter parts",
+            )
+        return compile_template(text, ctx)

@@ -91,7 +91,7 @@ def test_an_unknown_command_type_is_reported_failed_with_the_reason(robot: TreeH
     ("kind", "args", "reason"),
     [
         ("move", {"joint": "neck", "angle_deg": "far"}, "'angle_deg' must be a number, got 'far'"),
-        ("say", {}, "'text' must be non-empty text"),
+        ("say", {}, "say needs 'text'"),
         ("led", {"color": "plaid"}, "unknown color 'plaid'"),
         ("read", {"sensor": "smell"}, "unknown sensor 'smell'"),
     ],
@@ -126,3 +126,64 @@ def test_an_unplugged_speaker_is_reported_as_a_failed_command(robot: TreeHarness
     [report] = robot.did("report")
     assert report["status"] == "failed"
     assert "speaker unplugged" in report["result"]["error"]
+
+
+@pytest.mark.parametrize(
+    ("kind", "args", "reason"),
+    [
+        ("say", {"text": "hi", "volume": 50}, "'volume' must be at most 1, got 50"),
+        ("say", {"text": "hi", "volume": -3}, "'volume' must be at least 0, got -3"),
+        ("say", {"text": "hi", "volume": float("nan")}, "'volume' must be a finite number"),
+        ("say", {"text": "x" * 5000}, "'text' is 5000 characters long, more than 1000"),
+        ("say", {"text": "hi", "loud": True}, "unknown argument 'loud' for say"),
+        ("led", {"color": "pink", "seconds": 1e300}, "'seconds' must be at most 86400"),
+        ("led", {"color": "pink", "seconds": float("nan")}, "'seconds' must be a finite number"),
+        ("led", {"color": "pink", "seconds": float("-inf")}, "'seconds' must be a finite number"),
+        ("move", {"joint": "neck", "angle_deg": 10**330}, "'angle_deg' must be a number below"),
+        ("move", {"joint": "neck", "angle_deg": True}, "'angle_deg' must be a number, got True"),
+        ("move", {"joint": "neck"}, "move needs 'angle_deg'"),
+        ("move", {"joint": ["neck"], "angle_deg": 5}, "'joint' must be text"),
+    ],
+)
+def test_remote_arguments_are_checked_by_the_same_declarations_as_a_tree(
+    robot: TreeHarness, kind: str, args: dict[str, Any], reason: str
+) -> None:
+    send(robot, kind, **args)
+    robot.advance(1.0)
+    [report] = robot.did("report")
+    assert report["status"] == "failed"
+    assert reason in report["result"]["error"]
+    assert robot.did("say") == robot.did("led") == robot.did("servo") == []
+
+
+def test_a_refused_command_reports_its_own_failure_never_the_previous_result(
+    robot: TreeHarness,
+) -> None:
+    robot.world.temperature_c = 22.0
+    send(robot, "read", "cmd-1", sensor="temperature")
+    robot.advance(1.0)
+    send(robot, "move", "cmd-2", joint="neck", angle_deg=10**330)
+    robot.advance(1.0)
+    first, second = robot.did("report")
+    assert (first["id"], first["status"]) == ("cmd-1", "succeeded")
+    assert (second["id"], second["status"]) == ("cmd-2", "failed")
+    assert "angle_deg" in second["result"]["error"]
+
+
+def test_a_command_that_takes_too_long_fails_and_the_next_one_is_still_carried_out(
+    robot: TreeHarness,
+) -> None:
+    send(robot, "led", "cmd-1", color="pink", seconds=3600)  # an hour of light
+    robot.advance(61.0)
+    send(robot, "say", "cmd-2", text="still here")
+    robot.advance(2.0)
+    reports = [(r["id"], r["status"]) for r in robot.did("report")]
+    assert reports == [("cmd-1", "failed"), ("cmd-2", "succeeded")]
+    assert "timed out after 60 s" in robot.did("report")[0]["result"]["error"]
+    assert robot.said == ["still here"]
+
+
+def test_an_operators_braces_are_said_as_written(robot: TreeHarness) -> None:
+    send(robot, "say", text="I {love} you")
+    robot.advance(1.0)
+    assert robot.said == ["I {love} you"]
