@@ -24,12 +24,9 @@ class Clock(Protocol):
         """Wait ``seconds`` (no-op for zero or negative)."""
         ...
 
-    def sleep_until(self, deadline_s: float) -> None:
-        """Wait until :meth:`now` reaches ``deadline_s`` (returns at once if it has)."""
-        ...
-
-    def wake(self) -> None:
-        """Cut short any sleep in progress, and every later one: the engine is shutting down."""
+    def sleep_until(self, deadline_s: float, stop: ClockEvent | None = None) -> bool:
+        """Wait until :meth:`now` reaches ``deadline_s`` (returns at once if it has), or
+        until ``stop`` is set: returns True when it was (the scheduler's stop request)."""
         ...
 
     def event(self) -> ClockEvent:
@@ -39,8 +36,8 @@ class Clock(Protocol):
     def wait(self, event: ClockEvent, timeout_s: float) -> bool:
         """Wait until ``event`` is set or ``timeout_s`` of this clock's time has passed.
 
-        Returns True when the event is set (at once if it already is). Unlike :meth:`sleep`
-        it is not cut short by :meth:`wake`: a worker waits for its own event.
+        Returns True when the event is set (at once if it already is): each worker waits
+        for its own event, so stopping one never cuts short another's sleep.
         """
         ...
 
@@ -69,23 +66,20 @@ class ClockEvent:
 
 
 class RealClock:
-    """The machine's monotonic clock; sleeps can be woken early by :meth:`wake`."""
-
-    def __init__(self) -> None:
-        self._woken = threading.Event()
+    """The machine's monotonic clock."""
 
     def now(self) -> float:
         return time.monotonic()
 
     def sleep(self, seconds: float) -> None:
         if seconds > 0:
-            self._woken.wait(seconds)
+            time.sleep(seconds)
 
-    def sleep_until(self, deadline_s: float) -> None:
+    def sleep_until(self, deadline_s: float, stop: ClockEvent | None = None) -> bool:
+        if stop is not None:
+            return self.wait(stop, deadline_s - time.monotonic())
         self.sleep(deadline_s - time.monotonic())
-
-    def wake(self) -> None:
-        self._woken.set()
+        return False
 
     def event(self) -> ClockEvent:
         return ClockEvent(threading.Condition())
@@ -129,13 +123,14 @@ class VirtualClock:
         if seconds > 0:
             self.advance(seconds)
 
-    def sleep_until(self, deadline_s: float) -> None:
+    def sleep_until(self, deadline_s: float, stop: ClockEvent | None = None) -> bool:
+        """Jump to ``deadline_s`` at once, unless ``stop`` is already set (True then)."""
+        if stop is not None and stop.is_set():
+            return True
         with self._lock:
             self._now = max(self._now, deadline_s)
             self._lock.notify_all()
-
-    def wake(self) -> None:
-        """Nothing sleeps for real on a virtual clock."""
+        return False
 
     def event(self) -> ClockEvent:
         return ClockEvent(self._lock)

@@ -226,14 +226,16 @@ POLL_DURATION_WINDOW = 16
 class PollerThreads:
     """Runs pollers on threads of their own, each at its rate, until :meth:`stop`.
 
-    Waits are real time (``threading.Event.wait``) computed from ``clock``; meant for a
-    :class:`~engine.clock.RealClock` with threaded bus managers.
+    Each thread waits on ``clock`` for its own stop event (:meth:`Clock.wait`), so a
+    :class:`~engine.clock.VirtualClock` drives the threads as a real clock does, and
+    stopping the scheduler never cuts short a driver's sleep inside a poll (which made
+    the devices look offline after Ctrl-C).
     """
 
     def __init__(self, pollers: Sequence[Poller[Any]], clock: Clock) -> None:
         self.pollers = list(pollers)
         self.clock = clock
-        self._stop = threading.Event()
+        self._stop = clock.event()
         self._threads: list[threading.Thread] = []
 
     def start(self, origin_s: float | None = None) -> None:
@@ -263,7 +265,7 @@ class PollerThreads:
             # start early by the longest recent poll, so the reading is ready at the deadline
             lead_s = max(durations_s, default=0.0) + POLL_MARGIN_S
             wait_s = poller.next_due_s - lead_s - self.clock.now()
-            if wait_s > 0 and self._stop.wait(wait_s):
+            if self.clock.wait(self._stop, wait_s):
                 return
             started_s = self.clock.now()
             poller.poll_once()

@@ -44,14 +44,13 @@ class BranchingClock:
         elif seconds > 0:
             self._local.offset = offset + seconds
 
-    def sleep_until(self, deadline_s: float) -> None:
+    def sleep_until(self, deadline_s: float, stop: ClockEvent | None = None) -> bool:
         if self._offset() is None:
-            self.base.sleep_until(deadline_s)
-        else:
-            self.sleep(deadline_s - self.now())
-
-    def wake(self) -> None:
-        self.base.wake()
+            return self.base.sleep_until(deadline_s, stop)
+        if stop is not None and stop.is_set():
+            return True
+        self.sleep(deadline_s - self.now())
+        return False
 
     def event(self) -> ClockEvent:
         return self.base.event()

@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import logging
 import math
-import threading
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
@@ -99,7 +98,7 @@ class Scheduler:
         self.hooks = hooks if hooks is not None else []
         self.trees: list[RunningTree] = []
         self._measure = measure
-        self._stop = threading.Event()
+        self._stop = clock.event()
         self.hook_errors = 0
 
     def add(self, tree: RunningTree) -> RunningTree:
@@ -127,9 +126,9 @@ class Scheduler:
         raise KeyError(f"no tree named {name!r}")
 
     def stop(self) -> None:
-        """Ask the loop to end after the current tick (safe from a signal handler)."""
+        """Ask the loop to end after the current tick (safe from a signal handler); only
+        the scheduler's own wait is cut short, never a driver's or a poller's sleep."""
         self._stop.set()
-        self.clock.wake()
 
     @property
     def stopping(self) -> bool:
@@ -155,10 +154,9 @@ class Scheduler:
             while not self._stop.is_set():
                 deadline = self.next_deadline_s()
                 if until_s is not None and deadline > until_s:
-                    self.clock.sleep_until(until_s)
+                    self.clock.sleep_until(until_s, self._stop)
                     break
-                self.clock.sleep_until(deadline)
-                if self._stop.is_set():
+                if self.clock.sleep_until(deadline, self._stop):
                     break
                 self.step()
         finally:

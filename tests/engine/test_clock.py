@@ -56,13 +56,22 @@ def test_a_cleared_event_can_be_waited_for_again() -> None:
     assert clock.wait(stop, 0.0) is False
 
 
-def test_waking_the_real_clock_does_not_cut_short_a_workers_own_wait() -> None:
+def test_a_real_sleep_until_ends_early_when_its_stop_event_is_set() -> None:
     clock = RealClock()
-    clock.wake()  # the engine is stopping: sleeps end, but a worker waits for its own event
     stop = clock.event()
+    stop.set()  # the scheduler was asked to stop: its wait for the next deadline ends at once
+    assert clock.sleep_until(clock.now() + 3600.0, stop) is True
+    assert clock.sleep_until(clock.now() - 1.0) is False  # a deadline passed returns at once
+
+
+def test_a_virtual_sleep_until_jumps_unless_stopped() -> None:
+    clock = VirtualClock()
+    stop = clock.event()
+    assert clock.sleep_until(5.0, stop) is False
+    assert clock.now() == 5.0
     stop.set()
-    assert clock.wait(stop, 5.0) is True
-    assert clock.wait(clock.event(), 0.0) is False
+    assert clock.sleep_until(9.0, stop) is True
+    assert clock.now() == 5.0
 
 
 def test_an_event_of_another_clock_is_refused() -> None:

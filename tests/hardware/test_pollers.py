@@ -249,6 +249,38 @@ def test_pollers_on_threads_poll_by_themselves():
     assert reads and board.last("/sensors/touch/any") is True
 
 
+def test_a_virtual_clock_drives_poller_threads_poll_by_poll():
+    clock = VirtualClock()
+    board = RecordingBoard()
+    reads: list[float] = []
+
+    def read(driver: object) -> list[Staged]:
+        reads.append(clock.now())
+        return [Staged("/sensors/touch/any", True)]
+
+    poller: Poller[object] = Poller(
+        "touch",
+        rate_hz=10.0,
+        clock=clock,
+        blackboard=board,  # type: ignore[arg-type]
+        health=DeviceHealth("touch", None),
+        connect=object,
+        read=read,
+    )
+    threads = PollerThreads([poller], clock)
+    threads.start(origin_s=0.0)
+    try:
+        # the first poll is due now; then the thread waits on the virtual clock
+        assert clock.until_waiting(1, entered=2)
+        assert reads == [0.0]
+        clock.advance(0.1)  # one period of virtual time: exactly one more poll
+        assert clock.until_waiting(1, entered=3)
+        assert len(reads) == 2
+    finally:
+        threads.stop()
+    assert not threads.running
+
+
 def test_a_driver_bug_is_logged_once_per_failure_streak_not_at_every_poll(
     bench: Bench, caplog: pytest.LogCaptureFixture
 ):
