@@ -428,7 +428,7 @@ class ConfigChecker:
                     continue
                 kinds = ("event",) if spec.role == "gesture" else ("state",)
                 key = self.convert(Key(kinds=kinds), value, output)
-                if key is None:
+                if key is None or not self._same_type(keys.get(output), key, value, output):
                     ok = False
                 else:
                     keys[output] = key
@@ -439,6 +439,23 @@ class ConfigChecker:
             self.problems.add(raw.mark, f"{spec.chip} needs keys for " + ", ".join(missing))
             return None
         return keys if ok else None
+
+    def _same_type(self, default: str | None, key: str, raw: YValue, output: str) -> bool:
+        """A reading goes to a key that holds its kind of value (or to any /vars/ key):
+        touch's pads (a list) mapped onto /sensors/touch/any (a bool) would never fire."""
+        catalogue = self.ctx.catalogue
+        expected = catalogue.lookup(default) if default else None
+        target = catalogue.lookup(key)
+        if expected is None or target is None or target.value_type is object:
+            return True
+        if target.value_type is expected.value_type:
+            return True
+        self.problems.add(
+            raw.mark,
+            f"reading {output!r} is a {expected.type_name}, but {key} holds a {target.type_name}",
+            f"map it to {default} or to a /vars/ key",
+        )
+        return False
 
 
 def _identifier(name: str) -> str:

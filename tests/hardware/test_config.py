@@ -390,3 +390,22 @@ def test_a_device_name_that_is_not_an_identifier_is_refused(tmp_path, name):
         f"robot.yaml:6:3: device name {name!r} is not an identifier: use letters, digits and _"
     )
     assert "/devices/<name>/ok" in found[0]
+
+
+def test_readings_mapped_onto_keys_of_another_type_are_refused(tmp_path):
+    # touch's pads (a list) and any (a bool) swapped: touch would never fire
+    found = problems(
+        tmp_path,
+        "touch:\n  chip: mpr121\n  keys: {pads: /sensors/touch/any, any: /sensors/touch/pads}\n",
+    )
+    assert found == [
+        "robot.yaml:8:18: reading 'pads' is a list, but /sensors/touch/any holds a bool "
+        "(map it to /sensors/touch/pads or to a /vars/ key)",
+        "robot.yaml:8:43: reading 'any' is a bool, but /sensors/touch/pads holds a list "
+        "(map it to /sensors/touch/any or to a /vars/ key)",
+    ]
+
+
+def test_a_reading_may_go_to_a_variable_of_any_type(tmp_path):
+    config = load(tmp_path, "touch: {chip: mpr121, keys: {any: /vars/touched}}\n")
+    assert config.devices["touch"].keys["any"] == "/vars/touched"
