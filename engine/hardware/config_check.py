@@ -38,6 +38,7 @@ from engine.hardware.config import (
     hex_address,
 )
 from engine.values.params import (
+    RATE_HZ,
     REQUIRED,
     Boolean,
     CheckContext,
@@ -314,7 +315,7 @@ class ConfigChecker:
                 "name one of: " + ", ".join(fitting) if fitting else f"add a {wanted} bus",
             )
             return None
-        bus_name = self.convert(Text(), raw_bus, "bus")
+        bus_name: str | None = self.convert(Text(), raw_bus, "bus")
         if bus_name is None:
             return None
         bus = buses.get(bus_name)
@@ -347,7 +348,7 @@ class ConfigChecker:
             return None
         if value is None:
             return spec.default_address
-        address = self.convert(Integer(0, 0x7F), value, "address")
+        address: int | None = self.convert(Integer(0, 0x7F), value, "address")
         if address is None:
             return None
         if address not in spec.addresses:
@@ -374,7 +375,8 @@ class ConfigChecker:
             return None
         if value is None:
             return spec.default_rate_hz
-        return self.convert(Number(0.1, 1000.0, "Hz"), value, "rate_hz")
+        rate_hz: float | None = self.convert(RATE_HZ, value, "rate_hz")
+        return rate_hz
 
     def _options(self, raw: YMap, spec: ChipSpec) -> dict[str, Any] | None:
         values: dict[str, Any] = {}

@@ -79,7 +79,7 @@ class ManagedSpi:
 
     @property
     def mode(self) -> int:
-        return self._call(lambda spi: spi.mode)
+        return int(self._call(lambda spi: spi.mode))
 
     @mode.setter
     def mode(self, value: int) -> None:
@@ -87,7 +87,7 @@ class ManagedSpi:
 
     @property
     def max_speed_hz(self) -> int:
-        return self._call(lambda spi: spi.max_speed_hz)
+        return int(self._call(lambda spi: spi.max_speed_hz))
 
     @max_speed_hz.setter
     def max_speed_hz(self, value: int) -> None:

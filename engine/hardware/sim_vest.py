@@ -300,13 +300,13 @@ class SimVest:
                 for pad, touching in enumerate(world.touched):
                     chip.touch(pad, touching)
             elif what == "force" and device.role == "force":
-                for pad in device.pads:
-                    force_n = world.force_n.get(pad.name)
+                for force_pad in device.pads:
+                    force_n = world.force_n.get(force_pad.name)
                     if force_n is not None:
                         volts = fsr406_volts(
                             force_n, supply_v=FSR_SUPPLY_V, divider_ohm=FSR_DIVIDER_OHM
                         )
-                        chip.set_input_volts(pad.channel, volts)
+                        chip.set_input_volts(force_pad.channel, volts)
             elif what == "range" and device.role == "range" and device.side is not None:
                 chip.distance_mm = world.range_mm.get(device.side)
             elif what == "temperature" and device.role == "temperature":

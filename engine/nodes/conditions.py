@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from typing import Any, ClassVar
 
 from engine.blackboard.catalogue import VARIABLES_PREFIX, KeySpec
@@ -122,6 +122,9 @@ class Check(Condition):
                     if mismatch is not None:
                         problems.append((name, *mismatch))
         return problems
+
+    _test: Callable[[Any], bool]
+    """The comparison the parameters ask for, applied to the key's value."""
 
     def __init__(self, *a: Any) -> None:
         super().__init__(*a)

@@ -95,7 +95,7 @@ def leaf_type(cls: type[Leaf], *, source: str = "vest") -> NodeType:
 
     return NodeType(
         name=cls.type_name or cls.__name__,
-        kind=cls.kind,
+        kind="condition" if cls.kind == "condition" else "action",
         doc=inspect.cleandoc(cls.__doc__ or ""),
         params=tuple(cls.params),
         build=build,
