@@ -25,6 +25,7 @@ ticking.
 
 from __future__ import annotations
 
+import inspect
 from collections.abc import Mapping
 from types import SimpleNamespace
 from typing import Any, ClassVar
@@ -33,6 +34,7 @@ import py_trees
 from py_trees.common import Access, Status
 
 from engine.nodes.context import TreeContext
+from engine.nodes.spec import NodeType
 from engine.services.jobs import Job
 from engine.values.params import CheckContext, Param
 
@@ -66,8 +68,6 @@ class Leaf(py_trees.behaviour.Behaviour):
         super().__init__(name)
         self.args = args
         self.ctx = ctx
-        from engine.nodes.spec import leaf_type  # a leaf knows its own declaration
-
         read_keys, write_keys = leaf_type(type(self)).keys(vars(args))
         self.blackboard = self.attach_blackboard_client(name=name)
         for key in dict.fromkeys(read_keys):
@@ -187,3 +187,33 @@ class ServiceAction(Leaf):
             return Status.FAILURE
         status = self.job_status(self.job)
         return self.finished(self.job) if status == Status.SUCCESS else status
+
+
+def leaf_type(cls: type[Leaf], *, source: str = "vest") -> NodeType:
+    """The :class:`NodeType` of a leaf class (its name is ``cls.type_name`` or the class name)."""
+    if cls.kind not in ("condition", "action"):
+        raise TypeError(f"{cls.__name__}.kind must be 'condition' or 'action', not {cls.kind!r}")
+    names = [p.name for p in cls.params]
+    if len(set(names)) != len(names) or "name" in names:
+        raise TypeError(f"{cls.__name__}.params: names must be unique and not 'name'")
+
+    def build(
+        name: str, args: SimpleNamespace, children: list[Any], ctx: TreeContext
+    ) -> py_trees.behaviour.Behaviour:
+        return cls(name, args, ctx)
+
+    return NodeType(
+        name=cls.type_name or cls.__name__,
+        kind="condition" if cls.kind == "condition" else "action",
+        doc=inspect.cleandoc(cls.__doc__ or ""),
+        params=tuple(cls.params),
+        build=build,
+        check=cls.check_params if _overrides(cls, "check_params") else None,
+        fixed_reads=tuple(cls.reads),
+        fixed_writes=tuple(cls.writes),
+        source=source,
+    )
+
+
+def _overrides(cls: type, method: str) -> bool:
+    return getattr(cls, method) is not getattr(Leaf, method)

@@ -13,8 +13,8 @@ import logging
 from collections.abc import Callable, Iterator
 from importlib.metadata import EntryPoint, entry_points
 
-from engine.nodes.base import Leaf
-from engine.nodes.spec import NodeType, leaf_type
+from engine.nodes.base import Leaf, leaf_type
+from engine.nodes.spec import NodeType
 
 ENTRY_POINT_GROUP = "vest.nodes"
 

@@ -3,25 +3,21 @@
 A :class:`NodeType` names a node, its kind, its parameters and the blackboard keys it
 reads and writes, and knows how to build the py_trees behaviour. Leaf nodes written as
 classes (subclasses of :class:`~engine.nodes.base.Leaf`) are turned into a NodeType by
-:func:`leaf_type`.
+:func:`engine.nodes.base.leaf_type`.
 """
 
 from __future__ import annotations
 
-import inspect
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from types import SimpleNamespace
-from typing import TYPE_CHECKING, Any, Literal
+from typing import Any, Literal
 
 import py_trees
 
 from engine.nodes.context import TreeContext
 from engine.values.params import CheckContext, Key, ListOf, Param
 from engine.values.templates import CompiledTemplate
-
-if TYPE_CHECKING:
-    from engine.nodes.base import Leaf
 
 Kind = Literal["composite", "decorator", "condition", "action"]
 KINDS: tuple[Kind, ...] = ("composite", "decorator", "condition", "action")
@@ -78,35 +74,3 @@ class NodeType:
             values = value if isinstance(value, list) else [value]
             (writes if key_type.access == "write" else reads).extend(values)
         return reads, writes
-
-
-def leaf_type(cls: type[Leaf], *, source: str = "vest") -> NodeType:
-    """The :class:`NodeType` of a leaf class (its name is ``cls.type_name`` or the class name)."""
-    if cls.kind not in ("condition", "action"):
-        raise TypeError(f"{cls.__name__}.kind must be 'condition' or 'action', not {cls.kind!r}")
-    names = [p.name for p in cls.params]
-    if len(set(names)) != len(names) or "name" in names:
-        raise TypeError(f"{cls.__name__}.params: names must be unique and not 'name'")
-
-    def build(
-        name: str, args: SimpleNamespace, children: list[Any], ctx: TreeContext
-    ) -> py_trees.behaviour.Behaviour:
-        return cls(name, args, ctx)
-
-    return NodeType(
-        name=cls.type_name or cls.__name__,
-        kind="condition" if cls.kind == "condition" else "action",
-        doc=inspect.cleandoc(cls.__doc__ or ""),
-        params=tuple(cls.params),
-        build=build,
-        check=cls.check_params if _overrides(cls, "check_params") else None,
-        fixed_reads=tuple(cls.reads),
-        fixed_writes=tuple(cls.writes),
-        source=source,
-    )
-
-
-def _overrides(cls: type, method: str) -> bool:
-    from engine.nodes.base import Leaf
-
-    return getattr(cls, method) is not getattr(Leaf, method)
