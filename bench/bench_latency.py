@@ -87,7 +87,8 @@ from engine.blackboard.catalogue import default_catalogue
 from engine.clock import RealClock, stopwatch
 from engine.drivers.srf02 import RANGING_TIME_S
 from engine.hardware.assembly import Hardware, build_hardware
-from engine.hardware.config import RobotConfig, load_robot_config
+from engine.hardware.config import RobotConfig
+from engine.hardware.config_file import load_robot_config
 from engine.hardware.sim_vest import SimVest, UnwiredSenses, build_sim_vest
 from engine.nodes.decorators import Cooldown
 from engine.runtime.reload import TreeReloader

@@ -18,7 +18,8 @@ from engine.blackboard.catalogue import KeyCatalogue, KeySpec, default_catalogue
 from engine.drivers import mpr121
 from engine.errors import ConfigError
 from engine.files.problems import LoadError, Problem, Problems
-from engine.hardware.config import RobotConfig, load_robot_config
+from engine.hardware.config import RobotConfig
+from engine.hardware.config_file import load_robot_config
 from engine.hardware.sim_vest import check_fault_events
 from engine.loader.tree_file import NodeDefinition, TreeDefinition
 from engine.nodes.remote import COMMAND_TYPES

@@ -22,7 +22,7 @@ has one bus of the kind the chip needs), an ``address`` (I2C chips; default the 
 power-on address), ``rate_hz`` (polled chips only) and ``keys`` (what each of its readings
 feeds on the blackboard; sensible defaults). Chip options are the drivers' keyword options.
 
-:func:`load_robot_config` checks the whole file (the rules are in
+:func:`~engine.hardware.config_file.load_robot_config` checks the whole file (the rules are in
 :mod:`engine.hardware.config_check`) and raises a :class:`~engine.files.problems.LoadError`
 listing every problem with its file:line:column, as the tree loader does.
 """
@@ -34,11 +34,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from engine.blackboard.catalogue import KeyCatalogue, default_catalogue
 from engine.drivers.servo_joints import Joint
 from engine.errors import ConfigError
 from engine.files.problems import Mark
-from engine.files.yaml_source import YValue, load_yaml
 from engine.values.params import (
     Boolean,
     Choice,
@@ -378,26 +376,3 @@ class RobotConfig:
 
     def __iter__(self) -> Iterator[DeviceConfig]:
         return iter(self.devices.values())
-
-
-# -- loading -----------------------------------------------------------------------------------
-def load_robot_config(
-    path: Path, shown: str | None = None, *, catalogue: KeyCatalogue | None = None
-) -> RobotConfig:
-    """Read and check a robot config; :class:`~engine.files.problems.LoadError` lists every
-    problem with its file:line:column."""
-    name = shown or str(path)
-    return check_robot_config(load_yaml(path, name), name, path, catalogue=catalogue)
-
-
-def check_robot_config(
-    document: YValue | None,
-    name: str,
-    path: Path,
-    *,
-    catalogue: KeyCatalogue | None = None,
-) -> RobotConfig:
-    """Check a parsed robot config (see :func:`load_robot_config`)."""
-    from engine.hardware.config_check import ConfigChecker  # it builds on this module's types
-
-    return ConfigChecker(name, path, catalogue or default_catalogue()).check(document)

@@ -1,6 +1,6 @@
 """Checking a robot config: every rule, each problem with its file:line:column.
 
-:func:`engine.hardware.config.load_robot_config` runs :class:`ConfigChecker` on a parsed
+:func:`engine.hardware.config_file.load_robot_config` runs :class:`ConfigChecker` on a parsed
 file: the buses, each device (its chip, bus, address, rate, keys, the driver's options and
 the chip's own fields: force pads and their calibration tables, range sensors' side and
 XSHUT line or mux channel, gesture names, LED channels, servo joints), then the rules

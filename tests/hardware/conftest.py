@@ -11,7 +11,8 @@ from engine.blackboard.board import Blackboard
 from engine.blackboard.catalogue import default_catalogue
 from engine.clock import VirtualClock
 from engine.hardware.assembly import Hardware, build_hardware
-from engine.hardware.config import RobotConfig, load_robot_config
+from engine.hardware.config import RobotConfig
+from engine.hardware.config_file import load_robot_config
 from engine.hardware.sim_vest import SimVest, UnwiredSenses, build_sim_vest
 from engine.runtime.robot import Robot, load_behaviors
 from engine.scenario.world import World

@@ -8,7 +8,8 @@ from pathlib import Path
 import pytest
 
 from engine.files.problems import LoadError
-from engine.hardware.config import RobotConfig, load_robot_config
+from engine.hardware.config import RobotConfig
+from engine.hardware.config_file import load_robot_config
 
 from .conftest import ROOT
 

@@ -16,7 +16,7 @@ from engine.blackboard.catalogue import default_catalogue
 from engine.dialogs.library import load_dialog
 from engine.files.problems import LoadError
 from engine.files.yaml_source import MAX_FILE_BYTES, read_text
-from engine.hardware.config import load_robot_config
+from engine.hardware.config_file import load_robot_config
 from engine.loader.substitution import load_profile
 from engine.loader.tree_file import TreeLoader
 from engine.nodes.registry import default_registry
