@@ -96,7 +96,9 @@ def test_a_broken_tree_is_listed_problem_by_problem_with_exit_1(
     assert out == ""
     assert problem_lines(err) == [
         f"{broken / 'bad.yaml'}:4:7: unknown node type 'Chek' (did you mean 'Check'?)",
-        f"{broken / 'bad.yaml'}:5:23: unknown color 'pinkk' (did you mean 'pink'?)",
+        f"{broken / 'bad.yaml'}:5:23: unknown color 'pinkk' (did you mean 'pink'? "
+        "colors: off, black, white, red, green, blue, yellow, orange, pink, purple, cyan, "
+        "magenta, warm_white, or #RRGGBB)",
     ]
     assert err.strip().endswith("2 problems")
 
@@ -197,7 +199,9 @@ def test_the_installed_command_validates_and_fails_in_words(broken: Path) -> Non
     assert "Traceback" not in bad.stderr
     assert problem_lines(bad.stderr) == [
         "trees/bad.yaml:4:7: unknown node type 'Chek' (did you mean 'Check'?)",
-        "trees/bad.yaml:5:23: unknown color 'pinkk' (did you mean 'pink'?)",
+        "trees/bad.yaml:5:23: unknown color 'pinkk' (did you mean 'pink'? "
+        "colors: off, black, white, red, green, blue, yellow, orange, pink, purple, cyan, "
+        "magenta, warm_white, or #RRGGBB)",
         "trees/folder.yaml:1:1: is a folder, not a file",
         "trees/latin.yaml:2:18: byte 0xE9 is not UTF-8 text (save the file as UTF-8)",
     ]

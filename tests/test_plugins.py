@@ -163,7 +163,9 @@ def test_a_plugin_node_with_a_wrong_parameter_is_a_file_line_column_problem(
         TreeHarness.from_file(tree, registry=registry)
 
     assert [str(problem) for problem in raised.value.problems] == [
-        f"{tree}:3:18: unknown color 'pinkish' (did you mean 'pink'?)",
+        f"{tree}:3:18: unknown color 'pinkish' (did you mean 'pink'? "
+        "colors: off, black, white, red, green, blue, yellow, orange, pink, purple, cyan, "
+        "magenta, warm_white, or #RRGGBB)",
         f"{tree}:3:34: 'times' must be at most 20, got 50",
     ]
 

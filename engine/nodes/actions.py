@@ -49,8 +49,11 @@ class Color(ParamType):
         try:
             parse_color(str(value))
         except ValueError:
-            hint = did_you_mean(str(value), list(NAMED_COLORS)) or "or write #RRGGBB"
-            raise ParamProblem(f"unknown color {value!r}", hint) from None
+            nearest = did_you_mean(str(value), list(NAMED_COLORS))
+            known = "colors: " + ", ".join(NAMED_COLORS) + ", or #RRGGBB"
+            raise ParamProblem(
+                f"unknown color {value!r}", f"{nearest} {known}" if nearest else known
+            ) from None
         return str(value)
 
 

@@ -410,3 +410,23 @@ def test_readings_mapped_onto_keys_of_another_type_are_refused(tmp_path):
 def test_a_reading_may_go_to_a_variable_of_any_type(tmp_path):
     config = load(tmp_path, "touch: {chip: mpr121, keys: {any: /vars/touched}}\n")
     assert config.devices["touch"].keys["any"] == "/vars/touched"
+
+
+def test_a_release_threshold_above_the_touch_threshold_is_refused(tmp_path):
+    found = problems(
+        tmp_path, "touch: {chip: mpr121, touch_threshold: 10, release_threshold: 20}\n"
+    )
+    assert found == [
+        "robot.yaml:6:65: MPR121 release threshold 20 is above the touch threshold 10; release "
+        "must be at most touch (hysteresis) (release_threshold <= touch_threshold)"
+    ]
+
+
+def test_an_srf02_above_0x77_is_refused_with_its_range(tmp_path):
+    found = problems(tmp_path, "far: {chip: srf02, address: 0x78}\n")
+    assert found == ["robot.yaml:6:31: srf02 cannot be at address 0x78 (use 0x70..0x77)"]
+
+
+def test_a_vl53l0x_timeout_shorter_than_one_measurement_is_refused(tmp_path):
+    found = problems(tmp_path, "range_center: {chip: vl53l0x, side: center, timeout_s: 0.02}\n")
+    assert found == ["robot.yaml:6:58: 'timeout_s' must be at least 0.05, got 0.02"]

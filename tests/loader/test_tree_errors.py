@@ -111,7 +111,11 @@ def test_an_unknown_color_suggests_the_nearest(tmp_path: Path) -> None:
         root:
           SetLed: {color: pinkk}
         """,
-    ) == ["tree.yaml:2:19: unknown color 'pinkk' (did you mean 'pink'?)"]
+    ) == [
+        "tree.yaml:2:19: unknown color 'pinkk' (did you mean 'pink'? "
+        "colors: off, black, white, red, green, blue, yellow, orange, pink, purple, cyan, "
+        "magenta, warm_white, or #RRGGBB)"
+    ]
 
 
 # -- blackboard keys -------------------------------------------------------------------------
