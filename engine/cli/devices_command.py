@@ -13,7 +13,7 @@ from pathlib import Path
 from engine.clock import Clock, RealClock, VirtualClock
 from engine.hardware.assembly import build_hardware
 from engine.hardware.config_file import load_robot_config
-from engine.hardware.devices_command import describe_devices, format_rows
+from engine.hardware.device_report import describe_devices, format_rows
 from engine.hardware.sim_vest import build_sim_vest
 from engine.scenario.world import World
 

@@ -1,8 +1,10 @@
 """The robot's hardware as the engine sees it: config, pollers, services, the simulated vest.
 
-- :mod:`engine.hardware.config`: the robot config (which devices, where, what they feed);
-  :mod:`engine.hardware.config_check` its rules, with file:line:column problems.
-- :mod:`engine.hardware.managed`: drivers on bus-manager handles, ``/devices/<name>/ok``.
+- :mod:`engine.hardware.config`: the robot config's types (which devices, where, what they
+  feed); :mod:`engine.hardware.config_check` its rules, with file:line:column problems;
+  :mod:`engine.hardware.config_file` reads a config file through both.
+- :mod:`engine.hardware.managed_buses`: drivers on bus-manager handles.
+- :mod:`engine.hardware.device_health`: ``/devices/<name>/ok``.
 - :mod:`engine.hardware.pollers`: polled devices staged onto the blackboard at their rates.
 - :mod:`engine.hardware.services`: LEDs, servos and on-request sensors on the real drivers.
 - :mod:`engine.hardware.assembly`: :func:`~engine.hardware.assembly.build_hardware`, the
@@ -10,6 +12,6 @@
   simulated vest.
 - :mod:`engine.hardware.sim_vest`: :func:`~engine.hardware.sim_vest.build_sim_vest`,
   register-level simulated chips moved by the scenario's world, and fault injection.
-- :mod:`engine.hardware.timing`: the branching clock that lets inline polls take their time.
-- :mod:`engine.hardware.devices_command`: rows for ``vest devices``.
+- :mod:`engine.hardware.branching_clock`: the clock that lets inline polls take their time.
+- :mod:`engine.hardware.device_report`: the rows ``vest devices`` prints.
 """

@@ -26,7 +26,7 @@ Two ways to run, chosen by the clock unless ``threaded`` says otherwise:
 - inline (a :class:`~engine.clock.VirtualClock`: ``vest run --fast``, tests): bus managers
   run each transaction in the caller's thread; the pollers, the LED timer and the re-probes
   are scheduler hooks (:attr:`Hardware.hooks`) and each poll's waits stay in its own
-  :class:`~engine.hardware.timing.BranchingClock` branch. Deterministic.
+  :class:`~engine.hardware.branching_clock.BranchingClock` branch. Deterministic.
 - threaded (a real clock; always on real buses): one worker per bus, one thread per
   poller (:meth:`Hardware.start`), the LED timer still a scheduler hook.
 
@@ -53,8 +53,9 @@ from engine.drivers.gpio import OutputLine
 from engine.drivers.maestro import Maestro
 from engine.drivers.tca9548a import TCA9548A, LockedBus
 from engine.errors import ConfigError, DeviceError
+from engine.hardware.branching_clock import BranchingClock, branch_of
 from engine.hardware.config import BusConfig, DeviceConfig, RobotConfig
-from engine.hardware.managed import DeviceHealth
+from engine.hardware.device_health import DeviceHealth
 from engine.hardware.pollers import Poller, PollerThreads, make_poller
 from engine.hardware.services import (
     HardwareLeds,
@@ -63,7 +64,6 @@ from engine.hardware.services import (
     TemperatureSensor,
     UltrasoundSensor,
 )
-from engine.hardware.timing import BranchingClock, branch_of
 from engine.hardware.xshut import XshutChain
 from engine.services.interfaces import IotResults, Services, Speech
 

@@ -15,7 +15,7 @@ Two ways to run them, same code:
 - as scheduler hooks (``poller(now_s)`` polls when due, on drift-free deadlines): inline,
   deterministic, for a :class:`~engine.clock.VirtualClock` with ``threaded=False`` bus
   managers (``vest run --fast``, tests). On a
-  :class:`~engine.hardware.timing.BranchingClock` each poll's waits stay in its branch;
+  :class:`~engine.hardware.branching_clock.BranchingClock` each poll's waits stay in its branch;
 - on threads (:class:`PollerThreads`), one per poller, for the robot.
 
 A device that fails is not the end: the poller drops its driver, stages the readings of a
@@ -50,9 +50,10 @@ from engine.drivers.mcp3008 import MCP3008
 from engine.drivers.mpr121 import MPR121, PADS
 from engine.drivers.vl53l0x import VL53L0X
 from engine.drivers.zx_gesture import ZXGesture
+from engine.hardware.branching_clock import branch_of
 from engine.hardware.config import DeviceConfig
-from engine.hardware.managed import DeviceHealth, ManagedI2C, ManagedSpi
-from engine.hardware.timing import branch_of
+from engine.hardware.device_health import DeviceHealth
+from engine.hardware.managed_buses import ManagedI2C, ManagedSpi
 from engine.hardware.xshut import XshutChain
 
 _log = logging.getLogger("vest.pollers")

@@ -37,8 +37,8 @@ from engine.drivers.rgb_leds import ALL, RgbLeds
 from engine.drivers.servo_joints import Joint, ServoJoints
 from engine.drivers.srf02 import MAX_POLLS, POLL_INTERVAL_S, RANGING_TIME_S, SRF02
 from engine.errors import ServiceError
+from engine.hardware.branching_clock import branch_of
 from engine.hardware.config import DeviceConfig
-from engine.hardware.timing import branch_of
 from engine.services.jobs import ImmediateJob, Job
 
 D = TypeVar("D")

@@ -24,7 +24,7 @@ stop answering (I2C: NACK; SPI: MISO pulled high), answer garbage, or hold the w
 bus, for a while. An unplugged chip has no power: a gesture made meanwhile is not seen.
 
 On a :class:`~engine.clock.VirtualClock` the chips and the drivers share a
-:class:`~engine.hardware.timing.BranchingClock` (:attr:`SimVest.clock`), so inline polls
+:class:`~engine.hardware.branching_clock.BranchingClock` (:attr:`SimVest.clock`), so inline polls
 take their time on the chips without holding up the robot.
 """
 
@@ -52,8 +52,8 @@ from engine.drivers.sim.tca9548a import SimTCA9548A
 from engine.drivers.sim.vl53l0x import SimVL53L0X
 from engine.drivers.sim.zx_gesture import SimZXGesture
 from engine.files.problems import Problem
+from engine.hardware.branching_clock import BranchingClock
 from engine.hardware.config import BusConfig, DeviceConfig, RobotConfig
-from engine.hardware.timing import BranchingClock
 from engine.scenario.world import EVENT_KEYS, World
 from engine.values.params import did_you_mean
 

@@ -16,11 +16,11 @@ from engine.drivers.sim.mpr121 import SimMPR121
 from engine.drivers.sim.spi_bus import SimSpiDev
 from engine.drivers.sim.zx_gesture import SimZXGesture
 from engine.files.problems import Mark
+from engine.hardware.branching_clock import BranchingClock
 from engine.hardware.config import DeviceConfig, ForcePad
-from engine.hardware.managed import DeviceHealth
+from engine.hardware.device_health import DeviceHealth
 from engine.hardware.pollers import Poller, PollerThreads, Staged, make_poller
 from engine.hardware.sim_vest import SpiSocket
-from engine.hardware.timing import BranchingClock
 
 HERE = Mark("test", 1, 1)
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import threading
 
 from engine.clock import VirtualClock
-from engine.hardware.timing import BranchingClock, branch_of
+from engine.hardware.branching_clock import BranchingClock, branch_of
 
 
 def test_sleeping_in_a_branch_moves_only_the_branch():

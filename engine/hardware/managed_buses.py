@@ -1,4 +1,4 @@
-"""Drivers on managed buses, and the device status the blackboard shows.
+"""Drivers on managed buses: every access one transaction of the bus manager.
 
 A driver takes an ``smbus2.SMBus``-compatible bus and makes one register access after
 another, sleeping on its clock in between where its chip needs time (an ADC conversion, a
@@ -7,18 +7,13 @@ transaction of the device's :class:`~engine.drivers.bus_manager.DeviceHandle`: t
 manager retries it, counts it, refuses it while the device is offline, and between two
 accesses the bus is free for the other devices, so a 33 ms measurement never holds the
 bus for 33 ms. :class:`ManagedSpi` does the same for an ``spidev``-compatible node.
-
-:class:`DeviceHealth` keeps ``/devices/<name>/ok``: true while the bus manager has the
-device online and its driver reads sensible answers.
 """
 
 from __future__ import annotations
 
-import threading
 from collections.abc import Callable, Sequence
 from typing import Any, TypeVar
 
-from engine.blackboard.board import Blackboard
 from engine.drivers.bus_manager import DeviceHandle, Priority
 from engine.drivers.forwarding_bus import ForwardingI2C
 
@@ -107,64 +102,3 @@ class ManagedSpi:
     def writebytes(self, values: Sequence[int]) -> None:
         data = list(values)
         self._call(lambda spi: spi.writebytes(data))
-
-
-def ok_key(device: str) -> str:
-    """``/devices/<device>/ok``."""
-    return f"/devices/{device}/ok"
-
-
-class DeviceHealth:
-    """Whether one device works, staged as ``/devices/<name>/ok`` when it changes.
-
-    Two opinions make it: the bus manager's (online / offline, from its ``on_status``) and
-    the driver's (its answers make sense: identity, conversions finishing). ``last_error``
-    says why it last failed. Thread-safe.
-    """
-
-    def __init__(self, name: str, blackboard: Blackboard | None) -> None:
-        self.name = name
-        self.blackboard = blackboard
-        self._lock = threading.Lock()
-        self._bus_ok = True
-        self._driver_ok = True
-        self._shown: bool | None = None
-        self.last_error: str | None = None
-        self.changes = 0
-
-    @property
-    def ok(self) -> bool:
-        return self._bus_ok and self._driver_ok
-
-    @property
-    def bus_ok(self) -> bool:
-        """The bus manager has the device online."""
-        return self._bus_ok
-
-    @property
-    def driver_ok(self) -> bool:
-        """The driver's last answers made sense."""
-        return self._driver_ok
-
-    def bus_status(self, ok: bool) -> None:
-        """The bus manager's ``on_status``: online (True) or offline (False)."""
-        with self._lock:
-            self._bus_ok = ok
-            self._publish()
-
-    def driver_status(self, ok: bool, why: str | None = None) -> None:
-        """The driver's answers make sense (True), or stopped making sense because ``why``."""
-        with self._lock:
-            self._driver_ok = ok
-            if why is not None:
-                self.last_error = why
-            self._publish()
-
-    def _publish(self) -> None:
-        ok = self.ok
-        if ok == self._shown:
-            return
-        self._shown = ok
-        self.changes += 1
-        if self.blackboard is not None:
-            self.blackboard.stage(ok_key(self.name), ok)

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from engine.hardware.devices_command import describe_devices, format_rows
+from engine.hardware.device_report import describe_devices, format_rows
 
 from .conftest import SimRobot
 
