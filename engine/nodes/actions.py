@@ -224,26 +224,43 @@ class SetValue(Leaf):
 
 
 class ReadSensor(ServiceAction):
-    """Read an on-request sensor (temperature, ultrasound) onto the blackboard.
+    """Ask an on-request sensor (temperature, ultrasound) for a fresh reading.
 
-    RUNNING while the read is under way; SUCCESS when the new values are on the
-    blackboard (/sensors/temperature/c and /f, or /sensors/ultrasound/cm); FAILURE when
-    the sensor could not be read.
+    The sensor service stages the reading onto the blackboard, under the keys the robot
+    config maps it to (by default /sensors/temperature/c and /f, /sensors/ultrasound/cm);
+    the tree never writes it. RUNNING while the read is under way and until the reading is
+    on the blackboard; SUCCESS then; FAILURE when the sensor could not be read.
     """
 
     params: ClassVar = (Param("sensor", Choice(ON_REQUEST_SENSORS), doc="which sensor to read"),)
-    writes: ClassVar = (
-        "/sensors/temperature/c",
-        "/sensors/temperature/f",
-        "/sensors/ultrasound/cm",
-    )
+
+    def initialise(self) -> None:
+        self.fresh: Mapping[str, Any] | None = None
+        super().initialise()
 
     def start(self) -> Job:
         return self.ctx.actions.read_sensor(self.args.sensor)
 
+    def update(self) -> Status:
+        if self.fresh is None:
+            return super().update()
+        return self._committed()
+
     def finished(self, job: Job) -> Status:
-        for key, value in (job.result() or {}).items():
-            self.ctx.blackboard.set(key, value)
+        result = job.result()
+        self.fresh = result if isinstance(result, Mapping) else {}
+        return self._committed()
+
+    def _committed(self) -> Status:
+        """SUCCESS once every fresh value is what the blackboard holds (the commit between
+        ticks has taken the staged reading in)."""
+        assert self.fresh is not None
+        board = self.ctx.blackboard
+        waiting = [key for key, value in self.fresh.items() if board.get(key) != value]
+        if waiting:
+            self.feedback_message = "waiting for " + ", ".join(waiting)
+            return Status.RUNNING
+        self.feedback_message = ""
         return Status.SUCCESS
 
 

@@ -69,6 +69,7 @@ class Leaf(py_trees.behaviour.Behaviour):
         self.args = args
         self.ctx = ctx
         read_keys, write_keys = leaf_type(type(self)).keys(vars(args))
+        self.write_keys = frozenset(write_keys)
         self.blackboard = self.attach_blackboard_client(name=name)
         for key in dict.fromkeys(read_keys):
             self.blackboard.register_key(key, access=Access.READ)
@@ -91,7 +92,13 @@ class Leaf(py_trees.behaviour.Behaviour):
             return default
 
     def write(self, key: str, value: Any) -> None:
-        """Write one of this tree's variables (``/vars/...``) now."""
+        """Write one of this tree's variables (``/vars/...``) now: only a key the node
+        declared it writes (in ``writes`` or a write ``Key`` parameter)."""
+        if key not in self.write_keys:
+            raise PermissionError(
+                f"{type(self).__name__} writes {key!r} but does not declare it "
+                f"(it declares {sorted(self.write_keys) or 'no writes'})"
+            )
         self.ctx.blackboard.set(key, value)
 
     def now(self) -> float:
@@ -193,6 +200,12 @@ def leaf_type(cls: type[Leaf], *, source: str = "vest") -> NodeType:
     """The :class:`NodeType` of a leaf class (its name is ``cls.type_name`` or the class name)."""
     if cls.kind not in ("condition", "action"):
         raise TypeError(f"{cls.__name__}.kind must be 'condition' or 'action', not {cls.kind!r}")
+    outside = [key for key in cls.writes if not key.startswith("/vars/")]
+    if outside:
+        raise TypeError(
+            f"{cls.__name__}.writes names {outside}: trees write only /vars/ keys; a sensor's "
+            "readings are staged by its poller or service"
+        )
     names = [p.name for p in cls.params]
     if len(set(names)) != len(names) or "name" in names:
         raise TypeError(f"{cls.__name__}.params: names must be unique and not 'name'")

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from typing import Any, ClassVar
 
 from py_trees.common import Access, Status
@@ -28,11 +28,6 @@ class Reply(Leaf):
     params: ClassVar = (
         Param("heard", Key(), doc="the /vars/ key holding the utterance"),
         Param("dialog", Text(), "default", "which dialog (file in dialogs/, without .yaml)"),
-    )
-    writes: ClassVar = (
-        "/sensors/temperature/c",
-        "/sensors/temperature/f",
-        "/sensors/ultrasound/cm",
     )
 
     @classmethod
@@ -93,10 +88,10 @@ class Reply(Leaf):
         else:
             self._speak(self.answer)
 
-    def _speak(self, template: CompiledTemplate) -> None:
+    def _speak(self, template: CompiledTemplate, read: Callable[[str], Any] | None = None) -> None:
         self.phase = "speaking"
         try:
-            text = template.fill(self.read)
+            text = template.fill(read or self.read)
         except (KeyError, ValueError) as error:  # a field with no value, or a bad value
             self.job = ImmediateJob(error=ServiceError(str(error).strip("'\"")))
             return
@@ -107,9 +102,9 @@ class Reply(Leaf):
             return Status.FAILURE
         status = self.job_status(self.job, failed="could not answer")
         if status == Status.SUCCESS and self.phase == "reading" and self.answer is not None:
-            for key, value in (self.job.result() or {}).items():
-                self.ctx.blackboard.set(key, value)
-            self._speak(self.answer)
+            # the service stages the reading for every tree; this answer uses it at once
+            fresh = self.job.result() or {}
+            self._speak(self.answer, lambda key: fresh[key] if key in fresh else self.read(key))
             return self.update()
         return status
 

@@ -30,9 +30,6 @@ POLLED_READINGS: dict[str, tuple[str, ...]] = {
     "range": ("/sensors/range/left_mm", "/sensors/range/center_mm", "/sensors/range/right_mm"),
     "gesture": ("/sensors/gesture/last",),
 }
-ON_REQUEST_KEYS = frozenset(
-    {"/sensors/temperature/c", "/sensors/temperature/f", "/sensors/ultrasound/cm"}
-)
 COMMAND_TYPES = ("say", "led", "move", "read")
 
 
@@ -91,7 +88,6 @@ class CarryOut(ServiceAction):
         Param("timeout_s", SECONDS, 60.0, "FAILURE when a command takes longer, in seconds"),
     )
     reads: ClassVar = tuple(key for keys in POLLED_READINGS.values() for key in keys)
-    writes: ClassVar = tuple(sorted(ON_REQUEST_KEYS))
 
     def initialise(self) -> None:
         if self.args.save_result_as:
@@ -156,11 +152,7 @@ class CarryOut(ServiceAction):
         return ImmediateJob(values)
 
     def finished(self, job: Job) -> Status:
-        result = job.result()
-        if isinstance(result, Mapping):
-            for key, value in result.items():
-                if key in ON_REQUEST_KEYS:
-                    self.ctx.blackboard.set(key, value)
+        result = job.result()  # a reading is staged by the sensor service, not written here
         if self.args.save_result_as:
             self.write(self.args.save_result_as, result)
         return Status.SUCCESS

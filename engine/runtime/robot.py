@@ -18,6 +18,7 @@ from engine.nodes.registry import NodeRegistry, default_registry
 from engine.runtime.scheduler import RunningTree, Scheduler
 from engine.services.actions import ActionLog, TreeActions
 from engine.services.interfaces import Services
+from engine.services.staged_readings import with_staged_readings
 
 
 def tree_files(paths: list[Path]) -> list[Path]:
@@ -136,12 +137,13 @@ class Robot:
         self.blackboard = blackboard
         self.action_log = action_log or ActionLog()
         self.scheduler = Scheduler(clock, blackboard)
+        staged = with_staged_readings(services, blackboard)  # readings reach every tree
         for definition in behaviors.trees:
             context = TreeContext(
                 tree=definition.name,
                 clock=clock,
                 blackboard=blackboard,
-                actions=TreeActions(services, clock, definition.name, self.action_log),
+                actions=TreeActions(staged, clock, definition.name, self.action_log),
                 dialogs=behaviors.dialogs,
                 on_node_error=on_node_error,
             )

@@ -21,6 +21,7 @@ from engine.scenario.world import BlackboardSenses, World
 from engine.services.actions import ActionLog, ActionRecord, TreeActions
 from engine.services.interfaces import Services
 from engine.services.simulated import simulated_services
+from engine.services.staged_readings import with_staged_readings
 
 
 class HarnessReplacedError(VestError, RuntimeError):
@@ -69,7 +70,12 @@ class TreeHarness:
             tree=definition.name,
             clock=self.clock,
             blackboard=self.blackboard,
-            actions=TreeActions(self.services, self.clock, definition.name, self.log),
+            actions=TreeActions(
+                with_staged_readings(self.services, self.blackboard),
+                self.clock,
+                definition.name,
+                self.log,
+            ),
             dialogs=dialogs,
             on_node_error=lambda tree, path, error: self.node_errors.append((path, error)),
             on_node_warning=lambda tree, path, message: self.node_warnings.append((path, message)),
