@@ -13,7 +13,7 @@ from engine.files.problems import LoadError, Mark, Problems
 from engine.files.yaml_source import YMap, load_yaml
 from engine.loader.substitution import Profile, load_profile, read_params, undeclared_params
 from engine.loader.tree_file import TreeDefinition, TreeLoader
-from engine.nodes.context import NodeErrorHandler, TreeContext, log_node_error
+from engine.nodes.context import NodeErrorHandler, NodeErrorLog, TreeContext
 from engine.nodes.registry import NodeRegistry, default_registry
 from engine.runtime.scheduler import RunningTree, Scheduler
 from engine.services.actions import ActionLog, TreeActions
@@ -129,7 +129,7 @@ class Robot:
         services: Services,
         blackboard: Blackboard,
         action_log: ActionLog | None = None,
-        on_node_error: NodeErrorHandler = log_node_error,
+        on_node_error: NodeErrorHandler | None = None,
     ) -> None:
         self.behaviors = behaviors
         self.clock = clock
@@ -138,6 +138,7 @@ class Robot:
         self.action_log = action_log or ActionLog()
         self.scheduler = Scheduler(clock, blackboard)
         staged = with_staged_readings(services, blackboard)  # readings reach every tree
+        node_errors = on_node_error or NodeErrorLog()  # one count per node and error kind
         for definition in behaviors.trees:
             context = TreeContext(
                 tree=definition.name,
@@ -145,7 +146,7 @@ class Robot:
                 blackboard=blackboard,
                 actions=TreeActions(staged, clock, definition.name, self.action_log),
                 dialogs=behaviors.dialogs,
-                on_node_error=on_node_error,
+                on_node_error=node_errors,
             )
             self.scheduler.add(RunningTree(definition, context, definition.build(context)))
 

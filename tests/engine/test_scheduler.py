@@ -1,6 +1,7 @@
 """The scheduler: each tree at its own rate, drift-free, and a failing leaf never stops it."""
 
 import dataclasses
+import logging
 import textwrap
 from pathlib import Path
 
@@ -11,6 +12,7 @@ from engine.blackboard import Blackboard, default_catalogue
 from engine.clock import VirtualClock
 from engine.errors import ConfigError
 from engine.nodes import Condition, Param, Text, builtin_registry
+from engine.nodes.context import NodeErrorLog
 from engine.runtime.robot import Robot, load_behaviors
 from engine.services.simulated import simulated_services
 
@@ -162,3 +164,34 @@ def test_a_tree_built_in_code_with_an_absurd_rate_is_refused_before_it_can_spin(
     running.definition = dataclasses.replace(running.definition, rate_hz=5e-324)
     with pytest.raises(ConfigError, match=r"rate_hz must be 0.1..1000, got 5e-324"):
         robot.scheduler.add(running)
+
+
+def test_a_node_failing_at_every_tick_is_logged_once_then_counted(tmp_path, caplog):
+    class Broken(Condition):
+        def check(self) -> bool:
+            raise RuntimeError("no reads declared")
+
+    registry = builtin_registry()
+    registry.add(Broken)
+    write(tmp_path, "broken.yaml", "rate_hz: 10\nroot:\n  Broken: {}\n")
+    errors = NodeErrorLog(logging.getLogger("vest.test.nodes"))
+    clock = VirtualClock()
+    board = Blackboard(default_catalogue(), clock)
+    board.reset()
+    behaviors = load_behaviors([tmp_path], registry=registry)
+    robot = Robot(
+        behaviors,
+        clock=clock,
+        services=simulated_services(clock),
+        blackboard=board,
+        on_node_error=errors,
+    )
+    with caplog.at_level(logging.ERROR, logger="vest.test.nodes"):
+        robot.scheduler.run(until_s=59.95)  # 600 ticks, 600 failures
+    lines = [record.getMessage() for record in caplog.records]
+    assert lines == [
+        "broken: node Broken failed: RuntimeError: no reads declared",
+        "broken: node Broken failed with RuntimeError 10 times so far",
+        "broken: node Broken failed with RuntimeError 100 times so far",
+    ]
+    assert errors.counts == {("broken", "Broken", "RuntimeError"): 600}
