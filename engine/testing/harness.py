@@ -53,8 +53,10 @@ class TreeHarness:
         catalogue: KeyCatalogue | None = None,
         clock: VirtualClock | None = None,
         services: Services | None = None,
+        keep_node_errors: bool = False,
     ) -> None:
         TreeHarness._newest += 1
+        self.keep_node_errors = keep_node_errors
         self._number = TreeHarness._newest
         self.definition = definition
         self.clock = clock or VirtualClock()
@@ -77,12 +79,19 @@ class TreeHarness:
                 self.log,
             ),
             dialogs=dialogs,
-            on_node_error=lambda tree, path, error: self.node_errors.append((path, error)),
+            on_node_error=self._node_error,
             on_node_warning=lambda tree, path, message: self.node_warnings.append((path, message)),
         )
         self.tree = definition.build(self.context)
         self.origin_s = self.clock.now()
         self.ticks = 0
+
+    def _node_error(self, tree: str, path: str, error: BaseException) -> None:
+        """A node raised: the test fails with that exception, unless it asked to keep node
+        errors as data (``keep_node_errors=True``: ``node_errors``, the node FAILURE)."""
+        self.node_errors.append((path, error))
+        if not self.keep_node_errors:
+            raise error
 
     @classmethod
     def from_file(
@@ -92,6 +101,7 @@ class TreeHarness:
         *,
         dialogs_dir: str | Path | None = None,
         registry: NodeRegistry | None = None,
+        keep_node_errors: bool = False,
     ) -> TreeHarness:
         """Load and validate a tree file (LoadError with file:line:column on problems).
 
@@ -105,7 +115,12 @@ class TreeHarness:
         loader = TreeLoader(
             registry or default_registry(), catalogue, dialogs=dialogs, profile=loaded_profile
         )
-        return cls(loader.load(path), dialogs=dialogs, catalogue=catalogue)
+        return cls(
+            loader.load(path),
+            dialogs=dialogs,
+            catalogue=catalogue,
+            keep_node_errors=keep_node_errors,
+        )
 
     # -- the world ------------------------------------------------------------------------
     def _check_current(self) -> None:

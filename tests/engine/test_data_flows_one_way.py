@@ -70,7 +70,7 @@ def test_a_node_writing_a_key_it_did_not_declare_fails_and_writes_nothing(tmp_pa
     registry.add(Tattler)
     path = tmp_path / "tree.yaml"
     path.write_text("name: t\nrate_hz: 10\nroot:\n  Tattler: {}\n")
-    robot = TreeHarness.from_file(path, registry=registry)
+    robot = TreeHarness.from_file(path, registry=registry, keep_node_errors=True)
     assert robot.tick() == Status.FAILURE
     [(path_of_node, error)] = robot.node_errors
     assert path_of_node.endswith("Tattler")
@@ -82,3 +82,15 @@ def test_a_node_writing_a_key_it_did_not_declare_fails_and_writes_nothing(tmp_pa
 def test_a_node_declaring_a_write_outside_the_variables_is_refused_at_registration() -> None:
     with pytest.raises(TypeError, match="trees write only /vars/ keys"):
         default_registry(plugins=False).add(SensorFaker)
+
+
+def test_by_default_the_harness_fails_a_test_with_the_node_s_own_exception(
+    tmp_path: Path,
+) -> None:
+    registry = default_registry(plugins=False)
+    registry.add(Tattler)
+    path = tmp_path / "tree.yaml"
+    path.write_text("name: t\nrate_hz: 10\nroot:\n  Tattler: {}\n")
+    robot = TreeHarness.from_file(path, registry=registry)
+    with pytest.raises(PermissionError, match="does not declare it"):
+        robot.tick()

@@ -47,7 +47,7 @@ def test_an_update_returning_no_status_fails_the_node_and_names_its_class(
             - Say: {text: "plan B"}
         """,
     )
-    robot = TreeHarness.from_file(tree, registry=registry)
+    robot = TreeHarness.from_file(tree, registry=registry, keep_node_errors=True)
     # Forgetful: FAILURE (not None), so the Selector goes on: Say: SUCCESS -> SUCCESS
     assert robot.tick() == Status.SUCCESS
     forgetful = robot.tree.root.children[0]
