@@ -10,10 +10,14 @@ from __future__ import annotations
 import itertools
 from importlib.metadata import EntryPoint
 from pathlib import Path
+from typing import Any
 
+import py_trees
 import pytest
+from py_trees.common import Status
 
 from engine.files.problems import LoadError
+from engine.nodes.base import Condition
 from engine.nodes.docs import nodes_json, nodes_markdown
 from engine.nodes.registry import (
     ENTRY_POINT_GROUP,
@@ -266,3 +270,36 @@ def test_docs_nodes_md_is_the_generated_node_reference() -> None:
         "docs/nodes.md is out of date with the node declarations: regenerate it with "
         "`.venv/bin/vest nodes --format md > docs/nodes.md` (with no plugin package installed)"
     )
+
+
+class Greeter(Condition):
+    """SUCCESS when the plugin's own doorbell service says someone is at the door."""
+
+    def __init__(self, name: str, args: Any, ctx: Any, *, doorbell: list[str]) -> None:
+        super().__init__(name, args, ctx)
+        self.doorbell = doorbell
+
+    def check(self) -> bool:
+        return bool(self.doorbell)
+
+
+def test_a_plugin_node_gets_its_own_service_bound_at_registration(tmp_path: Path) -> None:
+    doorbell: list[str] = []
+    registry = builtin_registry()
+    registry.add(Greeter, doorbell=doorbell)
+    tree = tmp_path / "door.yaml"
+    tree.write_text("rate_hz: 10\nroot:\n  Greeter: {}\n")
+    robot = TreeHarness.from_file(tree, registry=registry)
+    assert robot.tick() == Status.FAILURE
+    doorbell.append("ding")
+    assert robot.tick() == Status.SUCCESS
+
+
+def test_binding_a_service_the_node_does_not_take_is_refused_in_words() -> None:
+    with pytest.raises(TypeError, match=r"Greeter cannot take speaker"):
+        builtin_registry().add(Greeter, speaker=object())
+
+
+def test_a_plain_py_trees_behaviour_is_refused_in_words() -> None:
+    with pytest.raises(TypeError, match=r"Success is a plain py_trees behaviour: subclass"):
+        builtin_registry().add(py_trees.behaviours.Success)  # type: ignore[arg-type]

@@ -196,8 +196,30 @@ class ServiceAction(Leaf):
         return self.finished(self.job) if status == Status.SUCCESS else status
 
 
-def leaf_type(cls: type[Leaf], *, source: str = "vest") -> NodeType:
-    """The :class:`NodeType` of a leaf class (its name is ``cls.type_name`` or the class name)."""
+def leaf_type(cls: type[Leaf], *, source: str = "vest", **bound: Any) -> NodeType:
+    """The :class:`NodeType` of a leaf class (its name is ``cls.type_name`` or the class name).
+
+    ``bound`` are keyword arguments every node of the type is built with, after
+    ``(name, args, ctx)``: its own services, as BehaviorTree.CPP's registerNodeType
+    forwards constructor arguments (``registry.add(Greeter, speaker=my_speaker)``).
+    """
+    if not (isinstance(cls, type) and issubclass(cls, Leaf)):
+        what = cls.__name__ if isinstance(cls, type) else repr(cls)
+        plain = isinstance(cls, type) and issubclass(cls, py_trees.behaviour.Behaviour)
+        raise TypeError(
+            f"{what} is "
+            + ("a plain py_trees behaviour" if plain else "not a node class")
+            + ": subclass engine.nodes.Condition, ServiceAction or Leaf (they declare the "
+            "parameters and blackboard keys the loader checks), or register a NodeType"
+        )
+    if bound:
+        try:
+            inspect.signature(cls).bind(None, None, None, **bound)
+        except TypeError as error:
+            raise TypeError(
+                f"{cls.__name__} cannot take {', '.join(sorted(bound))}: {error}; declare "
+                "them as keyword parameters of its __init__(self, name, args, ctx, *, ...)"
+            ) from None
     if cls.kind not in ("condition", "action"):
         raise TypeError(f"{cls.__name__}.kind must be 'condition' or 'action', not {cls.kind!r}")
     outside = [key for key in cls.writes if not key.startswith("/vars/")]
@@ -213,7 +235,7 @@ def leaf_type(cls: type[Leaf], *, source: str = "vest") -> NodeType:
     def build(
         name: str, args: SimpleNamespace, children: list[Any], ctx: TreeContext
     ) -> py_trees.behaviour.Behaviour:
-        return cls(name, args, ctx)
+        return cls(name, args, ctx, **bound)
 
     return NodeType(
         name=cls.type_name or cls.__name__,

@@ -12,6 +12,7 @@ import inspect
 import logging
 from collections.abc import Callable, Iterator
 from importlib.metadata import EntryPoint, entry_points
+from typing import Any
 
 from engine.nodes.base import Leaf, leaf_type
 from engine.nodes.spec import NodeType
@@ -28,9 +29,13 @@ class NodeRegistry:
         self._types: dict[str, NodeType] = {}
         self.plugin_errors: list[str] = []
 
-    def add(self, node: type[Leaf] | NodeType, *, source: str = "vest") -> NodeType:
-        """Register a leaf class or a NodeType; a name already taken is an error naming both."""
-        node_type = node if isinstance(node, NodeType) else leaf_type(node, source=source)
+    def add(self, node: type[Leaf] | NodeType, *, source: str = "vest", **bound: Any) -> NodeType:
+        """Register a leaf class or a NodeType; a name already taken is an error naming both.
+
+        ``bound``: keyword arguments each node of a leaf class is built with (its own
+        services: ``registry.add(Greeter, speaker=my_speaker)``).
+        """
+        node_type = node if isinstance(node, NodeType) else leaf_type(node, source=source, **bound)
         self._check_free(node_type)
         self._types[node_type.name] = node_type
         return node_type
@@ -104,9 +109,13 @@ class _SourcedRegistry:
         self._source = source
         self.staged: list[NodeType] = []
 
-    def add(self, node: type[Leaf] | NodeType, *, source: str | None = None) -> NodeType:
+    def add(
+        self, node: type[Leaf] | NodeType, *, source: str | None = None, **bound: Any
+    ) -> NodeType:
         node_type = (
-            node if isinstance(node, NodeType) else leaf_type(node, source=source or self._source)
+            node
+            if isinstance(node, NodeType)
+            else leaf_type(node, source=source or self._source, **bound)
         )
         self._registry._check_free(node_type)
         for staged in self.staged:
