@@ -13,7 +13,8 @@ from pathlib import Path
 from engine.blackboard.catalogue import default_catalogue
 from engine.dialogs.library import DialogLibrary, find_dialogs_folder
 from engine.errors import ConfigError
-from engine.loader.tree_file import NodeDefinition, TreeDefinition, TreeLoader
+from engine.loader.tree_definition import NodeDefinition, TreeDefinition
+from engine.loader.tree_file import TreeLoader
 from engine.nodes.registry import default_registry
 from engine.values.templates import CompiledTemplate
 

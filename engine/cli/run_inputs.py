@@ -21,7 +21,7 @@ from engine.files.problems import LoadError, Problem, Problems
 from engine.hardware.config import RobotConfig
 from engine.hardware.config_file import load_robot_config
 from engine.hardware.sim_vest import check_fault_events
-from engine.loader.tree_file import NodeDefinition, TreeDefinition
+from engine.loader.tree_definition import NodeDefinition, TreeDefinition
 from engine.nodes.remote import COMMAND_TYPES
 from engine.runtime.robot import Behaviors, load_behaviors
 from engine.scenario.scenario_file import Scenario, ScenarioEvent, load_scenario

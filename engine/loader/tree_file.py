@@ -22,10 +22,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
-from types import SimpleNamespace
 from typing import Any
-
-import py_trees
 
 from engine.blackboard.catalogue import KeyCatalogue
 from engine.dialogs.library import DialogLibrary
@@ -48,7 +45,7 @@ from engine.loader.substitution import (
     substitute,
     unresolved,
 )
-from engine.nodes.context import TreeContext
+from engine.loader.tree_definition import NodeDefinition, TreeDefinition
 from engine.nodes.registry import NodeRegistry
 from engine.nodes.spec import NodeType
 from engine.values.params import RATE_HZ, CheckContext, ParamProblem, did_you_mean
@@ -56,40 +53,6 @@ from engine.values.params import RATE_HZ, CheckContext, ParamProblem, did_you_me
 TOP_KEYS = ("name", "description", "rate_hz", "params", "root")
 SUBTREE = "Subtree"
 DEFAULT_RATE_HZ = 10.0
-
-
-@dataclass
-class NodeDefinition:
-    """One validated node: its type, display name, converted arguments and children."""
-
-    type: NodeType
-    name: str
-    args: dict[str, Any]
-    children: list[NodeDefinition]
-    mark: Mark
-
-
-@dataclass
-class TreeDefinition:
-    """A validated tree file, ready to build as often as needed."""
-
-    name: str
-    rate_hz: float
-    description: str
-    root: NodeDefinition
-    path: Path
-    files: list[Path] = field(default_factory=list)
-    declared_params: frozenset[str] = frozenset()
-    """Parameter names this tree and its subtrees declare (what a profile may set)."""
-
-    def build(self, ctx: TreeContext) -> py_trees.trees.BehaviourTree:
-        """A fresh py_trees tree whose nodes use ``ctx``."""
-        return py_trees.trees.BehaviourTree(_build(self.root, ctx))
-
-
-def _build(node: NodeDefinition, ctx: TreeContext) -> py_trees.behaviour.Behaviour:
-    children = [_build(child, ctx) for child in node.children]
-    return node.type.build(node.name, SimpleNamespace(**node.args), children, ctx)
 
 
 @dataclass

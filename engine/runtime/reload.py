@@ -24,7 +24,8 @@ import py_trees
 
 from engine.clock import Clock
 from engine.files.problems import LoadError, Mark, Problem
-from engine.loader.tree_file import TreeDefinition, TreeLoader
+from engine.loader.tree_definition import TreeDefinition
+from engine.loader.tree_file import TreeLoader
 from engine.runtime.scheduler import RunningTree
 
 _log = logging.getLogger("vest.reload")

@@ -12,7 +12,8 @@ from engine.dialogs.library import DialogLibrary
 from engine.files.problems import LoadError, Mark, Problems
 from engine.files.yaml_source import YMap, load_yaml
 from engine.loader.substitution import Profile, load_profile, read_params, undeclared_params
-from engine.loader.tree_file import TreeDefinition, TreeLoader
+from engine.loader.tree_definition import TreeDefinition
+from engine.loader.tree_file import TreeLoader
 from engine.nodes.context import NodeErrorHandler, NodeErrorLog, TreeContext
 from engine.nodes.registry import NodeRegistry, default_registry
 from engine.runtime.scheduler import RunningTree, Scheduler

@@ -18,7 +18,7 @@ import py_trees
 from engine.blackboard.board import Blackboard
 from engine.clock import Clock, stopwatch
 from engine.errors import ConfigError
-from engine.loader.tree_file import TreeDefinition
+from engine.loader.tree_definition import TreeDefinition
 from engine.nodes.context import TreeContext
 from engine.runtime.stats import TickStats
 from engine.values.params import RATE_HZ

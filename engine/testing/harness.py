@@ -14,7 +14,8 @@ from engine.clock import VirtualClock
 from engine.dialogs.library import DialogLibrary, find_dialogs_folder
 from engine.errors import VestError
 from engine.loader.substitution import load_profile
-from engine.loader.tree_file import TreeDefinition, TreeLoader
+from engine.loader.tree_definition import TreeDefinition
+from engine.loader.tree_file import TreeLoader
 from engine.nodes.context import TreeContext
 from engine.nodes.registry import NodeRegistry, default_registry
 from engine.scenario.world import BlackboardSenses, World

@@ -100,7 +100,7 @@ def test_fixing_a_subtree_that_a_refused_edit_added_reloads_the_tree(tmp_path):
 
 def test_a_reload_that_crashes_while_building_keeps_the_running_tree(tmp_path, monkeypatch):
     robot, tree_file, reports = start(tmp_path)
-    from engine.loader.tree_file import TreeDefinition
+    from engine.loader.tree_definition import TreeDefinition
 
     def broken_build(self, ctx):
         raise RuntimeError("disk on fire")

@@ -16,7 +16,8 @@ import pytest
 from engine.blackboard.catalogue import default_catalogue
 from engine.files.problems import LoadError
 from engine.loader.substitution import Profile, load_profile
-from engine.loader.tree_file import TreeDefinition, TreeLoader
+from engine.loader.tree_definition import TreeDefinition
+from engine.loader.tree_file import TreeLoader
 from engine.nodes.registry import default_registry
 from engine.testing import TreeHarness
 

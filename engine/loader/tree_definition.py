@@ -1,0 +1,53 @@
+"""A validated tree: what the loader hands the scheduler, built into py_trees on demand.
+
+A :class:`TreeDefinition` holds no py_trees objects: it can be built again and again (a
+hot reload, a test harness, a benchmark), each time with the :class:`TreeContext` of the
+robot that runs it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from types import SimpleNamespace
+from typing import Any
+
+import py_trees
+
+from engine.files.problems import Mark
+from engine.nodes.context import TreeContext
+from engine.nodes.spec import NodeType
+
+
+@dataclass
+class NodeDefinition:
+    """One validated node: its type, display name, converted arguments and children."""
+
+    type: NodeType
+    name: str
+    args: dict[str, Any]
+    children: list[NodeDefinition]
+    mark: Mark
+
+
+@dataclass
+class TreeDefinition:
+    """A validated tree file, ready to build as often as needed."""
+
+    name: str
+    rate_hz: float
+    description: str
+    root: NodeDefinition
+    path: Path
+    files: list[Path] = field(default_factory=list)
+    declared_params: frozenset[str] = frozenset()
+    """Parameter names this tree and its subtrees declare (what a profile may set)."""
+
+    def build(self, ctx: TreeContext) -> py_trees.trees.BehaviourTree:
+        """A fresh py_trees tree whose nodes use ``ctx``."""
+        return py_trees.trees.BehaviourTree(_build(self.root, ctx))
+
+
+def _build(node: NodeDefinition, ctx: TreeContext) -> py_trees.behaviour.Behaviour:
+    children = [_build(child, ctx) for child in node.children]
+    return node.type.build(node.name, SimpleNamespace(**node.args), children, ctx)
