@@ -25,8 +25,9 @@ ticking.
 
 from __future__ import annotations
 
+import functools
 import inspect
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from types import SimpleNamespace
 from typing import Any, ClassVar
 
@@ -63,6 +64,11 @@ class Leaf(py_trees.behaviour.Behaviour):
     params: ClassVar[tuple[Param, ...]] = ()
     reads: ClassVar[tuple[str, ...]] = ()
     writes: ClassVar[tuple[str, ...]] = ()
+    _guarding: bool = False
+    """True while a guarded lifecycle method runs (a subclass calling super() is not
+    guarded twice)."""
+    _failed_to_start: Exception | None = None
+    """What initialise() raised, answered as FAILURE by the update() after it."""
 
     def __init__(self, name: str, args: SimpleNamespace, ctx: TreeContext) -> None:
         super().__init__(name)
@@ -123,31 +129,83 @@ class Leaf(py_trees.behaviour.Behaviour):
             job.cancel()
 
     # -- the safety net -----------------------------------------------------------------
-    def tick(self) -> Any:
-        """py_trees' leaf tick, but an exception makes this node FAILURE, not the tree crash."""
-        try:
-            if self.status != Status.RUNNING:
-                self.initialise()
-            new_status = self.update()
-            if not isinstance(new_status, Status):  # py_trees' own tick refuses these too
-                raise TypeError(
-                    f"{type(self).__name__}.update() returned {new_status!r}, not a Status"
-                )
-            if new_status != Status.RUNNING:
-                self.stop(new_status)
-        except Exception as error:
-            new_status = self._failed(error)
-        self.status = new_status
-        yield self
+    def __init_subclass__(cls, **kwargs: Any) -> None:
+        """Guard the lifecycle methods a leaf class defines (py_trees says not to override
+        ``tick()``): an exception in ``initialise``, ``update`` or ``terminate``, or an
+        ``update`` that returns no Status, makes the node FAILURE, reported with its path;
+        the tree keeps ticking."""
+        super().__init_subclass__(**kwargs)
+        for method in ("initialise", "update", "terminate"):
+            if method in cls.__dict__:
+                setattr(cls, method, _GUARDS[method](cls.__dict__[method]))
 
-    def _failed(self, error: Exception) -> Status:
+    def _report(self, error: Exception) -> None:
         self.feedback_message = f"{type(error).__name__}: {error}"
         self.ctx.on_node_error(self.ctx.tree, node_path(self), error)
+
+
+def _guard_initialise(method: Callable[[Leaf], None]) -> Callable[[Leaf], None]:
+    @functools.wraps(method)
+    def initialise(self: Leaf) -> None:
+        if self._guarding:  # a subclass's initialise calls super's
+            return method(self)
+        self._guarding = True
         try:
-            self.stop(Status.FAILURE)
-        except Exception as stop_error:  # terminate() failing must not stop the tick either
-            self.ctx.on_node_error(self.ctx.tree, node_path(self), stop_error)
-        return Status.FAILURE
+            method(self)
+        except Exception as error:
+            self._failed_to_start = error  # update() then answers FAILURE
+        finally:
+            self._guarding = False
+
+    return initialise
+
+
+def _guard_update(method: Callable[[Leaf], Any]) -> Callable[[Leaf], Status]:
+    @functools.wraps(method)
+    def update(self: Leaf) -> Status:
+        if self._guarding:
+            return method(self)  # type: ignore[no-any-return]
+        if self._failed_to_start is not None:
+            failed, self._failed_to_start = self._failed_to_start, None
+            self._report(failed)
+            return Status.FAILURE
+        self._guarding = True
+        try:
+            status = method(self)
+            if not isinstance(status, Status):  # py_trees would make it INVALID, silently
+                raise TypeError(f"{type(self).__name__}.update() returned {status!r}, not a Status")
+            return status
+        except Exception as error:
+            self._report(error)
+            return Status.FAILURE
+        finally:
+            self._guarding = False
+
+    return update
+
+
+def _guard_terminate(method: Callable[[Leaf, Status], None]) -> Callable[[Leaf, Status], None]:
+    @functools.wraps(method)
+    def terminate(self: Leaf, new_status: Status) -> None:
+        if self._guarding:
+            return method(self, new_status)
+        self._guarding = True
+        try:
+            method(self, new_status)
+        except Exception as error:  # a failing terminate() must not stop the tick either
+            self._report(error)
+        finally:
+            self._guarding = False
+
+    return terminate
+
+
+_GUARDS: dict[str, Callable[[Any], Any]] = {
+    "initialise": _guard_initialise,
+    "update": _guard_update,
+    "terminate": _guard_terminate,
+}
+Leaf.terminate = _guard_terminate(Leaf.terminate)  # type: ignore[method-assign,assignment]
 
 
 class Condition(Leaf):

@@ -83,3 +83,49 @@ def test_a_turn_cut_short_by_a_timeout_is_started_again_next_round(tmp_path: Pat
     # the next round: the neck is not yet left, so it turns again
     assert robot.tick() == Status.RUNNING
     assert robot.did("servo") == [LEFT, LEFT]
+
+
+class Clumsy(Leaf):
+    """A developer's node that raises in initialise() on its first round, then works for
+    a tick, and raises again when it is halted."""
+
+    rounds = 0
+
+    def initialise(self) -> None:
+        Clumsy.rounds += 1
+        if Clumsy.rounds == 1:
+            raise RuntimeError("forgot to connect")
+
+    def update(self) -> Status:
+        return Status.RUNNING
+
+    def terminate(self, new_status: Status) -> None:
+        if new_status == Status.INVALID:
+            raise OSError("could not let go")
+
+
+def test_exceptions_in_initialise_and_terminate_fail_the_node_not_the_tree(
+    tmp_path: Path,
+) -> None:
+    registry = builtin_registry()
+    registry.add(Clumsy)
+    tree = write(
+        tmp_path,
+        "clumsy.yaml",
+        """\
+        root:
+          Timeout:
+            seconds: 0.25
+            child: {Clumsy: {}}
+        """,
+    )
+    robot = TreeHarness.from_file(tree, registry=registry, keep_node_errors=True)
+    # round 1: initialise raised -> Clumsy FAILURE -> Timeout FAILURE
+    assert robot.tick() == Status.FAILURE
+    # round 2: RUNNING until the Timeout halts it; its terminate raises, the tree goes on
+    assert robot.tick() == Status.RUNNING
+    assert robot.advance(0.3) == Status.FAILURE
+    assert [(path, type(error).__name__) for path, error in robot.node_errors] == [
+        ("Timeout/Clumsy", "RuntimeError"),
+        ("Timeout/Clumsy", "OSError"),
+    ]
