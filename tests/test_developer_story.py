@@ -32,7 +32,7 @@ from engine.nodes import (
 from engine.nodes.context import TreeContext
 from engine.services import Job
 from engine.testing import TreeHarness
-from engine.values.params import CheckContext
+from engine.values.params import CheckContext, ParamIssue
 
 REPO = Path(__file__).resolve().parents[1]
 GUIDE = REPO / "docs" / "developer-guide.md"
@@ -52,13 +52,11 @@ class SayInTurn(ServiceAction):
     )
 
     @classmethod
-    def check_params(
-        cls, args: Mapping[str, Any], ctx: CheckContext
-    ) -> list[tuple[str | None, str, str | None]]:
+    def check_params(cls, args: Mapping[str, Any], ctx: CheckContext) -> list[ParamIssue]:
         phrases = args["phrases"]
         twice = sorted({phrase for phrase in phrases if phrases.count(phrase) > 1})
         if twice:
-            return [("phrases", f"{twice[0]!r} is listed twice", "list each phrase once")]
+            return [ParamIssue("phrases", f"{twice[0]!r} is listed twice", "list each phrase once")]
         return []
 
     def __init__(self, name: str, args: SimpleNamespace, ctx: TreeContext) -> None:

@@ -336,9 +336,9 @@ class TreeLoader:
             else:
                 args[param.name] = param.default
         if ok and node_type.check is not None:
-            for param_name, why, advice in node_type.check(args, self.check_context):
-                where = given[param_name].mark if param_name in given else mark
-                problems.add(where, why, advice)
+            for issue in node_type.check(args, self.check_context):
+                where = given[issue.param].mark if issue.param in given else mark
+                problems.add(where, issue.message, issue.hint)
                 ok = False
         return (args if ok else None), name, children_raw
 

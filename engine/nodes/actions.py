@@ -25,6 +25,7 @@ from engine.values.params import (
     Key,
     Number,
     Param,
+    ParamIssue,
     ParamProblem,
     ParamType,
     Text,
@@ -278,14 +279,14 @@ class ReportResult(ServiceAction):
     )
 
     @classmethod
-    def check_params(
-        cls, args: Mapping[str, Any], ctx: CheckContext
-    ) -> list[tuple[str | None, str, str | None]]:
-        problems: list[tuple[str | None, str, str | None]] = []
+    def check_params(cls, args: Mapping[str, Any], ctx: CheckContext) -> list[ParamIssue]:
+        problems: list[ParamIssue] = []
         for name in ("command", "result"):
             key = args.get(name)
             if key is not None and not key.startswith("/vars/"):
-                problems.append((name, f"{key!r} is not a tree variable", "use a /vars/ key"))
+                problems.append(
+                    ParamIssue(name, f"{key!r} is not a tree variable", "use a /vars/ key")
+                )
         return problems
 
     def start(self) -> Job:

@@ -37,7 +37,7 @@ from py_trees.common import Access, Status
 from engine.nodes.context import TreeContext
 from engine.nodes.spec import NodeType
 from engine.services.jobs import Job
-from engine.values.params import CheckContext, Param
+from engine.values.params import CheckContext, Param, ParamIssue
 
 
 def node_path(node: py_trees.behaviour.Behaviour) -> str:
@@ -83,9 +83,7 @@ class Leaf(py_trees.behaviour.Behaviour):
             self.blackboard.register_key(key, access=Access.WRITE)
 
     @classmethod
-    def check_params(
-        cls, args: Mapping[str, Any], ctx: CheckContext
-    ) -> list[tuple[str | None, str, str | None]]:
+    def check_params(cls, args: Mapping[str, Any], ctx: CheckContext) -> list[ParamIssue]:
         """Checks across parameters at load time: (parameter, message, hint) per problem."""
         return []
 

@@ -17,6 +17,7 @@ from engine.values.params import (
     ListOf,
     Number,
     Param,
+    ParamIssue,
     Scalar,
 )
 
@@ -75,15 +76,13 @@ class Check(Condition):
     )
 
     @classmethod
-    def check_params(
-        cls, args: Mapping[str, Any], ctx: CheckContext
-    ) -> list[tuple[str | None, str, str | None]]:
+    def check_params(cls, args: Mapping[str, Any], ctx: CheckContext) -> list[ParamIssue]:
         given = [name for name in _COMPARISONS if args.get(name) is not None]
-        problems: list[tuple[str | None, str, str | None]] = []
+        problems: list[ParamIssue] = []
         if len(given) != 1:
             found = ", ".join(given) if given else "none"
             problems.append(
-                (
+                ParamIssue(
                     None,
                     f"Check needs exactly one comparison, found {found}",
                     "use one of " + ", ".join(_COMPARISONS),
@@ -92,17 +91,25 @@ class Check(Condition):
         between = args.get("between")
         if between is not None and between[0] > between[1]:
             problems.append(
-                ("between", f"low {between[0]:g} is above high {between[1]:g}", "write [low, high]")
+                ParamIssue(
+                    "between",
+                    f"low {between[0]:g} is above high {between[1]:g}",
+                    "write [low, high]",
+                )
             )
         spec = ctx.catalogue.lookup(args.get("key", ""))
         numeric = {"above", "below", "between"} & set(given)
         if spec is not None and numeric and spec.value_type in (bool, str, dict):
             problems.append(
-                (numeric.pop(), f"{args['key']} holds {spec.type_name}, not a number", "use equals")
+                ParamIssue(
+                    numeric.pop(),
+                    f"{args['key']} holds {spec.type_name}, not a number",
+                    "use equals",
+                )
             )
         if spec is not None and spec.value_type is list and args.get("item") is None:
             problems.append(
-                (
+                ParamIssue(
                     "item",
                     f"{args['key']} holds a list: say which item to check",
                     "add item: 0 for the first",
@@ -113,14 +120,14 @@ class Check(Condition):
             if args.get("item") is not None and spec.value_type not in (list, object):
                 holds = _HOLDS.get(spec.type_name, "an object")
                 problems.append(
-                    ("item", f"{args['key']} holds {holds}, not a list", "remove item:")
+                    ParamIssue("item", f"{args['key']} holds {holds}, not a list", "remove item:")
                 )
             if spec.value_type is not list:  # a list's items have no declared type
                 for name in ("equals", "not_equals"):
                     value = args.get(name)
                     mismatch = _mismatch(args["key"], spec, value) if value is not None else None
                     if mismatch is not None:
-                        problems.append((name, *mismatch))
+                        problems.append(ParamIssue(name, *mismatch))
         return problems
 
     _test: Callable[[Any], bool]
@@ -195,11 +202,9 @@ class OnEvent(Condition):
     )
 
     @classmethod
-    def check_params(
-        cls, args: Mapping[str, Any], ctx: CheckContext
-    ) -> list[tuple[str | None, str, str | None]]:
+    def check_params(cls, args: Mapping[str, Any], ctx: CheckContext) -> list[ParamIssue]:
         if args.get("equals") is not None and args.get("one_of") is not None:
-            return [("one_of", "give equals or one_of, not both", None)]
+            return [ParamIssue("one_of", "give equals or one_of, not both")]
         return []
 
     def __init__(self, *a: Any) -> None:

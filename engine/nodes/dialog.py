@@ -11,7 +11,7 @@ from engine.dialogs.model import Dialog
 from engine.errors import ServiceError
 from engine.nodes.base import Leaf
 from engine.services.jobs import ImmediateJob, Job
-from engine.values.params import CheckContext, Key, Param, Text, did_you_mean
+from engine.values.params import CheckContext, Key, Param, ParamIssue, Text, did_you_mean
 from engine.values.templates import CompiledTemplate
 
 
@@ -31,16 +31,14 @@ class Reply(Leaf):
     )
 
     @classmethod
-    def check_params(
-        cls, args: Mapping[str, Any], ctx: CheckContext
-    ) -> list[tuple[str | None, str, str | None]]:
+    def check_params(cls, args: Mapping[str, Any], ctx: CheckContext) -> list[ParamIssue]:
         dialog = args.get("dialog")
         if ctx.dialogs is not None and dialog is not None and ctx.dialogs.get(dialog) is None:
             known = ctx.dialogs.names
             hint = did_you_mean(dialog, known) or (
                 "dialogs: " + ", ".join(known) if known else "add dialogs/NAME.yaml"
             )
-            return [("dialog", f"no dialog named {dialog!r}", hint)]
+            return [ParamIssue("dialog", f"no dialog named {dialog!r}", hint)]
         return []
 
     def __init__(self, *a: Any) -> None:

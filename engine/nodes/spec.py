@@ -16,7 +16,7 @@ from typing import Any, Literal
 import py_trees
 
 from engine.nodes.context import TreeContext
-from engine.values.params import CheckContext, Key, ListOf, Param
+from engine.values.params import CheckContext, Key, ListOf, Param, ParamIssue
 from engine.values.templates import CompiledTemplate
 
 Kind = Literal["composite", "decorator", "condition", "action"]
@@ -26,7 +26,7 @@ Builder = Callable[
     [str, SimpleNamespace, list[py_trees.behaviour.Behaviour], TreeContext],
     py_trees.behaviour.Behaviour,
 ]
-ExtraCheck = Callable[[Mapping[str, Any], CheckContext], list[tuple[str | None, str, str | None]]]
+ExtraCheck = Callable[[Mapping[str, Any], CheckContext], list[ParamIssue]]
 """Cross-parameter checks: returns (parameter or None, message, hint) per problem."""
 
 

@@ -36,6 +36,19 @@ class ParamProblem(Exception):  # noqa: N818 - a problem report, not a failure
 
 
 @dataclass(frozen=True)
+class ParamIssue:
+    """A problem across a node's parameters, found once they are all converted.
+
+    ``param`` names the parameter whose value the loader points at (None: the node
+    itself); ``message`` says what is wrong, ``hint`` how to fix it.
+    """
+
+    param: str | None
+    message: str
+    hint: str | None = None
+
+
+@dataclass(frozen=True)
 class CheckContext:
     """What parameter checks may consult at load time (never hardware)."""
 
