@@ -16,6 +16,7 @@ import py_trees
 import pytest
 from py_trees.common import Status
 
+from engine.blackboard.catalogue import KeySpec
 from engine.files.problems import LoadError
 from engine.nodes.base import Condition
 from engine.nodes.docs import nodes_json, nodes_markdown
@@ -225,7 +226,7 @@ def test_a_broken_plugin_is_reported_without_stopping_the_others(
     assert registry.plugin_errors == [
         "plugin missing (no_such_vest_plugin:Thing): No module named 'no_such_vest_plugin'",
         "plugin crashing (broken_vest_plugin:register): the LED driver is missing",
-        "plugin empty (broken_vest_plugin:register_nothing): registered no node type",
+        "plugin empty (broken_vest_plugin:register_nothing): registered no node type and no key",
         "plugin number (broken_vest_plugin:NOT_A_NODE): "
         "is neither a Leaf subclass nor a register(registry) function",
     ]
@@ -303,3 +304,46 @@ def test_binding_a_service_the_node_does_not_take_is_refused_in_words() -> None:
 def test_a_plain_py_trees_behaviour_is_refused_in_words() -> None:
     with pytest.raises(TypeError, match=r"Success is a plain py_trees behaviour: subclass"):
         builtin_registry().add(py_trees.behaviours.Success)  # type: ignore[arg-type]
+
+
+DOORBELL_PLUGIN = """
+import py_trees
+
+from engine.blackboard.catalogue import KeySpec
+from engine.nodes.spec import NodeType
+
+
+def _twice(name, args, children, ctx):
+    return py_trees.decorators.Repeat(name=name, child=children[0], num_success=2)
+
+
+def register(registry):
+    registry.add_key(KeySpec("/sensors/doorbell/ringing", bool, "", "doorbell plugin", "rung"))
+    registry.add(NodeType("Twice", "decorator", "Do the child twice.", (), _twice))
+"""
+
+
+def test_a_plugin_adds_a_decorator_and_its_sensor_s_key(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    (tmp_path / "doorbell_vest_plugin.py").write_text(DOORBELL_PLUGIN, encoding="utf-8")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    registry = builtin_registry()
+    registry.load_plugins(entries=[entry("doorbell", "doorbell_vest_plugin:register")])
+    assert registry.plugin_errors == []
+    tree = tmp_path / "door.yaml"
+    tree.write_text(
+        "rate_hz: 10\nroot:\n  Sequence:\n"
+        "    - Check: {key: /sensors/doorbell/ringing, equals: true}\n"
+        "    - Twice: {child: {Say: {text: Coming!}}}\n"
+    )
+    robot = TreeHarness.from_file(tree, registry=registry)
+    robot.set("/sensors/doorbell/ringing", True)
+    robot.advance(5.0)
+    assert robot.said[:2] == ["Coming!", "Coming!"]
+    assert registry.catalogue().lookup("/sensors/doorbell/ringing") is not None
+
+
+def test_a_plugin_key_that_already_exists_is_refused() -> None:
+    with pytest.raises(ValueError, match="already exists"):
+        builtin_registry().add_key(KeySpec("/sensors/touch/any", bool, "", "me", "mine"))

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import json
 
-from engine.blackboard.catalogue import default_catalogue
+from engine.nodes.registry import default_registry
 
 NAME = "keys"
 HELP = "list the blackboard keys"
@@ -16,7 +16,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def main(args: argparse.Namespace) -> int:
-    specs = list(default_catalogue())
+    specs = list(default_registry().catalogue())  # with the keys plugins add
     if args.format == "json":
         print(
             json.dumps(

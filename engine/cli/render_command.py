@@ -10,7 +10,6 @@ import shutil
 import sys
 from pathlib import Path
 
-from engine.blackboard.catalogue import default_catalogue
 from engine.dialogs.library import DialogLibrary, find_dialogs_folder
 from engine.errors import ConfigError
 from engine.loader.tree_definition import NodeDefinition, TreeDefinition
@@ -109,12 +108,13 @@ def main(args: argparse.Namespace) -> int:
     from engine.cli.run_inputs import resolve_profile
     from engine.loader.substitution import load_profile
 
-    catalogue = default_catalogue()
+    registry = default_registry()
+    catalogue = registry.catalogue()
     folder = find_dialogs_folder(args.tree)
     dialogs = DialogLibrary.from_folder(folder, catalogue) if folder else None
     profile_path = resolve_profile(args.profile, [args.tree])  # by name or path, as vest run
     profile = load_profile(profile_path) if profile_path else None
-    loader = TreeLoader(default_registry(), catalogue, dialogs=dialogs, profile=profile)
+    loader = TreeLoader(registry, catalogue, dialogs=dialogs, profile=profile)
     definition = loader.load(args.tree)
     if args.format in ("ascii", "dot"):
         text = ascii_tree(definition) if args.format == "ascii" else dot_source(definition)

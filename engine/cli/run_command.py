@@ -19,7 +19,6 @@ import sys
 from pathlib import Path
 
 from engine.blackboard.board import Blackboard
-from engine.blackboard.catalogue import default_catalogue
 from engine.cli.output import shown, tell
 from engine.cli.run_inputs import DEFAULT_HARDWARE, load_run_inputs
 from engine.cli.timeline import Timeline
@@ -105,7 +104,7 @@ def main(args: argparse.Namespace) -> int:
     if args.fast and not config.simulated:
         raise ConfigError(f"{args.hardware}: --fast needs a simulated vest (simulated: true)")
     clock: Clock = VirtualClock() if args.fast else RealClock()
-    blackboard = Blackboard(default_catalogue(), clock)
+    blackboard = Blackboard(behaviors.loader.catalogue, clock)  # with plugin keys
     blackboard.reset()
     world = World()
     vest = build_sim_vest(config, world, clock) if config.simulated else None

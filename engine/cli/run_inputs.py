@@ -22,6 +22,7 @@ from engine.hardware.config import RobotConfig
 from engine.hardware.config_file import load_robot_config
 from engine.hardware.sim_vest import check_fault_events
 from engine.loader.tree_definition import NodeDefinition, TreeDefinition
+from engine.nodes.registry import NodeRegistry, default_registry
 from engine.nodes.remote import COMMAND_TYPES
 from engine.runtime.robot import Behaviors, load_behaviors
 from engine.scenario.scenario_file import Scenario, ScenarioEvent, load_scenario
@@ -71,10 +72,13 @@ def dialogs_folder(given: Path | None) -> Path | None:
     return given
 
 
-def robot_catalogue(config: RobotConfig | None) -> KeyCatalogue:
+def robot_catalogue(
+    config: RobotConfig | None, registry: NodeRegistry | None = None
+) -> KeyCatalogue:
     """The key catalogue of one robot: ``/devices/NAME/ok`` for each of its devices only
-    (the default catalogue, without a robot, accepts any NAME)."""
-    catalogue = default_catalogue()
+    (the default catalogue, without a robot, accepts any NAME), and the keys the
+    registry's plugins add."""
+    catalogue = registry.catalogue() if registry is not None else default_catalogue()
     if config is None:
         return catalogue
     pattern = catalogue.lookup("/devices/x/ok")
@@ -159,9 +163,14 @@ def load_checked_behaviors(
     problems: Problems,
 ) -> Behaviors | None:
     """Trees, dialogs and profile checked against the robot; None with problems added."""
+    registry = default_registry()
     try:
         behaviors = load_behaviors(
-            trees, dialogs_dir=dialogs, profile=profile, catalogue=robot_catalogue(config)
+            trees,
+            dialogs_dir=dialogs,
+            profile=profile,
+            registry=registry,
+            catalogue=robot_catalogue(config, registry),
         )
     except LoadError as error:
         problems.extend(error.problems)

@@ -107,7 +107,7 @@ class Validator:
     ) -> None:
         self.registry = registry
         self.config = config
-        self.catalogue = robot_catalogue(config)
+        self.catalogue = robot_catalogue(config, registry)
         self.lengths = list_lengths(config)
         self.dialogs_dir = dialogs_dir
         self.problems = problems if problems is not None else Problems()

@@ -14,6 +14,7 @@ from collections.abc import Callable, Iterator
 from importlib.metadata import EntryPoint, entry_points
 from typing import Any
 
+from engine.blackboard.catalogue import KeyCatalogue, KeySpec, default_catalogue
 from engine.nodes.base import Leaf, leaf_type
 from engine.nodes.spec import NodeType
 
@@ -23,11 +24,36 @@ _log = logging.getLogger("vest.plugins")
 
 
 class NodeRegistry:
-    """Node types by name."""
+    """Node types by name, and the blackboard keys plugins bring (a plugin's sensor).
+
+    Any kind of node may be added: a leaf class, or a :class:`NodeType` of any kind
+    (composite and decorator too: its ``build`` gets the built children).
+    """
 
     def __init__(self) -> None:
         self._types: dict[str, NodeType] = {}
+        self._keys: dict[str, KeySpec] = {}
         self.plugin_errors: list[str] = []
+
+    def add_key(self, spec: KeySpec) -> KeySpec:
+        """A blackboard key for the catalogue (e.g. the reading of a plugin's sensor); a
+        name the built-in catalogue or another plugin has is refused."""
+        if default_catalogue().lookup(spec.name) is not None or spec.name in self._keys:
+            raise ValueError(f"blackboard key {spec.name!r} already exists")
+        self._keys[spec.name] = spec
+        return spec
+
+    @property
+    def keys(self) -> list[KeySpec]:
+        """The keys added with :meth:`add_key`."""
+        return list(self._keys.values())
+
+    def catalogue(self, base: KeyCatalogue | None = None) -> KeyCatalogue:
+        """``base`` (default: the built-in catalogue) with the keys plugins added."""
+        catalogue = base or default_catalogue()
+        for spec in self._keys.values():
+            catalogue.add(spec)
+        return catalogue
 
     def add(self, node: type[Leaf] | NodeType, *, source: str = "vest", **bound: Any) -> NodeType:
         """Register a leaf class or a NodeType; a name already taken is an error naming both.
@@ -95,9 +121,14 @@ def _call_register(register: Callable[..., object], registry: NodeRegistry, sour
     """Run a plugin's register(); its node types join ``registry`` only if all of it worked."""
     staging = _SourcedRegistry(registry, source)
     register(staging)
-    if not staging.staged:
-        raise ValueError("registered no node type")
+    if not staging.staged and not staging.staged_keys:
+        raise ValueError("registered no node type and no key")
+    for spec in staging.staged_keys:
+        if default_catalogue().lookup(spec.name) is not None or spec.name in registry._keys:
+            raise ValueError(f"blackboard key {spec.name!r} already exists")
     registry.add_all(staging.staged)
+    for spec in staging.staged_keys:
+        registry.add_key(spec)
 
 
 class _SourcedRegistry:
@@ -108,6 +139,11 @@ class _SourcedRegistry:
         self._registry = registry
         self._source = source
         self.staged: list[NodeType] = []
+        self.staged_keys: list[KeySpec] = []
+
+    def add_key(self, spec: KeySpec) -> KeySpec:
+        self.staged_keys.append(spec)
+        return spec
 
     def add(
         self, node: type[Leaf] | NodeType, *, source: str | None = None, **bound: Any

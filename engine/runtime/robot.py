@@ -6,7 +6,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from engine.blackboard.board import Blackboard
-from engine.blackboard.catalogue import KeyCatalogue, default_catalogue
+from engine.blackboard.catalogue import KeyCatalogue
 from engine.clock import Clock
 from engine.dialogs.library import DialogLibrary
 from engine.files.problems import LoadError, Mark, Problems
@@ -71,7 +71,7 @@ def load_behaviors(
 ) -> Behaviors:
     """Validate dialogs, the profile and every tree; LoadError listing all problems."""
     registry = registry or default_registry()
-    catalogue = catalogue or default_catalogue()
+    catalogue = catalogue or registry.catalogue()
     problems = Problems()
     dialogs = DialogLibrary()
     checked_dialogs: DialogLibrary | None = dialogs

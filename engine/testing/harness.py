@@ -109,13 +109,12 @@ class TreeHarness:
         ``dialogs_dir`` defaults to the nearest ``dialogs/`` folder at or above the tree.
         """
         path = Path(path)
-        catalogue = default_catalogue()
+        registry = registry or default_registry()
+        catalogue = registry.catalogue()
         folder = Path(dialogs_dir) if dialogs_dir is not None else find_dialogs_folder(path)
         dialogs = DialogLibrary.from_folder(folder, catalogue) if folder else DialogLibrary()
         loaded_profile = load_profile(Path(profile)) if profile is not None else None
-        loader = TreeLoader(
-            registry or default_registry(), catalogue, dialogs=dialogs, profile=loaded_profile
-        )
+        loader = TreeLoader(registry, catalogue, dialogs=dialogs, profile=loaded_profile)
         return cls(
             loader.load(path),
             dialogs=dialogs,
