@@ -82,17 +82,16 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # run from a check
 
 from py_trees.common import Status
 
-from engine.blackboard.board import Blackboard
-from engine.blackboard.catalogue import default_catalogue
 from engine.clock import RealClock, stopwatch
 from engine.drivers.srf02 import RANGING_TIME_S
-from engine.hardware.assembly import Hardware, build_hardware
+from engine.hardware.assembly import Hardware
 from engine.hardware.config import RobotConfig
 from engine.hardware.config_file import load_robot_config
-from engine.hardware.sim_vest import SimVest, UnwiredSenses, build_sim_vest
+from engine.hardware.sim_vest import SimVest
 from engine.nodes.decorators import Cooldown
 from engine.runtime.reload import TreeReloader
 from engine.runtime.robot import Robot, load_behaviors
+from engine.runtime.robot_factory import build_robot
 from engine.runtime.scheduler import RunningTree
 from engine.runtime.stats import percentile
 from engine.scenario.world import World
@@ -211,27 +210,23 @@ def build_rig(profile: Path) -> Rig:
     clock = RealClock()
     behaviors = load_behaviors([TREES_DIR], dialogs_dir=DIALOGS_DIR, profile=profile)
     config = load_robot_config(SIM_CONFIG)
-    blackboard = Blackboard(default_catalogue(), clock)
-    blackboard.reset()
-    world = World()
-    vest = build_sim_vest(config, world, clock)
-    world.listeners.append(UnwiredSenses(blackboard))
-    hardware = build_hardware(config, clock, blackboard, vest=vest)
-    if hardware.startup_problems:
-        hardware.close()
-        vest.close()
-        raise SystemExit(f"the simulated vest did not start: {hardware.startup_problems}")
     instruments = Instruments(clock)
     simulated = simulated_services(clock, realistic=True)
-    services = hardware.services(speech=simulated.speech, iot=simulated.iot, fallback=simulated)
-    robot = Robot(
+    assembled = build_robot(
         behaviors,
+        config,
         clock=clock,
-        services=services,
-        blackboard=blackboard,
+        speech=simulated.speech,
+        iot=simulated.iot,
+        fallback=simulated,
         action_log=ActionLog(listeners=[instruments.action]),
     )
-    robot.scheduler.hooks.extend(hardware.hooks)
+    robot, world, hardware = assembled.robot, assembled.world, assembled.hardware
+    assert assembled.vest is not None
+    vest = assembled.vest
+    if hardware.startup_problems:
+        assembled.close()
+        raise SystemExit(f"the simulated vest did not start: {hardware.startup_problems}")
     robot.scheduler.hooks.append(TreeReloader(behaviors.loader, robot.trees, clock))
     robot.scheduler.hooks.append(instruments.step_hook)
     for poller in hardware.pollers:

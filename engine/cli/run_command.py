@@ -18,19 +18,14 @@ import argparse
 import sys
 from pathlib import Path
 
-from engine.blackboard.board import Blackboard
 from engine.cli.output import shown, tell
 from engine.cli.run_inputs import DEFAULT_HARDWARE, load_run_inputs
 from engine.cli.timeline import Timeline
 from engine.clock import Clock, RealClock, VirtualClock
 from engine.errors import ConfigError
-from engine.hardware.assembly import build_hardware
-from engine.hardware.sim_vest import UnwiredSenses, build_sim_vest
 from engine.runtime.reload import TreeReloader
-from engine.runtime.robot import Robot
+from engine.runtime.robot_factory import build_robot
 from engine.scenario.player import ScenarioPlayer
-from engine.scenario.world import World
-from engine.services.actions import ActionLog
 from engine.services.simulated import simulated_services
 
 NAME = "run"
@@ -104,33 +99,32 @@ def main(args: argparse.Namespace) -> int:
     if args.fast and not config.simulated:
         raise ConfigError(f"{args.hardware}: --fast needs a simulated vest (simulated: true)")
     clock: Clock = VirtualClock() if args.fast else RealClock()
-    blackboard = Blackboard(behaviors.loader.catalogue, clock)  # with plugin keys
-    blackboard.reset()
-    world = World()
-    vest = build_sim_vest(config, world, clock) if config.simulated else None
-    world.listeners.append(UnwiredSenses(blackboard))  # speech and cloud have no devices yet
-    hardware = build_hardware(config, clock, blackboard, vest=vest)
+    simulated = simulated_services(clock, realistic=True)
+    assembled = build_robot(
+        behaviors,
+        config,
+        clock=clock,
+        speech=simulated.speech,
+        iot=simulated.iot,
+        fallback=simulated,
+    )
+    robot, blackboard = assembled.robot, assembled.blackboard
     reloader: TreeReloader | None = None
     try:
         start_s = clock.now()  # after start-up, which takes simulated time too
         timeline = Timeline(sys.stdout, start_s=start_s, as_json=args.json)
-        for name, why in hardware.startup_problems.items():
+        for name, why in assembled.hardware.startup_problems.items():
             tell(f"warning: {shown(name)} did not start ({shown(why)}); it will be tried again")
-        log = ActionLog(listeners=[timeline.action], failure_listeners=[timeline.failed])
+        robot.action_log.listeners.append(timeline.action)
+        robot.action_log.failure_listeners.append(timeline.failed)
         blackboard.watchers.append(
             lambda key, value: timeline.blackboard_write(key, value, clock.now())
         )
-        simulated = simulated_services(clock, realistic=True)
-        services = hardware.services(speech=simulated.speech, iot=simulated.iot, fallback=simulated)
-        robot = Robot(
-            behaviors, clock=clock, services=services, blackboard=blackboard, action_log=log
-        )
         timeline.on_closed = robot.scheduler.stop
         # the world moves first, then the pollers read it, then the trees tick
-        robot.scheduler.hooks.append(
-            ScenarioPlayer(scenario, world, start_s=start_s, on_event=timeline.world)
+        robot.scheduler.hooks.insert(
+            0, ScenarioPlayer(scenario, assembled.world, start_s=start_s, on_event=timeline.world)
         )
-        robot.scheduler.hooks.extend(hardware.hooks)
         if not args.fast:  # reload work runs beside the scheduler, swaps between ticks
             reloader = TreeReloader(behaviors.loader, robot.trees, clock)
             robot.scheduler.hooks.append(reloader)
@@ -140,13 +134,11 @@ def main(args: argparse.Namespace) -> int:
         args.stop_signals.on_stop(robot.scheduler.stop)
         timeline.start()
         first_tick_s = clock.now()
-        hardware.start(origin_s=first_tick_s)  # readings staged just before each tick
+        assembled.start(origin_s=first_tick_s)  # readings staged just before each tick
         robot.scheduler.run(until_s=start_s + duration, start_s=first_tick_s)
         timeline.summary(robot.trees)
     finally:
         if reloader is not None:
             reloader.stop()
-        hardware.close()
-        if vest is not None:
-            vest.close()
+        assembled.close()
     return 0 if timeline.write_error is None else 1  # the robot ran; its timeline was lost

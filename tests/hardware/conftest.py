@@ -7,15 +7,13 @@ from pathlib import Path
 
 import pytest
 
-from engine.blackboard.board import Blackboard
-from engine.blackboard.catalogue import default_catalogue
 from engine.clock import VirtualClock
-from engine.hardware.assembly import Hardware, build_hardware
+from engine.hardware.assembly import Hardware
 from engine.hardware.config import RobotConfig
 from engine.hardware.config_file import load_robot_config
-from engine.hardware.sim_vest import SimVest, UnwiredSenses, build_sim_vest
-from engine.runtime.robot import Robot, load_behaviors
-from engine.scenario.world import World
+from engine.hardware.sim_vest import SimVest
+from engine.runtime.robot import load_behaviors
+from engine.runtime.robot_factory import build_robot
 from engine.services.simulated import SimulatedIot, SimulatedSpeech
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -31,22 +29,19 @@ class SimRobot:
 
     def __init__(self, config: RobotConfig) -> None:
         self.clock = VirtualClock()
-        self.blackboard = Blackboard(default_catalogue(), self.clock)
-        self.blackboard.reset()
-        self.world = World()
-        self.vest: SimVest = build_sim_vest(config, self.world, self.clock)
-        self.world.listeners.append(UnwiredSenses(self.blackboard))
-        self.hardware: Hardware = build_hardware(
-            config, self.clock, self.blackboard, vest=self.vest
-        )
         self.speech = SimulatedSpeech(self.clock)
         self.iot = SimulatedIot()
         behaviors = load_behaviors([ROOT / "trees"], dialogs_dir=ROOT / "dialogs")
-        self.services = self.hardware.services(speech=self.speech, iot=self.iot)
-        self.robot = Robot(
-            behaviors, clock=self.clock, services=self.services, blackboard=self.blackboard
+        self.assembled = build_robot(
+            behaviors, config, clock=self.clock, speech=self.speech, iot=self.iot
         )
-        self.robot.scheduler.hooks.extend(self.hardware.hooks)
+        self.robot = self.assembled.robot
+        self.blackboard = self.assembled.blackboard
+        self.world = self.assembled.world
+        self.hardware: Hardware = self.assembled.hardware
+        assert self.assembled.vest is not None
+        self.vest: SimVest = self.assembled.vest
+        self.services = self.robot.services
 
     @property
     def said(self) -> list[str]:
@@ -84,8 +79,7 @@ class SimRobot:
         self.world.happened("hear", text)
 
     def close(self) -> None:
-        self.hardware.close()
-        self.vest.close()
+        self.assembled.close()
 
 
 @pytest.fixture

@@ -1,0 +1,82 @@
+"""One factory builds the robot: `vest run`, the tests and the benchmarks use it.
+
+:func:`build_robot` wires what a robot config and the validated behaviors describe: one
+blackboard (with the catalogue the trees were checked against), the world a simulated vest
+answers to, the bus managers, drivers, pollers and hardware services, and the trees on a
+scheduler whose hooks poll the devices. Speech and the cloud have no devices yet, so the
+caller hands their services in. The caller adds its own hooks (a scenario player goes
+first: the world moves, then the pollers read it, then the trees tick) and runs it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from engine.blackboard.board import Blackboard
+from engine.clock import Clock
+from engine.hardware.assembly import Hardware, build_hardware
+from engine.hardware.config import RobotConfig
+from engine.hardware.sim_vest import SimVest, UnwiredSenses, build_sim_vest
+from engine.runtime.robot import Behaviors, Robot
+from engine.scenario.world import World
+from engine.services.actions import ActionLog
+from engine.services.interfaces import IotResults, Services, Speech
+
+
+@dataclass
+class AssembledRobot:
+    """A robot built by :func:`build_robot`; :meth:`close` releases what it opened."""
+
+    robot: Robot
+    clock: Clock
+    blackboard: Blackboard
+    world: World
+    hardware: Hardware
+    vest: SimVest | None
+
+    def start(self, origin_s: float) -> None:
+        """Start the poller threads (real time), phased on the trees' first deadline (s)."""
+        self.hardware.start(origin_s=origin_s)
+
+    def close(self) -> None:
+        """Stop the pollers and bus workers, close the buses and the simulated vest."""
+        try:
+            self.hardware.close()
+        finally:
+            if self.vest is not None:
+                self.vest.close()
+
+
+def build_robot(
+    behaviors: Behaviors,
+    config: RobotConfig,
+    *,
+    clock: Clock,
+    speech: Speech,
+    iot: IotResults,
+    fallback: Services | None = None,
+    action_log: ActionLog | None = None,
+) -> AssembledRobot:
+    """The robot of ``config`` running ``behaviors`` on ``clock``.
+
+    ``config.simulated`` builds the register-level simulated vest behind the same buses;
+    ``fallback`` serves what the config has no device for (e.g. simulated LEDs).
+    """
+    blackboard = Blackboard(behaviors.loader.catalogue, clock)
+    blackboard.reset()
+    world = World()
+    vest = build_sim_vest(config, world, clock) if config.simulated else None
+    world.listeners.append(UnwiredSenses(blackboard))  # speech and cloud have no devices yet
+    hardware = build_hardware(config, clock, blackboard, vest=vest)
+    try:
+        services = hardware.services(speech=speech, iot=iot, fallback=fallback)
+        robot = Robot(
+            behaviors, clock=clock, services=services, blackboard=blackboard, action_log=action_log
+        )
+    except BaseException:
+        hardware.close()
+        if vest is not None:
+            vest.close()
+        raise
+    robot.scheduler.hooks.extend(hardware.hooks)
+    return AssembledRobot(robot, clock, blackboard, world, hardware, vest)
