@@ -1,0 +1,105 @@
+"""The house's shape, checked: imports run one way, modules stay readable, time comes
+from the clock, and no module outside a chip's own names the chip."""
+
+from __future__ import annotations
+
+import ast
+import re
+from collections import defaultdict
+from pathlib import Path
+
+ENGINE = Path(__file__).resolve().parents[1] / "engine"
+MAX_LINES = 420  # "about 400": a module one reads in one sitting
+STILL_TOO_LONG = {
+    # waiting for the chip-kind registry, which splits them by chip: they may only shrink
+    "engine/hardware/config_check.py": 1099,
+    "engine/hardware/assembly.py": 602,
+    "engine/hardware/services.py": 478,
+}
+
+
+def _modules() -> dict[str, Path]:
+    modules = {}
+    for path in ENGINE.rglob("*.py"):
+        parts = path.relative_to(ENGINE.parent).with_suffix("").parts
+        name = ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+        modules[name] = path
+    return modules
+
+
+def _imports(path: Path, modules: dict[str, Path]) -> set[str]:
+    found: set[str] = set()
+    for node in ast.walk(ast.parse(path.read_text())):
+        if isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
+            candidates = [node.module, *(f"{node.module}.{a.name}" for a in node.names)]
+        elif isinstance(node, ast.Import):
+            candidates = [a.name for a in node.names]
+        else:
+            continue
+        found.update(c for c in candidates if c in modules)
+    return found
+
+
+def _cycles(graph: dict[str, set[str]]) -> list[list[str]]:
+    """Strongly connected components with more than one module (Tarjan)."""
+    index: dict[str, int] = {}
+    low: dict[str, int] = {}
+    stack: list[str] = []
+    on_stack: set[str] = set()
+    found: list[list[str]] = []
+
+    def visit(node: str) -> None:
+        index[node] = low[node] = len(index)
+        stack.append(node)
+        on_stack.add(node)
+        for target in graph[node]:
+            if target not in index:
+                visit(target)
+                low[node] = min(low[node], low[target])
+            elif target in on_stack:
+                low[node] = min(low[node], index[target])
+        if low[node] == index[node]:
+            component = []
+            while True:
+                member = stack.pop()
+                on_stack.discard(member)
+                component.append(member)
+                if member == node:
+                    break
+            if len(component) > 1:
+                found.append(sorted(component))
+
+    for node in list(graph):
+        if node not in index:
+            visit(node)
+    return found
+
+
+def test_no_import_circle_between_engine_modules() -> None:
+    modules = _modules()
+    graph: dict[str, set[str]] = defaultdict(set)
+    for name, path in modules.items():
+        graph[name] |= _imports(path, modules) - {name}
+    assert _cycles(graph) == []
+
+
+def test_no_engine_module_is_too_long_to_read_in_one_sitting() -> None:
+    long = {
+        str(path.relative_to(ENGINE.parent)): lines
+        for path in ENGINE.rglob("*.py")
+        if (lines := len(path.read_text().splitlines())) > MAX_LINES
+    }
+    grown = {
+        name: lines for name, lines in long.items() if lines > STILL_TOO_LONG.get(name, MAX_LINES)
+    }
+    assert grown == {}
+
+
+def test_only_the_clock_module_reads_time_or_sleeps() -> None:
+    pattern = re.compile(r"\btime\.(time|monotonic|sleep|perf_counter)\(|\bdatetime\.now\(")
+    readers = sorted(
+        str(path.relative_to(ENGINE.parent))
+        for path in ENGINE.rglob("*.py")
+        if path.name != "clock.py" and pattern.search(path.read_text())
+    )
+    assert readers == []
