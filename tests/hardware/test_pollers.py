@@ -4,11 +4,12 @@ from __future__ import annotations
 
 import logging
 import threading
+from collections.abc import Callable
 from typing import Any
 
 import pytest
 
-from engine.clock import RealClock, VirtualClock
+from engine.clock import Clock, RealClock, VirtualClock
 from engine.drivers.bus_manager import BusManager
 from engine.drivers.sim.i2c_bus import SimI2CBus
 from engine.drivers.sim.mcp3008 import SimMCP3008
@@ -220,6 +221,21 @@ def test_each_gesture_is_one_event_named_as_the_config_says(bench: Bench):
     assert events == [("/sensors/gesture/last", "wave"), ("/sensors/gesture/last", "swipe_up")]
 
 
+def touch_poller(
+    clock: Clock, board: RecordingBoard, read: Callable[[object], list[Staged]], *, rate_hz: float
+) -> Poller[object]:
+    """A poller of a pretend touch device whose reads ``read`` answers."""
+    return Poller(
+        "touch",
+        rate_hz=rate_hz,
+        clock=clock,
+        blackboard=board,  # type: ignore[arg-type]
+        health=DeviceHealth("touch", None),
+        connect=object,
+        read=read,
+    )
+
+
 def test_pollers_on_threads_poll_by_themselves():
     clock = RealClock()
     board = RecordingBoard()
@@ -229,15 +245,7 @@ def test_pollers_on_threads_poll_by_themselves():
         reads.append(1)
         return [Staged("/sensors/touch/any", True)]
 
-    poller: Poller[object] = Poller(
-        "touch",
-        rate_hz=50.0,
-        clock=clock,
-        blackboard=board,  # type: ignore[arg-type]
-        health=DeviceHealth("touch", None),
-        connect=object,
-        read=read,
-    )
+    poller = touch_poller(clock, board, read, rate_hz=50.0)
     threads = PollerThreads([poller], clock)
     threads.start()
     try:
@@ -258,15 +266,7 @@ def test_a_virtual_clock_drives_poller_threads_poll_by_poll():
         reads.append(clock.now())
         return [Staged("/sensors/touch/any", True)]
 
-    poller: Poller[object] = Poller(
-        "touch",
-        rate_hz=10.0,
-        clock=clock,
-        blackboard=board,  # type: ignore[arg-type]
-        health=DeviceHealth("touch", None),
-        connect=object,
-        read=read,
-    )
+    poller = touch_poller(clock, board, read, rate_hz=10.0)
     threads = PollerThreads([poller], clock)
     threads.start(origin_s=0.0)
     try:

@@ -94,6 +94,19 @@ def test_an_unknown_command_type_is_reported_failed_with_the_reason(robot: TreeH
         ("say", {}, "say needs 'text'"),
         ("led", {"color": "plaid"}, "unknown color 'plaid'"),
         ("read", {"sensor": "smell"}, "unknown sensor 'smell'"),
+        # checked by the same declarations as a tree's Say, SetLed and MoveServo
+        ("say", {"text": "hi", "volume": 50}, "'volume' must be at most 1, got 50"),
+        ("say", {"text": "hi", "volume": -3}, "'volume' must be at least 0, got -3"),
+        ("say", {"text": "hi", "volume": float("nan")}, "'volume' must be a finite number"),
+        ("say", {"text": "x" * 5000}, "'text' is 5000 characters long, more than 1000"),
+        ("say", {"text": "hi", "loud": True}, "unknown argument 'loud' for say"),
+        ("led", {"color": "pink", "seconds": 1e300}, "'seconds' must be at most 86400"),
+        ("led", {"color": "pink", "seconds": float("nan")}, "'seconds' must be a finite number"),
+        ("led", {"color": "pink", "seconds": float("-inf")}, "'seconds' must be a finite number"),
+        ("move", {"joint": "neck", "angle_deg": 10**330}, "'angle_deg' must be a number below"),
+        ("move", {"joint": "neck", "angle_deg": True}, "'angle_deg' must be a number, got True"),
+        ("move", {"joint": "neck"}, "move needs 'angle_deg'"),
+        ("move", {"joint": ["neck"], "angle_deg": 5}, "'joint' must be text"),
     ],
 )
 def test_bad_arguments_are_reported_failed_with_the_reason(
@@ -126,34 +139,6 @@ def test_an_unplugged_speaker_is_reported_as_a_failed_command(robot: TreeHarness
     [report] = robot.did("report")
     assert report["status"] == "failed"
     assert "speaker unplugged" in report["result"]["error"]
-
-
-@pytest.mark.parametrize(
-    ("kind", "args", "reason"),
-    [
-        ("say", {"text": "hi", "volume": 50}, "'volume' must be at most 1, got 50"),
-        ("say", {"text": "hi", "volume": -3}, "'volume' must be at least 0, got -3"),
-        ("say", {"text": "hi", "volume": float("nan")}, "'volume' must be a finite number"),
-        ("say", {"text": "x" * 5000}, "'text' is 5000 characters long, more than 1000"),
-        ("say", {"text": "hi", "loud": True}, "unknown argument 'loud' for say"),
-        ("led", {"color": "pink", "seconds": 1e300}, "'seconds' must be at most 86400"),
-        ("led", {"color": "pink", "seconds": float("nan")}, "'seconds' must be a finite number"),
-        ("led", {"color": "pink", "seconds": float("-inf")}, "'seconds' must be a finite number"),
-        ("move", {"joint": "neck", "angle_deg": 10**330}, "'angle_deg' must be a number below"),
-        ("move", {"joint": "neck", "angle_deg": True}, "'angle_deg' must be a number, got True"),
-        ("move", {"joint": "neck"}, "move needs 'angle_deg'"),
-        ("move", {"joint": ["neck"], "angle_deg": 5}, "'joint' must be text"),
-    ],
-)
-def test_remote_arguments_are_checked_by_the_same_declarations_as_a_tree(
-    robot: TreeHarness, kind: str, args: dict[str, Any], reason: str
-) -> None:
-    send(robot, kind, **args)
-    robot.advance(1.0)
-    [report] = robot.did("report")
-    assert report["status"] == "failed"
-    assert reason in report["result"]["error"]
-    assert robot.did("say") == robot.did("led") == robot.did("servo") == []
 
 
 def test_a_refused_command_reports_its_own_failure_never_the_previous_result(
