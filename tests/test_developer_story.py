@@ -11,7 +11,7 @@ import json
 from collections.abc import Mapping
 from pathlib import Path
 from types import SimpleNamespace
-from typing import Any, ClassVar
+from typing import Any
 
 import pytest
 
@@ -20,6 +20,7 @@ from engine.cli import main
 from engine.files.problems import LoadError
 from engine.loader.tree_file import TreeLoader
 from engine.nodes import (
+    Condition,
     ListOf,
     NodeRegistry,
     Number,
@@ -46,10 +47,8 @@ class SayInTurn(ServiceAction):
     say it (the same phrase is tried the next time).
     """
 
-    params: ClassVar = (
-        Param("phrases", ListOf(Text(), min_items=1), doc="what to say, one phrase per turn"),
-        Param("volume", Number(0.0, 1.0), None, "0..1; empty: the robot's default volume"),
-    )
+    phrases = Param("phrases", ListOf(Text(), min_items=1), doc="what to say, one phrase per turn")
+    volume = Param("volume", Number(0.0, 1.0), None, "0..1; empty: the robot's default volume")
 
     @classmethod
     def check_params(cls, args: Mapping[str, Any], ctx: CheckContext) -> list[ParamIssue]:
@@ -64,8 +63,8 @@ class SayInTurn(ServiceAction):
         self.turn = 0  # kept across rounds: the next phrase to say
 
     def start(self) -> Job:
-        phrase = self.args.phrases[self.turn % len(self.args.phrases)]
-        return self.ctx.actions.say(phrase, volume=self.args.volume)
+        phrase = self.phrases[self.turn % len(self.phrases)]
+        return self.ctx.actions.say(phrase, volume=self.volume)
 
     def finished(self, job: Job) -> Status:
         self.turn += 1  # only a phrase that was said counts
@@ -235,3 +234,39 @@ def test_the_guide_shows_the_code_that_is_tested(monkeypatch: pytest.MonkeyPatch
             f"docs/developer-guide.md no longer shows {leaf.__name__} as it is tested: "
             "copy the class from its source into the guide"
         )
+
+
+class Shout(Condition):
+    """SUCCESS when the room is louder than ``above_db`` (a typed parameter attribute)."""
+
+    above_db = Param("above_db", Number(0.0, 140.0, "dB"), 70.0, "threshold")
+    reads = ("/vars/loudness_db",)
+
+    def check(self) -> bool:
+        return (self.read("/vars/loudness_db") or 0.0) > self.above_db
+
+
+def test_a_parameter_declared_as_a_class_attribute_is_the_node_s_typed_value(
+    tmp_path: Path,
+) -> None:
+    registry = builtin_registry()
+    node_type = registry.add(Shout)
+    assert [p.name for p in node_type.params] == ["above_db"]  # docs and loader see it
+    tree = tmp_path / "loud.yaml"
+    tree.write_text("rate_hz: 10\nroot:\n  Shout: {above_db: 80}\n")
+    robot = TreeHarness.from_file(tree, registry=registry)
+    robot.set("/vars/loudness_db", 85.0)
+    assert robot.tick() == Status.SUCCESS
+    assert robot.tree.root.above_db == 80.0
+    assert Shout.above_db.name == "above_db"  # on the class: the declaration
+
+
+def test_a_parameter_named_like_a_node_attribute_is_refused() -> None:
+    class Confused(Condition):
+        status = Param("status", Text())
+
+        def check(self) -> bool:
+            return True
+
+    with pytest.raises(TypeError, match="cannot be named like an attribute every node has"):
+        builtin_registry().add(Confused)

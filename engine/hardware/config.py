@@ -89,7 +89,7 @@ class ChipSpec:
     default_address: int | None = None
     default_rate_hz: float | None = None
     outputs: dict[str, str] = field(default_factory=dict)
-    options: tuple[Param, ...] = ()
+    options: tuple[Param[Any], ...] = ()
     fields: tuple[str, ...] = ()
 
     @property

@@ -54,7 +54,7 @@ from engine.values.params import (
 )
 
 TOP_FIELDS = ("name", "description", "simulated", "buses", "gpio", "devices")
-BUS_FIELDS: dict[str, tuple[Param, ...]] = {
+BUS_FIELDS: dict[str, tuple[Param[Any], ...]] = {
     "i2c": (Param("number", Integer(0, 255), REQUIRED, "N of /dev/i2c-N"),),
     "spi": (
         Param("number", Integer(0, 255), REQUIRED, "N of /dev/spidevN.C"),
@@ -92,7 +92,7 @@ class ConfigChecker:
         self.start = Mark(name, 1, 1)
 
     # -- small helpers ---------------------------------------------------------------------
-    def convert(self, kind: ParamType, raw: YValue, what: str) -> Any:
+    def convert(self, kind: ParamType[Any], raw: YValue, what: str) -> Any:
         """``kind.convert`` of a value, or None after adding the problem at its place."""
         try:
             return kind.convert(plain(raw), self.ctx)
@@ -103,7 +103,7 @@ class ConfigChecker:
     def unknown_fields(self, raw: YMap, known: tuple[str, ...] | list[str], what: str) -> None:
         self.problems.unknown_fields(raw.key_marks, known, what)
 
-    def fields(self, raw: YMap, params: tuple[Param, ...], what: str) -> dict[str, Any] | None:
+    def fields(self, raw: YMap, params: tuple[Param[Any], ...], what: str) -> dict[str, Any] | None:
         """Convert the declared ``params`` of ``raw`` (unknown fields are checked apart)."""
         values: dict[str, Any] = {}
         ok = True

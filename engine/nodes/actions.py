@@ -38,7 +38,7 @@ MAX_SAID_CHARS = 1000
 """The longest phrase one Say speaks (about a minute of speech)."""
 
 
-class Color(ParamType):
+class Color(ParamType[str]):
     """A color name (pink, blue, ...) or #RRGGBB."""
 
     name = "color"
@@ -66,21 +66,19 @@ class Say(ServiceAction):
     a field has no value yet.
     """
 
-    params: ClassVar = (
-        Param(
-            "text",
-            Template(max_chars=MAX_SAID_CHARS),
-            doc="what to say; {key} fields are filled from the blackboard",
-        ),
-        Param("volume", Number(0.0, 1.0), None, "0..1; empty: the robot's default volume"),
+    text = Param(
+        "text",
+        Template(max_chars=MAX_SAID_CHARS),
+        doc="what to say; {key} fields are filled from the blackboard",
     )
+    volume = Param("volume", Number(0.0, 1.0), None, "0..1; empty: the robot's default volume")
 
     def start(self) -> Job:
         try:
-            text = self.args.text.fill(self.read)
+            text = self.text.fill(self.read)
         except (KeyError, ValueError) as error:
             return ImmediateJob(error=ServiceError(str(error).strip("'\"")))
-        return self.ctx.actions.say(text, volume=self.args.volume)
+        return self.ctx.actions.say(text, volume=self.volume)
 
 
 class SetLed(ServiceAction):
@@ -90,18 +88,16 @@ class SetLed(ServiceAction):
     ``seconds``); FAILURE when the LED service failed.
     """
 
-    params: ClassVar = (
-        Param("color", Color(), doc="a color name (pink, blue, off, ...) or #RRGGBB"),
-        Param(
-            "seconds",
-            SECONDS,
-            None,
-            "how long to keep it lit; empty: until another SetLed",
-        ),
+    color = Param("color", Color(), doc="a color name (pink, blue, off, ...) or #RRGGBB")
+    seconds = Param(
+        "seconds",
+        SECONDS,
+        None,
+        "how long to keep it lit; empty: until another SetLed",
     )
 
     def start(self) -> Job:
-        return self.ctx.actions.set_led(self.args.color, seconds=self.args.seconds)
+        return self.ctx.actions.set_led(self.color, seconds=self.seconds)
 
 
 class MoveServo(ServiceAction):
@@ -111,21 +107,17 @@ class MoveServo(ServiceAction):
     (unknown joint, beyond the joint's limits) or failed.
     """
 
-    params: ClassVar = (
-        Param("joint", Text(), doc="joint name from the robot config, e.g. neck"),
-        Param("angle_deg", Number(-180.0, 180.0, "deg"), doc="target angle in degrees"),
-        Param(
-            "speed_dps",
-            SPEED_DPS,
-            None,
-            "degrees per second; empty: the joint's own maximum",
-        ),
+    joint = Param("joint", Text(), doc="joint name from the robot config, e.g. neck")
+    angle_deg = Param("angle_deg", Number(-180.0, 180.0, "deg"), doc="target angle in degrees")
+    speed_dps = Param(
+        "speed_dps",
+        SPEED_DPS,
+        None,
+        "degrees per second; empty: the joint's own maximum",
     )
 
     def start(self) -> Job:
-        return self.ctx.actions.move_servo(
-            self.args.joint, self.args.angle_deg, speed_dps=self.args.speed_dps
-        )
+        return self.ctx.actions.move_servo(self.joint, self.angle_deg, speed_dps=self.speed_dps)
 
 
 class LookToward(Leaf):
@@ -138,15 +130,15 @@ class LookToward(Leaf):
     turning, it stops the move and turns again the next time it runs.
     """
 
-    params: ClassVar = (
-        Param("joint", Text(), "neck", "the joint to turn"),
-        Param("turn_deg", Number(0.0, 90.0, "deg"), 30.0, "how far to turn; left is positive"),
-        Param("max_mm", DISTANCE_MM, 1200.0, "ignore anything farther"),
-        Param("speed_dps", SPEED_DPS, None, "turn speed"),
-        Param("left", Key(), "/sensors/range/left_mm", "left distance key"),
-        Param("center", Key(), "/sensors/range/center_mm", "center distance key"),
-        Param("right", Key(), "/sensors/range/right_mm", "right distance key"),
+    joint = Param("joint", Text(), "neck", "the joint to turn")
+    turn_deg = Param(
+        "turn_deg", Number(0.0, 90.0, "deg"), 30.0, "how far to turn; left is positive"
     )
+    max_mm = Param("max_mm", DISTANCE_MM, 1200.0, "ignore anything farther")
+    speed_dps = Param("speed_dps", SPEED_DPS, None, "turn speed")
+    left = Param("left", Key(), "/sensors/range/left_mm", "left distance key")
+    center = Param("center", Key(), "/sensors/range/center_mm", "center distance key")
+    right = Param("right", Key(), "/sensors/range/right_mm", "right distance key")
 
     def __init__(self, *a: Any) -> None:
         super().__init__(*a)
@@ -158,23 +150,21 @@ class LookToward(Leaf):
         readings = []
         for side in ("left", "center", "right"):
             distance = self.read(getattr(self.args, side))
-            if distance is not None and distance <= self.args.max_mm:
+            if distance is not None and distance <= self.max_mm:
                 readings.append((distance, side))
         return min(readings)[1] if readings else None
 
     def initialise(self) -> None:
         self.job = None
         side = self.nearest_side()
-        target = {"left": self.args.turn_deg, "right": -self.args.turn_deg}.get(side or "center")
+        target = {"left": self.turn_deg, "right": -self.turn_deg}.get(side or "center")
         if target is None or target == self.angle_deg:
             self.feedback_message = f"nearest: {side or 'nothing'}; no turn needed"
             return
         self.previous_deg = self.angle_deg
         self.angle_deg = target
         self.feedback_message = f"nearest: {side}; turning to {target:g} deg"
-        self.job = self.ctx.actions.move_servo(
-            self.args.joint, target, speed_dps=self.args.speed_dps
-        )
+        self.job = self.ctx.actions.move_servo(self.joint, target, speed_dps=self.speed_dps)
 
     def update(self) -> Status:
         if self.job is None:
@@ -199,10 +189,10 @@ class Wait(Leaf):
     RUNNING until ``seconds`` have passed since it started; then SUCCESS.
     """
 
-    params: ClassVar = (Param("seconds", SECONDS, doc="how long"),)
+    seconds = Param("seconds", SECONDS, doc="how long")
 
     def initialise(self) -> None:
-        self.until_s = self.now() + self.args.seconds
+        self.until_s = self.now() + self.seconds
 
     def update(self) -> Status:
         return Status.SUCCESS if self.now() >= self.until_s else Status.RUNNING
@@ -214,13 +204,11 @@ class SetValue(Leaf):
     SUCCESS always.
     """
 
-    params: ClassVar = (
-        Param("key", Key(access="write"), doc="a /vars/ key"),
-        Param("value", AnyValue(), doc="the value to store"),
-    )
+    key = Param("key", Key(access="write"), doc="a /vars/ key")
+    value = Param("value", AnyValue(), doc="the value to store")
 
     def update(self) -> Status:
-        self.write(self.args.key, self.args.value)
+        self.write(self.key, self.value)
         return Status.SUCCESS
 
 
@@ -233,14 +221,14 @@ class ReadSensor(ServiceAction):
     on the blackboard; SUCCESS then; FAILURE when the sensor could not be read.
     """
 
-    params: ClassVar = (Param("sensor", Choice(ON_REQUEST_SENSORS), doc="which sensor to read"),)
+    sensor = Param("sensor", Choice(ON_REQUEST_SENSORS), doc="which sensor to read")
 
     def initialise(self) -> None:
         self.fresh: Mapping[str, Any] | None = None
         super().initialise()
 
     def start(self) -> Job:
-        return self.ctx.actions.read_sensor(self.args.sensor)
+        return self.ctx.actions.read_sensor(self.sensor)
 
     def update(self) -> Status:
         if self.fresh is None:

@@ -9,14 +9,15 @@ A developer writes a leaf in a few lines::
         or when no reading exists yet.
         \"\"\"
 
-        params = (Param("above_c", Number(unit="degC"), 25.0, "threshold in degC"),)
+        above_c = Param("above_c", Number(unit="degC"), 25.0, "threshold in degC")
         reads = ("/sensors/temperature/c",)
 
         def check(self) -> bool:
-            return (self.read("/sensors/temperature/c") or -273.0) > self.args.above_c
+            return (self.read("/sensors/temperature/c") or -273.0) > self.above_c
 
 and registers it: ``registry.add(IsWarm)``. Parameters are declared with types, defaults
-and docs; the loader validates YAML against them and ``vest nodes`` lists them.
+and docs; the loader validates YAML against them and ``vest nodes`` lists them. Each
+declared parameter is also a typed attribute: ``self.above_c`` is a ``float`` to mypy.
 
 An exception inside any leaf, or an ``update()`` that returns something other than a
 Status, makes that node FAILURE, is reported with the node's path, and the tree keeps
@@ -53,15 +54,17 @@ def node_path(node: py_trees.behaviour.Behaviour) -> str:
 class Leaf(py_trees.behaviour.Behaviour):
     """Base of vest leaf nodes. Subclasses set the class attributes and lifecycle methods.
 
-    Class attributes: ``kind`` ("condition" or "action"), ``params`` (a tuple of
-    :class:`Param`), ``reads`` / ``writes`` (fixed blackboard keys; keys given as ``Key``
+    Class attributes: each parameter as ``name = Param("name", Type(), default, doc)``
+    (then ``self.name`` is its converted, typed value; a ``params`` tuple of
+    :class:`Param` also works, read as ``self.args.name``), ``kind`` ("condition" or
+    "action"), ``reads`` / ``writes`` (fixed blackboard keys; keys given as ``Key``
     parameters are added automatically), ``type_name`` (defaults to the class name).
-    ``self.args`` holds the converted parameters, ``self.ctx`` the tree's context.
+    ``self.args`` holds every converted parameter, ``self.ctx`` the tree's context.
     """
 
     kind: ClassVar[str] = "action"
     type_name: ClassVar[str | None] = None
-    params: ClassVar[tuple[Param, ...]] = ()
+    params: ClassVar[tuple[Param[Any], ...]] = ()
     reads: ClassVar[tuple[str, ...]] = ()
     writes: ClassVar[tuple[str, ...]] = ()
     _guarding: bool = False
@@ -284,7 +287,8 @@ def leaf_type(cls: type[Leaf], *, source: str = "vest", **bound: Any) -> NodeTyp
             f"{cls.__name__}.writes names {outside}: trees write only /vars/ keys; a sensor's "
             "readings are staged by its poller or service"
         )
-    names = [p.name for p in cls.params]
+    params = declared_params(cls)
+    names = [p.name for p in params]
     if len(set(names)) != len(names) or "name" in names:
         raise TypeError(f"{cls.__name__}.params: names must be unique and not 'name'")
 
@@ -297,13 +301,55 @@ def leaf_type(cls: type[Leaf], *, source: str = "vest", **bound: Any) -> NodeTyp
         name=cls.type_name or cls.__name__,
         kind="condition" if cls.kind == "condition" else "action",
         doc=inspect.cleandoc(cls.__doc__ or ""),
-        params=tuple(cls.params),
+        params=params,
         build=build,
         check=cls.check_params if _overrides(cls, "check_params") else None,
         fixed_reads=tuple(cls.reads),
         fixed_writes=tuple(cls.writes),
         source=source,
     )
+
+
+_NODE_ATTRIBUTES = frozenset(
+    {
+        "name",
+        "status",
+        "parent",
+        "children",
+        "logger",
+        "feedback_message",
+        "blackboards",
+        "qualified_name",
+        "id",
+        "iterator",
+        "blackbox_level",
+        "args",
+        "ctx",
+        "blackboard",
+        "job",
+        "write_keys",
+    }
+)
+"""Attributes every node instance sets itself: a parameter of one of these names would be
+hidden by it."""
+
+
+def declared_params(cls: type[Leaf]) -> tuple[Param[Any], ...]:
+    """A leaf class's parameters: its ``params`` tuple, then every :class:`Param` declared
+    as a class attribute (base classes first, in the order they are written)."""
+    attributes: dict[str, Param[Any]] = {}
+    for klass in reversed(cls.__mro__):
+        for attribute, value in vars(klass).items():
+            if isinstance(value, Param):
+                if attribute in _NODE_ATTRIBUTES or hasattr(Leaf, attribute):
+                    raise TypeError(
+                        f"{cls.__name__}.{attribute}: a parameter cannot be named like an "
+                        "attribute every node has; choose another name"
+                    )
+                attributes[attribute] = value
+    listed = tuple(cls.params)
+    listed_names = {param.name for param in listed}
+    return listed + tuple(p for name, p in attributes.items() if name not in listed_names)
 
 
 def _overrides(cls: type, method: str) -> bool:

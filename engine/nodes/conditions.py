@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping
-from typing import Any, ClassVar
+from typing import Any
 
 from engine.blackboard.catalogue import VARIABLES_PREFIX, KeySpec
 from engine.blackboard.events import EVENT_LOG_LENGTH, EventLog
@@ -60,20 +60,18 @@ class Check(Condition):
     the key has no value yet.
     """
 
-    params: ClassVar = (
-        Param("key", Key(), doc="the blackboard key to look at"),
-        Param("equals", Scalar(), None, "SUCCESS when the value equals this"),
-        Param("not_equals", Scalar(), None, "SUCCESS when the value differs from this"),
-        Param("above", Number(), None, "SUCCESS when the value is greater than this"),
-        Param("below", Number(), None, "SUCCESS when the value is less than this"),
-        Param(
-            "between",
-            ListOf(Number(), 2, 2),
-            None,
-            "[low, high]: SUCCESS when low <= value <= high",
-        ),
-        Param("item", Integer(minimum=0), None, "for list values: which element (from 0)"),
+    key = Param("key", Key(), doc="the blackboard key to look at")
+    equals = Param("equals", Scalar(), None, "SUCCESS when the value equals this")
+    not_equals = Param("not_equals", Scalar(), None, "SUCCESS when the value differs from this")
+    above = Param("above", Number(), None, "SUCCESS when the value is greater than this")
+    below = Param("below", Number(), None, "SUCCESS when the value is less than this")
+    between = Param(
+        "between",
+        ListOf(Number(), 2, 2),
+        None,
+        "[low, high]: SUCCESS when low <= value <= high",
     )
+    item = Param("item", Integer(minimum=0), None, "for list values: which element (from 0)")
 
     @classmethod
     def check_params(cls, args: Mapping[str, Any], ctx: CheckContext) -> list[ParamIssue]:
@@ -135,23 +133,23 @@ class Check(Condition):
 
     def __init__(self, *a: Any) -> None:
         super().__init__(*a)
-        args = self.args
-        self._key = args.key
-        self._item = args.item
-        if args.equals is not None:
-            expected = args.equals
+        self._key = self.key
+        self._item = self.item
+        if self.equals is not None:
+            expected = self.equals
             self._test = lambda value: value == expected
-        elif args.not_equals is not None:
-            unexpected = args.not_equals
+        elif self.not_equals is not None:
+            unexpected = self.not_equals
             self._test = lambda value: value != unexpected
-        elif args.above is not None:
-            threshold = args.above
+        elif self.above is not None:
+            threshold = self.above
             self._test = lambda value: value > threshold
-        elif args.below is not None:
-            threshold = args.below
+        elif self.below is not None:
+            threshold = self.below
             self._test = lambda value: value < threshold
         else:
-            low, high = args.between
+            assert self.between is not None  # check_params: exactly one comparison is given
+            low, high = self.between
             self._test = lambda value: low <= value <= high
 
     def check(self) -> bool:
@@ -174,14 +172,12 @@ class Fresh(Condition):
     it is older or was never written.
     """
 
-    params: ClassVar = (
-        Param("key", Key(kinds=("state", "event")), doc="the blackboard key"),
-        Param("within_s", SECONDS, doc="how recent, in seconds"),
-    )
+    key = Param("key", Key(kinds=("state", "event")), doc="the blackboard key")
+    within_s = Param("within_s", SECONDS, doc="how recent, in seconds")
 
     def check(self) -> bool:
-        updated = self.ctx.blackboard.updated_s(self.args.key)
-        return updated is not None and self.now() - updated <= self.args.within_s
+        updated = self.ctx.blackboard.updated_s(self.key)
+        return updated is not None and self.now() - updated <= self.within_s
 
 
 class OnEvent(Condition):
@@ -194,11 +190,13 @@ class OnEvent(Condition):
     gets to them, the oldest are missed and a warning says how many.
     """
 
-    params: ClassVar = (
-        Param("key", Key(kinds=("event",)), doc="the event key, e.g. /sensors/gesture/last"),
-        Param("equals", Scalar(), None, "only events with this value count"),
-        Param("one_of", ListOf(Scalar(), 1), None, "only events with one of these values count"),
-        Param("save_as", Key(access="write"), None, "a /vars/ key to keep the event's value in"),
+    key = Param("key", Key(kinds=("event",)), doc="the event key, e.g. /sensors/gesture/last")
+    equals = Param("equals", Scalar(), None, "only events with this value count")
+    one_of = Param(
+        "one_of", ListOf(Scalar(), 1), None, "only events with one of these values count"
+    )
+    save_as = Param(
+        "save_as", Key(access="write"), None, "a /vars/ key to keep the event's value in"
     )
 
     @classmethod
@@ -209,12 +207,12 @@ class OnEvent(Condition):
 
     def __init__(self, *a: Any) -> None:
         super().__init__(*a)
-        self.handled_seq = self.ctx.blackboard.event_log(self.args.key).last_seq
-        wanted = self.args.one_of or ([self.args.equals] if self.args.equals is not None else None)
+        self.handled_seq = self.ctx.blackboard.event_log(self.key).last_seq
+        wanted = self.one_of or ([self.equals] if self.equals is not None else None)
         self._wanted = None if wanted is None else list(wanted)
 
     def check(self) -> bool:
-        log = self.read(self.args.key)
+        log = self.read(self.key)
         if not isinstance(log, EventLog) or log.last_seq <= self.handled_seq:
             return False
         events = log.after(self.handled_seq)
@@ -223,14 +221,14 @@ class OnEvent(Condition):
             self.ctx.on_node_warning(
                 self.ctx.tree,
                 node_path(self),
-                f"missed {missed} event{'s' if missed != 1 else ''} on {self.args.key}: "
+                f"missed {missed} event{'s' if missed != 1 else ''} on {self.key}: "
                 f"more than the {EVENT_LOG_LENGTH} a key keeps came before this node read them",
             )
         for event in events:
             self.handled_seq = event.seq
             if self._wanted is None or event.value in self._wanted:
-                if self.args.save_as is not None:
-                    self.write(self.args.save_as, event.value)
+                if self.save_as is not None:
+                    self.write(self.save_as, event.value)
                 self.feedback_message = f"event {event.seq}: {event.value!r}"
                 return True
         return False

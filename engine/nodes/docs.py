@@ -17,7 +17,7 @@ _TITLES = {
 }
 
 
-def _default(param: Param) -> str:
+def _default(param: Param[Any]) -> str:
     if param.default is REQUIRED:
         return "required"
     if param.default is None:

@@ -19,7 +19,7 @@ from py_trees.common import Status
 from engine.blackboard.events import EventLog
 from engine.errors import ServiceError
 from engine.nodes.actions import MoveServo, Say, SetLed
-from engine.nodes.base import Leaf, ServiceAction
+from engine.nodes.base import Leaf, ServiceAction, declared_params
 from engine.services.jobs import ImmediateJob, Job
 from engine.values.params import SECONDS, CheckContext, Key, Param, ParamProblem, did_you_mean
 from engine.values.templates import Template
@@ -49,7 +49,7 @@ def checked_args(command_type: str, args: Mapping[str, Any], ctx: CheckContext) 
     names, missing required ones, wrong types, NaN, inf, numbers past their bounds, text
     past its length. Text is taken as written (an operator's braces are no template).
     """
-    declared = {param.name: param for param in ACTION_NODES[command_type].params}
+    declared = {param.name: param for param in declared_params(ACTION_NODES[command_type])}
     for name in args:
         if name not in declared:
             hint = did_you_mean(str(name), list(declared)) or "arguments: " + ", ".join(declared)
@@ -82,24 +82,24 @@ class CarryOut(ServiceAction):
     saved always belongs to this command (it is cleared when the command starts).
     """
 
-    params: ClassVar = (
-        Param("command", Key(), doc="the /vars/ key holding the command"),
-        Param("save_result_as", Key(access="write"), None, "a /vars/ key for the result"),
-        Param("timeout_s", SECONDS, 60.0, "FAILURE when a command takes longer, in seconds"),
+    command = Param("command", Key(), doc="the /vars/ key holding the command")
+    save_result_as = Param(
+        "save_result_as", Key(access="write"), None, "a /vars/ key for the result"
     )
+    timeout_s = Param("timeout_s", SECONDS, 60.0, "FAILURE when a command takes longer, in seconds")
     reads: ClassVar = tuple(key for keys in POLLED_READINGS.values() for key in keys)
 
     def initialise(self) -> None:
-        if self.args.save_result_as:
-            self.write(self.args.save_result_as, None)
+        if self.save_result_as:
+            self.write(self.save_result_as, None)
         self.started_s = self.now()
         super().initialise()
 
     def start(self) -> Job:
-        command = self.read(self.args.command)
+        command = self.read(self.command)
         try:
             if not isinstance(command, Mapping):
-                raise CommandError(f"{self.args.command} holds no command")
+                raise CommandError(f"{self.command} holds no command")
             kind = command.get("type")
             args = command.get("args") or {}
             if not isinstance(args, Mapping):
@@ -153,19 +153,19 @@ class CarryOut(ServiceAction):
 
     def finished(self, job: Job) -> Status:
         result = job.result()  # a reading is staged by the sensor service, not written here
-        if self.args.save_result_as:
-            self.write(self.args.save_result_as, result)
+        if self.save_result_as:
+            self.write(self.save_result_as, result)
         return Status.SUCCESS
 
     def update(self) -> Status:
         status = super().update()
-        if status == Status.RUNNING and self.now() - self.started_s > self.args.timeout_s:
+        if status == Status.RUNNING and self.now() - self.started_s > self.timeout_s:
             if self.job is not None:
                 self.job.cancel()
-            self.feedback_message = f"timed out after {self.args.timeout_s:g} s"
+            self.feedback_message = f"timed out after {self.timeout_s:g} s"
             status = Status.FAILURE
-        if status == Status.FAILURE and self.args.save_result_as:
-            self.write(self.args.save_result_as, {"error": self.feedback_message})
+        if status == Status.FAILURE and self.save_result_as:
+            self.write(self.save_result_as, {"error": self.feedback_message})
         return status
 
 

@@ -37,7 +37,7 @@ class NodeType:
     name: str
     kind: Kind
     doc: str
-    params: tuple[Param, ...]
+    params: tuple[Param[Any], ...]
     build: Builder
     check: ExtraCheck | None = None
     fixed_reads: tuple[str, ...] = ()
@@ -52,7 +52,7 @@ class NodeType:
     def summary(self) -> str:
         return self.doc.strip().splitlines()[0] if self.doc.strip() else ""
 
-    def param(self, name: str) -> Param | None:
+    def param(self, name: str) -> Param[Any] | None:
         for param in self.params:
             if param.name == name:
                 return param

@@ -50,7 +50,7 @@ GESTURES = (
 _SECONDS = Number(0.01, 3600.0, "s")
 _DISTANCE_MM = Number(0.0, 8190.0, "mm")
 
-EVENT_FIELDS: dict[str, tuple[Param, ...] | ParamType] = {
+EVENT_FIELDS: dict[str, tuple[Param[Any], ...] | ParamType[Any]] = {
     "touch": (
         Param("pad", Integer(0, 11), doc="pad number 0..11"),
         Param("seconds", _SECONDS, 0.3, "how long the hand stays"),
@@ -188,7 +188,9 @@ def check_scenario(document: YValue | None, name: str, path: Path) -> Scenario:
     return Scenario(duration, tuple(events), path)
 
 
-def _convert(kind: ParamType, raw: YValue, what: str, ctx: CheckContext, problems: Problems) -> Any:
+def _convert(
+    kind: ParamType[Any], raw: YValue, what: str, ctx: CheckContext, problems: Problems
+) -> Any:
     try:
         return kind.convert(plain(raw), ctx)
     except ParamProblem as problem:
@@ -245,7 +247,7 @@ def _event(raw: YValue, ctx: CheckContext, problems: Problems, index: int) -> Sc
 
 
 def _fields(
-    kind: str, params: tuple[Param, ...], body: YValue, ctx: CheckContext, problems: Problems
+    kind: str, params: tuple[Param[Any], ...], body: YValue, ctx: CheckContext, problems: Problems
 ) -> dict[str, Any] | None:
     if not isinstance(body, YMap):
         problems.add(

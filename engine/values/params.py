@@ -10,8 +10,8 @@ import difflib
 import math
 import re
 from collections.abc import Iterable
-from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any, Literal, Protocol
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any, Generic, Literal, Protocol, TypeVar, overload
 
 if TYPE_CHECKING:
     from engine.blackboard.catalogue import KeyCatalogue
@@ -79,13 +79,17 @@ def did_you_mean(word: str, choices: Iterable[str]) -> str | None:
     return f"did you mean {close[0]!r}?" if close else None
 
 
-class ParamType:
-    """Base of parameter types. ``name`` is what docs and messages call the type."""
+T = TypeVar("T")
+
+
+class ParamType(Generic[T]):
+    """Base of parameter types: ``convert`` turns a YAML value into a ``T`` (or raises
+    :class:`ParamProblem`). ``name`` is what docs and messages call the type."""
 
     name = "value"
 
-    def convert(self, value: Any, ctx: CheckContext) -> Any:
-        return value
+    def convert(self, value: Any, ctx: CheckContext) -> T:
+        return value  # type: ignore[no-any-return]
 
     def describe(self) -> str:
         return self.name
@@ -95,7 +99,7 @@ class ParamType:
         return {}
 
 
-class Text(ParamType):
+class Text(ParamType[str]):
     name = "text"
 
     def json_schema(self) -> dict[str, Any]:
@@ -108,7 +112,7 @@ class Text(ParamType):
 
 
 @dataclass(frozen=True)
-class Number(ParamType):
+class Number(ParamType[float]):
     """A real number, optionally bounded (inclusive), with a unit for docs."""
 
     minimum: float | None = None
@@ -156,7 +160,7 @@ class Number(ParamType):
 
 
 @dataclass(frozen=True)
-class Integer(ParamType):
+class Integer(ParamType[int]):
     minimum: int | None = None
     maximum: int | None = None
     name = "integer"
@@ -186,7 +190,7 @@ class Integer(ParamType):
         return f"integer {low}..{high}"
 
 
-class Boolean(ParamType):
+class Boolean(ParamType[bool]):
     name = "true/false"
 
     def json_schema(self) -> dict[str, Any]:
@@ -199,7 +203,7 @@ class Boolean(ParamType):
 
 
 @dataclass(frozen=True)
-class Choice(ParamType):
+class Choice(ParamType[str]):
     options: tuple[str, ...]
     name = "choice"
 
@@ -236,7 +240,7 @@ def check_key_characters(key: str) -> None:
 
 
 @dataclass(frozen=True)
-class Key(ParamType):
+class Key(ParamType[str]):
     """A blackboard key from the catalogue.
 
     ``access`` says whether the node reads or writes it (the loader lists it so), ``kinds``
@@ -298,8 +302,8 @@ class Key(ParamType):
 
 
 @dataclass(frozen=True)
-class ListOf(ParamType):
-    item: ParamType
+class ListOf(ParamType[list[Any]]):
+    item: ParamType[Any]
     min_items: int = 0
     max_items: int | None = None
     name = "list"
@@ -331,7 +335,7 @@ class ListOf(ParamType):
         return schema
 
 
-class Scalar(ParamType):
+class Scalar(ParamType[Any]):
     """A number, text, or true/false (what a key is compared with)."""
 
     name = "number, text or true/false"
@@ -345,7 +349,7 @@ class Scalar(ParamType):
         return value
 
 
-class AnyValue(ParamType):
+class AnyValue(ParamType[Any]):
     """Any YAML value (number, text, list, mapping)."""
 
     name = "any value"
@@ -354,19 +358,55 @@ class AnyValue(ParamType):
 REQUIRED: Any = object()
 
 
-@dataclass(frozen=True)
-class Param:
-    """One declared parameter: its name, type, default (or :data:`REQUIRED`) and meaning."""
+class Param(Generic[T]):
+    """One declared parameter: its name, type, default (or :data:`REQUIRED`) and meaning.
 
-    name: str
-    type: ParamType
-    default: Any = REQUIRED
-    doc: str = ""
-    choices_doc: list[str] = field(default_factory=list)
+    Declared as a class attribute of a leaf, it is also how the node reads its value:
+    ``volume = Param("volume", Number(0.0, 1.0), None, "0..1")`` makes ``self.volume`` the
+    converted value, a ``float | None`` to a type checker (``float`` without the None
+    default). The loader, ``vest nodes``, the docs and the JSON Schema come from the same
+    declaration.
+    """
+
+    @overload
+    def __init__(
+        self: Param[T], name: str, type: ParamType[T], default: T = ..., doc: str = ""
+    ) -> None: ...
+
+    @overload
+    def __init__(
+        self: Param[T | None], name: str, type: ParamType[T], default: None, doc: str = ""
+    ) -> None: ...
+
+    def __init__(
+        self, name: str, type: ParamType[Any], default: Any = REQUIRED, doc: str = ""
+    ) -> None:
+        self.name = name
+        self.type = type
+        self.default = default
+        self.doc = doc
 
     @property
     def required(self) -> bool:
         return self.default is REQUIRED
+
+    def __set_name__(self, owner: type, attribute: str) -> None:
+        if attribute != self.name:
+            raise TypeError(
+                f"{owner.__name__}.{attribute} declares Param({self.name!r}): give it its "
+                "attribute's name"
+            )
+
+    @overload
+    def __get__(self, node: None, owner: type) -> Param[T]: ...
+
+    @overload
+    def __get__(self, node: object, owner: type) -> T: ...
+
+    def __get__(self, node: object | None, owner: type) -> Param[T] | T:
+        if node is None:
+            return self  # on the class: the declaration
+        return getattr(node.args, self.name)  # type: ignore[attr-defined, no-any-return]
 
 
 SECONDS = Number(0.0, 86_400.0, "s")

@@ -137,7 +137,7 @@ def _resolve(field: str, ctx: CheckContext) -> str:
     return spec.name
 
 
-class Template(ParamType):
+class Template(ParamType[CompiledTemplate]):
     """Text that may contain ``{key}`` fields filled from the blackboard when used."""
 
     name = "text with {fields}"

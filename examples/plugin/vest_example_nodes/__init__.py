@@ -28,8 +28,8 @@ class IsWarm(Condition):
     when the temperature has not been read yet.
     """
 
-    params: ClassVar = (
-        Param("above_c", Number(-40.0, 125.0, "degC"), 25.0, "warmer than this counts as warm"),
+    above_c = Param(
+        "above_c", Number(-40.0, 125.0, "degC"), 25.0, "warmer than this counts as warm"
     )
     reads: ClassVar = (TEMPERATURE_C,)
 
@@ -39,7 +39,7 @@ class IsWarm(Condition):
             self.feedback_message = "no temperature reading yet"
             return False
         self.feedback_message = f"{celsius:.1f} degC"
-        return bool(celsius > self.args.above_c)
+        return bool(celsius > self.above_c)
 
 
 class Blink(Leaf):
@@ -50,12 +50,10 @@ class Blink(Leaf):
     LEDs off.
     """
 
-    params: ClassVar = (
-        Param("color", Color(), "white", "a color name (pink, orange, ...) or #RRGGBB"),
-        Param("times", Integer(1, 20), 3, "how many flashes"),
-        Param("on_s", Number(0.05, 5.0, "s"), 0.3, "how long each flash stays lit"),
-        Param("off_s", Number(0.05, 5.0, "s"), 0.3, "the dark pause between flashes"),
-    )
+    color = Param("color", Color(), "white", "a color name (pink, orange, ...) or #RRGGBB")
+    times = Param("times", Integer(1, 20), 3, "how many flashes")
+    on_s = Param("on_s", Number(0.05, 5.0, "s"), 0.3, "how long each flash stays lit")
+    off_s = Param("off_s", Number(0.05, 5.0, "s"), 0.3, "the dark pause between flashes")
 
     def __init__(self, name: str, args: SimpleNamespace, ctx: TreeContext) -> None:
         super().__init__(name, args, ctx)
@@ -64,13 +62,13 @@ class Blink(Leaf):
         self.dark_until_s = 0.0
 
     def initialise(self) -> None:
-        self.flashes_left = self.args.times
+        self.flashes_left = self.times
         self._flash()
 
     def _flash(self) -> None:
         # The LED service keeps the color for on_s and then turns it off by itself.
         self.flashes_left -= 1
-        self.job = self.ctx.actions.set_led(self.args.color, seconds=self.args.on_s)
+        self.job = self.ctx.actions.set_led(self.color, seconds=self.on_s)
 
     def update(self) -> Status:
         if self.job is not None:  # lit: wait for the flash to end, never block the tick
@@ -82,9 +80,9 @@ class Blink(Leaf):
                 return Status.FAILURE
             self.job = None
             if self.flashes_left == 0:
-                self.feedback_message = f"blinked {self.args.times} times"
+                self.feedback_message = f"blinked {self.times} times"
                 return Status.SUCCESS
-            self.dark_until_s = self.now() + self.args.off_s
+            self.dark_until_s = self.now() + self.off_s
         if self.now() < self.dark_until_s:
             return Status.RUNNING
         self._flash()
