@@ -23,13 +23,11 @@ DEFAULT_WAIT_S = 2.0
 """How long (real seconds) a driver waits for one access of a busy threaded bus."""
 
 
-class ManagedI2C(ForwardingI2C):
-    """An ``smbus2.SMBus``-compatible bus: each call is one transaction of ``handle``.
-
-    ``priority`` is that of every access (:attr:`Priority.POLL` for pollers: refused while
-    the device is offline). Bus errors arrive as the manager raises them
-    (:class:`~engine.errors.DeviceError` naming device, bus and errno in words).
-    """
+class _OnHandle:
+    """Each access is one transaction of ``handle``, at ``priority`` (:attr:`Priority.POLL`
+    for pollers: refused while the device is offline), waiting at most ``wait_s`` real
+    seconds for a busy threaded bus. Bus errors arrive as the manager raises them
+    (:class:`~engine.errors.DeviceError` naming device, bus and errno in words)."""
 
     def __init__(
         self,
@@ -42,11 +40,15 @@ class ManagedI2C(ForwardingI2C):
         self.priority = priority
         self.wait_s = wait_s
 
-    def __repr__(self) -> str:
-        return f"<ManagedI2C {self.handle!r}>"
-
     def _call(self, fn: Callable[[Any], T]) -> T:
         return self.handle.call(fn, priority=self.priority, timeout_s=self.wait_s)
+
+    def __repr__(self) -> str:
+        return f"<{type(self).__name__} {self.handle!r}>"
+
+
+class ManagedI2C(_OnHandle, ForwardingI2C):
+    """An ``smbus2.SMBus``-compatible bus: each call is one transaction of its handle."""
 
     def _forward(self, method: str, *args: Any) -> Any:
         return self._call(lambda bus: getattr(bus, method)(*args))
@@ -55,22 +57,8 @@ class ManagedI2C(ForwardingI2C):
         """Nothing to release: the bus belongs to its manager's owner."""
 
 
-class ManagedSpi:
-    """An ``spidev.SpiDev``-compatible node: each exchange is one transaction of ``handle``."""
-
-    def __init__(
-        self,
-        handle: DeviceHandle[Any],
-        *,
-        priority: Priority = Priority.POLL,
-        wait_s: float | None = DEFAULT_WAIT_S,
-    ) -> None:
-        self.handle = handle
-        self.priority = priority
-        self.wait_s = wait_s
-
-    def _call(self, fn: Callable[[Any], T]) -> T:
-        return self.handle.call(fn, priority=self.priority, timeout_s=self.wait_s)
+class ManagedSpi(_OnHandle):
+    """An ``spidev.SpiDev``-compatible node: each exchange is one transaction of its handle."""
 
     @property
     def mode(self) -> int:
