@@ -38,10 +38,6 @@ from engine.drivers.servo_joints import Joint
 from engine.errors import ConfigError
 from engine.files.problems import Mark
 from engine.values.params import (
-    Boolean,
-    Choice,
-    Integer,
-    Number,
     Param,
     did_you_mean,
 )
@@ -113,145 +109,6 @@ class ChipSpec:
         )
 
 
-CHIPS: dict[str, ChipSpec] = {
-    spec.chip: spec
-    for spec in (
-        ChipSpec(
-            "mpr121",
-            "NXP MPR121 capacitive touch, 12 pads",
-            "i2c",
-            "touch",
-            addresses=tuple(range(0x5A, 0x5E)),
-            default_address=0x5A,
-            default_rate_hz=20.0,
-            outputs={"pads": "/sensors/touch/pads", "any": "/sensors/touch/any"},
-            options=(
-                Param("touch_threshold", Integer(1, 255), 12, "touch threshold, counts"),
-                Param("release_threshold", Integer(0, 255), 6, "release threshold, counts"),
-            ),
-        ),
-        ChipSpec(
-            "ads1115",
-            "TI ADS1115 16-bit ADC with FSR 406 force pads",
-            "i2c",
-            "force",
-            addresses=tuple(range(0x48, 0x4C)),
-            default_address=0x48,
-            default_rate_hz=20.0,
-            options=(
-                Param("gain", Choice(("2/3", "1", "2", "4", "8", "16")), "1", "PGA gain"),
-                Param(
-                    "data_rate_sps",
-                    Choice(("8", "16", "32", "64", "128", "250", "475", "860")),
-                    "860",
-                    "conversions per second (a reading takes about its inverse)",
-                ),
-            ),
-            fields=("pads",),
-        ),
-        ChipSpec(
-            "mcp3008",
-            "Microchip MCP3008 10-bit SPI ADC with FSR 406 force pads",
-            "spi",
-            "force",
-            default_rate_hz=20.0,
-            options=(
-                Param("vref_v", Number(0.25, 5.5, "V"), 3.3, "reference voltage"),
-                Param("max_speed_hz", Integer(10_000, 3_600_000), 1_000_000, "SPI clock"),
-            ),
-            fields=("pads",),
-        ),
-        ChipSpec(
-            "vl53l0x",
-            "ST VL53L0X time-of-flight distance",
-            "i2c",
-            "range",
-            addresses=tuple(range(0x08, 0x78)),
-            default_address=VL53L0X_BOOT_ADDRESS,
-            default_rate_hz=10.0,
-            outputs={"range": ""},
-            options=(
-                Param(
-                    "timeout_s",
-                    Number(0.05, 1.0, "s"),
-                    0.1,
-                    "longest measurement (one takes about 33 ms)",
-                ),
-            ),
-            fields=("side", "xshut", "mux", "channel"),
-        ),
-        ChipSpec(
-            "zx_gesture",
-            "XYZ Interactive ZX gesture sensor",
-            "i2c",
-            "gesture",
-            addresses=(0x10, 0x11),
-            default_address=0x10,
-            default_rate_hz=20.0,
-            outputs={"gesture": "/sensors/gesture/last"},
-            fields=("gesture_names",),
-        ),
-        ChipSpec(
-            "srf02",
-            "Devantech SRF02 ultrasonic range, read on request",
-            "i2c",
-            "ultrasound",
-            addresses=tuple(range(0x70, 0x78)),  # 0x78..0x7F are reserved on I2C
-            default_address=0x70,
-            outputs={"range": "/sensors/ultrasound/cm"},
-        ),
-        ChipSpec(
-            "mcp9808",
-            "Microchip MCP9808 temperature, read on request",
-            "i2c",
-            "temperature",
-            addresses=tuple(range(0x18, 0x20)),
-            default_address=0x18,
-            outputs={"celsius": "/sensors/temperature/c", "fahrenheit": "/sensors/temperature/f"},
-            options=(
-                Param(
-                    "resolution_c",
-                    Choice(("0.5", "0.25", "0.125", "0.0625")),
-                    "0.0625",
-                    "temperature step, degC",
-                ),
-            ),
-        ),
-        ChipSpec(
-            "pca9685",
-            "NXP PCA9685 16-channel PWM for the face LEDs",
-            "i2c",
-            "leds",
-            addresses=tuple(a for a in range(0x40, 0x78) if a != PCA9685_ALL_CALL),
-            default_address=0x40,
-            options=(
-                Param("frequency_hz", Number(24.0, 1526.0, "Hz"), 1000.0, "PWM frequency"),
-                Param("common_anode", Boolean(), False, "LEDs lit while the output is low"),
-            ),
-            fields=("leds",),
-        ),
-        ChipSpec(
-            "maestro",
-            "Pololu Mini Maestro servo controller (USB serial)",
-            "serial",
-            "servos",
-            options=(
-                Param("channels", Choice(("6", "12", "18", "24")), "12", "servo channels"),
-                Param("device_number", Integer(0, 127), 12, "Pololu-protocol device number"),
-                Param("protocol", Choice(("compact", "pololu")), "compact", "serial protocol"),
-            ),
-            fields=("joints",),
-        ),
-        ChipSpec(
-            "tca9548a",
-            "TI TCA9548A 8-channel I2C multiplexer",
-            "i2c",
-            "mux",
-            addresses=tuple(range(0x70, 0x78)),
-            default_address=0x70,
-        ),
-    )
-}
 COMMON_FIELDS = ("chip", "bus", "address", "rate_hz", "keys", "description")
 
 
@@ -298,7 +155,7 @@ class DeviceConfig:
     """One configured device. ``options`` are the driver's keyword options, converted."""
 
     name: str
-    chip: str
+    spec: ChipSpec
     bus: str
     mark: Mark
     address: int | None = None
@@ -316,8 +173,9 @@ class DeviceConfig:
     description: str = ""
 
     @property
-    def spec(self) -> ChipSpec:
-        return CHIPS[self.chip]
+    def chip(self) -> str:
+        """The chip's config name (``mpr121``)."""
+        return self.spec.chip
 
     @property
     def role(self) -> str:

@@ -11,29 +11,25 @@ is collected before the LoadError is raised, so a person fixes them all in one g
 
 from __future__ import annotations
 
-import math
 import re
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
 from engine.blackboard.catalogue import KeyCatalogue
 from engine.drivers.mpr121 import check_thresholds
-from engine.drivers.servo_joints import MAESTRO_MAX_US, MAESTRO_MIN_US, Joint
 from engine.files.problems import Mark, Problems
-from engine.files.yaml_source import YList, YMap, YScalar, YValue, describe, plain
+from engine.files.yaml_source import YMap, YScalar, YValue, describe, plain
+from engine.hardware.chips import ChipRegistry, default_chips
+from engine.hardware.chips.fields import ChipFields, number_text
 from engine.hardware.config import (
     BUS_KINDS,
-    CHIPS,
     COMMON_FIELDS,
-    ENGINE_GESTURES,
     PCA9685_ALL_CALL,
-    SIDES,
     VL53L0X_BOOT_ADDRESS,
-    ZX_GESTURES,
     BusConfig,
     ChipSpec,
     DeviceConfig,
-    ForcePad,
     RobotConfig,
     hex_address,
 )
@@ -45,7 +41,6 @@ from engine.values.params import (
     Choice,
     Integer,
     Key,
-    Number,
     Param,
     ParamProblem,
     ParamType,
@@ -65,16 +60,6 @@ BUS_FIELDS: dict[str, tuple[Param[Any], ...]] = {
         Param("baudrate", Integer(300, 4_000_000), 115200, "baud rate (ignored over USB)"),
     ),
 }
-JOINT_FIELDS = (
-    Param("channel", Integer(0, 23), REQUIRED, "Maestro channel"),
-    Param("min_deg", Number(-360.0, 360.0, "deg"), REQUIRED, "lowest angle"),
-    Param("max_deg", Number(-360.0, 360.0, "deg"), REQUIRED, "highest angle"),
-    Param("max_speed_dps", Number(0.0, 10_000.0, "deg/s"), REQUIRED, "speed limit"),
-    Param("min_us", Number(unit="us"), 1000.0, "pulse width at min_deg, 64..4000 us"),
-    Param("max_us", Number(unit="us"), 2000.0, "pulse width at max_deg, 64..4000 us"),
-    Param("home_deg", Number(-360.0, 360.0, "deg"), 0.0, "resting angle"),
-)
-LED_FIELDS = ("red", "green", "blue")
 DEVICE_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 """A device name: it names ``/devices/<name>/ok`` and is written in trees, so an identifier."""
 # Options whose YAML value is a number but which the drivers take from a fixed set.
@@ -84,7 +69,14 @@ _NUMERIC_CHOICES = {"gain", "data_rate_sps", "resolution_c", "channels"}
 class ConfigChecker:
     """Checks one parsed config file named ``name``; :meth:`check` raises every problem."""
 
-    def __init__(self, name: str, path: Path, catalogue: KeyCatalogue) -> None:
+    def __init__(
+        self,
+        name: str,
+        path: Path,
+        catalogue: KeyCatalogue,
+        chips: ChipRegistry | None = None,
+    ) -> None:
+        self.chips = chips or default_chips()
         self.name = name
         self.path = path
         self.ctx = CheckContext(catalogue)
@@ -100,7 +92,7 @@ class ConfigChecker:
             self.problems.add(raw.mark, f"{what!r} {problem.message}", problem.hint)
             return None
 
-    def unknown_fields(self, raw: YMap, known: tuple[str, ...] | list[str], what: str) -> None:
+    def unknown_fields(self, raw: YMap, known: Sequence[str], what: str) -> None:
         self.problems.unknown_fields(raw.key_marks, known, what)
 
     def fields(self, raw: YMap, params: tuple[Param[Any], ...], what: str) -> dict[str, Any] | None:
@@ -261,26 +253,27 @@ class ConfigChecker:
         chip_raw = raw.get("chip")
         if chip_raw is None:
             self.problems.add(
-                raw.mark, f"device {name!r} needs 'chip'", "chips: " + ", ".join(CHIPS)
+                raw.mark, f"device {name!r} needs 'chip'", "chips: " + ", ".join(self.chips.names)
             )
             return None
         chip = plain(chip_raw)
-        spec = CHIPS.get(chip) if isinstance(chip, str) else None
-        if spec is None:
+        kind = self.chips.get(chip) if isinstance(chip, str) else None
+        if kind is None:
             self.problems.add(
                 chip_raw.mark,
                 f"unknown chip {chip!r}",
-                (did_you_mean(chip, list(CHIPS)) if isinstance(chip, str) else None)
-                or "chips: " + ", ".join(CHIPS),
+                (did_you_mean(chip, self.chips.names) if isinstance(chip, str) else None)
+                or "chips: " + ", ".join(self.chips.names),
             )
             return None
+        spec = kind.spec
         known = [*COMMON_FIELDS, *(p.name for p in spec.options), *spec.fields]
         self.unknown_fields(raw, known, spec.chip)
         bus = self._device_bus(name, raw, spec, buses)
         address = self._address(raw, spec)
         rate_hz = self._rate(raw, spec)
         options = self._options(raw, spec)
-        extra = _ChipFields(self, name, raw, spec).check()
+        extra = kind.check_fields(ChipFields(self, name, raw, spec))
         keys = self._keys(raw, spec, (extra or {}).get("side"))
         if bus is None or options is None or extra is None or keys is None:
             return None
@@ -289,7 +282,7 @@ class ConfigChecker:
         description = self._text(raw, "description", "")
         return DeviceConfig(
             name=name,
-            chip=spec.chip,
+            spec=spec,
             bus=bus,
             mark=raw.mark,
             address=address,
@@ -387,7 +380,7 @@ class ConfigChecker:
                 converted = param.default
             elif param.name in _NUMERIC_CHOICES:
                 # YAML reads 0.0625 and 12 as numbers; the choices are spelled as text.
-                text = _number_text(plain(value))
+                text = number_text(plain(value))
                 converted = self.convert(param.type, YScalar(text, value.mark), param.name)
             else:
                 converted = self.convert(param.type, value, param.name)
@@ -466,12 +459,6 @@ def _identifier(name: str) -> str:
     return text if not text[0].isdigit() else "_" + text
 
 
-def _number_text(value: Any) -> Any:
-    if isinstance(value, bool) or not isinstance(value, int | float):
-        return value
-    return f"{value:g}" if isinstance(value, float) else str(value)
-
-
 def _numeric_choice(name: str, value: Any) -> Any:
     if name not in _NUMERIC_CHOICES:
         return value
@@ -479,417 +466,6 @@ def _numeric_choice(name: str, value: Any) -> Any:
         return 2 / 3
     number = float(value)
     return int(number) if number.is_integer() and name != "resolution_c" else number
-
-
-class _ChipFields:
-    """The structured fields of one chip: pads, joints, leds, side/xshut/mux, gesture names."""
-
-    def __init__(self, checker: ConfigChecker, name: str, raw: YMap, spec: ChipSpec) -> None:
-        self.c = checker
-        self.name = name
-        self.raw = raw
-        self.spec = spec
-
-    def check(self) -> dict[str, Any] | None:
-        values: dict[str, Any] = {}
-        ok = True
-        role = self.spec.role
-        if role == "force":
-            pads = self._pads()
-            ok = pads is not None
-            values["pads"] = pads or ()
-        elif role == "range":
-            placed = self._range_place()
-            ok = placed is not None
-            values.update(placed or {})
-        elif role == "gesture":
-            names = self._gesture_names()
-            ok = names is not None
-            values["gesture_names"] = names or {}
-        elif role == "leds":
-            leds = self._leds()
-            ok = leds is not None
-            values["leds"] = leds or {}
-        elif role == "servos":
-            joints = self._joints()
-            ok = joints is not None
-            values["joints"] = joints or ()
-        return values if ok else None
-
-    # -- force pads ------------------------------------------------------------------------
-    def _pads(self) -> tuple[ForcePad, ...] | None:
-        section = self.c.mapping(
-            self.raw.get("pads"),
-            "'pads'",
-            "e.g. pads: {left: {channel: 0, calibration: [[0.0, 0.0], [3.0, 6.0]]}}",
-        )
-        if section is None:
-            if "pads" not in self.raw:
-                self.c.problems.add(
-                    self.raw.mark,
-                    f"{self.spec.chip} device {self.name!r} needs 'pads'",
-                    "e.g. pads: {left: {channel: 0, calibration: [[0.0, 0.0], [3.0, 6.0]]}}",
-                )
-            return None
-        channels = 4 if self.spec.chip == "ads1115" else 8
-        pads: list[ForcePad] = []
-        used: dict[int, str] = {}
-        ok = True
-        for pad_name, body in section.items():
-            pad = self._pad(pad_name, body, channels)
-            if pad is None:
-                ok = False
-                continue
-            if pad.channel in used:
-                self.c.problems.add(
-                    pad.mark,
-                    f"pad {pad_name!r} uses channel {pad.channel}, already used by pad "
-                    f"{used[pad.channel]!r}",
-                    "give each pad its own channel",
-                )
-                ok = False
-            used[pad.channel] = pad_name
-            pads.append(pad)
-        if not pads and ok:
-            self.c.problems.add(section.mark, "'pads' lists no pad", "e.g. left: {channel: 0}")
-            ok = False
-        return tuple(pads) if ok else None
-
-    def _pad(self, pad_name: str, body: YValue, channels: int) -> ForcePad | None:
-        raw = self.c.mapping(body, f"pad {pad_name!r}", "e.g. {channel: 0, calibration: [...]}")
-        if raw is None:
-            return None
-        self.c.unknown_fields(raw, ("channel", "key", "calibration"), "pad")
-        values = self.c.fields(
-            raw,
-            (
-                Param("channel", Integer(0, channels - 1), REQUIRED, "ADC input"),
-                Param("key", Key(), f"/sensors/force/{pad_name}_n", "blackboard key"),
-            ),
-            f"pad {pad_name!r}",
-        )
-        table_raw = raw.get("calibration")
-        if table_raw is None:
-            self.c.problems.add(
-                raw.mark,
-                f"pad {pad_name!r} needs 'calibration'",
-                "a volts -> newtons table, e.g. [[0.0, 0.0], [0.83, 0.2], [3.0, 6.0]]",
-            )
-            return None
-        table = self._calibration(table_raw)
-        if values is None or table is None:
-            return None
-        if self.c.ctx.catalogue.lookup(values["key"]) is None:  # the default key
-            self.c.problems.add(
-                raw.mark,
-                f"pad {pad_name!r} would feed {values['key']}, which is not a blackboard key",
-                "name its 'key', e.g. /sensors/force/left_n",
-            )
-            return None
-        return ForcePad(pad_name, values["channel"], values["key"], table, raw.mark)
-
-    def _calibration(self, raw: YValue) -> tuple[tuple[float, float], ...] | None:
-        example = "pairs of [volts, newtons], e.g. [[0.0, 0.0], [0.83, 0.2], [3.0, 6.0]]"
-        if not isinstance(raw, YList):
-            self.c.problems.add(
-                raw.mark, f"'calibration' must be a list, got {describe(raw)}", example
-            )
-            return None
-        points: list[tuple[float, float]] = []
-        ok = True
-        for index, item in enumerate(raw):
-            value = plain(item)
-            if (
-                not isinstance(value, list)
-                or len(value) != 2
-                or any(isinstance(v, bool) or not isinstance(v, int | float) for v in value)
-            ):
-                self.c.problems.add(
-                    item.mark,
-                    f"calibration point {index + 1} must be [volts, newtons], got {describe(item)}",
-                    example,
-                )
-                ok = False
-                continue
-            volts, newtons = float(value[0]), float(value[1])
-            if not (math.isfinite(volts) and math.isfinite(newtons)):
-                self.c.problems.add(
-                    item.mark,
-                    f"calibration point {index + 1} is [{volts:g}, {newtons:g}]: volts and "
-                    "newtons must be finite numbers",
-                    example,
-                )
-                ok = False
-                continue
-            if newtons < 0:
-                self.c.problems.add(
-                    item.mark, f"calibration point {index + 1} has negative force {newtons:g} N"
-                )
-                ok = False
-                continue
-            if points and volts <= points[-1][0]:
-                self.c.problems.add(
-                    item.mark,
-                    f"calibration is not increasing: point {index + 1} has {volts:g} V after "
-                    f"{points[-1][0]:g} V",
-                    "list the points by strictly increasing volts",
-                )
-                ok = False
-            elif points and newtons < points[-1][1]:
-                self.c.problems.add(
-                    item.mark,
-                    f"calibration is not increasing: point {index + 1} has {newtons:g} N after "
-                    f"{points[-1][1]:g} N",
-                    "a harder squeeze must never read as a lighter one",
-                )
-                ok = False
-            points.append((volts, newtons))
-        if ok and len(points) < 2:
-            self.c.problems.add(
-                raw.mark, f"calibration needs at least two points, got {len(points)}", example
-            )
-            ok = False
-        return tuple(points) if ok else None
-
-    # -- range sensors ---------------------------------------------------------------------
-    def _range_place(self) -> dict[str, Any] | None:
-        values: dict[str, Any] = {"side": None, "xshut": None, "mux": None, "mux_channel": None}
-        ok = True
-        side_raw = self.raw.get("side")
-        if side_raw is None:
-            self.c.problems.add(
-                self.raw.mark,
-                f"vl53l0x device {self.name!r} needs 'side'",
-                "left, center or right: the way it looks",
-            )
-            ok = False
-        else:
-            values["side"] = self.c.convert(Choice(SIDES), side_raw, "side")
-            ok = ok and values["side"] is not None
-        xshut_raw = self.raw.get("xshut")
-        if xshut_raw is not None:
-            values["xshut"] = self.c.convert(Integer(0, 1023), xshut_raw, "xshut")
-            ok = ok and values["xshut"] is not None
-        mux_raw, channel_raw = self.raw.get("mux"), self.raw.get("channel")
-        if mux_raw is not None:
-            values["mux"] = self.c.convert(Text(), mux_raw, "mux")
-            ok = ok and values["mux"] is not None
-            if channel_raw is None:
-                self.c.problems.add(
-                    self.raw.key_marks["mux"],
-                    f"device {self.name!r} names a mux but no 'channel'",
-                    "the TCA9548A channel it is wired to, 0..7",
-                )
-                ok = False
-        if channel_raw is not None:
-            if mux_raw is None:
-                self.c.problems.add(
-                    self.raw.key_marks["channel"],
-                    "'channel' is a TCA9548A channel, but no 'mux' is named",
-                    "add mux: NAME of the tca9548a device",
-                )
-                ok = False
-            values["mux_channel"] = self.c.convert(Integer(0, 7), channel_raw, "channel")
-            ok = ok and values["mux_channel"] is not None
-        if xshut_raw is not None and mux_raw is not None:
-            self.c.problems.add(
-                self.raw.key_marks["xshut"],
-                "a VL53L0X is either re-addressed through its XSHUT line or behind a mux",
-                "remove 'xshut' or 'mux'",
-            )
-            ok = False
-        return values if ok else None
-
-    # -- gestures --------------------------------------------------------------------------
-    def _gesture_names(self) -> dict[str, str] | None:
-        section = self.c.mapping(
-            self.raw.get("gesture_names"), "'gesture_names'", "e.g. {swipe_left: wave}"
-        )
-        names = {gesture: gesture for gesture in ZX_GESTURES}
-        if section is None:
-            return None if "gesture_names" in self.raw else names
-        ok = True
-        for reported, value in section.items():
-            if reported not in ZX_GESTURES:
-                self.c.problems.add(
-                    section.key_marks[reported],
-                    f"the ZX sensor reports no gesture {reported!r}",
-                    did_you_mean(reported, ZX_GESTURES) or "it reports " + ", ".join(ZX_GESTURES),
-                )
-                ok = False
-                continue
-            engine_name = self.c.convert(Choice(ENGINE_GESTURES), value, reported)
-            if engine_name is None:
-                ok = False
-            else:
-                names[reported] = engine_name
-        return names if ok else None
-
-    # -- LEDs ------------------------------------------------------------------------------
-    def _leds(self) -> dict[str, tuple[int, int, int]] | None:
-        section = self.c.mapping(
-            self.raw.get("leds"), "'leds'", "e.g. leds: {face: {red: 0, green: 1, blue: 2}}"
-        )
-        if section is None:
-            if "leds" not in self.raw:
-                self.c.problems.add(
-                    self.raw.mark,
-                    f"pca9685 device {self.name!r} needs 'leds'",
-                    "e.g. leds: {face: {red: 0, green: 1, blue: 2}}",
-                )
-            return None
-        leds: dict[str, tuple[int, int, int]] = {}
-        owner: dict[int, str] = {}
-        ok = True
-        for led, body in section.items():
-            if led == "all":
-                self.c.problems.add(
-                    section.key_marks[led], "'all' names every LED", "choose another LED name"
-                )
-                ok = False
-                continue
-            raw = self.c.mapping(body, f"LED {led!r}", "e.g. {red: 0, green: 1, blue: 2}")
-            if raw is None:
-                ok = False
-                continue
-            self.c.unknown_fields(raw, LED_FIELDS, "LED")
-            values = self.c.fields(
-                raw,
-                tuple(
-                    Param(color, Integer(0, 15), REQUIRED, "PCA9685 channel")
-                    for color in LED_FIELDS
-                ),
-                f"LED {led!r}",
-            )
-            if values is None:
-                ok = False
-                continue
-            for color in LED_FIELDS:
-                channel = values[color]
-                if channel in owner:
-                    self.c.problems.add(
-                        raw.entries[color].mark,
-                        f"PCA9685 channel {channel} is already used by LED {owner[channel]!r}",
-                        "give each color its own channel",
-                    )
-                    ok = False
-                owner[channel] = f"{led}.{color}"
-            leds[led] = (values["red"], values["green"], values["blue"])
-        if not leds and ok:
-            self.c.problems.add(section.mark, "'leds' lists no LED")
-            ok = False
-        return leds if ok else None
-
-    # -- servo joints ----------------------------------------------------------------------
-    def _joints(self) -> tuple[Joint, ...] | None:
-        section = self.c.mapping(
-            self.raw.get("joints"),
-            "'joints'",
-            "e.g. joints: {neck: {channel: 0, min_deg: -60, max_deg: 60, max_speed_dps: 120}}",
-        )
-        if section is None:
-            if "joints" not in self.raw:
-                self.c.problems.add(
-                    self.raw.mark,
-                    f"maestro device {self.name!r} needs 'joints'",
-                    "e.g. joints: {neck: {channel: 0, min_deg: -60, max_deg: 60, "
-                    "max_speed_dps: 120}}",
-                )
-            return None
-        channels_raw = self.raw.get("channels")
-        channels = 12
-        if channels_raw is not None and _number_text(plain(channels_raw)) in (
-            "6",
-            "12",
-            "18",
-            "24",
-        ):
-            channels = int(_number_text(plain(channels_raw)))
-        joints: list[Joint] = []
-        owner: dict[int, str] = {}
-        ok = True
-        for joint_name, body in section.items():
-            joint = self._joint(joint_name, body, channels)
-            if joint is None:
-                ok = False
-                continue
-            if joint.channel in owner:
-                self.c.problems.add(
-                    section.entries[joint_name].mark,
-                    f"joint {joint_name!r} uses channel {joint.channel}, already used by joint "
-                    f"{owner[joint.channel]!r}",
-                    "give each joint its own channel",
-                )
-                ok = False
-            owner[joint.channel] = joint_name
-            joints.append(joint)
-        if not joints and ok:
-            self.c.problems.add(section.mark, "'joints' lists no joint")
-            ok = False
-        return tuple(joints) if ok else None
-
-    def _joint(self, joint_name: str, body: YValue, channels: int) -> Joint | None:
-        raw = self.c.mapping(
-            body, f"joint {joint_name!r}", "e.g. {channel: 0, min_deg: -60, max_deg: 60, ...}"
-        )
-        if raw is None:
-            return None
-        self.c.unknown_fields(raw, [p.name for p in JOINT_FIELDS], "joint")
-        values = self.c.fields(raw, JOINT_FIELDS, f"joint {joint_name!r}")
-        if values is None:
-            return None
-        place = raw.entries.get
-        problems = self.c.problems
-        before = len(problems)
-        if values["channel"] >= channels:
-            problems.add(
-                place("channel", raw).mark,
-                f"joint {joint_name!r}: channel {values['channel']} is beyond the Maestro's "
-                f"{channels} channels (0..{channels - 1})",
-            )
-        if not values["min_deg"] < values["max_deg"]:
-            problems.add(
-                place("min_deg", raw).mark,
-                f"joint {joint_name!r}: limits inverted, min_deg {values['min_deg']:g} is not "
-                f"below max_deg {values['max_deg']:g}",
-                "swap them",
-            )
-        if not 0 < values["min_us"] < values["max_us"]:
-            problems.add(
-                place("min_us", raw).mark,
-                f"joint {joint_name!r}: pulse limits {values['min_us']:g}..{values['max_us']:g} "
-                "us are not increasing and positive",
-            )
-        else:
-            for name in ("min_us", "max_us"):
-                if not MAESTRO_MIN_US <= values[name] <= MAESTRO_MAX_US:
-                    problems.add(
-                        place(name, raw).mark,
-                        f"joint {joint_name!r}: {name} {values[name]:g} us is outside the "
-                        f"Maestro's pulse range {MAESTRO_MIN_US:g}..{MAESTRO_MAX_US:g} us "
-                        f"({MAESTRO_MIN_US:g} us is its lowest Min setting)",
-                        "hobby servos take about 500..2500 us; match the Min and Max set in "
-                        "the Maestro Control Center",
-                    )
-        if not values["max_speed_dps"] > 0:
-            problems.add(
-                place("max_speed_dps", raw).mark,
-                f"joint {joint_name!r}: max_speed_dps must be above 0",
-            )
-        if len(problems) > before:
-            return None
-        if not values["min_deg"] <= values["home_deg"] <= values["max_deg"]:
-            problems.add(
-                place("home_deg", raw).mark,
-                f"joint {joint_name!r}: home_deg {values['home_deg']:g} is outside its limits "
-                f"{values['min_deg']:g}..{values['max_deg']:g}",
-            )
-            return None
-        try:
-            return Joint(name=joint_name, **values)
-        except ValueError as error:  # e.g. a speed limit the Maestro cannot express
-            problems.add(place("max_speed_dps", raw).mark, str(error))
-            return None
 
 
 class _CrossChecks:

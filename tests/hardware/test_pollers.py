@@ -18,7 +18,8 @@ from engine.drivers.sim.spi_bus import SimSpiDev
 from engine.drivers.sim.zx_gesture import SimZXGesture
 from engine.files.problems import Mark
 from engine.hardware.branching_clock import BranchingClock
-from engine.hardware.config import DeviceConfig, ForcePad
+from engine.hardware.chips import default_chips
+from engine.hardware.config import ChipSpec, DeviceConfig, ForcePad
 from engine.hardware.device_health import DeviceHealth
 from engine.hardware.pollers import Poller, PollerThreads, Staged, make_poller
 from engine.hardware.sim_vest import SpiSocket
@@ -88,9 +89,15 @@ def bench() -> Bench:
     return Bench()
 
 
+def chip_spec(chip: str) -> ChipSpec:
+    kind = default_chips().get(chip)
+    assert kind is not None
+    return kind.spec
+
+
 TOUCH = DeviceConfig(
     name="touch",
-    chip="mpr121",
+    spec=chip_spec("mpr121"),
     bus="i2c",
     mark=HERE,
     address=0x5A,
@@ -169,7 +176,7 @@ def test_a_chip_answering_nonsense_is_marked_not_ok_though_the_bus_is_fine(bench
     )
     device = DeviceConfig(
         name="force",
-        chip="mcp3008",
+        spec=chip_spec("mcp3008"),
         bus="spi",
         mark=HERE,
         rate_hz=10.0,
@@ -202,7 +209,7 @@ def test_each_gesture_is_one_event_named_as_the_config_says(bench: Bench):
     zx = bench.bus.attach(SimZXGesture(bench.clock))
     device = DeviceConfig(
         name="gesture",
-        chip="zx_gesture",
+        spec=chip_spec("zx_gesture"),
         bus="i2c",
         mark=HERE,
         address=0x10,

@@ -1,0 +1,40 @@
+"""The TI ADS1115 16-bit ADC reading FSR 406 force pads (4 channels), polled."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from engine.hardware.chips.fields import ChipFields
+from engine.hardware.chips.force_pads import force_pads
+from engine.hardware.chips.kind import ChipKind
+from engine.hardware.config import ChipSpec
+from engine.values.params import Choice, Param
+
+
+def _pads(fields: ChipFields) -> dict[str, Any] | None:
+    pads = force_pads(fields, channels=4)
+    return None if pads is None else {"pads": pads}
+
+
+KIND = ChipKind(
+    ChipSpec(
+        "ads1115",
+        "TI ADS1115 16-bit ADC with FSR 406 force pads",
+        "i2c",
+        "force",
+        addresses=tuple(range(0x48, 0x4C)),
+        default_address=0x48,
+        default_rate_hz=20.0,
+        options=(
+            Param("gain", Choice(("2/3", "1", "2", "4", "8", "16")), "1", "PGA gain"),
+            Param(
+                "data_rate_sps",
+                Choice(("8", "16", "32", "64", "128", "250", "475", "860")),
+                "860",
+                "conversions per second (a reading takes about its inverse)",
+            ),
+        ),
+        fields=("pads",),
+    ),
+    _pads,
+)

@@ -1,0 +1,61 @@
+"""A chip kind: what the robot config knows of one chip, and the registry of them all.
+
+The BehaviorTree.CPP factory idea applied to hardware: each chip kind is declared in one
+module of :mod:`engine.hardware.chips` (its :class:`~engine.hardware.config.ChipSpec` and
+the check of its own structured fields), and :func:`engine.hardware.chips.default_chips`
+gathers them into a :class:`ChipRegistry` object, handed to whoever needs it (no global).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass
+from typing import Any
+
+from engine.hardware.chips.fields import ChipFields
+from engine.hardware.config import ChipSpec
+
+FieldsCheck = Callable[[ChipFields], dict[str, Any] | None]
+"""Checks a device's structured fields; returns the values for its DeviceConfig (e.g.
+``{"pads": (...)}``), or None after adding each problem with its place."""
+
+
+def no_fields(fields: ChipFields) -> dict[str, Any] | None:
+    """A chip with no structured fields of its own."""
+    return {}
+
+
+@dataclass(frozen=True)
+class ChipKind:
+    """One kind of chip: its spec, and the check of its structured fields."""
+
+    spec: ChipSpec
+    check_fields: FieldsCheck = no_fields
+
+    @property
+    def name(self) -> str:
+        return self.spec.chip
+
+
+class ChipRegistry:
+    """Chip kinds by their config name (``chip: mpr121``)."""
+
+    def __init__(self, kinds: list[ChipKind] | None = None) -> None:
+        self._kinds: dict[str, ChipKind] = {}
+        for kind in kinds or []:
+            self.add(kind)
+
+    def add(self, kind: ChipKind) -> None:
+        if kind.name in self._kinds:
+            raise ValueError(f"chip kind {kind.name!r} is registered twice")
+        self._kinds[kind.name] = kind
+
+    def get(self, name: str) -> ChipKind | None:
+        return self._kinds.get(name)
+
+    @property
+    def names(self) -> list[str]:
+        return list(self._kinds)
+
+    def __iter__(self) -> Iterator[ChipKind]:
+        return iter(self._kinds.values())

@@ -1,0 +1,33 @@
+"""The Microchip MCP3008 10-bit SPI ADC reading FSR 406 force pads (8 channels), polled."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from engine.hardware.chips.fields import ChipFields
+from engine.hardware.chips.force_pads import force_pads
+from engine.hardware.chips.kind import ChipKind
+from engine.hardware.config import ChipSpec
+from engine.values.params import Integer, Number, Param
+
+
+def _pads(fields: ChipFields) -> dict[str, Any] | None:
+    pads = force_pads(fields, channels=8)
+    return None if pads is None else {"pads": pads}
+
+
+KIND = ChipKind(
+    ChipSpec(
+        "mcp3008",
+        "Microchip MCP3008 10-bit SPI ADC with FSR 406 force pads",
+        "spi",
+        "force",
+        default_rate_hz=20.0,
+        options=(
+            Param("vref_v", Number(0.25, 5.5, "V"), 3.3, "reference voltage"),
+            Param("max_speed_hz", Integer(10_000, 3_600_000), 1_000_000, "SPI clock"),
+        ),
+        fields=("pads",),
+    ),
+    _pads,
+)

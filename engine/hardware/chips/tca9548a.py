@@ -1,0 +1,17 @@
+"""The TI TCA9548A I2C multiplexer: a bus part, 8 channels behind one address."""
+
+from __future__ import annotations
+
+from engine.hardware.chips.kind import ChipKind
+from engine.hardware.config import ChipSpec
+
+KIND = ChipKind(
+    ChipSpec(
+        "tca9548a",
+        "TI TCA9548A 8-channel I2C multiplexer",
+        "i2c",
+        "mux",
+        addresses=tuple(range(0x70, 0x78)),
+        default_address=0x70,
+    ),
+)

@@ -1,0 +1,83 @@
+"""The ST VL53L0X time-of-flight sensor: one side, re-addressed by XSHUT or behind a mux."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from engine.hardware.chips.fields import ChipFields
+from engine.hardware.chips.kind import ChipKind
+from engine.hardware.config import SIDES, VL53L0X_BOOT_ADDRESS, ChipSpec
+from engine.values.params import Choice, Integer, Number, Param, Text
+
+
+def _range_place(fields: ChipFields) -> dict[str, Any] | None:
+    values: dict[str, Any] = {"side": None, "xshut": None, "mux": None, "mux_channel": None}
+    ok = True
+    side_raw = fields.raw.get("side")
+    if side_raw is None:
+        fields.checker.problems.add(
+            fields.raw.mark,
+            f"vl53l0x device {fields.name!r} needs 'side'",
+            "left, center or right: the way it looks",
+        )
+        ok = False
+    else:
+        values["side"] = fields.checker.convert(Choice(SIDES), side_raw, "side")
+        ok = ok and values["side"] is not None
+    xshut_raw = fields.raw.get("xshut")
+    if xshut_raw is not None:
+        values["xshut"] = fields.checker.convert(Integer(0, 1023), xshut_raw, "xshut")
+        ok = ok and values["xshut"] is not None
+    mux_raw, channel_raw = fields.raw.get("mux"), fields.raw.get("channel")
+    if mux_raw is not None:
+        values["mux"] = fields.checker.convert(Text(), mux_raw, "mux")
+        ok = ok and values["mux"] is not None
+        if channel_raw is None:
+            fields.checker.problems.add(
+                fields.raw.key_marks["mux"],
+                f"device {fields.name!r} names a mux but no 'channel'",
+                "the TCA9548A channel it is wired to, 0..7",
+            )
+            ok = False
+    if channel_raw is not None:
+        if mux_raw is None:
+            fields.checker.problems.add(
+                fields.raw.key_marks["channel"],
+                "'channel' is a TCA9548A channel, but no 'mux' is named",
+                "add mux: NAME of the tca9548a device",
+            )
+            ok = False
+        values["mux_channel"] = fields.checker.convert(Integer(0, 7), channel_raw, "channel")
+        ok = ok and values["mux_channel"] is not None
+    if xshut_raw is not None and mux_raw is not None:
+        fields.checker.problems.add(
+            fields.raw.key_marks["xshut"],
+            "a VL53L0X is either re-addressed through its XSHUT line or behind a mux",
+            "remove 'xshut' or 'mux'",
+        )
+        ok = False
+    return values if ok else None
+
+
+KIND = ChipKind(
+    ChipSpec(
+        "vl53l0x",
+        "ST VL53L0X time-of-flight distance",
+        "i2c",
+        "range",
+        addresses=tuple(range(0x08, 0x78)),
+        default_address=VL53L0X_BOOT_ADDRESS,
+        default_rate_hz=10.0,
+        outputs={"range": ""},
+        options=(
+            Param(
+                "timeout_s",
+                Number(0.05, 1.0, "s"),
+                0.1,
+                "longest measurement (one takes about 33 ms)",
+            ),
+        ),
+        fields=("side", "xshut", "mux", "channel"),
+    ),
+    _range_place,
+)

@@ -1,0 +1,56 @@
+"""The XYZ Interactive ZX gesture sensor: swipes and hovers, named as the config says."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from engine.hardware.chips.fields import ChipFields
+from engine.hardware.chips.kind import ChipKind
+from engine.hardware.config import ENGINE_GESTURES, ZX_GESTURES, ChipSpec
+from engine.values.params import Choice, did_you_mean
+
+
+def _gesture_names_check(fields: ChipFields) -> dict[str, str] | None:
+    section = fields.checker.mapping(
+        fields.raw.get("gesture_names"), "'gesture_names'", "e.g. {swipe_left: wave}"
+    )
+    names = {gesture: gesture for gesture in ZX_GESTURES}
+    if section is None:
+        return None if "gesture_names" in fields.raw else names
+    ok = True
+    for reported, value in section.items():
+        if reported not in ZX_GESTURES:
+            fields.checker.problems.add(
+                section.key_marks[reported],
+                f"the ZX sensor reports no gesture {reported!r}",
+                did_you_mean(reported, ZX_GESTURES) or "it reports " + ", ".join(ZX_GESTURES),
+            )
+            ok = False
+            continue
+        engine_name = fields.checker.convert(Choice(ENGINE_GESTURES), value, reported)
+        if engine_name is None:
+            ok = False
+        else:
+            names[reported] = engine_name
+    return names if ok else None
+
+
+def _gesture_names(fields: ChipFields) -> dict[str, Any] | None:
+    names = _gesture_names_check(fields)
+    return None if names is None else {"gesture_names": names}
+
+
+KIND = ChipKind(
+    ChipSpec(
+        "zx_gesture",
+        "XYZ Interactive ZX gesture sensor",
+        "i2c",
+        "gesture",
+        addresses=(0x10, 0x11),
+        default_address=0x10,
+        default_rate_hz=20.0,
+        outputs={"gesture": "/sensors/gesture/last"},
+        fields=("gesture_names",),
+    ),
+    _gesture_names,
+)
