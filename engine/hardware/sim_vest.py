@@ -37,22 +37,16 @@ from typing import Any
 from engine.blackboard.board import Blackboard
 from engine.clock import Clock, VirtualClock
 from engine.drivers.gpio import OutputLine
-from engine.drivers.sim.ads1115 import SimADS1115
 from engine.drivers.sim.fsr import fsr406_volts
 from engine.drivers.sim.gpio import SimOutputLine
 from engine.drivers.sim.i2c_bus import SimI2CBus, SimI2CDevice
 from engine.drivers.sim.maestro_emulator import MaestroEmulator
 from engine.drivers.sim.mcp3008 import SimMCP3008
-from engine.drivers.sim.mcp9808 import SimMCP9808
-from engine.drivers.sim.mpr121 import SimMPR121
-from engine.drivers.sim.pca9685 import SimPCA9685
 from engine.drivers.sim.spi_bus import Bit, SimSpiDev, SimSpiDevice
-from engine.drivers.sim.srf02 import SimSRF02
 from engine.drivers.sim.tca9548a import SimTCA9548A
-from engine.drivers.sim.vl53l0x import SimVL53L0X
-from engine.drivers.sim.zx_gesture import SimZXGesture
 from engine.files.problems import Problem
 from engine.hardware.branching_clock import BranchingClock
+from engine.hardware.chips import ChipRegistry, default_chips
 from engine.hardware.config import BusConfig, DeviceConfig, RobotConfig
 from engine.scenario.world import EVENT_KEYS, World
 from engine.values.params import did_you_mean
@@ -105,9 +99,16 @@ class SimVest:
     :class:`~engine.drivers.sim.mpr121.SimMPR121`).
     """
 
-    def __init__(self, config: RobotConfig, world: World, clock: Clock) -> None:
+    def __init__(
+        self,
+        config: RobotConfig,
+        world: World,
+        clock: Clock,
+        chip_kinds: ChipRegistry | None = None,
+    ) -> None:
         self.config = config
         self.world = world
+        self.chip_kinds = chip_kinds or default_chips()
         self.base_clock = clock
         self.clock: Clock = BranchingClock(clock) if isinstance(clock, VirtualClock) else clock
         self.i2c: dict[str, SimI2CBus] = {}
@@ -125,10 +126,10 @@ class SimVest:
         try:
             # Muxes first: the chips behind them go onto their downstream buses.
             for device in config.devices.values():
-                if device.chip == "tca9548a":
+                if device.role == "mux":
                     self._add(device)
             for device in config.devices.values():
-                if device.chip != "tca9548a":
+                if device.role != "mux":
                     self._add(device)
         except BaseException:
             self.close()
@@ -136,57 +137,49 @@ class SimVest:
 
     # -- making the chips ------------------------------------------------------------------
     def _add(self, device: DeviceConfig) -> None:
-        bus_config = self.config.buses[device.bus]
-        if bus_config.kind == "serial":
-            self._add_maestro(device)
-            return
-        if bus_config.kind == "spi":
-            chip = SimMCP3008(vref_v=device.options.get("vref_v", 3.3))
-            socket = SpiSocket(chip, self.clock)
-            node = SimSpiDev(socket, bus_config.number, bus_config.chip_select)
-            self.spi[bus_config.name] = node
-            self._sockets[device.name] = socket
-            self.chips[device.name] = chip
-            return
-        bus = self._bus_for(device)
-        address = device.address
-        assert address is not None
-        clock = self.clock
-        model: SimI2CDevice
-        if device.chip == "mpr121":
-            model = SimMPR121(address)
-        elif device.chip == "ads1115":
-            model = SimADS1115(clock, address)
-        elif device.chip == "zx_gesture":
-            model = SimZXGesture(clock, address)
-        elif device.chip == "srf02":
-            model = SimSRF02(clock, address)
-        elif device.chip == "mcp9808":
-            model = SimMCP9808(clock, address, temperature_c=self.world.temperature_c)
-        elif device.chip == "pca9685":
-            model = SimPCA9685(clock, address)
-        elif device.chip == "tca9548a":
-            downstream = [
-                SimI2CBus(clock, bus_number=100 * (bus_config.number or 0) + channel)
-                for channel in range(8)
-            ]
-            for channel, channel_bus in enumerate(downstream):
-                self._mux_buses[(device.name, channel)] = channel_bus
-            self.chips[device.name] = SimTCA9548A(address, downstream, upstream=bus)
-            self._places[device.name] = (bus, address)
-            return
-        elif device.chip == "vl53l0x":
-            if device.xshut is not None:  # in standby until the start-up chain switches it on
-                self.chips[device.name] = SimVL53L0X(clock, bus, xshut_high=False)
-            else:
-                self.chips[device.name] = SimVL53L0X(clock, bus, address)
-            self._places[device.name] = (bus, address)
-            return
-        else:  # pragma: no cover - the config knows no other chip
+        kind = self.chip_kinds.get(device.chip)
+        if kind is None or kind.simulate is None:  # pragma: no cover - every kind has one
             raise ValueError(f"the simulated vest has no model of {device.chip!r}")
+        kind.simulate(self, device)
+
+    # -- what a chip kind's model is placed with (chips.kind.SimPlacement) -----------------
+    def i2c_bus_for(self, device: DeviceConfig) -> SimI2CBus:
+        return self._bus_for(device)
+
+    def attach_i2c(self, device: DeviceConfig, model: SimI2CDevice) -> None:
+        bus = self._bus_for(device)
         bus.attach(model)
+        self.keep(device, model, bus)
+
+    def keep(self, device: DeviceConfig, model: Any, bus: SimI2CBus | None = None) -> None:
         self.chips[device.name] = model
-        self._places[device.name] = (bus, address)
+        if bus is not None and device.address is not None:
+            self._places[device.name] = (bus, device.address)
+
+    def add_mux(self, device: DeviceConfig) -> None:
+        """A TCA9548A: eight downstream buses behind one address."""
+        bus_config = self.config.buses[device.bus]
+        bus = self._bus_for(device)
+        assert device.address is not None
+        downstream = [
+            SimI2CBus(self.clock, bus_number=100 * (bus_config.number or 0) + channel)
+            for channel in range(8)
+        ]
+        for channel, channel_bus in enumerate(downstream):
+            self._mux_buses[(device.name, channel)] = channel_bus
+        self.keep(device, SimTCA9548A(device.address, downstream, upstream=bus), bus)
+
+    def add_spi(self, device: DeviceConfig) -> None:
+        """An MCP3008 on its SPI node, its inputs moved by the world's forces."""
+        bus_config = self.config.buses[device.bus]
+        chip = SimMCP3008(vref_v=device.options.get("vref_v", 3.3))
+        socket = SpiSocket(chip, self.clock)
+        self.spi[bus_config.name] = SimSpiDev(socket, bus_config.number, bus_config.chip_select)
+        self._sockets[device.name] = socket
+        self.chips[device.name] = chip
+
+    def add_maestro(self, device: DeviceConfig) -> None:
+        self._add_maestro(device)
 
     def _bus_for(self, device: DeviceConfig) -> SimI2CBus:
         if device.mux is not None:

@@ -20,6 +20,10 @@ def test_every_shipped_chip_has_its_kind() -> None:
     ]  # fmt: skip
 
 
+def test_every_shipped_chip_kind_has_a_simulated_model() -> None:
+    assert [kind.name for kind in default_chips() if kind.simulate is None] == []
+
+
 def test_a_chip_kind_registered_twice_is_refused() -> None:
     kind = ChipKind(ChipSpec("mpr121", "again", "i2c", "touch"))
     with pytest.raises(ValueError, match="registered twice"):

@@ -4,16 +4,22 @@ from __future__ import annotations
 
 from typing import Any
 
+from engine.drivers.sim.ads1115 import SimADS1115
 from engine.hardware.chips.fields import ChipFields
 from engine.hardware.chips.force_pads import force_pads
-from engine.hardware.chips.kind import ChipKind
-from engine.hardware.config import ChipSpec
+from engine.hardware.chips.kind import ChipKind, SimPlacement
+from engine.hardware.config import ChipSpec, DeviceConfig
 from engine.values.params import Choice, Param
 
 
 def _pads(fields: ChipFields) -> dict[str, Any] | None:
     pads = force_pads(fields, channels=4)
     return None if pads is None else {"pads": pads}
+
+
+def _simulate(vest: SimPlacement, device: DeviceConfig) -> None:
+    assert device.address is not None
+    vest.attach_i2c(device, SimADS1115(vest.clock, device.address))
 
 
 KIND = ChipKind(
@@ -37,4 +43,5 @@ KIND = ChipKind(
         fields=("pads",),
     ),
     _pads,
+    simulate=_simulate,
 )

@@ -10,10 +10,13 @@ from __future__ import annotations
 
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Protocol
 
+from engine.clock import Clock
+from engine.drivers.sim.i2c_bus import SimI2CBus, SimI2CDevice
 from engine.hardware.chips.fields import ChipFields
-from engine.hardware.config import ChipSpec
+from engine.hardware.config import ChipSpec, DeviceConfig
+from engine.scenario.world import World
 
 FieldsCheck = Callable[[ChipFields], dict[str, Any] | None]
 """Checks a device's structured fields; returns the values for its DeviceConfig (e.g.
@@ -25,12 +28,43 @@ def no_fields(fields: ChipFields) -> dict[str, Any] | None:
     return {}
 
 
+class SimPlacement(Protocol):
+    """Where a chip kind's simulated model goes: the simulated vest answers."""
+
+    clock: Clock
+    world: World
+
+    def i2c_bus_for(self, device: DeviceConfig) -> SimI2CBus:
+        """The simulated I2C bus the device is on (behind its mux, if any)."""
+        ...
+
+    def attach_i2c(self, device: DeviceConfig, model: SimI2CDevice) -> None:
+        """Attach ``model`` at the device's address and keep it as the device's chip."""
+        ...
+
+    def keep(self, device: DeviceConfig, model: Any, bus: SimI2CBus | None = None) -> None:
+        """Keep ``model`` as the device's chip (a model that attached itself)."""
+        ...
+
+    def add_mux(self, device: DeviceConfig) -> None: ...
+
+    def add_spi(self, device: DeviceConfig) -> None: ...
+
+    def add_maestro(self, device: DeviceConfig) -> None: ...
+
+
+SimModel = Callable[[SimPlacement, DeviceConfig], None]
+"""Puts the register-level model that stands in for a chip into the simulated vest."""
+
+
 @dataclass(frozen=True)
 class ChipKind:
-    """One kind of chip: its spec, and the check of its structured fields."""
+    """One kind of chip: its spec, the check of its structured fields, and the simulated
+    model that stands in for it without hardware."""
 
     spec: ChipSpec
     check_fields: FieldsCheck = no_fields
+    simulate: SimModel | None = None
 
     @property
     def name(self) -> str:

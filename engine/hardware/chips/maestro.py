@@ -7,8 +7,8 @@ from typing import Any
 from engine.drivers.servo_joints import MAESTRO_MAX_US, MAESTRO_MIN_US, Joint
 from engine.files.yaml_source import YValue, plain
 from engine.hardware.chips.fields import ChipFields, number_text
-from engine.hardware.chips.kind import ChipKind
-from engine.hardware.config import ChipSpec
+from engine.hardware.chips.kind import ChipKind, SimPlacement
+from engine.hardware.config import ChipSpec, DeviceConfig
 from engine.values.params import REQUIRED, Choice, Integer, Number, Param
 
 JOINT_FIELDS = (
@@ -134,6 +134,10 @@ def _joints(fields: ChipFields) -> dict[str, Any] | None:
     return None if joints is None else {"joints": joints}
 
 
+def _simulate(vest: SimPlacement, device: DeviceConfig) -> None:
+    vest.add_maestro(device)
+
+
 KIND = ChipKind(
     ChipSpec(
         "maestro",
@@ -148,4 +152,5 @@ KIND = ChipKind(
         fields=("joints",),
     ),
     _joints,
+    simulate=_simulate,
 )

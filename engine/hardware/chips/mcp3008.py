@@ -6,14 +6,18 @@ from typing import Any
 
 from engine.hardware.chips.fields import ChipFields
 from engine.hardware.chips.force_pads import force_pads
-from engine.hardware.chips.kind import ChipKind
-from engine.hardware.config import ChipSpec
+from engine.hardware.chips.kind import ChipKind, SimPlacement
+from engine.hardware.config import ChipSpec, DeviceConfig
 from engine.values.params import Integer, Number, Param
 
 
 def _pads(fields: ChipFields) -> dict[str, Any] | None:
     pads = force_pads(fields, channels=8)
     return None if pads is None else {"pads": pads}
+
+
+def _simulate(vest: SimPlacement, device: DeviceConfig) -> None:
+    vest.add_spi(device)
 
 
 KIND = ChipKind(
@@ -30,4 +34,5 @@ KIND = ChipKind(
         fields=("pads",),
     ),
     _pads,
+    simulate=_simulate,
 )

@@ -2,9 +2,17 @@
 
 from __future__ import annotations
 
-from engine.hardware.chips.kind import ChipKind
-from engine.hardware.config import ChipSpec
+from engine.drivers.sim.mcp9808 import SimMCP9808
+from engine.hardware.chips.kind import ChipKind, SimPlacement
+from engine.hardware.config import ChipSpec, DeviceConfig
 from engine.values.params import Choice, Param
+
+
+def _simulate(vest: SimPlacement, device: DeviceConfig) -> None:
+    assert device.address is not None
+    model = SimMCP9808(vest.clock, device.address, temperature_c=vest.world.temperature_c)
+    vest.attach_i2c(device, model)
+
 
 KIND = ChipKind(
     ChipSpec(
@@ -24,4 +32,5 @@ KIND = ChipKind(
             ),
         ),
     ),
+    simulate=_simulate,
 )

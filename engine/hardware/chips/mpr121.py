@@ -2,9 +2,16 @@
 
 from __future__ import annotations
 
-from engine.hardware.chips.kind import ChipKind
-from engine.hardware.config import ChipSpec
+from engine.drivers.sim.mpr121 import SimMPR121
+from engine.hardware.chips.kind import ChipKind, SimPlacement
+from engine.hardware.config import ChipSpec, DeviceConfig
 from engine.values.params import Integer, Param
+
+
+def _simulate(vest: SimPlacement, device: DeviceConfig) -> None:
+    assert device.address is not None
+    vest.attach_i2c(device, SimMPR121(device.address))
+
 
 KIND = ChipKind(
     ChipSpec(
@@ -21,4 +28,5 @@ KIND = ChipKind(
             Param("release_threshold", Integer(0, 255), 6, "release threshold, counts"),
         ),
     ),
+    simulate=_simulate,
 )

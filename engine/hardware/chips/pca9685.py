@@ -4,9 +4,10 @@ from __future__ import annotations
 
 from typing import Any
 
+from engine.drivers.sim.pca9685 import SimPCA9685
 from engine.hardware.chips.fields import ChipFields
-from engine.hardware.chips.kind import ChipKind
-from engine.hardware.config import PCA9685_ALL_CALL, ChipSpec
+from engine.hardware.chips.kind import ChipKind, SimPlacement
+from engine.hardware.config import PCA9685_ALL_CALL, ChipSpec, DeviceConfig
 from engine.values.params import REQUIRED, Boolean, Integer, Number, Param
 
 LED_FIELDS = ("red", "green", "blue")
@@ -71,6 +72,11 @@ def _leds(fields: ChipFields) -> dict[str, Any] | None:
     return None if leds is None else {"leds": leds}
 
 
+def _simulate(vest: SimPlacement, device: DeviceConfig) -> None:
+    assert device.address is not None
+    vest.attach_i2c(device, SimPCA9685(vest.clock, device.address))
+
+
 KIND = ChipKind(
     ChipSpec(
         "pca9685",
@@ -86,4 +92,5 @@ KIND = ChipKind(
         fields=("leds",),
     ),
     _leds,
+    simulate=_simulate,
 )

@@ -2,8 +2,15 @@
 
 from __future__ import annotations
 
-from engine.hardware.chips.kind import ChipKind
-from engine.hardware.config import ChipSpec
+from engine.drivers.sim.srf02 import SimSRF02
+from engine.hardware.chips.kind import ChipKind, SimPlacement
+from engine.hardware.config import ChipSpec, DeviceConfig
+
+
+def _simulate(vest: SimPlacement, device: DeviceConfig) -> None:
+    assert device.address is not None
+    vest.attach_i2c(device, SimSRF02(vest.clock, device.address))
+
 
 KIND = ChipKind(
     ChipSpec(
@@ -15,4 +22,5 @@ KIND = ChipKind(
         default_address=0x70,
         outputs={"range": "/sensors/ultrasound/cm"},
     ),
+    simulate=_simulate,
 )

@@ -2,8 +2,13 @@
 
 from __future__ import annotations
 
-from engine.hardware.chips.kind import ChipKind
-from engine.hardware.config import ChipSpec
+from engine.hardware.chips.kind import ChipKind, SimPlacement
+from engine.hardware.config import ChipSpec, DeviceConfig
+
+
+def _simulate(vest: SimPlacement, device: DeviceConfig) -> None:
+    vest.add_mux(device)
+
 
 KIND = ChipKind(
     ChipSpec(
@@ -14,4 +19,5 @@ KIND = ChipKind(
         addresses=tuple(range(0x70, 0x78)),
         default_address=0x70,
     ),
+    simulate=_simulate,
 )

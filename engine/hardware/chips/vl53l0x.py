@@ -4,9 +4,10 @@ from __future__ import annotations
 
 from typing import Any
 
+from engine.drivers.sim.vl53l0x import SimVL53L0X
 from engine.hardware.chips.fields import ChipFields
-from engine.hardware.chips.kind import ChipKind
-from engine.hardware.config import SIDES, VL53L0X_BOOT_ADDRESS, ChipSpec
+from engine.hardware.chips.kind import ChipKind, SimPlacement
+from engine.hardware.config import SIDES, VL53L0X_BOOT_ADDRESS, ChipSpec, DeviceConfig
 from engine.values.params import Choice, Integer, Number, Param, Text
 
 
@@ -59,6 +60,15 @@ def _range_place(fields: ChipFields) -> dict[str, Any] | None:
     return values if ok else None
 
 
+def _simulate(vest: SimPlacement, device: DeviceConfig) -> None:
+    bus = vest.i2c_bus_for(device)
+    if device.xshut is not None:  # in standby until the start-up chain switches it on
+        vest.keep(device, SimVL53L0X(vest.clock, bus, xshut_high=False), bus)
+    else:
+        assert device.address is not None
+        vest.keep(device, SimVL53L0X(vest.clock, bus, device.address), bus)
+
+
 KIND = ChipKind(
     ChipSpec(
         "vl53l0x",
@@ -80,4 +90,5 @@ KIND = ChipKind(
         fields=("side", "xshut", "mux", "channel"),
     ),
     _range_place,
+    simulate=_simulate,
 )

@@ -4,9 +4,10 @@ from __future__ import annotations
 
 from typing import Any
 
+from engine.drivers.sim.zx_gesture import SimZXGesture
 from engine.hardware.chips.fields import ChipFields
-from engine.hardware.chips.kind import ChipKind
-from engine.hardware.config import ENGINE_GESTURES, ZX_GESTURES, ChipSpec
+from engine.hardware.chips.kind import ChipKind, SimPlacement
+from engine.hardware.config import ENGINE_GESTURES, ZX_GESTURES, ChipSpec, DeviceConfig
 from engine.values.params import Choice, did_you_mean
 
 
@@ -40,6 +41,11 @@ def _gesture_names(fields: ChipFields) -> dict[str, Any] | None:
     return None if names is None else {"gesture_names": names}
 
 
+def _simulate(vest: SimPlacement, device: DeviceConfig) -> None:
+    assert device.address is not None
+    vest.attach_i2c(device, SimZXGesture(vest.clock, device.address))
+
+
 KIND = ChipKind(
     ChipSpec(
         "zx_gesture",
@@ -53,4 +59,5 @@ KIND = ChipKind(
         fields=("gesture_names",),
     ),
     _gesture_names,
+    simulate=_simulate,
 )
