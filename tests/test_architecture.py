@@ -13,7 +13,7 @@ MAX_LINES = 420  # "about 400": a module one reads in one sitting
 STILL_TOO_LONG = {
     # waiting for the chip-kind registry, which splits them by chip: they may only shrink
     "engine/hardware/config_check.py": 675,
-    "engine/hardware/assembly.py": 602,
+    "engine/hardware/assembly.py": 570,
     "engine/hardware/services.py": 478,
 }
 

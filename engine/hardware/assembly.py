@@ -46,7 +46,6 @@ from typing import Any, Protocol
 
 from engine.blackboard.board import Blackboard
 from engine.clock import Clock, VirtualClock
-from engine.drivers import mcp9808, mpr121, pca9685, srf02, vl53l0x, zx_gesture
 from engine.drivers.bus_errors import describe_exception
 from engine.drivers.bus_manager import BusManager, DeviceHandle, DeviceStats
 from engine.drivers.gpio import OutputLine
@@ -54,6 +53,7 @@ from engine.drivers.maestro import Maestro
 from engine.drivers.tca9548a import TCA9548A, LockedBus
 from engine.errors import ConfigError, DeviceError
 from engine.hardware.branching_clock import BranchingClock, branch_of
+from engine.hardware.chips import ChipRegistry, default_chips
 from engine.hardware.config import BusConfig, DeviceConfig, RobotConfig
 from engine.hardware.device_health import DeviceHealth
 from engine.hardware.pollers import Poller, PollerThreads, make_poller
@@ -88,46 +88,14 @@ class BusProvider(Protocol):
 
 
 # -- probes: is the chip back, and is it the right chip? ------------------------------------------
-def _expect(what: str, got: object, wanted: object) -> None:
-    if got != wanted:
-        raise DeviceError(f"{what} reads {got!r}, expected {wanted!r}")
-
-
-def probe_for(device: DeviceConfig) -> Callable[[Any], object] | None:
-    """A read of the chip's identity (or of a harmless register) that raises unless it is there."""
-    address = device.address
-    if address is None:
+def probe_for(
+    device: DeviceConfig, chips: ChipRegistry | None = None
+) -> Callable[[Any], object] | None:
+    """The chip kind's read of its identity at the device's address (None: nothing to read)."""
+    kind = (chips or default_chips()).get(device.chip)
+    if device.address is None or kind is None or kind.probe is None:
         return None
-    chip = device.chip
-    if chip == "mpr121":
-        return lambda bus: bus.read_byte_data(address, mpr121.CONFIG2)
-    if chip == "ads1115":
-        return lambda bus: bus.read_i2c_block_data(address, 0x01, 2)
-    if chip == "vl53l0x":
-        return lambda bus: _expect(
-            "VL53L0X model ID",
-            bus.read_byte_data(address, vl53l0x.IDENTIFICATION_MODEL_ID),
-            vl53l0x.IDENTITY[0],
-        )
-    if chip == "zx_gesture":
-        return lambda bus: _expect(
-            "ZX model", bus.read_byte_data(address, zx_gesture.MODEL), zx_gesture.MODEL_ID
-        )
-    if chip == "srf02":
-        return lambda bus: _expect(
-            "SRF02 register 1", bus.read_byte_data(address, srf02.UNUSED), srf02.UNUSED_VALUE
-        )
-    if chip == "mcp9808":
-        return lambda bus: _expect(
-            "MCP9808 manufacturer ID",
-            bus.read_i2c_block_data(address, mcp9808.MANUFACTURER_ID, 2),
-            [0x00, 0x54],
-        )
-    if chip == "pca9685":
-        return lambda bus: bus.read_byte_data(address, pca9685.PRE_SCALE)
-    if chip == "tca9548a":
-        return lambda bus: bus.read_byte(address)
-    return None
+    return kind.probe(device.address)
 
 
 # -- the machine's buses ---------------------------------------------------------------------------

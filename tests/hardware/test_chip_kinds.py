@@ -24,6 +24,11 @@ def test_every_shipped_chip_kind_has_a_simulated_model() -> None:
     assert [kind.name for kind in default_chips() if kind.simulate is None] == []
 
 
+def test_every_shipped_i2c_chip_kind_knows_how_to_probe_for_itself() -> None:
+    i2c = [kind for kind in default_chips() if kind.spec.bus_kind == "i2c"]
+    assert [kind.name for kind in i2c if kind.probe is None] == []
+
+
 def test_a_chip_kind_registered_twice_is_refused() -> None:
     kind = ChipKind(ChipSpec("mpr121", "again", "i2c", "touch"))
     with pytest.raises(ValueError, match="registered twice"):

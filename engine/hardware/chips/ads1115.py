@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Any
 
 from engine.drivers.sim.ads1115 import SimADS1115
@@ -20,6 +21,10 @@ def _pads(fields: ChipFields) -> dict[str, Any] | None:
 def _simulate(vest: SimPlacement, device: DeviceConfig) -> None:
     assert device.address is not None
     vest.attach_i2c(device, SimADS1115(vest.clock, device.address))
+
+
+def _probe(address: int) -> Callable[[Any], object]:
+    return lambda bus: bus.read_i2c_block_data(address, 0x01, 2)
 
 
 KIND = ChipKind(
@@ -44,4 +49,5 @@ KIND = ChipKind(
     ),
     _pads,
     simulate=_simulate,
+    probe=_probe,
 )

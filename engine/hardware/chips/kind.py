@@ -14,6 +14,7 @@ from typing import Any, Protocol
 
 from engine.clock import Clock
 from engine.drivers.sim.i2c_bus import SimI2CBus, SimI2CDevice
+from engine.errors import DeviceError
 from engine.hardware.chips.fields import ChipFields
 from engine.hardware.config import ChipSpec, DeviceConfig
 from engine.scenario.world import World
@@ -54,6 +55,17 @@ class SimPlacement(Protocol):
 
 
 SimModel = Callable[[SimPlacement, DeviceConfig], None]
+Probe = Callable[[int], Callable[[Any], object]]
+"""Given the chip's address, a bus read of its identity (or of a harmless register) that
+raises unless the chip is there: how a device is found and re-probed while offline."""
+
+
+def expect_identity(what: str, got: object, wanted: object) -> None:
+    """Raise when an identity register does not read as the datasheet says."""
+    if got != wanted:
+        raise DeviceError(f"{what} reads {got!r}, expected {wanted!r}")
+
+
 """Puts the register-level model that stands in for a chip into the simulated vest."""
 
 
@@ -65,6 +77,7 @@ class ChipKind:
     spec: ChipSpec
     check_fields: FieldsCheck = no_fields
     simulate: SimModel | None = None
+    probe: Probe | None = None
 
     @property
     def name(self) -> str:

@@ -2,8 +2,12 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from typing import Any
+
+from engine.drivers import mcp9808 as driver
 from engine.drivers.sim.mcp9808 import SimMCP9808
-from engine.hardware.chips.kind import ChipKind, SimPlacement
+from engine.hardware.chips.kind import ChipKind, SimPlacement, expect_identity
 from engine.hardware.config import ChipSpec, DeviceConfig
 from engine.values.params import Choice, Param
 
@@ -12,6 +16,14 @@ def _simulate(vest: SimPlacement, device: DeviceConfig) -> None:
     assert device.address is not None
     model = SimMCP9808(vest.clock, device.address, temperature_c=vest.world.temperature_c)
     vest.attach_i2c(device, model)
+
+
+def _probe(address: int) -> Callable[[Any], object]:
+    return lambda bus: expect_identity(
+        "MCP9808 manufacturer ID",
+        bus.read_i2c_block_data(address, driver.MANUFACTURER_ID, 2),
+        [0x00, 0x54],
+    )
 
 
 KIND = ChipKind(
@@ -33,4 +45,5 @@ KIND = ChipKind(
         ),
     ),
     simulate=_simulate,
+    probe=_probe,
 )

@@ -2,6 +2,10 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from typing import Any
+
+from engine.drivers import mpr121 as driver
 from engine.drivers.sim.mpr121 import SimMPR121
 from engine.hardware.chips.kind import ChipKind, SimPlacement
 from engine.hardware.config import ChipSpec, DeviceConfig
@@ -11,6 +15,10 @@ from engine.values.params import Integer, Param
 def _simulate(vest: SimPlacement, device: DeviceConfig) -> None:
     assert device.address is not None
     vest.attach_i2c(device, SimMPR121(device.address))
+
+
+def _probe(address: int) -> Callable[[Any], object]:
+    return lambda bus: bus.read_byte_data(address, driver.CONFIG2)
 
 
 KIND = ChipKind(
@@ -29,4 +37,5 @@ KIND = ChipKind(
         ),
     ),
     simulate=_simulate,
+    probe=_probe,
 )

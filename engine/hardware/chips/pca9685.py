@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Any
 
+from engine.drivers import pca9685 as driver
 from engine.drivers.sim.pca9685 import SimPCA9685
 from engine.hardware.chips.fields import ChipFields
 from engine.hardware.chips.kind import ChipKind, SimPlacement
@@ -77,6 +79,10 @@ def _simulate(vest: SimPlacement, device: DeviceConfig) -> None:
     vest.attach_i2c(device, SimPCA9685(vest.clock, device.address))
 
 
+def _probe(address: int) -> Callable[[Any], object]:
+    return lambda bus: bus.read_byte_data(address, driver.PRE_SCALE)
+
+
 KIND = ChipKind(
     ChipSpec(
         "pca9685",
@@ -93,4 +99,5 @@ KIND = ChipKind(
     ),
     _leds,
     simulate=_simulate,
+    probe=_probe,
 )

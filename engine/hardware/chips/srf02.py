@@ -2,14 +2,24 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from typing import Any
+
+from engine.drivers import srf02 as driver
 from engine.drivers.sim.srf02 import SimSRF02
-from engine.hardware.chips.kind import ChipKind, SimPlacement
+from engine.hardware.chips.kind import ChipKind, SimPlacement, expect_identity
 from engine.hardware.config import ChipSpec, DeviceConfig
 
 
 def _simulate(vest: SimPlacement, device: DeviceConfig) -> None:
     assert device.address is not None
     vest.attach_i2c(device, SimSRF02(vest.clock, device.address))
+
+
+def _probe(address: int) -> Callable[[Any], object]:
+    return lambda bus: expect_identity(
+        "SRF02 register 1", bus.read_byte_data(address, driver.UNUSED), driver.UNUSED_VALUE
+    )
 
 
 KIND = ChipKind(
@@ -23,4 +33,5 @@ KIND = ChipKind(
         outputs={"range": "/sensors/ultrasound/cm"},
     ),
     simulate=_simulate,
+    probe=_probe,
 )

@@ -2,12 +2,19 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from typing import Any
+
 from engine.hardware.chips.kind import ChipKind, SimPlacement
 from engine.hardware.config import ChipSpec, DeviceConfig
 
 
 def _simulate(vest: SimPlacement, device: DeviceConfig) -> None:
     vest.add_mux(device)
+
+
+def _probe(address: int) -> Callable[[Any], object]:
+    return lambda bus: bus.read_byte(address)
 
 
 KIND = ChipKind(
@@ -20,4 +27,5 @@ KIND = ChipKind(
         default_address=0x70,
     ),
     simulate=_simulate,
+    probe=_probe,
 )

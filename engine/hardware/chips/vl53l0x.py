@@ -2,11 +2,13 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Any
 
+from engine.drivers import vl53l0x as driver
 from engine.drivers.sim.vl53l0x import SimVL53L0X
 from engine.hardware.chips.fields import ChipFields
-from engine.hardware.chips.kind import ChipKind, SimPlacement
+from engine.hardware.chips.kind import ChipKind, SimPlacement, expect_identity
 from engine.hardware.config import SIDES, VL53L0X_BOOT_ADDRESS, ChipSpec, DeviceConfig
 from engine.values.params import Choice, Integer, Number, Param, Text
 
@@ -69,6 +71,14 @@ def _simulate(vest: SimPlacement, device: DeviceConfig) -> None:
         vest.keep(device, SimVL53L0X(vest.clock, bus, device.address), bus)
 
 
+def _probe(address: int) -> Callable[[Any], object]:
+    return lambda bus: expect_identity(
+        "VL53L0X model ID",
+        bus.read_byte_data(address, driver.IDENTIFICATION_MODEL_ID),
+        driver.IDENTITY[0],
+    )
+
+
 KIND = ChipKind(
     ChipSpec(
         "vl53l0x",
@@ -91,4 +101,5 @@ KIND = ChipKind(
     ),
     _range_place,
     simulate=_simulate,
+    probe=_probe,
 )

@@ -2,11 +2,13 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Any
 
+from engine.drivers import zx_gesture as driver
 from engine.drivers.sim.zx_gesture import SimZXGesture
 from engine.hardware.chips.fields import ChipFields
-from engine.hardware.chips.kind import ChipKind, SimPlacement
+from engine.hardware.chips.kind import ChipKind, SimPlacement, expect_identity
 from engine.hardware.config import ENGINE_GESTURES, ZX_GESTURES, ChipSpec, DeviceConfig
 from engine.values.params import Choice, did_you_mean
 
@@ -46,6 +48,12 @@ def _simulate(vest: SimPlacement, device: DeviceConfig) -> None:
     vest.attach_i2c(device, SimZXGesture(vest.clock, device.address))
 
 
+def _probe(address: int) -> Callable[[Any], object]:
+    return lambda bus: expect_identity(
+        "ZX model", bus.read_byte_data(address, driver.MODEL), driver.MODEL_ID
+    )
+
+
 KIND = ChipKind(
     ChipSpec(
         "zx_gesture",
@@ -60,4 +68,5 @@ KIND = ChipKind(
     ),
     _gesture_names,
     simulate=_simulate,
+    probe=_probe,
 )
