@@ -16,7 +16,7 @@ from engine.drivers.bus_errors import describe_exception
 from engine.errors import VestError
 from engine.hardware.assembly import Hardware, probe_for
 from engine.hardware.config import DeviceConfig
-from engine.hardware.pollers import Staged
+from engine.hardware.readings import Staged
 
 COLUMNS = ("device", "chip", "where", "identity", "reading")
 WAIT_S = 2.0  # real seconds to wait for one answer on a busy threaded bus

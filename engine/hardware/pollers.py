@@ -1,14 +1,10 @@
 """Pollers (the paper's "hardware nodes"): each polled device read at its rate, staged.
 
 A :class:`Poller` owns one device's driver. At its rate it reads the device through the
-device's bus-manager handle and stages what it read onto the blackboard:
-
-- touch (MPR121): ``/sensors/touch/pads`` (12 booleans) and ``/sensors/touch/any``;
-- force (ADS1115 or MCP3008 + FSR 406): each pad's volts through its
-  :class:`~engine.drivers.force_calibration.ForceCalibration`, ``/sensors/force/left_n``...;
-- range (VL53L0X): ``/sensors/range/<side>_mm``, ``None`` when nothing is in range;
-- gesture (ZX): one event on ``/sensors/gesture/last`` per gesture, named as the config's
-  ``gesture_names`` say.
+device's bus-manager handle and stages what it read onto the blackboard. What a reading
+is comes from the chip's kind (:mod:`engine.hardware.chips`, its ``poll``): touch pads
+and "any", each force pad's newtons through its calibration, a range in mm (``None``
+when nothing is in range), one event per gesture.
 
 Two ways to run them, same code:
 
@@ -36,38 +32,23 @@ import math
 import threading
 from collections import deque
 from collections.abc import Callable, Iterable, Sequence
-from dataclasses import dataclass
 from typing import Any, Generic, TypeVar
 
 from engine.blackboard.board import Blackboard
 from engine.clock import Clock
-from engine.drivers.ads1115 import ADS1115
 from engine.drivers.bus_errors import describe_exception
-from engine.drivers.bus_manager import DeviceHandle, Priority
+from engine.drivers.bus_manager import DeviceHandle
 from engine.drivers.device_errors import ImplausibleReadingError
-from engine.drivers.force_calibration import ForceCalibration
-from engine.drivers.mcp3008 import MCP3008
-from engine.drivers.mpr121 import MPR121, PADS
-from engine.drivers.vl53l0x import VL53L0X
-from engine.drivers.zx_gesture import ZXGesture
 from engine.hardware.branching_clock import branch_of
+from engine.hardware.chips import ChipRegistry, default_chips
 from engine.hardware.config import DeviceConfig
 from engine.hardware.device_health import DeviceHealth
-from engine.hardware.managed_buses import ManagedI2C, ManagedSpi
+from engine.hardware.readings import PollSetup, Staged
 from engine.hardware.xshut import XshutChain
 
 _log = logging.getLogger("vest.pollers")
 
 D = TypeVar("D")
-
-
-@dataclass(frozen=True)
-class Staged:
-    """One blackboard write a poll makes: ``key = value``, or an event when ``event``."""
-
-    key: str
-    value: Any
-    event: bool = False
 
 
 class Poller(Generic[D]):
@@ -295,25 +276,17 @@ def make_poller(
     blackboard: Blackboard,
     health: DeviceHealth,
     chain: XshutChain | None = None,
+    chips: ChipRegistry | None = None,
 ) -> Poller[Any]:
     """The poller for a polled device of the config (touch, force, range, gesture).
 
     ``chain``: the XSHUT chain of a VL53L0X on one, which brings the chip back when it no
     longer answers at its address.
     """
-    makers = {
-        "touch": _touch,
-        "force": _force,
-        "range": _range,
-        "gesture": _gesture,
-    }
-    maker = makers.get(device.role)
-    if maker is None or device.rate_hz is None:
+    kind = (chips or default_chips()).get(device.chip)
+    if kind is None or kind.poll is None or device.rate_hz is None:
         raise ValueError(f"device {device.name!r} ({device.chip}) is not polled")
-    if device.role == "range":
-        connect, read, rest = _range(device, handle, clock, chain)
-    else:
-        connect, read, rest = maker(device, handle, clock)
+    connect, read, rest = kind.poll(PollSetup(device, handle, clock, chain))
 
     def read_counted(driver: Any) -> Sequence[Staged]:
         try:
@@ -332,87 +305,3 @@ def make_poller(
         read=read_counted,
         rest=rest,
     )
-
-
-Parts = tuple[Callable[[], Any], Callable[[Any], Sequence[Staged]], Sequence[Staged]]
-
-
-def _touch(device: DeviceConfig, handle: DeviceHandle[Any], clock: Clock) -> Parts:
-    pads_key, any_key = device.keys["pads"], device.keys["any"]
-
-    def connect() -> MPR121:
-        return MPR121(ManagedI2C(handle), address=_address(device), **device.options)
-
-    def read(driver: MPR121) -> list[Staged]:
-        pads = driver.touched()
-        return [Staged(pads_key, pads), Staged(any_key, any(pads))]
-
-    return connect, read, [Staged(pads_key, [False] * PADS), Staged(any_key, False)]
-
-
-def _force(device: DeviceConfig, handle: DeviceHandle[Any], clock: Clock) -> Parts:
-    calibrations = [(pad, ForceCalibration(pad.calibration)) for pad in device.pads]
-
-    def connect() -> ADS1115 | MCP3008:
-        if device.chip == "mcp3008":
-            return MCP3008(ManagedSpi(handle), **device.options)
-        return ADS1115(ManagedI2C(handle), address=_address(device), clock=clock, **device.options)
-
-    def read(driver: ADS1115 | MCP3008) -> list[Staged]:
-        return [
-            Staged(pad.key, calibration.newtons(driver.read_volts(pad.channel)))
-            for pad, calibration in calibrations
-        ]
-
-    return connect, read, [Staged(pad.key, 0.0) for pad in device.pads]
-
-
-def _range(
-    device: DeviceConfig,
-    handle: DeviceHandle[Any],
-    clock: Clock,
-    chain: XshutChain | None = None,
-) -> Parts:
-    key = device.keys["range"]
-    address = _address(device)
-
-    def connect() -> VL53L0X:
-        try:
-            return VL53L0X(ManagedI2C(handle), address=address, clock=clock, **device.options)
-        except OSError:
-            # Not at its address: power-cycled (back at 0x29), or left in standby at start-up.
-            if chain is None or not chain.may_reboot(device.name):
-                raise
-        chain.reboot(device.name)
-        # Ahead of the polls, which the bus manager refuses while it has the chip offline.
-        bus = ManagedI2C(handle, priority=Priority.REQUEST)
-        driver = VL53L0X(bus, address=address, clock=clock, **device.options)
-        bus.priority = Priority.POLL
-        return driver
-
-    def read(driver: VL53L0X) -> list[Staged]:
-        distance_mm = driver.read_range_mm()
-        return [Staged(key, None if distance_mm is None else float(distance_mm))]
-
-    return connect, read, [Staged(key, None)]
-
-
-def _gesture(device: DeviceConfig, handle: DeviceHandle[Any], clock: Clock) -> Parts:
-    key = device.keys["gesture"]
-    names = device.gesture_names
-
-    def connect() -> ZXGesture:
-        return ZXGesture(ManagedI2C(handle), address=_address(device))
-
-    def read(driver: ZXGesture) -> list[Staged]:
-        gesture = driver.read_gesture()
-        if gesture is None:
-            return []
-        return [Staged(key, names.get(gesture, gesture), event=True)]
-
-    return connect, read, []
-
-
-def _address(device: DeviceConfig) -> int:
-    assert device.address is not None, f"{device.name} is an I2C device"
-    return device.address

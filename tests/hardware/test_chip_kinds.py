@@ -29,6 +29,11 @@ def test_every_shipped_i2c_chip_kind_knows_how_to_probe_for_itself() -> None:
     assert [kind.name for kind in i2c if kind.probe is None] == []
 
 
+def test_the_polled_chip_kinds_are_the_ones_with_a_poller() -> None:
+    chips = default_chips()
+    assert [k.name for k in chips if k.poll is not None] == [k.name for k in chips if k.spec.polled]
+
+
 def test_a_chip_kind_registered_twice_is_refused() -> None:
     kind = ChipKind(ChipSpec("mpr121", "again", "i2c", "touch"))
     with pytest.raises(ValueError, match="registered twice"):

@@ -21,7 +21,8 @@ from engine.hardware.branching_clock import BranchingClock
 from engine.hardware.chips import default_chips
 from engine.hardware.config import ChipSpec, DeviceConfig, ForcePad
 from engine.hardware.device_health import DeviceHealth
-from engine.hardware.pollers import Poller, PollerThreads, Staged, make_poller
+from engine.hardware.pollers import Poller, PollerThreads, make_poller
+from engine.hardware.readings import Staged
 from engine.hardware.sim_vest import SpiSocket
 
 HERE = Mark("test", 1, 1)

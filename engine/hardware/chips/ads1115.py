@@ -5,11 +5,14 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
+from engine.drivers.ads1115 import ADS1115
 from engine.drivers.sim.ads1115 import SimADS1115
 from engine.hardware.chips.fields import ChipFields
-from engine.hardware.chips.force_pads import force_pads
+from engine.hardware.chips.force_pads import force_pads, force_poll
 from engine.hardware.chips.kind import ChipKind, SimPlacement
 from engine.hardware.config import ChipSpec, DeviceConfig
+from engine.hardware.managed_buses import ManagedI2C
+from engine.hardware.readings import PollParts, PollSetup
 from engine.values.params import Choice, Param
 
 
@@ -25,6 +28,18 @@ def _simulate(vest: SimPlacement, device: DeviceConfig) -> None:
 
 def _probe(address: int) -> Callable[[Any], object]:
     return lambda bus: bus.read_i2c_block_data(address, 0x01, 2)
+
+
+def _poll(setup: PollSetup) -> PollParts:
+    return force_poll(
+        setup.device,
+        lambda: ADS1115(
+            ManagedI2C(setup.handle),
+            address=setup.address,
+            clock=setup.clock,
+            **setup.device.options,
+        ),
+    )
 
 
 KIND = ChipKind(
@@ -50,4 +65,5 @@ KIND = ChipKind(
     _pads,
     simulate=_simulate,
     probe=_probe,
+    poll=_poll,
 )

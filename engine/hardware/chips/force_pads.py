@@ -4,11 +4,21 @@ calibration table, as the robot config names them."""
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
+from typing import Protocol
 
+from engine.drivers.force_calibration import ForceCalibration
 from engine.files.yaml_source import YList, YValue, describe, plain
 from engine.hardware.chips.fields import ChipFields
-from engine.hardware.config import ForcePad
+from engine.hardware.config import DeviceConfig, ForcePad
+from engine.hardware.readings import PollParts, Staged
 from engine.values.params import REQUIRED, Integer, Key, Param
+
+
+class ForceReader(Protocol):
+    """An ADC driver that reads one input in volts (ADS1115, MCP3008)."""
+
+    def read_volts(self, channel: int) -> float: ...
 
 
 def force_pads(fields: ChipFields, channels: int) -> tuple[ForcePad, ...] | None:
@@ -145,3 +155,16 @@ def _calibration(fields: ChipFields, raw: YValue) -> tuple[tuple[float, float], 
         )
         ok = False
     return tuple(points) if ok else None
+
+
+def force_poll(device: DeviceConfig, connect: Callable[[], ForceReader]) -> PollParts:
+    """The poller parts of an ADC's force pads: each pad's volts through its calibration."""
+    calibrations = [(pad, ForceCalibration(pad.calibration)) for pad in device.pads]
+
+    def read(driver: ForceReader) -> list[Staged]:
+        return [
+            Staged(pad.key, calibration.newtons(driver.read_volts(pad.channel)))
+            for pad, calibration in calibrations
+        ]
+
+    return connect, read, [Staged(pad.key, 0.0) for pad in device.pads]

@@ -17,6 +17,7 @@ from engine.drivers.sim.i2c_bus import SimI2CBus, SimI2CDevice
 from engine.errors import DeviceError
 from engine.hardware.chips.fields import ChipFields
 from engine.hardware.config import ChipSpec, DeviceConfig
+from engine.hardware.readings import PollMaker
 from engine.scenario.world import World
 
 FieldsCheck = Callable[[ChipFields], dict[str, Any] | None]
@@ -78,6 +79,8 @@ class ChipKind:
     check_fields: FieldsCheck = no_fields
     simulate: SimModel | None = None
     probe: Probe | None = None
+    poll: PollMaker | None = None
+    """For a polled chip: how its poller connects, reads and rests (engine.hardware.readings)."""
 
     @property
     def name(self) -> str:

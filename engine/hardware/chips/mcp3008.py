@@ -4,10 +4,13 @@ from __future__ import annotations
 
 from typing import Any
 
+from engine.drivers.mcp3008 import MCP3008
 from engine.hardware.chips.fields import ChipFields
-from engine.hardware.chips.force_pads import force_pads
+from engine.hardware.chips.force_pads import force_pads, force_poll
 from engine.hardware.chips.kind import ChipKind, SimPlacement
 from engine.hardware.config import ChipSpec, DeviceConfig
+from engine.hardware.managed_buses import ManagedSpi
+from engine.hardware.readings import PollParts, PollSetup
 from engine.values.params import Integer, Number, Param
 
 
@@ -18,6 +21,12 @@ def _pads(fields: ChipFields) -> dict[str, Any] | None:
 
 def _simulate(vest: SimPlacement, device: DeviceConfig) -> None:
     vest.add_spi(device)
+
+
+def _poll(setup: PollSetup) -> PollParts:
+    return force_poll(
+        setup.device, lambda: MCP3008(ManagedSpi(setup.handle), **setup.device.options)
+    )
 
 
 KIND = ChipKind(
@@ -35,4 +44,5 @@ KIND = ChipKind(
     ),
     _pads,
     simulate=_simulate,
+    poll=_poll,
 )

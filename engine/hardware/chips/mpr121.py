@@ -6,9 +6,12 @@ from collections.abc import Callable
 from typing import Any
 
 from engine.drivers import mpr121 as driver
+from engine.drivers.mpr121 import MPR121, PADS
 from engine.drivers.sim.mpr121 import SimMPR121
 from engine.hardware.chips.kind import ChipKind, SimPlacement
 from engine.hardware.config import ChipSpec, DeviceConfig
+from engine.hardware.managed_buses import ManagedI2C
+from engine.hardware.readings import PollParts, PollSetup, Staged
 from engine.values.params import Integer, Param
 
 
@@ -19,6 +22,20 @@ def _simulate(vest: SimPlacement, device: DeviceConfig) -> None:
 
 def _probe(address: int) -> Callable[[Any], object]:
     return lambda bus: bus.read_byte_data(address, driver.CONFIG2)
+
+
+def _poll(setup: PollSetup) -> PollParts:
+    device = setup.device
+    pads_key, any_key = device.keys["pads"], device.keys["any"]
+
+    def connect() -> MPR121:
+        return MPR121(ManagedI2C(setup.handle), address=setup.address, **device.options)
+
+    def read(driver: MPR121) -> list[Staged]:
+        pads = driver.touched()
+        return [Staged(pads_key, pads), Staged(any_key, any(pads))]
+
+    return connect, read, [Staged(pads_key, [False] * PADS), Staged(any_key, False)]
 
 
 KIND = ChipKind(
@@ -38,4 +55,5 @@ KIND = ChipKind(
     ),
     simulate=_simulate,
     probe=_probe,
+    poll=_poll,
 )

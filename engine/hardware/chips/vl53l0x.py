@@ -6,10 +6,14 @@ from collections.abc import Callable
 from typing import Any
 
 from engine.drivers import vl53l0x as driver
+from engine.drivers.bus_manager import Priority
 from engine.drivers.sim.vl53l0x import SimVL53L0X
+from engine.drivers.vl53l0x import VL53L0X
 from engine.hardware.chips.fields import ChipFields
 from engine.hardware.chips.kind import ChipKind, SimPlacement, expect_identity
 from engine.hardware.config import SIDES, VL53L0X_BOOT_ADDRESS, ChipSpec, DeviceConfig
+from engine.hardware.managed_buses import ManagedI2C
+from engine.hardware.readings import PollParts, PollSetup, Staged
 from engine.values.params import Choice, Integer, Number, Param, Text
 
 
@@ -79,6 +83,32 @@ def _probe(address: int) -> Callable[[Any], object]:
     )
 
 
+def _poll(setup: PollSetup) -> PollParts:
+    device, handle, clock, chain = setup.device, setup.handle, setup.clock, setup.chain
+    key = device.keys["range"]
+    address = setup.address
+
+    def connect() -> VL53L0X:
+        try:
+            return VL53L0X(ManagedI2C(handle), address=address, clock=clock, **device.options)
+        except OSError:
+            # Not at its address: power-cycled (back at 0x29), or left in standby at start-up.
+            if chain is None or not chain.may_reboot(device.name):
+                raise
+        chain.reboot(device.name)
+        # Ahead of the polls, which the bus manager refuses while it has the chip offline.
+        bus = ManagedI2C(handle, priority=Priority.REQUEST)
+        driver = VL53L0X(bus, address=address, clock=clock, **device.options)
+        bus.priority = Priority.POLL
+        return driver
+
+    def read(driver: VL53L0X) -> list[Staged]:
+        distance_mm = driver.read_range_mm()
+        return [Staged(key, None if distance_mm is None else float(distance_mm))]
+
+    return connect, read, [Staged(key, None)]
+
+
 KIND = ChipKind(
     ChipSpec(
         "vl53l0x",
@@ -102,4 +132,5 @@ KIND = ChipKind(
     _range_place,
     simulate=_simulate,
     probe=_probe,
+    poll=_poll,
 )

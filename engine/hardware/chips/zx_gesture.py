@@ -7,9 +7,12 @@ from typing import Any
 
 from engine.drivers import zx_gesture as driver
 from engine.drivers.sim.zx_gesture import SimZXGesture
+from engine.drivers.zx_gesture import ZXGesture
 from engine.hardware.chips.fields import ChipFields
 from engine.hardware.chips.kind import ChipKind, SimPlacement, expect_identity
 from engine.hardware.config import ENGINE_GESTURES, ZX_GESTURES, ChipSpec, DeviceConfig
+from engine.hardware.managed_buses import ManagedI2C
+from engine.hardware.readings import PollParts, PollSetup, Staged
 from engine.values.params import Choice, did_you_mean
 
 
@@ -54,6 +57,22 @@ def _probe(address: int) -> Callable[[Any], object]:
     )
 
 
+def _poll(setup: PollSetup) -> PollParts:
+    key = setup.device.keys["gesture"]
+    names = setup.device.gesture_names
+
+    def connect() -> ZXGesture:
+        return ZXGesture(ManagedI2C(setup.handle), address=setup.address)
+
+    def read(driver: ZXGesture) -> list[Staged]:
+        gesture = driver.read_gesture()
+        if gesture is None:
+            return []
+        return [Staged(key, names.get(gesture, gesture), event=True)]
+
+    return connect, read, []
+
+
 KIND = ChipKind(
     ChipSpec(
         "zx_gesture",
@@ -69,4 +88,5 @@ KIND = ChipKind(
     _gesture_names,
     simulate=_simulate,
     probe=_probe,
+    poll=_poll,
 )
