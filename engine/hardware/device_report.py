@@ -10,11 +10,11 @@ takes 66 ms), so it is for the command line, not for a running robot's ticks.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
 
 from engine.drivers.bus_errors import describe_exception
 from engine.errors import VestError
 from engine.hardware.assembly import Hardware, probe_for
+from engine.hardware.chips import default_chips
 from engine.hardware.config import DeviceConfig
 from engine.hardware.readings import Staged
 
@@ -104,17 +104,7 @@ def _reading(hardware: Hardware, device: DeviceConfig) -> str:
 
 
 def _show_writes(device: DeviceConfig, writes: list[Staged]) -> str:
-    role = device.role
-    if role == "touch":
-        pads = next((w.value for w in writes if isinstance(w.value, list)), [])
-        touched = [str(pad) for pad, on in enumerate(pads) if on]
-        return "pads touched: " + (", ".join(touched) or "none")
-    if role == "force":
-        names = {pad.key: pad.name for pad in device.pads}
-        return ", ".join(f"{names.get(w.key, w.key)} {w.value:.1f} N" for w in writes)
-    if role == "range":
-        value: Any = writes[0].value if writes else None
-        return "nothing in range" if value is None else f"{value:.0f} mm"
-    if role == "gesture":
-        return "gesture: " + (str(writes[0].value) if writes else "none")
+    kind = default_chips().get(device.chip)
+    if kind is not None and kind.show is not None:
+        return kind.show(device, writes)
     return ", ".join(f"{w.key}={w.value!r}" for w in writes)

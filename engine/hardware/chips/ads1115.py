@@ -8,7 +8,7 @@ from typing import Any
 from engine.drivers.ads1115 import ADS1115
 from engine.drivers.sim.ads1115 import SimADS1115
 from engine.hardware.chips.fields import ChipFields
-from engine.hardware.chips.force_pads import force_pads, force_poll
+from engine.hardware.chips.force_pads import force_pads, force_poll, show_forces
 from engine.hardware.chips.kind import ChipKind, SimPlacement
 from engine.hardware.config import ChipSpec, DeviceConfig
 from engine.hardware.managed_buses import ManagedI2C
@@ -66,4 +66,5 @@ KIND = ChipKind(
     simulate=_simulate,
     probe=_probe,
     poll=_poll,
+    show=show_forces,
 )

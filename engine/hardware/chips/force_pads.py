@@ -4,7 +4,7 @@ calibration table, as the robot config names them."""
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from typing import Protocol
 
 from engine.drivers.force_calibration import ForceCalibration
@@ -168,3 +168,9 @@ def force_poll(device: DeviceConfig, connect: Callable[[], ForceReader]) -> Poll
         ]
 
     return connect, read, [Staged(pad.key, 0.0) for pad in device.pads]
+
+
+def show_forces(device: DeviceConfig, writes: Sequence[Staged]) -> str:
+    """``left 6.0 N, right 0.0 N``: one reading of the pads, as ``vest devices`` prints it."""
+    names = {pad.key: pad.name for pad in device.pads}
+    return ", ".join(f"{names.get(w.key, w.key)} {w.value:.1f} N" for w in writes)

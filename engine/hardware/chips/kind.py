@@ -8,7 +8,7 @@ gathers them into a :class:`ChipRegistry` object, handed to whoever needs it (no
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
 from typing import Any, Protocol
 
@@ -17,7 +17,7 @@ from engine.drivers.sim.i2c_bus import SimI2CBus, SimI2CDevice
 from engine.errors import DeviceError
 from engine.hardware.chips.fields import ChipFields
 from engine.hardware.config import ChipSpec, DeviceConfig
-from engine.hardware.readings import PollMaker
+from engine.hardware.readings import PollMaker, Staged
 from engine.scenario.world import World
 
 FieldsCheck = Callable[[ChipFields], dict[str, Any] | None]
@@ -56,6 +56,7 @@ class SimPlacement(Protocol):
 
 
 SimModel = Callable[[SimPlacement, DeviceConfig], None]
+ShowReading = Callable[[DeviceConfig, Sequence[Staged]], str]
 Probe = Callable[[int], Callable[[Any], object]]
 """Given the chip's address, a bus read of its identity (or of a harmless register) that
 raises unless the chip is there: how a device is found and re-probed while offline."""
@@ -81,6 +82,8 @@ class ChipKind:
     probe: Probe | None = None
     poll: PollMaker | None = None
     """For a polled chip: how its poller connects, reads and rests (engine.hardware.readings)."""
+    show: ShowReading | None = None
+    """For a polled chip: one reading in words, as ``vest devices`` prints it."""
 
     @property
     def name(self) -> str:

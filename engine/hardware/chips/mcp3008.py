@@ -6,7 +6,7 @@ from typing import Any
 
 from engine.drivers.mcp3008 import MCP3008
 from engine.hardware.chips.fields import ChipFields
-from engine.hardware.chips.force_pads import force_pads, force_poll
+from engine.hardware.chips.force_pads import force_pads, force_poll, show_forces
 from engine.hardware.chips.kind import ChipKind, SimPlacement
 from engine.hardware.config import ChipSpec, DeviceConfig
 from engine.hardware.managed_buses import ManagedSpi
@@ -45,4 +45,5 @@ KIND = ChipKind(
     _pads,
     simulate=_simulate,
     poll=_poll,
+    show=show_forces,
 )

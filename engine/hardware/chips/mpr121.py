@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from typing import Any
 
 from engine.drivers import mpr121 as driver
@@ -38,6 +38,12 @@ def _poll(setup: PollSetup) -> PollParts:
     return connect, read, [Staged(pads_key, [False] * PADS), Staged(any_key, False)]
 
 
+def _show(device: DeviceConfig, writes: Sequence[Staged]) -> str:
+    pads = next((w.value for w in writes if isinstance(w.value, list)), [])
+    touched = [str(pad) for pad, on in enumerate(pads) if on]
+    return "pads touched: " + (", ".join(touched) or "none")
+
+
 KIND = ChipKind(
     ChipSpec(
         "mpr121",
@@ -56,4 +62,5 @@ KIND = ChipKind(
     simulate=_simulate,
     probe=_probe,
     poll=_poll,
+    show=_show,
 )

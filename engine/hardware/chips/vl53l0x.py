@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from typing import Any
 
 from engine.drivers import vl53l0x as driver
@@ -109,6 +109,11 @@ def _poll(setup: PollSetup) -> PollParts:
     return connect, read, [Staged(key, None)]
 
 
+def _show(device: DeviceConfig, writes: Sequence[Staged]) -> str:
+    value = writes[0].value if writes else None
+    return "nothing in range" if value is None else f"{value:.0f} mm"
+
+
 KIND = ChipKind(
     ChipSpec(
         "vl53l0x",
@@ -133,4 +138,5 @@ KIND = ChipKind(
     simulate=_simulate,
     probe=_probe,
     poll=_poll,
+    show=_show,
 )

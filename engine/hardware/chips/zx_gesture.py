@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from typing import Any
 
 from engine.drivers import zx_gesture as driver
@@ -73,6 +73,10 @@ def _poll(setup: PollSetup) -> PollParts:
     return connect, read, []
 
 
+def _show(device: DeviceConfig, writes: Sequence[Staged]) -> str:
+    return "gesture: " + (str(writes[0].value) if writes else "none")
+
+
 KIND = ChipKind(
     ChipSpec(
         "zx_gesture",
@@ -89,4 +93,5 @@ KIND = ChipKind(
     simulate=_simulate,
     probe=_probe,
     poll=_poll,
+    show=_show,
 )
