@@ -15,9 +15,9 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from engine.blackboard.catalogue import KeyCatalogue, KeySpec, default_catalogue
-from engine.drivers import mpr121
 from engine.errors import ConfigError
 from engine.files.problems import LoadError, Problem, Problems
+from engine.hardware.chips import default_chips
 from engine.hardware.config import RobotConfig
 from engine.hardware.config_file import load_robot_config
 from engine.hardware.sim_vest import check_fault_events
@@ -94,13 +94,21 @@ def robot_catalogue(
 
 
 def list_lengths(config: RobotConfig | None) -> dict[str, int]:
-    """How many items each list key holds on this robot (a touch chip's pads)."""
-    devices = config.devices.values() if config is not None else ()
-    lengths = {
-        d.keys["pads"]: mpr121.PADS for d in devices if d.chip == "mpr121" and "pads" in d.keys
-    }
-    if config is None:  # without a robot, the vest's own MPR121
-        lengths["/sensors/touch/pads"] = mpr121.PADS
+    """How many items each list key holds on this robot (a touch chip's pads); without a
+    robot, the chips' default keys."""
+    chips = default_chips()
+    lengths: dict[str, int] = {}
+    if config is None:
+        for kind in chips:
+            for output, length in kind.list_lengths:
+                if kind.spec.outputs.get(output):
+                    lengths[kind.spec.outputs[output]] = length
+        return lengths
+    for device in config.devices.values():
+        chip_kind = chips.get(device.chip)
+        for output, length in chip_kind.list_lengths if chip_kind is not None else ():
+            if output in device.keys:
+                lengths[device.keys[output]] = length
     return lengths
 
 

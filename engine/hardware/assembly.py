@@ -367,7 +367,7 @@ class _Assembler:
         for device in config.devices.values():
             self.hw.health[device.name] = DeviceHealth(device.name, self.blackboard)
         used = {device.bus for device in config.devices.values()}
-        muxed = {device.bus for device in config.devices.values() if device.chip == "tca9548a"}
+        muxed = {device.bus for device in config.devices.values() if device.role == "mux"}
         for bus in config.buses.values():
             if bus.name in used and bus.kind != "serial":
                 opened = (
@@ -383,18 +383,18 @@ class _Assembler:
                 name = str(bus.number) if bus.kind == "i2c" else bus.path
                 self.hw.managers[bus.name] = self._manager(opened, name=name, kind=bus.kind.upper())
         for device in config.devices.values():
-            if device.chip == "tca9548a":
+            if device.role == "mux":
                 self._mux(device)
         for bus in config.buses.values():
             chain = [
                 d
                 for d in config.devices.values()
-                if d.bus == bus.name and d.chip == "vl53l0x" and d.xshut is not None
+                if d.bus == bus.name and d.xshut is not None  # re-addressed by XSHUT
             ]
             if chain:
                 self._xshut_chain(bus, chain)
         for device in config.devices.values():
-            if device.chip != "tca9548a":
+            if device.role != "mux":
                 self._device(device)
         if home_servos and self.hw.servos is not None:
             try:

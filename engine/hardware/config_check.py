@@ -17,7 +17,6 @@ from pathlib import Path
 from typing import Any
 
 from engine.blackboard.catalogue import KeyCatalogue
-from engine.drivers.mpr121 import check_thresholds
 from engine.files.problems import Mark, Problems
 from engine.files.yaml_source import YMap, YScalar, YValue, describe, plain
 from engine.hardware.chips import ChipRegistry, default_chips
@@ -273,7 +272,7 @@ class ConfigChecker:
         address = self._address(raw, spec)
         rate_hz = self._rate(raw, spec)
         options = self._options(raw, spec)
-        extra = kind.check_fields(ChipFields(self, name, raw, spec))
+        extra = kind.check_fields(ChipFields(self, name, raw, spec, options))
         keys = self._keys(raw, spec, (extra or {}).get("side"))
         if bus is None or options is None or extra is None or keys is None:
             return None
@@ -388,13 +387,6 @@ class ConfigChecker:
                 ok = False
                 continue
             values[param.name] = _numeric_choice(param.name, converted)
-        if ok and spec.chip == "mpr121":
-            try:  # the driver refuses these; say so now rather than at start-up
-                check_thresholds(values["touch_threshold"], values["release_threshold"])
-            except ValueError as error:
-                where = raw.get("release_threshold") or raw.get("touch_threshold") or raw
-                self.problems.add(where.mark, str(error), "release_threshold <= touch_threshold")
-                ok = False
         return values if ok else None
 
     def _keys(self, raw: YMap, spec: ChipSpec, side: str | None) -> dict[str, str] | None:

@@ -42,6 +42,8 @@ class ChipFields:
     name: str
     raw: YMap
     spec: ChipSpec
+    options: dict[str, Any] | None = None
+    """The driver's options, converted (None when one of them has a problem)."""
 
 
 def number_text(value: Any) -> Any:

@@ -82,6 +82,9 @@ class ChipKind:
     probe: Probe | None = None
     poll: PollMaker | None = None
     """For a polled chip: how its poller connects, reads and rests (engine.hardware.readings)."""
+    list_lengths: tuple[tuple[str, int], ...] = ()
+    """Readings that are lists, and how many items each holds (touch ``pads``: 12), so a
+    tree's ``item:`` can be checked against the robot."""
     show: ShowReading | None = None
     """For a polled chip: one reading in words, as ``vest devices`` prints it."""
 

@@ -6,8 +6,9 @@ from collections.abc import Callable, Sequence
 from typing import Any
 
 from engine.drivers import mpr121 as driver
-from engine.drivers.mpr121 import MPR121, PADS
+from engine.drivers.mpr121 import MPR121, PADS, check_thresholds
 from engine.drivers.sim.mpr121 import SimMPR121
+from engine.hardware.chips.fields import ChipFields
 from engine.hardware.chips.kind import ChipKind, SimPlacement
 from engine.hardware.config import ChipSpec, DeviceConfig
 from engine.hardware.managed_buses import ManagedI2C
@@ -44,6 +45,22 @@ def _show(device: DeviceConfig, writes: Sequence[Staged]) -> str:
     return "pads touched: " + (", ".join(touched) or "none")
 
 
+def _check_thresholds(fields: ChipFields) -> dict[str, Any] | None:
+    """The driver refuses a release threshold above the touch threshold: say so now, with
+    the place, rather than at start-up."""
+    options = fields.options
+    if options is None:
+        return {}
+    try:
+        check_thresholds(options["touch_threshold"], options["release_threshold"])
+    except ValueError as error:
+        raw = fields.raw
+        where = raw.get("release_threshold") or raw.get("touch_threshold") or raw
+        fields.checker.problems.add(where.mark, str(error), "release_threshold <= touch_threshold")
+        return None
+    return {}
+
+
 KIND = ChipKind(
     ChipSpec(
         "mpr121",
@@ -63,4 +80,6 @@ KIND = ChipKind(
     probe=_probe,
     poll=_poll,
     show=_show,
+    list_lengths=(("pads", PADS),),
+    check_fields=_check_thresholds,
 )
