@@ -87,6 +87,8 @@ class ChipSpec:
     outputs: dict[str, str] = field(default_factory=dict)
     options: tuple[Param[Any], ...] = ()
     fields: tuple[str, ...] = ()
+    address_notes: dict[int, str] = field(default_factory=dict)
+    """Why an address the chip's range would suggest is not allowed (a hint's first words)."""
 
     @property
     def polled(self) -> bool:

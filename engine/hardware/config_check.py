@@ -24,8 +24,6 @@ from engine.hardware.chips.fields import ChipFields, number_text
 from engine.hardware.config import (
     BUS_KINDS,
     COMMON_FIELDS,
-    PCA9685_ALL_CALL,
-    VL53L0X_BOOT_ADDRESS,
     BusConfig,
     ChipSpec,
     DeviceConfig,
@@ -345,8 +343,8 @@ class ConfigChecker:
             return None
         if address not in spec.addresses:
             hint = f"use {spec.addresses_text()}"
-            if spec.chip == "pca9685" and address == PCA9685_ALL_CALL:
-                hint = "0x70 is every PCA9685's LED All Call address; " + hint
+            if address in spec.address_notes:
+                hint = f"{spec.address_notes[address]}; {hint}"
             self.problems.add(
                 value.mark,
                 f"{spec.chip} cannot be at address {hex_address(address)}",
@@ -475,6 +473,10 @@ class _CrossChecks:
         self.devices = devices
         self.raws = raws
 
+    @property
+    def problems(self) -> Problems:
+        return self.c.problems
+
     def mark(self, device: DeviceConfig, field_name: str) -> Mark:
         raw = self.raws[device.name]
         value = raw.entries.get(field_name)
@@ -482,9 +484,12 @@ class _CrossChecks:
 
     def run(self) -> None:
         self.addresses()
-        self.all_call()
         self.muxes()
-        self.range_chains()
+        for kind in self.c.chips:  # the rules a chip kind has for devices of its kind
+            if kind.check_together is not None:
+                mine = [d for d in self.devices.values() if d.chip == kind.name]
+                if mine:
+                    kind.check_together(self, mine)
         self.keys()
         self.singletons()
 
@@ -547,40 +552,13 @@ class _CrossChecks:
                     "another address",
                 )
 
-    def all_call(self) -> None:
-        """Until the PCA9685 driver turns All Call off, the chip also takes writes to 0x70."""
-        for pwm in self.devices.values():
-            if pwm.chip != "pca9685":
-                continue
-            for device in self.devices.values():
-                if (
-                    device is pwm
-                    or device.bus != pwm.bus
-                    or device.address != PCA9685_ALL_CALL
-                    or device.mux is not None
-                ):
-                    continue
-                hint = "move it to 0x71..0x77"
-                if device.chip == "srf02":
-                    hint = (
-                        "change the SRF02's address to 0x71..0x77 (0xE2..0xEE in Devantech's "
-                        "8-bit numbering), e.g. 0x75"
-                    )
-                self.c.problems.add(
-                    self.mark(device, "address"),
-                    f"{device.name!r} at 0x70 shares its bus with PCA9685 {pwm.name!r}, whose "
-                    "LED All Call address is 0x70: at power-up the PCA9685 also takes every "
-                    "write to 0x70 into its own registers",
-                    hint,
-                )
-
     def muxes(self) -> None:
         for device in self.devices.values():
             if device.mux is None:
                 continue
             mux = self.devices.get(device.mux)
-            if mux is None or mux.chip != "tca9548a":
-                muxes = [d.name for d in self.devices.values() if d.chip == "tca9548a"]
+            if mux is None or mux.role != "mux":
+                muxes = [d.name for d in self.devices.values() if d.role == "mux"]
                 self.c.problems.add(
                     self.mark(device, "mux"),
                     f"{device.mux!r} is not a tca9548a device of this config",
@@ -592,53 +570,6 @@ class _CrossChecks:
                     f"mux {mux.name!r} is on bus {mux.bus!r}, not on {device.bus!r}",
                     f"put {device.name!r} on bus {mux.bus!r}",
                 )
-
-    def range_chains(self) -> None:
-        """VL53L0X chips all boot at 0x29: each needs XSHUT or a mux, but for one at 0x29."""
-        lines: dict[int, DeviceConfig] = {}
-        for device in self.devices.values():
-            if device.xshut is None:
-                continue
-            holder = lines.get(device.xshut)
-            if holder is not None:
-                self.c.problems.add(
-                    self.mark(device, "xshut"),
-                    f"GPIO line {device.xshut} is already the XSHUT of {holder.name!r}",
-                    "each VL53L0X needs its own XSHUT line",
-                )
-            lines[device.xshut] = device
-        for bus in self.buses.values():
-            direct = [
-                d
-                for d in self.devices.values()
-                if d.chip == "vl53l0x" and d.bus == bus.name and d.mux is None
-            ]
-            unswitched = [d for d in direct if d.xshut is None]
-            for device in unswitched:
-                if device.address != VL53L0X_BOOT_ADDRESS:
-                    self.c.problems.add(
-                        self.mark(device, "address"),
-                        f"VL53L0X {device.name!r} has no XSHUT line, so it boots at 0x29 and "
-                        f"cannot be moved to {hex_address(device.address)}",
-                        "add 'xshut: LINE' or use address 0x29",
-                    )
-            if unswitched and len(direct) > 1:
-                self.c.problems.add(
-                    self.mark(unswitched[-1], "xshut"),
-                    f"{len(direct)} VL53L0X share bus {bus.name!r} but "
-                    f"{', '.join(repr(d.name) for d in unswitched)} has no XSHUT line; every "
-                    "chip boots at 0x29",
-                    "give each its own XSHUT line, or put them behind a TCA9548A",
-                )
-            chained = [d for d in direct if d.xshut is not None]
-            for device in chained[:-1]:
-                if device.address == VL53L0X_BOOT_ADDRESS:
-                    self.c.problems.add(
-                        self.mark(device, "address"),
-                        f"VL53L0X {device.name!r} stays at 0x29, where the chips switched on "
-                        "after it boot",
-                        "give it another address, or list it last",
-                    )
 
     def keys(self) -> None:
         feeders: dict[str, DeviceConfig] = {}

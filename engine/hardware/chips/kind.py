@@ -15,8 +15,9 @@ from typing import Any, Protocol
 from engine.clock import Clock
 from engine.drivers.sim.i2c_bus import SimI2CBus, SimI2CDevice
 from engine.errors import DeviceError
+from engine.files.problems import Mark, Problems
 from engine.hardware.chips.fields import ChipFields
-from engine.hardware.config import ChipSpec, DeviceConfig
+from engine.hardware.config import BusConfig, ChipSpec, DeviceConfig
 from engine.hardware.readings import PollMaker, Staged
 from engine.scenario.world import World
 
@@ -28,6 +29,23 @@ FieldsCheck = Callable[[ChipFields], dict[str, Any] | None]
 def no_fields(fields: ChipFields) -> dict[str, Any] | None:
     """A chip with no structured fields of its own."""
     return {}
+
+
+class DevicesTogether(Protocol):
+    """What a chip kind's rules across devices see: every bus and device of the config,
+    the problems, and each device field's place."""
+
+    buses: dict[str, BusConfig]
+    devices: dict[str, DeviceConfig]
+
+    @property
+    def problems(self) -> Problems: ...
+
+    def mark(self, device: DeviceConfig, field_name: str) -> Mark: ...
+
+
+TogetherCheck = Callable[[DevicesTogether, list[DeviceConfig]], None]
+"""Rules between the devices of one chip kind and the rest of the config (adds problems)."""
 
 
 class SimPlacement(Protocol):
@@ -85,6 +103,9 @@ class ChipKind:
     list_lengths: tuple[tuple[str, int], ...] = ()
     """Readings that are lists, and how many items each holds (touch ``pads``: 12), so a
     tree's ``item:`` can be checked against the robot."""
+    check_together: TogetherCheck | None = None
+    """Rules between this kind's devices and the others (the VL53L0X boot address, the
+    PCA9685's All Call address)."""
     show: ShowReading | None = None
     """For a polled chip: one reading in words, as ``vest devices`` prints it."""
 

@@ -8,7 +8,7 @@ from typing import Any
 from engine.drivers import pca9685 as driver
 from engine.drivers.sim.pca9685 import SimPCA9685
 from engine.hardware.chips.fields import ChipFields
-from engine.hardware.chips.kind import ChipKind, SimPlacement
+from engine.hardware.chips.kind import ChipKind, DevicesTogether, SimPlacement
 from engine.hardware.config import PCA9685_ALL_CALL, ChipSpec, DeviceConfig
 from engine.values.params import REQUIRED, Boolean, Integer, Number, Param
 
@@ -83,6 +83,32 @@ def _probe(address: int) -> Callable[[Any], object]:
     return lambda bus: bus.read_byte_data(address, driver.PRE_SCALE)
 
 
+def _all_call(checks: DevicesTogether, mine: list[DeviceConfig]) -> None:
+    """Until the PCA9685 driver turns All Call off, the chip also takes writes to 0x70."""
+    for pwm in mine:
+        for device in checks.devices.values():
+            if (
+                device is pwm
+                or device.bus != pwm.bus
+                or device.address != PCA9685_ALL_CALL
+                or device.mux is not None
+            ):
+                continue
+            hint = "move it to 0x71..0x77"
+            if device.chip == "srf02":
+                hint = (
+                    "change the SRF02's address to 0x71..0x77 (0xE2..0xEE in Devantech's "
+                    "8-bit numbering), e.g. 0x75"
+                )
+            checks.problems.add(
+                checks.mark(device, "address"),
+                f"{device.name!r} at 0x70 shares its bus with PCA9685 {pwm.name!r}, whose "
+                "LED All Call address is 0x70: at power-up the PCA9685 also takes every "
+                "write to 0x70 into its own registers",
+                hint,
+            )
+
+
 KIND = ChipKind(
     ChipSpec(
         "pca9685",
@@ -91,6 +117,7 @@ KIND = ChipKind(
         "leds",
         addresses=tuple(a for a in range(0x40, 0x78) if a != PCA9685_ALL_CALL),
         default_address=0x40,
+        address_notes={PCA9685_ALL_CALL: "0x70 is every PCA9685's LED All Call address"},
         options=(
             Param("frequency_hz", Number(24.0, 1526.0, "Hz"), 1000.0, "PWM frequency"),
             Param("common_anode", Boolean(), False, "LEDs lit while the output is low"),
@@ -100,4 +127,5 @@ KIND = ChipKind(
     _leds,
     simulate=_simulate,
     probe=_probe,
+    check_together=_all_call,
 )

@@ -10,8 +10,8 @@ from engine.drivers.bus_manager import Priority
 from engine.drivers.sim.vl53l0x import SimVL53L0X
 from engine.drivers.vl53l0x import VL53L0X
 from engine.hardware.chips.fields import ChipFields
-from engine.hardware.chips.kind import ChipKind, SimPlacement, expect_identity
-from engine.hardware.config import SIDES, VL53L0X_BOOT_ADDRESS, ChipSpec, DeviceConfig
+from engine.hardware.chips.kind import ChipKind, DevicesTogether, SimPlacement, expect_identity
+from engine.hardware.config import SIDES, VL53L0X_BOOT_ADDRESS, ChipSpec, DeviceConfig, hex_address
 from engine.hardware.managed_buses import ManagedI2C
 from engine.hardware.readings import PollParts, PollSetup, Staged
 from engine.values.params import Choice, Integer, Number, Param, Text
@@ -114,6 +114,50 @@ def _show(device: DeviceConfig, writes: Sequence[Staged]) -> str:
     return "nothing in range" if value is None else f"{value:.0f} mm"
 
 
+def _range_chains(checks: DevicesTogether, mine: list[DeviceConfig]) -> None:
+    """VL53L0X chips all boot at 0x29: each needs XSHUT or a mux, but for one at 0x29."""
+    lines: dict[int, DeviceConfig] = {}
+    for device in checks.devices.values():
+        if device.xshut is None:
+            continue
+        holder = lines.get(device.xshut)
+        if holder is not None:
+            checks.problems.add(
+                checks.mark(device, "xshut"),
+                f"GPIO line {device.xshut} is already the XSHUT of {holder.name!r}",
+                "each VL53L0X needs its own XSHUT line",
+            )
+        lines[device.xshut] = device
+    for bus in checks.buses.values():
+        direct = [d for d in mine if d.bus == bus.name and d.mux is None]
+        unswitched = [d for d in direct if d.xshut is None]
+        for device in unswitched:
+            if device.address != VL53L0X_BOOT_ADDRESS:
+                checks.problems.add(
+                    checks.mark(device, "address"),
+                    f"VL53L0X {device.name!r} has no XSHUT line, so it boots at 0x29 and "
+                    f"cannot be moved to {hex_address(device.address)}",
+                    "add 'xshut: LINE' or use address 0x29",
+                )
+        if unswitched and len(direct) > 1:
+            checks.problems.add(
+                checks.mark(unswitched[-1], "xshut"),
+                f"{len(direct)} VL53L0X share bus {bus.name!r} but "
+                f"{', '.join(repr(d.name) for d in unswitched)} has no XSHUT line; every "
+                "chip boots at 0x29",
+                "give each its own XSHUT line, or put them behind a TCA9548A",
+            )
+        chained = [d for d in direct if d.xshut is not None]
+        for device in chained[:-1]:
+            if device.address == VL53L0X_BOOT_ADDRESS:
+                checks.problems.add(
+                    checks.mark(device, "address"),
+                    f"VL53L0X {device.name!r} stays at 0x29, where the chips switched on "
+                    "after it boot",
+                    "give it another address, or list it last",
+                )
+
+
 KIND = ChipKind(
     ChipSpec(
         "vl53l0x",
@@ -139,4 +183,5 @@ KIND = ChipKind(
     probe=_probe,
     poll=_poll,
     show=_show,
+    check_together=_range_chains,
 )
