@@ -22,7 +22,6 @@ from engine.files.yaml_source import YMap, YScalar, YValue, describe, plain
 from engine.hardware.chips import ChipRegistry, default_chips
 from engine.hardware.chips.fields import ChipFields, number_text
 from engine.hardware.config import (
-    BUS_KINDS,
     COMMON_FIELDS,
     BusConfig,
     ChipSpec,
@@ -30,12 +29,12 @@ from engine.hardware.config import (
     RobotConfig,
     hex_address,
 )
+from engine.hardware.config_buses import check_buses
+from engine.hardware.config_cross_checks import CrossChecks
 from engine.values.params import (
     RATE_HZ,
-    REQUIRED,
     Boolean,
     CheckContext,
-    Choice,
     Integer,
     Key,
     Param,
@@ -46,17 +45,6 @@ from engine.values.params import (
 )
 
 TOP_FIELDS = ("name", "description", "simulated", "buses", "gpio", "devices")
-BUS_FIELDS: dict[str, tuple[Param[Any], ...]] = {
-    "i2c": (Param("number", Integer(0, 255), REQUIRED, "N of /dev/i2c-N"),),
-    "spi": (
-        Param("number", Integer(0, 255), REQUIRED, "N of /dev/spidevN.C"),
-        Param("chip_select", Integer(0, 255), 0, "C of /dev/spidevN.C"),
-    ),
-    "serial": (
-        Param("port", Text(), REQUIRED, "the port, e.g. /dev/ttyACM0"),
-        Param("baudrate", Integer(300, 4_000_000), 115200, "baud rate (ignored over USB)"),
-    ),
-}
 DEVICE_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 """A device name: it names ``/devices/<name>/ok`` and is written in trees, so an identifier."""
 # Options whose YAML value is a number but which the drivers take from a fixed set.
@@ -140,7 +128,7 @@ class ConfigChecker:
             self.unknown_fields(gpio, ("chip",), "gpio")
             if "chip" in gpio:
                 gpio_chip = self.convert(Text(), gpio.entries["chip"], "chip") or gpio_chip
-        buses = self._buses(document)
+        buses = check_buses(self, document)
         devices = self._devices(document, buses)
         self.problems.raise_if_any()
         return RobotConfig(
@@ -161,56 +149,6 @@ class ConfigChecker:
         return value if value is not None else default
 
     # -- buses ---------------------------------------------------------------------------
-    def _buses(self, document: YMap) -> dict[str, BusConfig]:
-        raw = document.get("buses")
-        if raw is None:
-            self.problems.add(
-                document.mark, "a robot config needs 'buses:'", "e.g. i2c: {kind: i2c, number: 1}"
-            )
-            return {}
-        section = self.mapping(raw, "'buses'", "e.g. i2c: {kind: i2c, number: 1}")
-        buses: dict[str, BusConfig] = {}
-        for name, body in section.items() if section is not None else ():
-            bus = self._bus(name, body)
-            if bus is not None:
-                buses[name] = bus
-        self._one_entry_per_adapter(buses)
-        return buses
-
-    def _one_entry_per_adapter(self, buses: dict[str, BusConfig]) -> None:
-        """Two entries for one device file would be two bus managers on one adapter."""
-        first: dict[str, BusConfig] = {}
-        for bus in buses.values():
-            holder = first.get(bus.path)
-            if holder is None:
-                first[bus.path] = bus
-                continue
-            self.problems.add(
-                bus.mark,
-                f"bus {bus.name!r} is {bus.path}, like bus {holder.name!r} "
-                f"(line {holder.mark.line}): one adapter needs one bus entry, or two owners "
-                "would use it at once",
-                f"remove {bus.name!r} and put its devices on bus {holder.name!r}",
-            )
-
-    def _bus(self, name: str, body: YValue) -> BusConfig | None:
-        raw = self.mapping(body, f"bus {name!r}", "e.g. {kind: i2c, number: 1}")
-        if raw is None:
-            return None
-        kind_raw = raw.get("kind")
-        if kind_raw is None:
-            self.problems.add(raw.mark, f"bus {name!r} needs 'kind'", "i2c, spi or serial")
-            return None
-        kind = self.convert(Choice(BUS_KINDS), kind_raw, "kind")
-        if kind is None:
-            return None
-        params = BUS_FIELDS[kind]
-        self.unknown_fields(raw, ["kind", *(p.name for p in params)], f"{kind} bus")
-        values = self.fields(raw, params, f"{kind} bus {name!r}")
-        if values is None:
-            return None
-        return BusConfig(name=name, kind=kind, mark=raw.mark, **values)
-
     # -- devices ---------------------------------------------------------------------------
     def _devices(self, document: YMap, buses: dict[str, BusConfig]) -> dict[str, DeviceConfig]:
         raw = document.get("devices")
@@ -240,7 +178,7 @@ class ConfigChecker:
                 devices[name] = device
                 assert isinstance(body, YMap)
                 marks[name] = body
-        _CrossChecks(self, buses, devices, marks).run()
+        CrossChecks(self.problems, self.chips, buses, devices, marks).run()
         return devices
 
     def _device(self, name: str, body: YValue, buses: dict[str, BusConfig]) -> DeviceConfig | None:
@@ -456,143 +394,3 @@ def _numeric_choice(name: str, value: Any) -> Any:
         return 2 / 3
     number = float(value)
     return int(number) if number.is_integer() and name != "resolution_c" else number
-
-
-class _CrossChecks:
-    """Rules between devices: addresses, the All Call trap, XSHUT chains, muxes, keys."""
-
-    def __init__(
-        self,
-        checker: ConfigChecker,
-        buses: dict[str, BusConfig],
-        devices: dict[str, DeviceConfig],
-        raws: dict[str, YMap],
-    ) -> None:
-        self.c = checker
-        self.buses = buses
-        self.devices = devices
-        self.raws = raws
-
-    @property
-    def problems(self) -> Problems:
-        return self.c.problems
-
-    def mark(self, device: DeviceConfig, field_name: str) -> Mark:
-        raw = self.raws[device.name]
-        value = raw.entries.get(field_name)
-        return value.mark if value is not None else raw.mark
-
-    def run(self) -> None:
-        self.addresses()
-        self.muxes()
-        for kind in self.c.chips:  # the rules a chip kind has for devices of its kind
-            if kind.check_together is not None:
-                mine = [d for d in self.devices.values() if d.chip == kind.name]
-                if mine:
-                    kind.check_together(self, mine)
-        self.keys()
-        self.singletons()
-
-    def _line(self, device: DeviceConfig) -> str:
-        return f"line {device.mark.line}"
-
-    def addresses(self) -> None:
-        """One device per address of one bus (or mux channel); one device per SPI node or port."""
-        holders: dict[tuple[str, str | None, int | None, int | None], DeviceConfig] = {}
-        for device in self.devices.values():
-            bus = self.buses[device.bus]
-            if device.address is None:
-                place: tuple[str, str | None, int | None, int | None] = (bus.name, None, None, None)
-            else:
-                place = (bus.name, device.mux, device.mux_channel, device.address)
-            holder = holders.get(place)
-            if holder is not None:
-                where = (
-                    f"{bus.path}"
-                    if device.address is None
-                    else f"I2C {hex_address(device.address)} on bus {bus.name!r}"
-                    + (f" ({device.mux} channel {device.mux_channel})" if device.mux else "")
-                )
-                self.c.problems.add(
-                    self.mark(device, "address" if device.address is not None else "bus"),
-                    f"{where} is used by both {holder.name!r} ({self._line(holder)}) and "
-                    f"{device.name!r}",
-                    "give each device its own address"
-                    if device.address is not None
-                    else "one device per SPI node or serial port",
-                )
-                continue
-            holders[place] = device
-        # A chip on the upstream bus answers on every mux channel too.
-        for device in self.devices.values():
-            if device.mux is None:
-                continue
-            upstream = holders.get((device.bus, None, None, device.address))
-            if upstream is not None:
-                self.c.problems.add(
-                    self.mark(device, "address"),
-                    f"I2C {hex_address(device.address)} behind {device.mux} clashes with "
-                    f"{upstream.name!r} ({self._line(upstream)}) on the upstream bus",
-                    "chips on the upstream bus answer on every channel; move one",
-                )
-        # A mux keeps its channel selected while the other mux selects one of its own.
-        behind: dict[tuple[str, int | None], DeviceConfig] = {}
-        for device in self.devices.values():
-            if device.mux is None:
-                continue
-            other = behind.setdefault((device.bus, device.address), device)
-            if other.mux != device.mux:
-                self.c.problems.add(
-                    self.mark(device, "address"),
-                    f"I2C {hex_address(device.address)} is behind mux {device.mux!r} and, "
-                    f"as {other.name!r} ({self._line(other)}), behind mux {other.mux!r} on "
-                    f"the same bus {device.bus!r}: each mux keeps its channel selected, so "
-                    "both chips would answer at once",
-                    f"put both behind {other.mux!r} on different channels, or give one "
-                    "another address",
-                )
-
-    def muxes(self) -> None:
-        for device in self.devices.values():
-            if device.mux is None:
-                continue
-            mux = self.devices.get(device.mux)
-            if mux is None or mux.role != "mux":
-                muxes = [d.name for d in self.devices.values() if d.role == "mux"]
-                self.c.problems.add(
-                    self.mark(device, "mux"),
-                    f"{device.mux!r} is not a tca9548a device of this config",
-                    did_you_mean(device.mux, muxes) or "muxes: " + (", ".join(muxes) or "none"),
-                )
-            elif mux.bus != device.bus:
-                self.c.problems.add(
-                    self.mark(device, "mux"),
-                    f"mux {mux.name!r} is on bus {mux.bus!r}, not on {device.bus!r}",
-                    f"put {device.name!r} on bus {mux.bus!r}",
-                )
-
-    def keys(self) -> None:
-        feeders: dict[str, DeviceConfig] = {}
-        for device in self.devices.values():
-            for key in device.fed_keys:
-                holder = feeders.get(key)
-                if holder is not None:
-                    self.c.problems.add(
-                        device.mark,
-                        f"{device.name!r} and {holder.name!r} ({self._line(holder)}) both feed "
-                        f"{key}",
-                        "give one of them other keys",
-                    )
-                feeders[key] = device
-
-    def singletons(self) -> None:
-        """The on-request sensors and the actuators are one device each."""
-        for role in ("temperature", "ultrasound", "leds", "servos"):
-            doing = [d for d in self.devices.values() if d.role == role]
-            for device in doing[1:]:
-                self.c.problems.add(
-                    self.mark(device, "chip"),
-                    f"two devices serve {role}: {doing[0].name!r} ({self._line(doing[0])}) and "
-                    f"{device.name!r}",
-                    "keep one",
-                )
