@@ -84,9 +84,9 @@ from py_trees.common import Status
 
 from engine.clock import RealClock, stopwatch
 from engine.drivers.srf02 import RANGING_TIME_S
-from engine.hardware.assembly import Hardware
 from engine.hardware.config import RobotConfig
 from engine.hardware.config_file import load_robot_config
+from engine.hardware.robot_hardware import Hardware
 from engine.hardware.sim_vest import SimVest
 from engine.nodes.decorators import Cooldown
 from engine.runtime.reload import TreeReloader

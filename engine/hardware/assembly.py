@@ -37,57 +37,37 @@ its poller or at its next request.
 
 from __future__ import annotations
 
-import errno
 import logging
-import os
 from collections.abc import Callable
-from dataclasses import dataclass, field
-from typing import Any, Protocol
+from typing import Any
 
 from engine.blackboard.board import Blackboard
 from engine.clock import Clock, VirtualClock
 from engine.drivers.bus_errors import describe_exception
-from engine.drivers.bus_manager import BusManager, DeviceHandle, DeviceStats
-from engine.drivers.gpio import OutputLine
+from engine.drivers.bus_manager import BusManager, DeviceHandle
 from engine.drivers.maestro import Maestro
 from engine.drivers.tca9548a import TCA9548A, LockedBus
-from engine.errors import ConfigError, DeviceError
-from engine.hardware.branching_clock import BranchingClock, branch_of
+from engine.errors import DeviceError
+from engine.hardware.branching_clock import BranchingClock
 from engine.hardware.chips import ChipRegistry, default_chips
 from engine.hardware.config import BusConfig, DeviceConfig, RobotConfig
 from engine.hardware.device_health import DeviceHealth
-from engine.hardware.pollers import Poller, PollerThreads, make_poller
+from engine.hardware.pollers import Poller, make_poller
+from engine.hardware.real_buses import BusProvider, RealBuses
+from engine.hardware.robot_hardware import Hardware
 from engine.hardware.services import (
     HardwareLeds,
-    HardwareSensors,
     HardwareServos,
     TemperatureSensor,
     UltrasoundSensor,
 )
 from engine.hardware.xshut import XshutChain
-from engine.services.interfaces import IotResults, Services, Speech
 
 _log = logging.getLogger("vest.hardware")
 
-Hook = Callable[[float], None]
 _OFFLINE_AFTER = 3  # the bus managers' default: failed transactions that mark a device offline
 
 
-class BusProvider(Protocol):
-    """Where the buses come from: the machine's device files, or the simulated vest."""
-
-    def open_i2c(self, bus: BusConfig) -> Any: ...
-
-    def open_spi(self, bus: BusConfig) -> Any: ...
-
-    def serial_port(self, bus: BusConfig) -> Any:
-        """A port name (opened by the Maestro driver) or an open pyserial-compatible port."""
-        ...
-
-    def output_line(self, offset: int, consumer: str) -> OutputLine: ...
-
-
-# -- probes: is the chip back, and is it the right chip? ------------------------------------------
 def probe_for(
     device: DeviceConfig, chips: ChipRegistry | None = None
 ) -> Callable[[Any], object] | None:
@@ -96,195 +76,6 @@ def probe_for(
     if device.address is None or kind is None or kind.probe is None:
         return None
     return kind.probe(device.address)
-
-
-# -- the machine's buses ---------------------------------------------------------------------------
-_OPEN_WORDS = {
-    errno.ENOENT: "no such device file",
-    errno.EACCES: "permission denied",
-    errno.EPERM: "permission denied",
-    errno.EBUSY: "busy: another program has it",
-}
-
-
-class RealBuses:
-    """The machine's buses, opened on demand and closed by :meth:`close`."""
-
-    def __init__(self, config: RobotConfig) -> None:
-        self.config = config
-        self._opened: list[Any] = []
-
-    def open_i2c(self, bus: BusConfig) -> Any:
-        import smbus2  # only on a robot
-
-        try:
-            handle = smbus2.SMBus(bus.number)
-        except OSError as error:
-            hint = {
-                errno.ENOENT: "enable I2C (raspi-config, or the board's device tree) and check N",
-                errno.EACCES: "add yourself to the i2c group",
-                errno.EPERM: "add yourself to the i2c group",
-            }.get(error.errno or 0, "")
-            raise self._error(bus, error, hint) from error
-        self._opened.append(handle)
-        return handle
-
-    def open_spi(self, bus: BusConfig) -> Any:
-        try:
-            import spidev  # type: ignore[import-not-found]  # only on a robot
-        except ImportError as error:
-            raise DeviceError(
-                f"{bus.describe()} ({bus.path}): the spidev package is not installed "
-                "(pip install spidev)"
-            ) from error
-        node = spidev.SpiDev()
-        try:
-            node.open(bus.number, bus.chip_select)
-        except OSError as error:
-            raise self._error(bus, error, "enable SPI and add yourself to the spi group") from error
-        self._opened.append(node)
-        return node
-
-    def serial_port(self, bus: BusConfig) -> Any:
-        return bus.port
-
-    def output_line(self, offset: int, consumer: str) -> OutputLine:
-        from engine.drivers.gpio import GpioOutputLine
-
-        line = GpioOutputLine(self.config.gpio_chip, offset, consumer=consumer)
-        self._opened.append(line)
-        return line
-
-    @staticmethod
-    def _error(bus: BusConfig, error: OSError, hint: str) -> DeviceError:
-        code = error.errno or errno.EIO
-        words = _OPEN_WORDS.get(code, os.strerror(code).lower())
-        failure = DeviceError(
-            f"cannot open {bus.describe()} ({bus.path}): {words}" + (f"; {hint}" if hint else "")
-        )
-        failure.errno = code  # kept for callers, out of the message a person reads
-        return failure
-
-    def close(self) -> None:
-        for thing in reversed(self._opened):
-            try:
-                thing.close()
-            except OSError as error:
-                _log.warning("closing %r: %s", thing, error)
-        self._opened.clear()
-
-
-# -- the hardware ---------------------------------------------------------------------------------
-@dataclass
-class Hardware:
-    """One robot's buses, devices, pollers and services. Close it when done."""
-
-    config: RobotConfig
-    clock: Clock
-    """The drivers' clock (a :class:`BranchingClock` when inline on a virtual clock)."""
-    threaded: bool
-    managers: dict[str, BusManager[Any]] = field(default_factory=dict)
-    handles: dict[str, DeviceHandle[Any]] = field(default_factory=dict)
-    health: dict[str, DeviceHealth] = field(default_factory=dict)
-    pollers: list[Poller[Any]] = field(default_factory=list)
-    leds: HardwareLeds | None = None
-    servos: HardwareServos | None = None
-    sensors: HardwareSensors = field(default_factory=HardwareSensors)
-    startup_problems: dict[str, str] = field(default_factory=dict)
-    """Devices that did not start, and why (they are retried while the robot runs)."""
-    muxes: dict[str, TCA9548A] = field(default_factory=dict)
-    chains: dict[str, XshutChain] = field(default_factory=dict)
-    """The VL53L0X XSHUT chain of each bus that has one, by bus name."""
-    _owned: list[Any] = field(default_factory=list)
-    _threads: PollerThreads | None = None
-    _closed: bool = False
-
-    # -- running -------------------------------------------------------------------------
-    @property
-    def hooks(self) -> list[Hook]:
-        """Scheduler hooks: inline, the pollers and re-probes; always the LED timer."""
-        hooks: list[Hook] = []
-        if not self.threaded:
-            hooks.extend(self.pollers)
-            hooks.append(self.run_due_probes)
-        if self.leds is not None:
-            hooks.append(self.leds)
-        return hooks
-
-    def run_due_probes(self, now_s: float) -> None:
-        """Re-probe offline devices that are due (inline; workers do it themselves)."""
-        for manager in self.managers.values():
-            with branch_of(self.clock):
-                manager.run_due_probes()
-
-    def start(self, origin_s: float | None = None) -> None:
-        """Threaded: start the poller threads (inline, the hooks poll).
-
-        ``origin_s``: the trees' first deadline, so readings are staged just before ticks.
-        """
-        if self.threaded and self._threads is None:
-            self._threads = PollerThreads(self.pollers, self.clock)
-            self._threads.start(origin_s)
-
-    def stop(self) -> None:
-        """Stop the poller threads, if running."""
-        if self._threads is not None:
-            self._threads.stop()
-            self._threads = None
-
-    def services(
-        self, *, speech: Speech, iot: IotResults, fallback: Services | None = None
-    ) -> Services:
-        """The robot's services: LEDs, servos and sensors from this hardware, ``speech`` and
-        ``iot`` as given; what the config lacks comes from ``fallback``."""
-        missing = [
-            what for what, have in (("leds", self.leds), ("servos", self.servos)) if have is None
-        ]
-        if missing and fallback is None:
-            raise ConfigError(
-                f"{self.config.path}: no device for {', '.join(missing)}; add one or pass a "
-                "fallback"
-            )
-        return Services(
-            speech=speech,
-            leds=self.leds if self.leds is not None else fallback.leds,  # type: ignore[union-attr]
-            servos=self.servos if self.servos is not None else fallback.servos,  # type: ignore[union-attr]
-            sensors=self.sensors,
-            iot=iot,
-        )
-
-    def stats(self) -> dict[str, DeviceStats]:
-        """Every device's bus statistics, by device name."""
-        snapshot: dict[str, DeviceStats] = {}
-        for manager in self.managers.values():
-            snapshot.update(manager.stats())
-        return snapshot
-
-    def poller(self, name: str) -> Poller[Any]:
-        for poller in self.pollers:
-            if poller.name == name:
-                return poller
-        raise KeyError(f"no poller for device {name!r}")
-
-    def close(self) -> None:
-        """Stop pollers and bus workers; close what was opened here (never the sim vest)."""
-        if self._closed:
-            return
-        self._closed = True
-        self.stop()
-        for manager in self.managers.values():
-            manager.close()
-        for thing in reversed(self._owned):
-            try:
-                thing.close()
-            except OSError as error:
-                _log.warning("closing %r: %s", thing, error)
-
-    def __enter__(self) -> Hardware:
-        return self
-
-    def __exit__(self, *exc: object) -> None:
-        self.close()
 
 
 def build_hardware(

@@ -13,10 +13,11 @@ from dataclasses import dataclass
 
 from engine.drivers.bus_errors import describe_exception
 from engine.errors import VestError
-from engine.hardware.assembly import Hardware, probe_for
+from engine.hardware.assembly import probe_for
 from engine.hardware.chips import default_chips
 from engine.hardware.config import DeviceConfig
 from engine.hardware.readings import Staged
+from engine.hardware.robot_hardware import Hardware
 
 COLUMNS = ("device", "chip", "where", "identity", "reading")
 WAIT_S = 2.0  # real seconds to wait for one answer on a busy threaded bus

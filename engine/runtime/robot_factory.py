@@ -14,8 +14,9 @@ from dataclasses import dataclass
 
 from engine.blackboard.board import Blackboard
 from engine.clock import Clock
-from engine.hardware.assembly import Hardware, build_hardware
+from engine.hardware.assembly import build_hardware
 from engine.hardware.config import RobotConfig
+from engine.hardware.robot_hardware import Hardware
 from engine.hardware.sim_vest import SimVest, UnwiredSenses, build_sim_vest
 from engine.runtime.robot import Behaviors, Robot
 from engine.scenario.world import World

@@ -8,9 +8,9 @@ from pathlib import Path
 import pytest
 
 from engine.clock import VirtualClock
-from engine.hardware.assembly import Hardware
 from engine.hardware.config import RobotConfig
 from engine.hardware.config_file import load_robot_config
+from engine.hardware.robot_hardware import Hardware
 from engine.hardware.sim_vest import SimVest
 from engine.runtime.robot import load_behaviors
 from engine.runtime.robot_factory import build_robot

@@ -20,9 +20,10 @@ from engine.clock import RealClock, VirtualClock
 from engine.drivers import mcp9808, vl53l0x
 from engine.drivers.sim.i2c_bus import SimI2CBus
 from engine.errors import DeviceError
-from engine.hardware.assembly import Hardware, build_hardware
+from engine.hardware.assembly import build_hardware
 from engine.hardware.config import SIDES, BusConfig, RobotConfig
 from engine.hardware.config_file import load_robot_config
+from engine.hardware.robot_hardware import Hardware
 from engine.hardware.sim_vest import SimVest, build_sim_vest
 from engine.scenario.world import World
 
