@@ -35,10 +35,10 @@ from engine.files.yaml_source import (
     load_yaml,
     resolved,
 )
+from engine.services.interfaces import ON_REQUEST_SENSORS
 from engine.values.params import CheckContext, ParamProblem, did_you_mean
 from engine.values.templates import CompiledTemplate, compile_template
 
-ON_REQUEST_SENSORS = ("temperature", "ultrasound")
 MAX_PHRASE_EXPANSIONS = 200
 """How many phrases one ``hear:`` phrase may expand to through its ``~concepts``."""
 MAX_DIALOG_EXPANSIONS = 2000

@@ -48,6 +48,7 @@ from engine.drivers.bus_manager import BusManager, DeviceHandle
 from engine.drivers.maestro import Maestro
 from engine.drivers.tca9548a import TCA9548A, LockedBus
 from engine.errors import DeviceError
+from engine.hardware.actuator_services import HardwareLeds, HardwareServos
 from engine.hardware.branching_clock import BranchingClock
 from engine.hardware.chips import ChipRegistry, default_chips
 from engine.hardware.config import BusConfig, DeviceConfig, RobotConfig
@@ -55,12 +56,7 @@ from engine.hardware.device_health import DeviceHealth
 from engine.hardware.pollers import Poller, make_poller
 from engine.hardware.real_buses import BusProvider, RealBuses
 from engine.hardware.robot_hardware import Hardware
-from engine.hardware.services import (
-    HardwareLeds,
-    HardwareServos,
-    TemperatureSensor,
-    UltrasoundSensor,
-)
+from engine.hardware.sensor_services import TemperatureSensor, UltrasoundSensor
 from engine.hardware.xshut import XshutChain
 
 _log = logging.getLogger("vest.hardware")

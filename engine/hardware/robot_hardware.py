@@ -12,15 +12,12 @@ from engine.clock import Clock
 from engine.drivers.bus_manager import BusManager, DeviceHandle, DeviceStats
 from engine.drivers.tca9548a import TCA9548A
 from engine.errors import ConfigError
+from engine.hardware.actuator_services import HardwareLeds, HardwareServos
 from engine.hardware.branching_clock import branch_of
 from engine.hardware.config import RobotConfig
 from engine.hardware.device_health import DeviceHealth
 from engine.hardware.pollers import Poller, PollerThreads
-from engine.hardware.services import (
-    HardwareLeds,
-    HardwareSensors,
-    HardwareServos,
-)
+from engine.hardware.sensor_services import HardwareSensors
 from engine.hardware.xshut import XshutChain
 from engine.services.interfaces import IotResults, Services, Speech
 

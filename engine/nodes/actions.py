@@ -14,6 +14,7 @@ from py_trees.common import Status
 from engine.colors import NAMED_COLORS, parse_color
 from engine.errors import ServiceError
 from engine.nodes.base import Leaf, ServiceAction
+from engine.services.interfaces import ON_REQUEST_SENSORS
 from engine.services.jobs import ImmediateJob, Job
 from engine.values.params import (
     DISTANCE_MM,
@@ -33,7 +34,6 @@ from engine.values.params import (
 )
 from engine.values.templates import Template
 
-ON_REQUEST_SENSORS = ("temperature", "ultrasound")
 MAX_SAID_CHARS = 1000
 """The longest phrase one Say speaks (about a minute of speech)."""
 

@@ -29,6 +29,10 @@ class Servos(Protocol):
         ...
 
 
+ON_REQUEST_SENSORS = ("temperature", "ultrasound")
+"""The sensors a tree reads on request (the others are polled onto the blackboard)."""
+
+
 class Sensors(Protocol):
     def read(self, sensor: str) -> Job:
         """Read an on-request sensor (``temperature``, ``ultrasound``).
