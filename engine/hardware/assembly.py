@@ -48,7 +48,7 @@ from engine.drivers.bus_manager import BusManager, DeviceHandle
 from engine.drivers.maestro import Maestro
 from engine.drivers.tca9548a import TCA9548A, LockedBus
 from engine.errors import DeviceError
-from engine.hardware.actuator_services import HardwareLeds, HardwareServos
+from engine.hardware.actuator_services import HardwareServos
 from engine.hardware.branching_clock import BranchingClock
 from engine.hardware.chips import ChipRegistry, default_chips
 from engine.hardware.config import BusConfig, DeviceConfig, RobotConfig
@@ -56,7 +56,6 @@ from engine.hardware.device_health import DeviceHealth
 from engine.hardware.pollers import Poller, make_poller
 from engine.hardware.real_buses import BusProvider, RealBuses
 from engine.hardware.robot_hardware import Hardware
-from engine.hardware.sensor_services import TemperatureSensor, UltrasoundSensor
 from engine.hardware.xshut import XshutChain
 
 _log = logging.getLogger("vest.hardware")
@@ -130,6 +129,7 @@ class _Assembler:
         self.provider = provider
         self.blackboard = blackboard
         self.clock = hardware.clock
+        self.chips = default_chips()
         self._upstream: dict[str, LockedBus] = {}
 
     def _manager(self, bus: Any, *, name: str, kind: str) -> BusManager[Any]:
@@ -260,7 +260,6 @@ class _Assembler:
             self._servos(device)
             return
         handle = self._claim(device)
-        role = device.role
         poller: Poller[Any] | None = None
         if device.polled:
             try:
@@ -281,15 +280,12 @@ class _Assembler:
             if poller is not None:
                 if device.name not in hw.startup_problems:
                     poller.connect()
-            elif role == "leds":
-                hw.leds = HardwareLeds(device, handle, self.clock)
-                hw.leds.connect()
-            elif role == "temperature":
-                hw.sensors.temperature = TemperatureSensor(device, handle, self.clock)
-                hw.sensors.temperature.connect()
-            elif role == "ultrasound":
-                hw.sensors.ultrasound = UltrasoundSensor(device, handle, self.clock)
-                hw.sensors.ultrasound.connect()
+            else:
+                kind = self.chips.get(device.chip)
+                if kind is not None and kind.service is not None:
+                    service = kind.service(device, handle, self.clock)
+                    hw.place(device.role, service)
+                    service.connect()
         except Exception as error:
             if device.name not in hw.startup_problems:
                 self._failed(device, error)

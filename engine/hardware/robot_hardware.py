@@ -17,7 +17,7 @@ from engine.hardware.branching_clock import branch_of
 from engine.hardware.config import RobotConfig
 from engine.hardware.device_health import DeviceHealth
 from engine.hardware.pollers import Poller, PollerThreads
-from engine.hardware.sensor_services import HardwareSensors
+from engine.hardware.sensor_services import HardwareSensors, TemperatureSensor, UltrasoundSensor
 from engine.hardware.xshut import XshutChain
 from engine.services.interfaces import IotResults, Services, Speech
 
@@ -67,6 +67,17 @@ class Hardware:
         for manager in self.managers.values():
             with branch_of(self.clock):
                 manager.run_due_probes()
+
+    def place(self, role: str, service: object) -> None:
+        """Keep a device's service where the robot's services are found, by its role."""
+        if role == "leds" and isinstance(service, HardwareLeds):
+            self.leds = service
+        elif role == "temperature" and isinstance(service, TemperatureSensor):
+            self.sensors.temperature = service
+        elif role == "ultrasound" and isinstance(service, UltrasoundSensor):
+            self.sensors.ultrasound = service
+        else:
+            raise ValueError(f"no place for a {type(service).__name__} as {role!r}")
 
     def start(self, origin_s: float | None = None) -> None:
         """Threaded: start the poller threads (inline, the hooks poll).

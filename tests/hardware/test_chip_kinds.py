@@ -34,6 +34,14 @@ def test_the_polled_chip_kinds_are_the_ones_with_a_poller() -> None:
     assert [k.name for k in chips if k.poll is not None] == [k.name for k in chips if k.spec.polled]
 
 
+def test_chips_read_on_request_or_commanded_bring_their_service() -> None:
+    # the Maestro owns its serial port, so the assembly builds its service itself
+    on_request = [
+        k for k in default_chips() if k.spec.role in ("temperature", "ultrasound", "leds")
+    ]
+    assert [k.name for k in on_request if k.service is None] == []
+
+
 def test_a_chip_kind_registered_twice_is_refused() -> None:
     kind = ChipKind(ChipSpec("mpr121", "again", "i2c", "touch"))
     with pytest.raises(ValueError, match="registered twice"):

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 from typing import Any, Protocol
 
 from engine.clock import Clock
+from engine.drivers.bus_manager import DeviceHandle
 from engine.drivers.sim.i2c_bus import SimI2CBus, SimI2CDevice
 from engine.errors import DeviceError
 from engine.files.problems import Mark, Problems
@@ -43,6 +44,14 @@ class DevicesTogether(Protocol):
 
     def mark(self, device: DeviceConfig, field_name: str) -> Mark: ...
 
+
+class DeviceService(Protocol):
+    """A hardware service on one device: it connects (makes its driver) or raises."""
+
+    def connect(self) -> None: ...
+
+
+ServiceMaker = Callable[[DeviceConfig, DeviceHandle[Any], Clock], DeviceService]
 
 TogetherCheck = Callable[[DevicesTogether, list[DeviceConfig]], None]
 """Rules between the devices of one chip kind and the rest of the config (adds problems)."""
@@ -103,6 +112,10 @@ class ChipKind:
     list_lengths: tuple[tuple[str, int], ...] = ()
     """Readings that are lists, and how many items each holds (touch ``pads``: 12), so a
     tree's ``item:`` can be checked against the robot."""
+    service: ServiceMaker | None = None
+    """For a chip read on request or commanded (not the Maestro, which owns its port): the
+    service on its device handle, placed by the chip's role (leds, temperature,
+    ultrasound)."""
     check_together: TogetherCheck | None = None
     """Rules between this kind's devices and the others (the VL53L0X boot address, the
     PCA9685's All Call address)."""

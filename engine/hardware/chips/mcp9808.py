@@ -9,6 +9,7 @@ from engine.drivers import mcp9808 as driver
 from engine.drivers.sim.mcp9808 import SimMCP9808
 from engine.hardware.chips.kind import ChipKind, SimPlacement, expect_identity
 from engine.hardware.config import ChipSpec, DeviceConfig
+from engine.hardware.sensor_services import TemperatureSensor
 from engine.values.params import Choice, Param
 
 
@@ -46,4 +47,5 @@ KIND = ChipKind(
     ),
     simulate=_simulate,
     probe=_probe,
+    service=TemperatureSensor,
 )

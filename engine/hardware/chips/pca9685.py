@@ -7,6 +7,7 @@ from typing import Any
 
 from engine.drivers import pca9685 as driver
 from engine.drivers.sim.pca9685 import SimPCA9685
+from engine.hardware.actuator_services import HardwareLeds
 from engine.hardware.chips.fields import ChipFields
 from engine.hardware.chips.kind import ChipKind, DevicesTogether, SimPlacement
 from engine.hardware.config import PCA9685_ALL_CALL, ChipSpec, DeviceConfig
@@ -128,4 +129,5 @@ KIND = ChipKind(
     simulate=_simulate,
     probe=_probe,
     check_together=_all_call,
+    service=HardwareLeds,
 )

@@ -9,6 +9,7 @@ from engine.drivers import srf02 as driver
 from engine.drivers.sim.srf02 import SimSRF02
 from engine.hardware.chips.kind import ChipKind, SimPlacement, expect_identity
 from engine.hardware.config import ChipSpec, DeviceConfig
+from engine.hardware.sensor_services import UltrasoundSensor
 
 
 def _simulate(vest: SimPlacement, device: DeviceConfig) -> None:
@@ -34,4 +35,5 @@ KIND = ChipKind(
     ),
     simulate=_simulate,
     probe=_probe,
+    service=UltrasoundSensor,
 )
