@@ -1,25 +1,17 @@
-"""Services on the vest's drivers: LEDs, servo joints, temperature and ultrasound on request.
+"""What the hardware services are made of: jobs on a device's bus-manager handle.
 
-They implement :mod:`engine.services.interfaces` (speech stays simulated for now). Every
-method returns a :class:`~engine.services.jobs.Job` at once; the work is one or a few
-transactions on the device's bus manager at :attr:`~engine.drivers.bus_manager.Priority.REQUEST`
-priority, ahead of routine polls. With ``threaded`` bus managers the transactions run on the
-bus's worker and a job is done when its future is; inline they have run by the time the
-method returns.
+The services themselves are :mod:`engine.hardware.actuator_services` (the face LEDs, the
+servo joints) and :mod:`engine.hardware.sensor_services` (temperature and ultrasound read
+on request); a chip kind names its own (:mod:`engine.hardware.chips`). They implement
+:mod:`engine.services.interfaces`: every method returns a
+:class:`~engine.services.jobs.Job` at once; the work is one or a few transactions on the
+device's bus manager at :attr:`~engine.drivers.bus_manager.Priority.REQUEST` priority,
+ahead of routine polls. With ``threaded`` bus managers the transactions run on the bus's
+worker and a job is done when its future is; inline they have run by the time the method
+returns.
 
-- :class:`HardwareLeds`: every LED of the config's PCA9685 in one color; with ``seconds``
-  the LEDs go dark again when the hook (``leds(now_s)``, a scheduler hook) sees the time,
-  tried again until the chip took it. A rebuilt driver (after a failure: a replugged chip
-  starts dark) lights the color the LEDs should show.
-- :class:`HardwareServos`: joints in degrees on the Maestro; a move beyond a joint's limits
-  is a failed job that says so, and nothing is sent. The job lasts as long as the move
-  takes at its speed.
-- :class:`HardwareSensors`: ``read("temperature")`` is one MCP9808 register read;
-  ``read("ultrasound")`` commands an SRF02 ranging and comes back for the result once the
-  ranging time (66 ms) has passed on the clock, never waiting for it in a tick.
-
-Drivers are made inside the first transaction that needs them, on the bus itself, and
-made again after a failure (a replugged chip starts from power-on).
+Drivers are made inside the first transaction that needs them (:class:`DriverSlot`), on
+the bus itself, and made again after a failure (a replugged chip starts from power-on).
 """
 
 from __future__ import annotations

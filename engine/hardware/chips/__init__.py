@@ -1,8 +1,11 @@
-"""The chip kinds vest knows, one module each: the robot config's view of a chip.
+"""The chip kinds vest knows, one module each: everything the engine knows of a chip.
 
-:func:`default_chips` builds the registry the config checker uses. Adding a chip to the
-config means one module here (its :class:`~engine.hardware.config.ChipSpec` and the
-check of its own fields) and a line below.
+Each module declares ``KIND``: the chip's :class:`~engine.hardware.config.ChipSpec` (config
+fields, options, addresses, role, readings), the check of its own fields, its identity
+probe, how it is polled or which service it offers, how ``vest devices`` shows a reading,
+which simulated model stands in for it and its rules across devices.
+:func:`default_chips` builds the registry; adding a chip means its driver, its simulated
+model, one module here, a line below, and its tests.
 """
 
 from __future__ import annotations
