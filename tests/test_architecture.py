@@ -109,3 +109,32 @@ def test_only_the_clock_module_reads_time_or_sleeps() -> None:
         if path.name != "clock.py" and pattern.search(path.read_text())
     )
     assert readers == []
+
+
+def _docstrings(tree: ast.AST) -> set[int]:
+    """ids of the string constants that are docstrings (modules, classes, functions)."""
+    found: set[int] = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Module | ast.ClassDef | ast.FunctionDef | ast.AsyncFunctionDef):
+            body = node.body
+            if body and isinstance(body[0], ast.Expr) and isinstance(body[0].value, ast.Constant):
+                found.add(id(body[0].value))
+    return found
+
+
+def test_every_sensor_key_name_is_written_once_in_the_catalogue() -> None:
+    written: list[str] = []
+    for path in ENGINE.rglob("*.py"):
+        if path.name == "catalogue.py":
+            continue
+        tree = ast.parse(path.read_text())
+        docstrings = _docstrings(tree)
+        for node in ast.walk(tree):
+            if (
+                isinstance(node, ast.Constant)
+                and isinstance(node.value, str)
+                and node.value.startswith("/sensors/")
+                and id(node) not in docstrings
+            ):
+                written.append(f"{path.relative_to(ENGINE.parent)}:{node.lineno}")
+    assert written == []

@@ -19,6 +19,30 @@ Kind = Literal["state", "event"]
 VARIABLES_PREFIX = "/vars/"
 
 
+# -- every sensor key's name, defined once (the catalogue below describes each) ----------------
+TOUCH_PADS = "/sensors/touch/pads"
+TOUCH_ANY = "/sensors/touch/any"
+FORCE_LEFT_N = "/sensors/force/left_n"
+FORCE_RIGHT_N = "/sensors/force/right_n"
+RANGE_LEFT_MM = "/sensors/range/left_mm"
+RANGE_CENTER_MM = "/sensors/range/center_mm"
+RANGE_RIGHT_MM = "/sensors/range/right_mm"
+GESTURE_LAST = "/sensors/gesture/last"
+TEMPERATURE_C = "/sensors/temperature/c"
+TEMPERATURE_F = "/sensors/temperature/f"
+ULTRASOUND_CM = "/sensors/ultrasound/cm"
+
+
+def force_key(pad: str) -> str:
+    """The default key of a force pad: ``/sensors/force/<pad>_n``."""
+    return f"/sensors/force/{pad}_n"
+
+
+def range_key(side: str) -> str:
+    """The key of a range sensor looking ``side`` (left, center, right): ``.../<side>_mm``."""
+    return f"/sensors/range/{side}_mm"
+
+
 @dataclass(frozen=True)
 class KeySpec:
     """What one blackboard key holds.
@@ -118,21 +142,21 @@ def default_catalogue() -> KeyCatalogue:
     return KeyCatalogue(
         [
             KeySpec(
-                "/sensors/touch/pads",
+                TOUCH_PADS,
                 list,
                 "",
                 "touch poller (MPR121)",
                 "12 booleans, True while that pad is touched",
             ),
             KeySpec(
-                "/sensors/touch/any",
+                TOUCH_ANY,
                 bool,
                 "",
                 "touch poller (MPR121)",
                 "True while any pad is touched",
             ),
             KeySpec(
-                "/sensors/force/left_n",
+                FORCE_LEFT_N,
                 float,
                 "N",
                 "force poller (ADS1115 + FSR 406)",
@@ -140,7 +164,7 @@ def default_catalogue() -> KeyCatalogue:
                 alias="force_left_n",
             ),
             KeySpec(
-                "/sensors/force/right_n",
+                FORCE_RIGHT_N,
                 float,
                 "N",
                 "force poller (ADS1115 + FSR 406)",
@@ -148,7 +172,7 @@ def default_catalogue() -> KeyCatalogue:
                 alias="force_right_n",
             ),
             KeySpec(
-                "/sensors/range/left_mm",
+                RANGE_LEFT_MM,
                 float,
                 "mm",
                 "range poller (VL53L0X)",
@@ -156,7 +180,7 @@ def default_catalogue() -> KeyCatalogue:
                 alias="range_left_mm",
             ),
             KeySpec(
-                "/sensors/range/center_mm",
+                RANGE_CENTER_MM,
                 float,
                 "mm",
                 "range poller (VL53L0X)",
@@ -164,7 +188,7 @@ def default_catalogue() -> KeyCatalogue:
                 alias="range_center_mm",
             ),
             KeySpec(
-                "/sensors/range/right_mm",
+                RANGE_RIGHT_MM,
                 float,
                 "mm",
                 "range poller (VL53L0X)",
@@ -172,7 +196,7 @@ def default_catalogue() -> KeyCatalogue:
                 alias="range_right_mm",
             ),
             KeySpec(
-                "/sensors/gesture/last",
+                GESTURE_LAST,
                 str,
                 "",
                 "gesture poller (ZX sensor)",
@@ -180,7 +204,7 @@ def default_catalogue() -> KeyCatalogue:
                 kind="event",
             ),
             KeySpec(
-                "/sensors/temperature/c",
+                TEMPERATURE_C,
                 float,
                 "degC",
                 "temperature service (MCP9808)",
@@ -188,7 +212,7 @@ def default_catalogue() -> KeyCatalogue:
                 alias="temperature_c",
             ),
             KeySpec(
-                "/sensors/temperature/f",
+                TEMPERATURE_F,
                 float,
                 "degF",
                 "temperature service (MCP9808)",
@@ -196,7 +220,7 @@ def default_catalogue() -> KeyCatalogue:
                 alias="temperature_f",
             ),
             KeySpec(
-                "/sensors/ultrasound/cm",
+                ULTRASOUND_CM,
                 float,
                 "cm",
                 "ultrasound service (SRF02)",

@@ -16,7 +16,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-from engine.blackboard.catalogue import KeyCatalogue
+from engine.blackboard.catalogue import KeyCatalogue, range_key
 from engine.files.problems import Mark, Problems
 from engine.files.yaml_source import YMap, YScalar, YValue, describe, plain
 from engine.hardware.chips import ChipRegistry, default_chips
@@ -328,7 +328,7 @@ class ConfigChecker:
     def _keys(self, raw: YMap, spec: ChipSpec, side: str | None) -> dict[str, str] | None:
         keys = dict(spec.outputs)
         if spec.role == "range" and side is not None:
-            keys["range"] = f"/sensors/range/{side}_mm"
+            keys["range"] = range_key(side)
         section = self.mapping(raw.get("keys"), "'keys'", "e.g. keys: {any: /sensors/touch/any}")
         ok = True
         if section is not None:

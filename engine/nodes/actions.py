@@ -11,6 +11,7 @@ from typing import Any, ClassVar
 
 from py_trees.common import Status
 
+from engine.blackboard.catalogue import RANGE_CENTER_MM, RANGE_LEFT_MM, RANGE_RIGHT_MM
 from engine.colors import NAMED_COLORS, parse_color
 from engine.errors import ServiceError
 from engine.nodes.base import Leaf, ServiceAction
@@ -136,9 +137,9 @@ class LookToward(Leaf):
     )
     max_mm = Param("max_mm", DISTANCE_MM, 1200.0, "ignore anything farther")
     speed_dps = Param("speed_dps", SPEED_DPS, None, "turn speed")
-    left = Param("left", Key(), "/sensors/range/left_mm", "left distance key")
-    center = Param("center", Key(), "/sensors/range/center_mm", "center distance key")
-    right = Param("right", Key(), "/sensors/range/right_mm", "right distance key")
+    left = Param("left", Key(), RANGE_LEFT_MM, "left distance key")
+    center = Param("center", Key(), RANGE_CENTER_MM, "center distance key")
+    right = Param("right", Key(), RANGE_RIGHT_MM, "right distance key")
 
     def __init__(self, *a: Any) -> None:
         super().__init__(*a)

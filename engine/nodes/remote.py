@@ -16,6 +16,16 @@ from typing import Any, ClassVar
 
 from py_trees.common import Status
 
+from engine.blackboard.catalogue import (
+    FORCE_LEFT_N,
+    FORCE_RIGHT_N,
+    GESTURE_LAST,
+    RANGE_CENTER_MM,
+    RANGE_LEFT_MM,
+    RANGE_RIGHT_MM,
+    TOUCH_ANY,
+    TOUCH_PADS,
+)
 from engine.blackboard.events import EventLog
 from engine.errors import ServiceError
 from engine.nodes.actions import MoveServo, Say, SetLed
@@ -25,10 +35,10 @@ from engine.values.params import SECONDS, CheckContext, Key, Param, ParamProblem
 from engine.values.templates import Template
 
 POLLED_READINGS: dict[str, tuple[str, ...]] = {
-    "touch": ("/sensors/touch/pads", "/sensors/touch/any"),
-    "force": ("/sensors/force/left_n", "/sensors/force/right_n"),
-    "range": ("/sensors/range/left_mm", "/sensors/range/center_mm", "/sensors/range/right_mm"),
-    "gesture": ("/sensors/gesture/last",),
+    "touch": (TOUCH_PADS, TOUCH_ANY),
+    "force": (FORCE_LEFT_N, FORCE_RIGHT_N),
+    "range": (RANGE_LEFT_MM, RANGE_CENTER_MM, RANGE_RIGHT_MM),
+    "gesture": (GESTURE_LAST,),
 }
 COMMAND_TYPES = ("say", "led", "move", "read")
 

@@ -11,6 +11,15 @@ from dataclasses import dataclass, field
 from typing import Any, Protocol
 
 from engine.blackboard.board import Blackboard
+from engine.blackboard.catalogue import (
+    FORCE_LEFT_N,
+    FORCE_RIGHT_N,
+    GESTURE_LAST,
+    TOUCH_ANY,
+    TOUCH_PADS,
+    ULTRASOUND_CM,
+    range_key,
+)
 from engine.services.simulated import temperature_reading
 
 PADS = 12
@@ -48,7 +57,7 @@ class WorldListener(Protocol):
 
 
 EVENT_KEYS = {
-    "gesture": "/sensors/gesture/last",
+    "gesture": GESTURE_LAST,
     "hear": "/speech/heard",
     "cloud": "/iot/inbox",
 }
@@ -67,14 +76,14 @@ class BlackboardSenses:
 
     def world_changed(self, world: World, what: str) -> None:
         if what == "touch":
-            self.blackboard.stage("/sensors/touch/pads", list(world.touched))
-            self.blackboard.stage("/sensors/touch/any", any(world.touched))
+            self.blackboard.stage(TOUCH_PADS, list(world.touched))
+            self.blackboard.stage(TOUCH_ANY, any(world.touched))
         elif what == "force":
-            self.blackboard.stage("/sensors/force/left_n", world.force_n["left"])
-            self.blackboard.stage("/sensors/force/right_n", world.force_n["right"])
+            self.blackboard.stage(FORCE_LEFT_N, world.force_n["left"])
+            self.blackboard.stage(FORCE_RIGHT_N, world.force_n["right"])
         elif what == "range":
             for side in SIDES:
-                self.blackboard.stage(f"/sensors/range/{side}_mm", world.range_mm[side])
+                self.blackboard.stage(range_key(side), world.range_mm[side])
 
     def world_event(self, kind: str, value: Any) -> None:
         key = EVENT_KEYS.get(kind)
@@ -90,5 +99,5 @@ class BlackboardSenses:
         """On-request sensor readers for :class:`~engine.services.simulated.SimulatedSensors`."""
         return {
             "temperature": lambda: temperature_reading(self.world.temperature_c),
-            "ultrasound": lambda: {"/sensors/ultrasound/cm": self.world.ultrasound_cm},
+            "ultrasound": lambda: {ULTRASOUND_CM: self.world.ultrasound_cm},
         }

@@ -10,6 +10,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
+from engine.blackboard.catalogue import TEMPERATURE_C, TEMPERATURE_F
 from engine.clock import Clock
 from engine.errors import ServiceError
 from engine.services.interfaces import Services
@@ -161,4 +162,4 @@ def fahrenheit(celsius: float) -> float:
 
 def temperature_reading(celsius: float) -> dict[str, float]:
     """The blackboard values a temperature read produces."""
-    return {"/sensors/temperature/c": celsius, "/sensors/temperature/f": fahrenheit(celsius)}
+    return {TEMPERATURE_C: celsius, TEMPERATURE_F: fahrenheit(celsius)}

@@ -7,6 +7,7 @@ import math
 from collections.abc import Callable, Sequence
 from typing import Protocol
 
+from engine.blackboard.catalogue import force_key
 from engine.drivers.force_calibration import ForceCalibration
 from engine.files.yaml_source import YList, YValue, describe, plain
 from engine.hardware.chips.fields import ChipFields
@@ -68,7 +69,7 @@ def _pad(fields: ChipFields, pad_name: str, body: YValue, channels: int) -> Forc
         raw,
         (
             Param("channel", Integer(0, channels - 1), REQUIRED, "ADC input"),
-            Param("key", Key(), f"/sensors/force/{pad_name}_n", "blackboard key"),
+            Param("key", Key(), force_key(pad_name), "blackboard key"),
         ),
         f"pad {pad_name!r}",
     )

@@ -5,6 +5,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
+from engine.blackboard.catalogue import TEMPERATURE_C, TEMPERATURE_F
 from engine.drivers import mcp9808 as driver
 from engine.drivers.sim.mcp9808 import SimMCP9808
 from engine.hardware.chips.kind import ChipKind, SimPlacement, expect_identity
@@ -35,7 +36,7 @@ KIND = ChipKind(
         "temperature",
         addresses=tuple(range(0x18, 0x20)),
         default_address=0x18,
-        outputs={"celsius": "/sensors/temperature/c", "fahrenheit": "/sensors/temperature/f"},
+        outputs={"celsius": TEMPERATURE_C, "fahrenheit": TEMPERATURE_F},
         options=(
             Param(
                 "resolution_c",

@@ -5,6 +5,7 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from typing import Any
 
+from engine.blackboard.catalogue import TOUCH_ANY, TOUCH_PADS
 from engine.drivers import mpr121 as driver
 from engine.drivers.mpr121 import MPR121, PADS, check_thresholds
 from engine.drivers.sim.mpr121 import SimMPR121
@@ -70,7 +71,7 @@ KIND = ChipKind(
         addresses=tuple(range(0x5A, 0x5E)),
         default_address=0x5A,
         default_rate_hz=20.0,
-        outputs={"pads": "/sensors/touch/pads", "any": "/sensors/touch/any"},
+        outputs={"pads": TOUCH_PADS, "any": TOUCH_ANY},
         options=(
             Param("touch_threshold", Integer(1, 255), 12, "touch threshold, counts"),
             Param("release_threshold", Integer(0, 255), 6, "release threshold, counts"),

@@ -5,6 +5,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
+from engine.blackboard.catalogue import ULTRASOUND_CM
 from engine.drivers import srf02 as driver
 from engine.drivers.sim.srf02 import SimSRF02
 from engine.hardware.chips.kind import ChipKind, SimPlacement, expect_identity
@@ -31,7 +32,7 @@ KIND = ChipKind(
         "ultrasound",
         addresses=tuple(range(0x70, 0x78)),  # 0x78..0x7F are reserved on I2C
         default_address=0x70,
-        outputs={"range": "/sensors/ultrasound/cm"},
+        outputs={"range": ULTRASOUND_CM},
     ),
     simulate=_simulate,
     probe=_probe,

@@ -5,6 +5,7 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from typing import Any
 
+from engine.blackboard.catalogue import GESTURE_LAST
 from engine.drivers import zx_gesture as driver
 from engine.drivers.sim.zx_gesture import SimZXGesture
 from engine.drivers.zx_gesture import ZXGesture
@@ -86,7 +87,7 @@ KIND = ChipKind(
         addresses=(0x10, 0x11),
         default_address=0x10,
         default_rate_hz=20.0,
-        outputs={"gesture": "/sensors/gesture/last"},
+        outputs={"gesture": GESTURE_LAST},
         fields=("gesture_names",),
     ),
     _gesture_names,
