@@ -13,7 +13,17 @@ A dialog file::
         say: "The temperature is {temperature_f:.0f} degrees"
       - hear: ["~greeting robot"]
         say: "Hello!"
+      - id: pets                    # a name for the rule (default: its first phrase)
+        hear: ["do you like animals"]
+        say: "I love animals. Do you have a pet?"
+        then:                       # a follow-up: what the robot listens for next
+          listen_s: 10              # for this long (default 8)
+          rules:
+            - hear: ["yes", "i do"]
+              say: "Lovely!"
+          otherwise: "I see."       # said when the answer matches no rule
     fallback: "Sorry, I did not catch that."
+    min_score: 0.7                  # how sure the matcher must be (0..1)
 """
 
 from __future__ import annotations
@@ -24,7 +34,15 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from engine.blackboard.catalogue import KeyCatalogue
-from engine.dialogs.model import Dialog, DialogRule, normalize
+from engine.dialogs.model import (
+    DEFAULT_LISTEN_S,
+    DEFAULT_MIN_SCORE,
+    Dialog,
+    DialogRule,
+    FollowUp,
+    Phrase,
+)
+from engine.dialogs.words import normalize
 from engine.files.problems import LoadError, Mark, Problems
 from engine.files.yaml_source import (
     YList,
@@ -44,7 +62,9 @@ MAX_PHRASE_EXPANSIONS = 200
 MAX_DIALOG_EXPANSIONS = 2000
 """How many phrases all of a dialog's ``hear:`` phrases may expand to together."""
 _TOP_KEYS = ("dialog", "description", "concepts", "rules", "fallback", "min_score")
-_RULE_KEYS = ("hear", "say", "read")
+_RULE_KEYS = ("id", "hear", "say", "read", "then")
+_FOLLOW_UP_KEYS = ("rules", "listen_s", "otherwise")
+MAX_FOLLOW_UP_DEPTH = 5
 
 
 def find_dialogs_folder(path: Path) -> Path | None:
@@ -120,34 +140,19 @@ def check_dialog(
     ctx = CheckContext(catalogue)
     dialog_name = _text(document.get("dialog"), problems, "dialog") or default_name
     concepts = _concepts(document.get("concepts"), problems)
-    rules: list[DialogRule] = []
-    raw_rules = document.get("rules")
-    if raw_rules is None:
-        problems.add(document.mark, "a dialog needs 'rules:'", "add a list of hear/say rules")
-    elif not isinstance(raw_rules, YList):
-        problems.add(raw_rules.mark, f"'rules' must be a list, got {describe(raw_rules)}")
-    else:
-        budget = _Budget()
-        for raw in raw_rules:
-            rule = _rule(raw, concepts, ctx, problems, budget)
-            if rule is not None:
-                rules.append(rule)
+    budget = _Budget()
+    rules = _rules(document.get("rules"), document.mark, concepts, ctx, problems, budget, 0)
+    _check_ids(rules, problems)
     fallback = None
     raw_fallback = document.get("fallback")
     if raw_fallback is not None:
         fallback = _template(raw_fallback, ctx, problems)
-    min_score = 0.8
+    min_score = DEFAULT_MIN_SCORE
     raw_score = document.get("min_score")
     if raw_score is not None:
-        value = raw_score.value if isinstance(raw_score, YScalar) else None
-        if isinstance(value, bool) or not isinstance(value, int | float) or not 0 < value <= 1:
-            problems.add(
-                raw_score.mark, f"'min_score' must be a number in 0..1, got {describe(raw_score)}"
-            )
-        else:
-            min_score = float(value)
+        min_score = _number(raw_score, problems, "min_score", 0.0, 1.0, DEFAULT_MIN_SCORE)
     problems.raise_if_any()
-    return Dialog(dialog_name, tuple(rules), fallback, min_score, file)
+    return Dialog(dialog_name, rules, fallback, min_score, file)
 
 
 def _text(value: YValue | None, problems: Problems, what: str) -> str | None:
@@ -205,12 +210,91 @@ class _Budget:
     left: int = MAX_DIALOG_EXPANSIONS
 
 
+def _rules(
+    raw_rules: YValue | None,
+    where: Mark,
+    concepts: dict[str, list[str]],
+    ctx: CheckContext,
+    problems: Problems,
+    budget: _Budget,
+    depth: int,
+) -> tuple[DialogRule, ...]:
+    if raw_rules is None:
+        problems.add(where, "a dialog needs 'rules:'", "add a list of hear/say rules")
+        return ()
+    if not isinstance(raw_rules, YList):
+        problems.add(raw_rules.mark, f"'rules' must be a list, got {describe(raw_rules)}")
+        return ()
+    rules = (_rule(raw, concepts, ctx, problems, budget, depth) for raw in raw_rules)
+    return tuple(rule for rule in rules if rule is not None)
+
+
+def _check_ids(rules: tuple[DialogRule, ...], problems: Problems) -> None:
+    """Rule ids are unique in a dialog, follow-ups included (`vest hear` names rules by id)."""
+    seen: dict[str, DialogRule] = {}
+    pending = list(rules)
+    while pending:
+        rule = pending.pop(0)
+        if rule.id in seen:
+            problems.add(
+                rule.mark or Mark("", 1, 1),
+                f"two rules have the id {rule.id!r} (also line {seen[rule.id].line})",
+                "give one of them another 'id:'",
+            )
+        seen.setdefault(rule.id, rule)
+        if rule.follow_up is not None:
+            pending.extend(rule.follow_up.rules)
+
+
+def _number(
+    raw: YValue, problems: Problems, what: str, low: float, high: float, default: float
+) -> float:
+    value = raw.value if isinstance(raw, YScalar) else None
+    if isinstance(value, bool) or not isinstance(value, int | float) or not low < value <= high:
+        problems.add(
+            raw.mark,
+            f"{what!r} must be a number above {low:g} and at most {high:g}, got {describe(raw)}",
+        )
+        return default
+    return float(value)
+
+
+def _follow_up(
+    raw: YValue,
+    concepts: dict[str, list[str]],
+    ctx: CheckContext,
+    problems: Problems,
+    budget: _Budget,
+    depth: int,
+) -> FollowUp | None:
+    if not isinstance(raw, YMap):
+        problems.add(raw.mark, "'then' is a mapping with 'rules:' (and 'listen_s', 'otherwise')")
+        return None
+    if depth >= MAX_FOLLOW_UP_DEPTH:
+        problems.add(
+            raw.mark,
+            f"follow-ups nest deeper than {MAX_FOLLOW_UP_DEPTH}",
+            "flatten the conversation",
+        )
+        return None
+    problems.unknown_fields(raw.key_marks, _FOLLOW_UP_KEYS, "follow-up")
+    rules = _rules(raw.get("rules"), raw.mark, concepts, ctx, problems, budget, depth + 1)
+    listen_s = DEFAULT_LISTEN_S
+    raw_listen = raw.get("listen_s")
+    if raw_listen is not None:
+        listen_s = _number(raw_listen, problems, "listen_s", 0.0, 3600.0, DEFAULT_LISTEN_S)
+    raw_otherwise = raw.get("otherwise")
+    otherwise = _template(raw_otherwise, ctx, problems) if raw_otherwise is not None else None
+    return FollowUp(rules, listen_s, otherwise)
+
+
 def _rule(
     raw: YValue,
     concepts: dict[str, list[str]],
     ctx: CheckContext,
     problems: Problems,
     budget: _Budget,
+    depth: int,
 ) -> DialogRule | None:
     if not isinstance(raw, YMap):
         problems.add(raw.mark, "each rule is a mapping with 'hear:' and 'say:'")
@@ -258,9 +342,22 @@ def _rule(
                 did_you_mean(read, ON_REQUEST_SENSORS) or "use " + " or ".join(ON_REQUEST_SENSORS),
             )
             read = None
+    raw_then = raw.get("then")
+    follow_up = None
+    if raw_then is not None:
+        follow_up = _follow_up(raw_then, concepts, ctx, problems, budget, depth)
+    rule_id = _text(raw.get("id"), problems, "id")
     if answer is None or not phrases:
         return None
-    return DialogRule(tuple(dict.fromkeys(phrases)), answer, read, raw.mark.line)
+    unique = tuple(dict.fromkeys(phrases))
+    return DialogRule(
+        id=rule_id or unique[0],
+        phrases=tuple(Phrase.of(text) for text in unique),
+        answer=answer,
+        read=read,
+        follow_up=follow_up,
+        mark=raw.mark,
+    )
 
 
 def _template(value: YValue, ctx: CheckContext, problems: Problems) -> CompiledTemplate | None:

@@ -1,83 +1,112 @@
-"""Dialog rules and how a heard utterance is matched to one.
+"""Dialog rules and how a heard utterance is matched to one, on words, not characters.
 
-Matching normalizes both sides (case, punctuation, contractions; in any script) and
-tolerates small recognition errors: an exact phrase scores 1.0, a phrase inside a longer
-utterance 0.95, otherwise the similarity of the two texts, accepted from ``min_score``.
+A phrase matches an utterance only when every *meaning word* of the phrase is in it
+(see :mod:`engine.dialogs.words`); a phrase made only of function words ("who are you")
+matches only when all its words are there and nothing else meaningful is ("who are your
+parents" is another question). The score is how much of the phrase was heard (function
+words count less), lowered for each meaningful word the phrase does not explain. Below
+``min_score``, or when two rules score too close to tell apart, nothing matches and the
+robot says its fallback: a wrong answer is worse than none.
 """
 
 from __future__ import annotations
 
-import difflib
-import re
-import unicodedata
-from dataclasses import dataclass
+from collections.abc import Sequence
+from dataclasses import dataclass, field
 
+from engine.dialogs.words import is_function_word, same_word, weight, words
+from engine.files.problems import Mark
 from engine.values.templates import CompiledTemplate
 
-_CONTRACTIONS = {
-    "what's": "what is",
-    "who's": "who is",
-    "it's": "it is",
-    "how's": "how is",
-    "i'm": "i am",
-    "you're": "you are",
-    "what're": "what are",
-    "favourite": "favorite",
-    "colour": "color",
-}
-_SPACES = re.compile(r"\s+")
-_WORD_CATEGORIES = ("L", "M", "N")
-"""Letters, marks and digits of any script (marks: the vowel signs of Devanagari, accents)."""
+EXTRA_WORD_FACTOR = 0.85
+"""The score is multiplied by this for each meaning word heard that the phrase lacks."""
+AMBIGUITY_MARGIN = 0.1
+"""Two rules scoring within this of each other cannot be told apart: neither matches.
+Nor can two that both reach ``min_score`` ("what is your name and your favorite color")."""
+DEFAULT_MIN_SCORE = 0.7
+DEFAULT_LISTEN_S = 8.0
 
 
-def _word_character(char: str) -> bool:
-    return char == "'" or unicodedata.category(char)[0] in _WORD_CATEGORIES
+@dataclass(frozen=True)
+class Phrase:
+    """One phrase a rule listens for, as words with what the matcher needs to know."""
+
+    text: str
+    words: tuple[str, ...]
+    required: frozenset[str]
+    """Meaning words; every word when the phrase has none."""
+    only_function_words: bool
+    total_weight: float
+
+    @classmethod
+    def of(cls, text: str) -> Phrase:
+        said = words(text)
+        meaning = frozenset(w for w in said if not is_function_word(w))
+        return cls(
+            text=text,
+            words=said,
+            required=meaning or frozenset(said),
+            only_function_words=not meaning,
+            total_weight=sum(weight(w) for w in said),
+        )
+
+    def score(self, heard: Sequence[str]) -> float:
+        """0..1: 0 when a required word is missing; 1 for the phrase exactly."""
+        if not self.words:
+            return 0.0
+        found = [w for w in self.words if any(same_word(h, w) for h in heard)]
+        if any(w not in found for w in self.required):
+            return 0.0
+        extra = [
+            h
+            for h in heard
+            if not is_function_word(h) and not any(same_word(h, w) for w in self.words)
+        ]
+        if extra and self.only_function_words:
+            return 0.0
+        covered = sum(weight(w) for w in dict.fromkeys(found)) / sum(
+            weight(w) for w in dict.fromkeys(self.words)
+        )
+        return covered * EXTRA_WORD_FACTOR ** len(extra)
 
 
-def normalize(text: str) -> str:
-    """Case folded, no punctuation, contractions spelled out, single spaces; in any script.
+@dataclass(frozen=True)
+class FollowUp:
+    """What the robot listens for after a rule's answer asked a question.
 
-    Accents are kept (``café`` stays ``café``); both sides of a match are normalized the
-    same way (Unicode NFKC), so a composed and a decomposed ``é`` are the same letter.
+    ``rules`` are tried first for the next utterance heard within ``listen_s`` seconds;
+    when none matches, the dialog's own rules are; when those do not either, ``otherwise``
+    is said (the dialog's fallback when there is none).
     """
-    folded = unicodedata.normalize("NFKC", text).casefold().replace("\u2019", "'")
-    words = "".join(c if _word_character(c) else " " for c in folded).split()
-    expanded = " ".join(_CONTRACTIONS.get(word, word) for word in words)
-    return _SPACES.sub(" ", expanded.replace("'", "")).strip()
+
+    rules: tuple[DialogRule, ...]
+    listen_s: float = DEFAULT_LISTEN_S
+    otherwise: CompiledTemplate | None = None
 
 
 @dataclass(frozen=True)
 class DialogRule:
     """Hear one of ``phrases`` -> (optionally read ``read`` first) -> say ``answer``."""
 
-    phrases: tuple[str, ...]
+    id: str
+    phrases: tuple[Phrase, ...]
     answer: CompiledTemplate
     read: str | None = None
-    line: int = 0
+    follow_up: FollowUp | None = None
+    mark: Mark | None = None
+    """Where the rule is written."""
 
-    def literal_score(self, heard: str) -> float:
-        """1.0 for an exact phrase, 0.95 for a phrase inside the utterance, else 0."""
-        best = 0.0
-        padded = f" {heard} "
-        for phrase in self.phrases:
-            if heard == phrase:
-                return 1.0
-            if f" {phrase} " in padded:
-                best = 0.95
-        return best
+    @property
+    def line(self) -> int:
+        return self.mark.line if self.mark is not None else 0
 
-    def fuzzy_score(self, heard: str, at_least: float) -> float:
-        """The best similarity of ``heard`` to a phrase, skipping phrases that cannot beat
-        ``at_least`` (cheap upper bounds first: difflib is the costly part of matching)."""
-        best = 0.0
-        matcher = difflib.SequenceMatcher(None, heard)
+    def score(self, heard: Sequence[str]) -> tuple[float, Phrase | None]:
+        """The best phrase's score, and that phrase."""
+        best: tuple[float, Phrase | None] = (0.0, None)
         for phrase in self.phrases:
-            matcher.set_seq2(phrase)
-            if matcher.real_quick_ratio() < at_least or matcher.quick_ratio() < at_least:
-                continue
-            ratio = matcher.ratio()
-            if ratio >= at_least:
-                best, at_least = max(best, ratio), max(at_least, ratio)
+            score = phrase.score(heard)
+            if score > best[0]:
+                best = (score, phrase)
         return best
 
 
@@ -85,6 +114,47 @@ class DialogRule:
 class Match:
     rule: DialogRule
     score: float
+    phrase: Phrase
+
+
+@dataclass(frozen=True)
+class Verdict:
+    """What the matcher made of an utterance: the match, or why there is none."""
+
+    match: Match | None
+    reason: str
+    candidates: tuple[Match, ...] = field(default=())
+    """Every rule that scored above 0, best first."""
+
+
+def judge(rules: Sequence[DialogRule], utterance: str, min_score: float) -> Verdict:
+    """The rule ``utterance`` means, or why none: no rule's words, too low, or ambiguous."""
+    heard = words(utterance)
+    if not heard:
+        return Verdict(None, "nothing was heard")
+    candidates: list[Match] = []
+    for rule in rules:
+        score, phrase = rule.score(heard)
+        if phrase is not None and score > 0:
+            candidates.append(Match(rule, score, phrase))
+    candidates.sort(key=lambda m: -m.score)
+    found = tuple(candidates)
+    if not candidates:
+        return Verdict(None, "no rule's meaning words were all heard", found)
+    best = candidates[0]
+    if best.score < min_score:
+        return Verdict(
+            None, f"best rule {best.rule.id!r} scored {best.score:.2f} < {min_score:.2f}", found
+        )
+    runner_up = candidates[1].score if len(candidates) > 1 else 0.0
+    if runner_up >= min_score or runner_up > best.score - AMBIGUITY_MARGIN:
+        other = candidates[1]
+        return Verdict(
+            None,
+            f"ambiguous: {best.rule.id!r} {best.score:.2f} and {other.rule.id!r} {other.score:.2f}",
+            found,
+        )
+    return Verdict(best, f"phrase {best.phrase.text!r}", found)
 
 
 @dataclass(frozen=True)
@@ -94,29 +164,43 @@ class Dialog:
     name: str
     rules: tuple[DialogRule, ...]
     fallback: CompiledTemplate | None = None
-    min_score: float = 0.8
+    min_score: float = DEFAULT_MIN_SCORE
     source: str = ""
 
+    def judge(self, utterance: str, follow_up: FollowUp | None = None) -> Verdict:
+        """The matching rule, trying ``follow_up``'s rules first when the robot just asked."""
+        if follow_up is not None:
+            verdict = judge(follow_up.rules, utterance, self.min_score)
+            if verdict.match is not None:
+                return verdict
+        return judge(self.rules, utterance, self.min_score)
+
     def match(self, utterance: str) -> Match | None:
-        """The best rule for ``utterance``, or None when none scores ``min_score``."""
-        heard = normalize(utterance)
-        if not heard:
-            return None
-        best: Match | None = None
-        for rule in self.rules:  # exact and contained phrases win before any fuzzy match
-            score = rule.literal_score(heard)
-            if score > 0 and (best is None or score > best.score):
-                best = Match(rule, score)
-        if best is not None:
-            return best
-        for rule in self.rules:
-            floor = best.score if best is not None else self.min_score
-            score = rule.fuzzy_score(heard, floor)
-            if score >= floor and (best is None or score > best.score):
-                best = Match(rule, score)
-        return best
+        """The best rule for ``utterance``, or None when no rule clearly means it."""
+        return self.judge(utterance).match
+
+    def all_rules(self) -> list[DialogRule]:
+        """Every rule, follow-ups included."""
+        found: list[DialogRule] = []
+        pending = list(self.rules)
+        while pending:
+            rule = pending.pop(0)
+            found.append(rule)
+            if rule.follow_up is not None:
+                pending.extend(rule.follow_up.rules)
+        return found
 
     @property
     def phrases(self) -> list[str]:
-        """Every phrase the rules listen for (for the speech recognizer's vocabulary)."""
-        return [phrase for rule in self.rules for phrase in rule.phrases]
+        """Every phrase the rules listen for, follow-ups included (the recognizer's vocabulary)."""
+        return [phrase.text for rule in self.all_rules() for phrase in rule.phrases]
+
+    def templates(self) -> list[CompiledTemplate]:
+        """Every answer the dialog may say: rules, follow-ups, fallbacks."""
+        said: list[CompiledTemplate] = [rule.answer for rule in self.all_rules()]
+        said += [
+            r.follow_up.otherwise for r in self.all_rules() if r.follow_up and r.follow_up.otherwise
+        ]
+        if self.fallback is not None:
+            said.append(self.fallback)
+        return said

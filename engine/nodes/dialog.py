@@ -7,7 +7,7 @@ from typing import Any, ClassVar
 
 from py_trees.common import Access, Status
 
-from engine.dialogs.model import Dialog
+from engine.dialogs.model import Dialog, FollowUp
 from engine.errors import ServiceError
 from engine.nodes.base import Leaf
 from engine.services.jobs import ImmediateJob, Job
@@ -20,9 +20,11 @@ class Reply(Leaf):
 
     When the rule says ``read: temperature`` (or ultrasound), the sensor is read first and
     the answer is filled with the new value; ``{fields}`` of other keys are filled with
-    their current value. RUNNING while reading and speaking; SUCCESS when the answer was
-    said; FAILURE when no rule matched and the dialog has no fallback, a field has no value
-    yet, or a sensor or the speech service failed.
+    their current value. When the rule's answer asked a question (``then:``), the next
+    utterance within its ``listen_s`` is matched against the follow-up's rules first.
+    RUNNING while reading and speaking; SUCCESS when the answer was said; FAILURE when no
+    rule matched and the dialog has no fallback, a field has no value yet, or a sensor or
+    the speech service failed.
     """
 
     params: ClassVar = (
@@ -46,6 +48,8 @@ class Reply(Leaf):
         self.job: Job | None = None
         self.answer: CompiledTemplate | None = None
         self.phase = "idle"
+        self.follow_up: FollowUp | None = None
+        self.follow_up_until_s = 0.0
         for key in dict.fromkeys(self._answer_keys()):  # whatever an answer may fill in
             self.blackboard.register_key(key, access=Access.READ)
 
@@ -56,10 +60,7 @@ class Reply(Leaf):
         dialog = dialogs.get(self.args.dialog) if dialogs is not None else None
         if dialog is None:
             return []
-        templates = [rule.answer for rule in dialog.rules]
-        if dialog.fallback is not None:
-            templates.append(dialog.fallback)
-        return [key for template in templates for key in template.keys]
+        return [key for template in dialog.templates() for key in template.keys]
 
     def dialog(self) -> Dialog:
         dialogs = self.ctx.dialogs
@@ -72,14 +73,24 @@ class Reply(Leaf):
         self.job, self.answer, self.phase = None, None, "idle"
         heard = self.read(self.args.heard)
         dialog = self.dialog()
-        match = dialog.match(str(heard)) if heard else None
+        asked = self.follow_up if self.ctx.clock.now() <= self.follow_up_until_s else None
+        self.follow_up, self.follow_up_until_s = None, 0.0
+        verdict = dialog.judge(str(heard), asked) if heard else None
+        match = verdict.match if verdict is not None else None
         if match is None:
-            self.feedback_message = f"no rule matches {heard!r}"
-            if dialog.fallback is not None:
-                self._speak(dialog.fallback)
+            why = verdict.reason if verdict is not None else "nothing was heard"
+            self.feedback_message = f"no rule matches {heard!r}: {why}"
+            said = asked.otherwise if asked is not None else None
+            said = said if said is not None else dialog.fallback
+            if said is not None:
+                self._speak(said)
             return
-        self.feedback_message = f"matched rule at line {match.rule.line} ({match.score:.2f})"
+        self.feedback_message = (
+            f"rule {match.rule.id!r} at line {match.rule.line} ({match.score:.2f})"
+        )
         self.answer = match.rule.answer
+        if match.rule.follow_up is not None:
+            self.follow_up = match.rule.follow_up
         if match.rule.read:
             self.phase = "reading"
             self.job = self.ctx.actions.read_sensor(match.rule.read)
@@ -99,6 +110,8 @@ class Reply(Leaf):
         if self.job is None:
             return Status.FAILURE
         status = self.job_status(self.job, failed="could not answer")
+        if status == Status.SUCCESS and self.phase == "speaking" and self.follow_up is not None:
+            self.follow_up_until_s = self.ctx.clock.now() + self.follow_up.listen_s
         if status == Status.SUCCESS and self.phase == "reading" and self.answer is not None:
             # the service stages the reading for every tree; this answer uses it at once
             fresh = self.job.result() or {}

@@ -103,3 +103,31 @@ def test_a_temperature_sensor_that_cannot_be_read_fails_the_answer(robot: TreeHa
         "MCP9808 not answering",
     )
     assert robot.did("read") == []
+
+
+def test_the_robot_asks_back_and_listens_for_the_answer(robot: TreeHarness) -> None:
+    hear(robot, "do you like animals")
+    hear(robot, "yes, I have a dog")
+    assert robot.said == [
+        "I love animals. Do you have a pet?",
+        "How lovely! Pets are good friends.",
+    ]
+
+
+def test_an_answer_it_cannot_place_gets_the_follow_up_s_otherwise(robot: TreeHarness) -> None:
+    hear(robot, "do you like animals")
+    hear(robot, "banana")
+    assert robot.said[-1] == "I see. Animals are wonderful."
+
+
+def test_after_the_follow_up_times_out_an_answer_means_nothing(robot: TreeHarness) -> None:
+    hear(robot, "do you like animals")
+    robot.advance(11.0)  # the follow-up listens for 10 s
+    hear(robot, "yes")
+    assert robot.said[-1] == FALLBACK
+
+
+def test_a_question_instead_of_an_answer_is_answered(robot: TreeHarness) -> None:
+    hear(robot, "do you like animals")
+    hear(robot, "what is your name")
+    assert robot.said[-1] == NAME

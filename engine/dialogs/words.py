@@ -1,0 +1,111 @@
+"""Words as the dialog matcher sees them: normalized, stemmed, and weighed by meaning.
+
+A *function word* ("what", "is", "your", "please", "robot") shapes a question but does not
+say what it is about; a *meaning word* ("name", "temperature", "cake", "not") does. The
+matcher requires every meaning word of a phrase and forgives missing function words, so
+"do you like cake" never matches "do you like animals". Words outside English have no
+function-word list and all count as meaning words.
+"""
+
+from __future__ import annotations
+
+import difflib
+import re
+import unicodedata
+
+_CONTRACTIONS = {
+    "what's": "what is",
+    "who's": "who is",
+    "where's": "where is",
+    "it's": "it is",
+    "how's": "how is",
+    "that's": "that is",
+    "there's": "there is",
+    "i'm": "i am",
+    "i've": "i have",
+    "i'd": "i would",
+    "i'll": "i will",
+    "you're": "you are",
+    "you've": "you have",
+    "what're": "what are",
+    "don't": "do not",
+    "doesn't": "does not",
+    "didn't": "did not",
+    "isn't": "is not",
+    "aren't": "are not",
+    "can't": "can not",
+    "cannot": "can not",
+    "won't": "will not",
+    "haven't": "have not",
+    "favourite": "favorite",
+    "colour": "color",
+    "colours": "colors",
+}
+_SPACES = re.compile(r"\s+")
+_WORD_CATEGORIES = ("L", "M", "N")
+"""Letters, marks and digits of any script (marks: the vowel signs of Devanagari, accents)."""
+
+_FUNCTION_WORD_LINES = (
+    "a an the this that these those there here it its",
+    "i me my mine we us our you your yours yourself he him his she her they them their",
+    "is are am was were be been being do does did have has had will would shall should",
+    "can could may might must",
+    "what who whom whose which how why where when",
+    "to of in on at for with about from by as into over",
+    "and or but so if then than just really very too also",
+    "please hey hi hello oh um uh er ah okay ok well robot tell say let know",
+)
+FUNCTION_WORDS = frozenset(" ".join(_FUNCTION_WORD_LINES).split())
+"""Words that shape a question without saying what it is about. Negations ("no", "not",
+"never") are not among them: they turn an answer around."""
+
+FUNCTION_WEIGHT = 0.3
+"""How much a function word counts towards a phrase's coverage (a meaning word counts 1)."""
+
+
+def _word_character(char: str) -> bool:
+    return char == "'" or unicodedata.category(char)[0] in _WORD_CATEGORIES
+
+
+def normalize(text: str) -> str:
+    """Case folded, no punctuation, contractions spelled out, single spaces; in any script.
+
+    Accents are kept (``café`` stays ``café``); both sides of a match are normalized the
+    same way (Unicode NFKC), so a composed and a decomposed ``é`` are the same letter.
+    """
+    folded = unicodedata.normalize("NFKC", text).casefold().replace("\u2019", "'")
+    words = "".join(c if _word_character(c) else " " for c in folded).split()
+    expanded = " ".join(_CONTRACTIONS.get(word, word) for word in words)
+    return _SPACES.sub(" ", expanded.replace("'", "")).strip()
+
+
+def stem(word: str) -> str:
+    """A plural's singular ("colors" -> "color", "puppies" -> "puppy"); other words as they are."""
+    if len(word) > 4 and word.endswith("ies"):
+        return word[:-3] + "y"
+    if len(word) > 3 and word.endswith("s") and not word.endswith(("ss", "us", "is")):
+        return word[:-1]
+    return word
+
+
+def is_function_word(word: str) -> bool:
+    return word in FUNCTION_WORDS
+
+
+def weight(word: str) -> float:
+    """1 for a meaning word, :data:`FUNCTION_WEIGHT` for a function word."""
+    return FUNCTION_WEIGHT if is_function_word(word) else 1.0
+
+
+def same_word(heard: str, expected: str) -> bool:
+    """The same word, or a long word misspelled by a letter or two ("temprature")."""
+    if heard == expected:
+        return True
+    if min(len(heard), len(expected)) < 6:
+        return False
+    return difflib.SequenceMatcher(None, heard, expected).ratio() >= 0.85
+
+
+def words(text: str) -> tuple[str, ...]:
+    """The stemmed words of ``text`` after :func:`normalize`."""
+    return tuple(stem(word) for word in normalize(text).split())

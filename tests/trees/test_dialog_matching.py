@@ -1,0 +1,99 @@
+"""Matching on words, not characters: the robot answers the question asked, or says it
+did not understand. A wrong answer to a child is worse than none."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from engine.blackboard.catalogue import default_catalogue
+from engine.dialogs.library import load_dialog
+from engine.dialogs.model import Dialog
+
+DEFAULT = Path(__file__).resolve().parents[2] / "dialogs" / "default.yaml"
+
+
+@pytest.fixture(scope="module")
+def dialog() -> Dialog:
+    return load_dialog(DEFAULT, default_catalogue())
+
+
+def rule_for(dialog: Dialog, utterance: str) -> str | None:
+    match = dialog.match(utterance)
+    return match.rule.id if match is not None else None
+
+
+@pytest.mark.parametrize(
+    ("utterance", "rule"),
+    [
+        ("what is your name", "name"),
+        ("What's your name?", "name"),
+        ("hey robot, what is your name please", "name"),
+        ("who are you", "name"),
+        ("what are you called", "name"),
+        ("which colour do you like", "color"),
+        ("what colors do you like", "color"),
+        ("what is your favourite color", "color"),
+        ("what's the temperature", "temperature"),
+        ("is it cold in here", "temperature"),
+        ("how are you", "how_are_you"),
+        ("do you like animals", "pets"),
+        ("do you like dogs", "pets"),
+    ],
+)
+def test_the_ways_of_asking_in_the_dialog_are_understood(
+    dialog: Dialog, utterance: str, rule: str
+) -> None:
+    assert rule_for(dialog, utterance) == rule
+
+
+@pytest.mark.parametrize(
+    "utterance",
+    [
+        "do you like cake",  # not "do you like animals"
+        "what is your favorite food",  # not the color answer
+        "how old are you",  # not "how are you"
+        "who are your parents",  # not "who are you"
+        "what time is it",
+        "what is the weather like tomorrow",
+        "can you dance",
+        "tell me a story",
+        "",
+        "um",
+    ],
+)
+def test_questions_the_dialog_does_not_answer_get_no_rule(dialog: Dialog, utterance: str) -> None:
+    assert rule_for(dialog, utterance) is None
+
+
+def test_a_question_that_asks_two_things_is_not_half_answered(dialog: Dialog) -> None:
+    verdict = dialog.judge("what is your name and your favorite color")
+    assert verdict.match is None
+    assert "ambiguous" in verdict.reason
+
+
+def test_the_verdict_says_why_nothing_matched(dialog: Dialog) -> None:
+    assert "meaning words" in dialog.judge("do you like cake").reason
+
+
+def test_a_small_slip_in_a_long_word_is_forgiven(dialog: Dialog) -> None:
+    assert rule_for(dialog, "what is the temprature") == "temperature"
+
+
+def test_follow_up_answers_are_tried_first_while_the_robot_listens(dialog: Dialog) -> None:
+    pets = next(rule for rule in dialog.rules if rule.id == "pets")
+    asked = pets.follow_up
+    assert asked is not None
+    assert dialog.judge("yes I have a dog", asked).match.rule.id == "has_pet"  # type: ignore[union-attr]
+    assert dialog.judge("no", asked).match.rule.id == "no_pet"  # type: ignore[union-attr]
+    assert dialog.judge("I do not", asked).match.rule.id == "no_pet"  # type: ignore[union-attr]
+    # a child who asks something else instead is answered
+    assert dialog.judge("what is your name", asked).match.rule.id == "name"  # type: ignore[union-attr]
+    # outside the follow-up, "yes" means nothing
+    assert dialog.match("yes") is None
+
+
+def test_the_recognizer_vocabulary_holds_the_follow_up_phrases(dialog: Dialog) -> None:
+    assert "i have a dog" in dialog.phrases
+    assert "nope" in dialog.phrases
