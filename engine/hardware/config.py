@@ -203,6 +203,19 @@ class DeviceConfig:
 
 
 @dataclass(frozen=True)
+class AudioConfig:
+    """The ALSA devices for speech: names such as ``default`` or ``plughw:1,0``; None for
+    none (the simulated vest's room carries the sound)."""
+
+    microphone: str | None = "default"
+    speaker: str | None = "default"
+
+    @classmethod
+    def for_simulation(cls) -> AudioConfig:
+        return cls(microphone=None, speaker=None)
+
+
+@dataclass(frozen=True)
 class RobotConfig:
     """A checked robot config."""
 
@@ -213,6 +226,7 @@ class RobotConfig:
     devices: dict[str, DeviceConfig]
     gpio_chip: str = "/dev/gpiochip0"
     description: str = ""
+    audio: AudioConfig = field(default_factory=AudioConfig)
 
     def device(self, name: str) -> DeviceConfig:
         """The device called ``name``; ConfigError naming the nearest and the known ones."""

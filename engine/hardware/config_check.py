@@ -23,6 +23,7 @@ from engine.hardware.chips import ChipRegistry, default_chips
 from engine.hardware.chips.fields import ChipFields, number_text
 from engine.hardware.config import (
     COMMON_FIELDS,
+    AudioConfig,
     BusConfig,
     ChipSpec,
     DeviceConfig,
@@ -44,7 +45,7 @@ from engine.values.params import (
     did_you_mean,
 )
 
-TOP_FIELDS = ("name", "description", "simulated", "buses", "gpio", "devices")
+TOP_FIELDS = ("name", "description", "simulated", "buses", "gpio", "audio", "devices")
 DEVICE_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 """A device name: it names ``/devices/<name>/ok`` and is written in trees, so an identifier."""
 # Options whose YAML value is a number but which the drivers take from a fixed set.
@@ -128,6 +129,7 @@ class ConfigChecker:
             self.unknown_fields(gpio, ("chip",), "gpio")
             if "chip" in gpio:
                 gpio_chip = self.convert(Text(), gpio.entries["chip"], "chip") or gpio_chip
+        audio = self._audio(document, simulated)
         buses = check_buses(self, document)
         devices = self._devices(document, buses)
         self.problems.raise_if_any()
@@ -139,7 +141,27 @@ class ConfigChecker:
             devices=devices,
             gpio_chip=gpio_chip,
             description=description,
+            audio=audio,
         )
+
+    def _audio(self, document: YMap, simulated: bool) -> AudioConfig:
+        """The ALSA devices: ``default`` on a robot; none on the simulated vest (its room
+        carries the sound) unless named."""
+        default = AudioConfig.for_simulation() if simulated else AudioConfig()
+        audio = self.mapping(
+            document.get("audio"), "'audio'", "e.g. audio: {microphone: default, speaker: default}"
+        )
+        if audio is None:
+            return default
+        self.unknown_fields(audio, ("microphone", "speaker"), "audio")
+        found: dict[str, str | None] = {}
+        for field in ("microphone", "speaker"):
+            if field in audio:
+                name = self.convert(Text(), audio.entries[field], field)
+                found[field] = None if name in (None, "none") else name
+            else:
+                found[field] = getattr(default, field)
+        return AudioConfig(microphone=found["microphone"], speaker=found["speaker"])
 
     def _text(self, document: YMap, key: str, default: str) -> str:
         raw = document.get(key)

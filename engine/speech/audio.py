@@ -1,0 +1,141 @@
+"""Mono audio as float samples, WAV files, resampling and noise at a chosen SNR.
+
+Samples are float32 in -1..1; ``rate_hz`` is samples per second. The recognizer and the
+voice activity detector take 16 kHz (:data:`SPEECH_RATE_HZ`); voices make 22.05 kHz.
+"""
+
+from __future__ import annotations
+
+import io
+import wave
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import numpy.typing as npt
+
+Samples = npt.NDArray[np.float32]
+SPEECH_RATE_HZ = 16000
+MAX_WAV_S = 600.0
+"""Longer recordings are refused: the robot hears utterances, not lectures."""
+
+
+class AudioFileError(ValueError):
+    """A WAV file that cannot be read, with its path and why."""
+
+
+@dataclass(frozen=True)
+class Audio:
+    """Mono audio: ``samples`` (float32, -1..1) at ``rate_hz``."""
+
+    samples: Samples
+    rate_hz: int
+
+    @property
+    def seconds(self) -> float:
+        return len(self.samples) / self.rate_hz
+
+    @classmethod
+    def silence(cls, seconds: float, rate_hz: int = SPEECH_RATE_HZ) -> Audio:
+        return cls(np.zeros(round(seconds * rate_hz), dtype=np.float32), rate_hz)
+
+    def resampled(self, rate_hz: int) -> Audio:
+        """At ``rate_hz``, by linear interpolation after a moving-average low-pass when
+        going down (enough for speech: the recognizer listens below 8 kHz)."""
+        if rate_hz == self.rate_hz or len(self.samples) == 0:
+            return Audio(self.samples, rate_hz) if len(self.samples) == 0 else self
+        samples = self.samples
+        if rate_hz < self.rate_hz:
+            width = max(1, round(self.rate_hz / rate_hz))
+            if width > 1:
+                kernel = np.ones(width, dtype=np.float32) / width
+                samples = np.convolve(samples, kernel, mode="same").astype(np.float32)
+        count = round(len(samples) * rate_hz / self.rate_hz)
+        at = np.linspace(0, len(samples) - 1, count, dtype=np.float64)
+        out = np.interp(at, np.arange(len(samples)), samples).astype(np.float32)
+        return Audio(out, rate_hz)
+
+    def scaled(self, volume: float) -> Audio:
+        """Louder or softer by ``volume`` (0..1 of full scale), clipped."""
+        return Audio(np.clip(self.samples * volume, -1.0, 1.0).astype(np.float32), self.rate_hz)
+
+    def then(self, other: Audio) -> Audio:
+        """This audio followed by ``other`` (at this rate)."""
+        other = other.resampled(self.rate_hz)
+        return Audio(np.concatenate([self.samples, other.samples]), self.rate_hz)
+
+    def pcm16(self) -> bytes:
+        """16-bit little-endian PCM."""
+        return (np.clip(self.samples, -1.0, 1.0) * 32767).astype("<i2").tobytes()
+
+    @classmethod
+    def from_pcm16(cls, data: bytes, rate_hz: int) -> Audio:
+        usable = len(data) - len(data) % 2
+        ints = np.frombuffer(data[:usable], dtype="<i2")
+        return cls((ints.astype(np.float32) / 32768.0), rate_hz)
+
+    def wav_bytes(self) -> bytes:
+        buffer = io.BytesIO()
+        with wave.open(buffer, "wb") as out:
+            out.setnchannels(1)
+            out.setsampwidth(2)
+            out.setframerate(self.rate_hz)
+            out.writeframes(self.pcm16())
+        return buffer.getvalue()
+
+
+def write_wav(path: Path, audio: Audio) -> None:
+    """A 16-bit mono WAV file."""
+    path.write_bytes(audio.wav_bytes())
+
+
+def read_wav(path: Path) -> Audio:
+    """A WAV file (8/16/32-bit PCM, any rate, channels mixed to mono); AudioFileError
+    with the path and why when it is not one."""
+    try:
+        with path.open("rb") as file:
+            return wav_from_bytes(file.read(int(MAX_WAV_S * 48000 * 4 * 2) + 1024), str(path))
+    except OSError as error:
+        raise AudioFileError(f"{path}: cannot read ({error.strerror or error})") from None
+
+
+def wav_from_bytes(data: bytes, name: str) -> Audio:
+    try:
+        with wave.open(io.BytesIO(data), "rb") as wav:
+            channels, width, rate = wav.getnchannels(), wav.getsampwidth(), wav.getframerate()
+            frames = wav.getnframes()
+            if rate <= 0 or frames / rate > MAX_WAV_S:
+                raise AudioFileError(
+                    f"{name}: {frames / max(rate, 1):.0f} s of audio, more than {MAX_WAV_S:.0f} s"
+                )
+            raw = wav.readframes(frames)
+    except (wave.Error, EOFError) as error:
+        raise AudioFileError(f"{name}: not a WAV file ({error})") from None
+    dtypes: dict[int, str] = {1: "u1", 2: "<i2", 4: "<i4"}
+    if width not in dtypes:
+        raise AudioFileError(f"{name}: {8 * width}-bit samples; use 8, 16 or 32-bit PCM")
+    usable = len(raw) - len(raw) % (width * channels)
+    ints = np.frombuffer(raw[:usable], dtype=dtypes[width]).astype(np.float32)
+    scale = {1: 128.0, 2: 32768.0, 4: 2147483648.0}[width]
+    samples = (ints - 128.0) / scale if width == 1 else ints / scale
+    if channels > 1:
+        samples = samples.reshape(-1, channels).mean(axis=1)
+    return Audio(samples.astype(np.float32), rate)
+
+
+def with_noise(audio: Audio, snr_db: float, seed: int = 0) -> Audio:
+    """``audio`` with white noise mixed in at ``snr_db`` decibels below the speech power
+    (measured over the samples that are not silence); the same ``seed``, the same noise."""
+    voiced = audio.samples[np.abs(audio.samples) > 1e-4]
+    power = float(np.mean(voiced**2)) if len(voiced) else 1e-6
+    noise = np.random.default_rng(seed).standard_normal(len(audio.samples)).astype(np.float32)
+    noise *= np.float32(np.sqrt(power / 10 ** (snr_db / 10)))
+    return Audio(np.clip(audio.samples + noise, -1.0, 1.0).astype(np.float32), audio.rate_hz)
+
+
+def noise(seconds: float, level_dbfs: float, seed: int = 0, rate_hz: int = SPEECH_RATE_HZ) -> Audio:
+    """White noise at ``level_dbfs`` (RMS, decibels below full scale): a room's hum."""
+    count = round(seconds * rate_hz)
+    samples = np.random.default_rng(seed).standard_normal(count).astype(np.float32)
+    samples *= np.float32(10 ** (level_dbfs / 20))
+    return Audio(samples, rate_hz)

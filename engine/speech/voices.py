@@ -1,0 +1,171 @@
+"""The robot's voices: a neural voice (Piper's ONNX format, run here with ONNX Runtime)
+and espeak-ng, the robotic fallback that needs no model.
+
+Both speak one sentence at a time (:func:`sentences` splits a reply), so the speaker can
+play the first while the next is synthesized. Neither imports GPL code: the neural voice
+is phonemized by the ``espeak-ng`` program, run as a separate process, and the model is
+run by ONNX Runtime (MIT). ``speed`` is 1 for the voice's natural rate, 2 for twice as fast.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+import shutil
+import subprocess
+import unicodedata
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Protocol
+
+import numpy as np
+
+from engine.speech.audio import Audio
+
+ESPEAK = "espeak-ng"
+_SENTENCE_END = re.compile(r"(?<=[.!?])\s+")
+_CLAUSE_MARKS = re.compile(r"[,;:]")
+MAX_SENTENCE_CHARS = 400
+"""A longer run of text without a full stop is cut at a word near this many characters."""
+
+
+class VoiceError(RuntimeError):
+    """A voice that cannot speak (model missing, espeak-ng missing or failing), in words."""
+
+
+class Voice(Protocol):
+    name: str
+
+    def synthesize(self, sentence: str, *, speed: float = 1.0) -> Audio:
+        """One sentence as audio; VoiceError when the voice cannot speak."""
+        ...
+
+
+def sentences(text: str) -> list[str]:
+    """``text`` cut into sentences (and overlong sentences at a word boundary)."""
+    found: list[str] = []
+    for sentence in _SENTENCE_END.split(text.strip()):
+        while len(sentence) > MAX_SENTENCE_CHARS:
+            cut = sentence.rfind(" ", 0, MAX_SENTENCE_CHARS)
+            cut = cut if cut > 0 else MAX_SENTENCE_CHARS
+            found.append(sentence[:cut].strip())
+            sentence = sentence[cut:]
+        if sentence.strip():
+            found.append(sentence.strip())
+    return found
+
+
+def _espeak(args: list[str], text: str) -> bytes:
+    if shutil.which(ESPEAK) is None:
+        raise VoiceError("espeak-ng is not installed (scripts/setup installs it)")
+    try:
+        done = subprocess.run(
+            [ESPEAK, *args, "--", text], capture_output=True, timeout=30, check=False
+        )
+    except (OSError, subprocess.TimeoutExpired) as error:
+        raise VoiceError(f"espeak-ng failed: {error}") from None
+    if done.returncode != 0:
+        why = done.stderr.decode(errors="replace").strip() or f"exit {done.returncode}"
+        raise VoiceError(f"espeak-ng failed: {why}")
+    return done.stdout
+
+
+class EspeakVoice:
+    """espeak-ng's formant voice: robotic, but always there and instant."""
+
+    def __init__(self, language: str = "en-us", words_per_minute: int = 165) -> None:
+        self.name = "espeak"
+        self.language = language
+        self.words_per_minute = words_per_minute
+
+    def synthesize(self, sentence: str, *, speed: float = 1.0) -> Audio:
+        wpm = max(80, min(450, round(self.words_per_minute * speed)))
+        data = _espeak(["--stdout", "-v", self.language, "-s", str(wpm)], sentence)
+        return _streamed_wav(data)
+
+
+def _streamed_wav(data: bytes) -> Audio:
+    """espeak-ng's WAV on a pipe: its header cannot know the length, so the samples are
+    everything after the ``data`` chunk's header (16-bit mono)."""
+    at = data.find(b"data", 12)
+    if not data.startswith(b"RIFF") or at < 0:
+        raise VoiceError("espeak-ng wrote no WAV audio")
+    rate_hz = int.from_bytes(data[24:28], "little")
+    return Audio.from_pcm16(data[at + 8 :], rate_hz)
+
+
+@dataclass(frozen=True)
+class VoiceModel:
+    """A neural voice's files: the ONNX model and its JSON config beside it."""
+
+    name: str
+    model: Path
+    config: Path
+
+
+class NeuralVoice:
+    """A Piper-format VITS voice: text -> espeak-ng IPA phonemes -> ids -> ONNX -> audio."""
+
+    def __init__(self, files: VoiceModel, *, use_cuda: bool = False, threads: int = 1) -> None:
+        import onnxruntime
+
+        try:
+            config: dict[str, Any] = json.loads(files.config.read_text(encoding="utf-8"))
+            self.rate_hz = int(config["audio"]["sample_rate"])
+            self.language = str(config.get("espeak", {}).get("voice", "en-us"))
+            self.ids: dict[str, list[int]] = config["phoneme_id_map"]
+            inference = config.get("inference", {})
+        except (OSError, ValueError, KeyError, TypeError) as error:
+            raise VoiceError(f"{files.config}: not a voice config ({error})") from None
+        self.noise_scale = float(inference.get("noise_scale", 0.667))
+        self.length_scale = float(inference.get("length_scale", 1.0))
+        self.noise_w = float(inference.get("noise_w", 0.8))
+        self.name = files.name
+        options = onnxruntime.SessionOptions()
+        options.intra_op_num_threads = threads
+        options.inter_op_num_threads = 1
+        providers = ["CPUExecutionProvider"]
+        if use_cuda and "CUDAExecutionProvider" in onnxruntime.get_available_providers():
+            providers.insert(0, "CUDAExecutionProvider")
+        try:
+            self.session = onnxruntime.InferenceSession(
+                str(files.model), options, providers=providers
+            )
+        except Exception as error:  # onnxruntime raises its own untyped errors
+            raise VoiceError(f"{files.model}: cannot load the voice ({error})") from None
+
+    def phonemes(self, sentence: str) -> list[str]:
+        """IPA phonemes, one character each (accents decomposed), with the clause marks."""
+        lines = _espeak(["-q", "--ipa", "-v", self.language], sentence).decode().split("\n")
+        clauses = [re.sub(r"\([^)]+\)", "", line).strip() for line in lines]
+        clauses = [clause for clause in clauses if clause]
+        marks = _CLAUSE_MARKS.findall(sentence)
+        end = sentence.rstrip()[-1:] if sentence.rstrip()[-1:] in ".?!" else "."
+        if len(marks) == len(clauses) - 1:
+            text = "".join(c + m + " " for c, m in zip(clauses, marks, strict=False))
+            text += clauses[-1] + end if clauses else ""
+        else:
+            text = " ".join(clauses) + end
+        return list(unicodedata.normalize("NFD", text))
+
+    def synthesize(self, sentence: str, *, speed: float = 1.0) -> Audio:
+        ids = [*self.ids["^"], *self.ids["_"]]
+        for phoneme in self.phonemes(sentence):
+            if phoneme in self.ids:
+                ids += [*self.ids[phoneme], *self.ids["_"]]
+        ids += self.ids["$"]
+        scales = np.array(
+            [self.noise_scale, self.length_scale / max(speed, 0.1), self.noise_w],
+            dtype=np.float32,
+        )
+        inputs = {
+            "input": np.array([ids], dtype=np.int64),
+            "input_lengths": np.array([len(ids)], dtype=np.int64),
+            "scales": scales,
+        }
+        output = self.session.run(None, inputs)[0]
+        samples = np.asarray(output, dtype=np.float32).reshape(-1)
+        peak = float(np.max(np.abs(samples))) if len(samples) else 0.0
+        if peak > 1e-8:
+            samples = samples / peak * 0.9
+        return Audio(samples.astype(np.float32), self.rate_hz)
