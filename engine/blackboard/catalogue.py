@@ -31,6 +31,7 @@ GESTURE_LAST = "/sensors/gesture/last"
 TEMPERATURE_C = "/sensors/temperature/c"
 TEMPERATURE_F = "/sensors/temperature/f"
 ULTRASOUND_CM = "/sensors/ultrasound/cm"
+SPEECH_HEARD = "/speech/heard"
 
 
 def force_key(pad: str) -> str:
@@ -228,7 +229,7 @@ def default_catalogue() -> KeyCatalogue:
                 alias="ultrasound_cm",
             ),
             KeySpec(
-                "/speech/heard",
+                SPEECH_HEARD,
                 str,
                 "",
                 "speech recognizer",

@@ -4,7 +4,10 @@ Without arguments: every tree in trees/ on examples/scenarios/demo.yaml, in real
 through the simulated vest (examples/robots/sim.yaml): the scenario moves register-level
 chip models that the real drivers read. --hardware CONFIG names a robot config; on a robot
 (e.g. examples/robots/hbs2.yaml) the same drivers read the real chips.
---fast runs on a virtual clock as fast as the machine allows; --json prints one JSON
+Speech goes through the real models: a scenario's ``hear:`` is spoken into the simulated
+room, heard by Silero VAD and Whisper, and the answers are synthesized (--audio-out DIR
+keeps a WAV per utterance); ``--speech text`` skips the models and hands the trees the
+text. --fast runs on a virtual clock as fast as the machine allows; --json prints one JSON
 object per robot action: {"t": seconds, "tree": name, "action": ..., "args": {...}}.
 In real time, a changed tree file is reloaded between ticks (an invalid change keeps the
 running tree); Ctrl-C or SIGTERM stops cleanly at any moment, start-up included. The
@@ -26,7 +29,10 @@ from engine.errors import ConfigError
 from engine.runtime.reload import TreeReloader
 from engine.runtime.robot_factory import build_robot
 from engine.scenario.player import ScenarioPlayer
+from engine.services.interfaces import Speech
 from engine.services.simulated import simulated_services
+from engine.speech.robot_speech import RobotSpeech, audio_folder, build_speech
+from engine.speech.settings import speech_settings
 
 NAME = "run"
 HELP = "run the behaviors (default: the demo scenario on the simulated vest)"
@@ -68,6 +74,20 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument("--json", action="store_true", help="one JSON object per action")
     parser.add_argument(
+        "--speech",
+        choices=("models", "text"),
+        default="models",
+        help="models: hear and speak through the real speech models (default); "
+        "text: hand the trees what is said as text, speak nothing",
+    )
+    parser.add_argument(
+        "--audio-out",
+        type=Path,
+        default=None,
+        metavar="DIR",
+        help="write what the robot says as a WAV file per utterance into DIR",
+    )
+    parser.add_argument(
         "--hardware",
         type=Path,
         default=DEFAULT_HARDWARE,
@@ -100,11 +120,25 @@ def main(args: argparse.Namespace) -> int:
         raise ConfigError(f"{args.hardware}: --fast needs a simulated vest (simulated: true)")
     clock: Clock = VirtualClock() if args.fast else RealClock()
     simulated = simulated_services(clock, realistic=True)
+    speech: Speech | RobotSpeech = simulated.speech
+    if args.speech == "models":
+        speech = build_speech(
+            config.audio,
+            clock,
+            simulated=config.simulated,
+            phrases=behaviors.dialogs.phrases(),
+            settle=args.fast,
+            on_utterance=audio_folder(args.audio_out) if args.audio_out else None,
+            **speech_settings(behaviors.loader.profile),
+        )
+        for event in scenario.events:
+            if event.kind == "hear" and event.value["text"] is not None:
+                speech.prepare(event.value["text"])
     assembled = build_robot(
         behaviors,
         config,
         clock=clock,
-        speech=simulated.speech,
+        speech=speech,
         iot=simulated.iot,
         fallback=simulated,
     )
@@ -115,6 +149,9 @@ def main(args: argparse.Namespace) -> int:
         timeline = Timeline(sys.stdout, start_s=start_s, as_json=args.json)
         for name, why in assembled.hardware.startup_problems.items():
             tell(f"warning: {shown(name)} did not start ({shown(why)}); it will be tried again")
+        if assembled.speech is not None:
+            for part, why in assembled.speech.problems.items():
+                tell(f"warning: speech {part}: {shown(why)}")
         robot.action_log.listeners.append(timeline.action)
         robot.action_log.failure_listeners.append(timeline.failed)
         blackboard.watchers.append(

@@ -13,6 +13,7 @@ import json
 from collections.abc import Callable
 from typing import Any, TextIO
 
+from engine.blackboard.catalogue import SPEECH_HEARD
 from engine.cli.output import discard, finite_json, reason, shown, tell
 from engine.runtime.scheduler import RunningTree
 from engine.scenario.scenario_file import ScenarioEvent
@@ -95,7 +96,11 @@ class Timeline:
             self._line(at_s, "world", event.describe())
 
     def blackboard_write(self, key: str, value: Any, at_s: float) -> None:
-        """Show a device going offline or coming back (``/devices/<name>/ok`` changing)."""
+        """Show what the robot heard, and a device going offline or coming back
+        (``/devices/<name>/ok`` changing)."""
+        if key == SPEECH_HEARD and not self.as_json:
+            self._line(at_s, "vest", f"hears {value!r}")
+            return
         if self.as_json or not (key.startswith("/devices/") and key.endswith("/ok")):
             return
         previous = self._device_ok.get(key)

@@ -343,16 +343,19 @@ class UnwiredSenses:
     :class:`SimVest` instead of :class:`~engine.scenario.world.BlackboardSenses`, which
     would also write the polled senses straight onto the blackboard."""
 
-    KINDS = ("hear", "cloud")
-
-    def __init__(self, blackboard: Blackboard) -> None:
+    def __init__(self, blackboard: Blackboard, *, hear: bool = True) -> None:
+        """``hear``: stage what people say as text (no speech recognition is running)."""
         self.blackboard = blackboard
+        self.kinds = ("hear", "cloud") if hear else ("cloud",)
 
     def world_changed(self, world: World, what: str) -> None:
         """Everything that changes is sensed through the simulated chips."""
 
     def world_event(self, kind: str, value: Any) -> None:
-        if kind in self.KINDS:
+        if kind == "hear" and kind in self.kinds:
+            if value.get("text") is not None:  # a recording cannot be heard without a recognizer
+                self.blackboard.stage_event(EVENT_KEYS[kind], value["text"])
+        elif kind in self.kinds:
             self.blackboard.stage_event(EVENT_KEYS[kind], value)
 
 

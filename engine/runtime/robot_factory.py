@@ -3,9 +3,11 @@
 :func:`build_robot` wires what a robot config and the validated behaviors describe: one
 blackboard (with the catalogue the trees were checked against), the world a simulated vest
 answers to, the bus managers, drivers, pollers and hardware services, and the trees on a
-scheduler whose hooks poll the devices. Speech and the cloud have no devices yet, so the
-caller hands their services in. The caller adds its own hooks (a scenario player goes
-first: the world moves, then the pollers read it, then the trees tick) and runs it.
+scheduler whose hooks poll the devices. The caller hands in the speech (the assembled
+:class:`~engine.speech.robot_speech.RobotSpeech`, or any Speech service, e.g. a recording
+fake, with heard text then staged as text) and the cloud's service. The caller adds its
+own hooks (a scenario player goes first: the world moves, then the pollers read it, then
+the trees tick) and runs it.
 """
 
 from __future__ import annotations
@@ -22,6 +24,7 @@ from engine.runtime.robot import Behaviors, Robot
 from engine.scenario.world import World
 from engine.services.actions import ActionLog
 from engine.services.interfaces import IotResults, Services, Speech
+from engine.speech.robot_speech import RobotSpeech
 
 
 @dataclass
@@ -34,6 +37,7 @@ class AssembledRobot:
     world: World
     hardware: Hardware
     vest: SimVest | None
+    speech: RobotSpeech | None = None
 
     def start(self, origin_s: float) -> None:
         """Start the poller threads (real time), phased on the trees' first deadline (s)."""
@@ -42,6 +46,8 @@ class AssembledRobot:
     def close(self) -> None:
         """Stop the pollers and bus workers, close the buses and the simulated vest."""
         try:
+            if self.speech is not None:
+                self.speech.close()
             self.hardware.close()
         finally:
             if self.vest is not None:
@@ -53,7 +59,7 @@ def build_robot(
     config: RobotConfig,
     *,
     clock: Clock,
-    speech: Speech,
+    speech: Speech | RobotSpeech,
     iot: IotResults,
     fallback: Services | None = None,
     action_log: ActionLog | None = None,
@@ -67,10 +73,16 @@ def build_robot(
     blackboard.reset()
     world = World()
     vest = build_sim_vest(config, world, clock) if config.simulated else None
-    world.listeners.append(UnwiredSenses(blackboard))  # speech and cloud have no devices yet
+    robot_speech = speech if isinstance(speech, RobotSpeech) else None
+    if robot_speech is not None:
+        robot_speech.hears_into(blackboard)
+        world.listeners.append(robot_speech)
+    heard_as_text = robot_speech is None or robot_speech.listener is None
+    world.listeners.append(UnwiredSenses(blackboard, hear=heard_as_text))  # the cloud: no device
     hardware = build_hardware(config, clock, blackboard, vest=vest)
     try:
-        services = hardware.services(speech=speech, iot=iot, fallback=fallback)
+        service = robot_speech.speaker if robot_speech is not None else speech
+        services = hardware.services(speech=service, iot=iot, fallback=fallback)  # type: ignore[arg-type]
         robot = Robot(
             behaviors, clock=clock, services=services, blackboard=blackboard, action_log=action_log
         )
@@ -80,4 +92,6 @@ def build_robot(
             vest.close()
         raise
     robot.scheduler.hooks.extend(hardware.hooks)
-    return AssembledRobot(robot, clock, blackboard, world, hardware, vest)
+    if robot_speech is not None:  # the microphone hears the room the world just changed
+        robot.scheduler.hooks.append(robot_speech)
+    return AssembledRobot(robot, clock, blackboard, world, hardware, vest, robot_speech)

@@ -10,6 +10,8 @@
       - {at: 8.0,  obstacle: {left_mm: 250, center_mm: 600, right_mm: 900, seconds: 2.0}}
       - {at: 10.0, temperature: {c: 22.2}}
       - {at: 11.0, hear: "what is the temperature"}
+      - {at: 12.5, hear: {text: "what is your name", snr_db: 10}}   # in a noisy room
+      - {at: 13.5, hear: {wav: recordings/question.wav}}             # beside the scenario
       - {at: 14.0, cloud: {type: say, args: {text: "hello from the cloud"}}}
 """
 
@@ -75,7 +77,11 @@ EVENT_FIELDS: dict[str, tuple[Param[Any], ...] | ParamType[Any]] = {
         Param("cm", Number(0.0, 600.0, "cm"), REQUIRED, "distance of the object"),
         Param("seconds", _SECONDS, 5.0, "how long it stays"),
     ),
-    "hear": Text(),
+    "hear": (
+        Param("text", Text(), None, "what is said, spoken by the robot's TTS voice"),
+        Param("wav", Text(), None, "a WAV recording of it (relative to the scenario file)"),
+        Param("snr_db", Number(-10.0, 60.0, "dB"), None, "white noise this far below the speech"),
+    ),
     "unplug": (
         Param("device", Text(), REQUIRED, "a device of the robot config"),
         Param("seconds", _SECONDS, 3.0, "how long it stays unplugged"),
@@ -128,7 +134,9 @@ class ScenarioEvent:
         if self.kind == "fault":
             return f"{value['device']}: {value['kind']} for {value['seconds']:g} s"
         if self.kind == "hear":
-            return f"someone says {value!r}"
+            said = repr(value["text"]) if value["text"] is not None else value["wav"]
+            noise = f" at {value['snr_db']:g} dB SNR" if value["snr_db"] is not None else ""
+            return f"someone says {said}{noise}"
         if self.kind == "cloud":
             return f"operator sends {value['type']} {value['args'] or {}}"
         return f"{self.kind} {value}"
@@ -173,7 +181,7 @@ def check_scenario(document: YValue | None, name: str, path: Path) -> Scenario:
         problems.add(raw_events.mark, f"'events' must be a list, got {describe(raw_events)}")
     elif raw_events is not None:
         for index, raw in enumerate(raw_events):
-            event = _event(raw, ctx, problems, index)
+            event = _event(raw, ctx, problems, index, path.parent)
             if event is None:
                 continue
             if duration and event.at_s > duration:
@@ -198,7 +206,9 @@ def _convert(
         return None
 
 
-def _event(raw: YValue, ctx: CheckContext, problems: Problems, index: int) -> ScenarioEvent | None:
+def _event(
+    raw: YValue, ctx: CheckContext, problems: Problems, index: int, folder: Path
+) -> ScenarioEvent | None:
     if not isinstance(raw, YMap):
         problems.add(raw.mark, "an event is a mapping like {at: 1.0, touch: {pad: 3}}")
         return None
@@ -226,7 +236,10 @@ def _event(raw: YValue, ctx: CheckContext, problems: Problems, index: int) -> Sc
         )
         return None
     body = raw.entries[kind]
-    if isinstance(fields, ParamType):
+    if kind == "hear" and not isinstance(body, YMap):  # hear: "text" is hear: {text: ...}
+        text = _convert(Text(), body, kind, ctx, problems)
+        value = None if text is None else {"text": text, "wav": None, "snr_db": None}
+    elif isinstance(fields, ParamType):
         value = _convert(fields, body, kind, ctx, problems)
     else:
         value = _fields(kind, fields, body, ctx, problems)
@@ -238,12 +251,30 @@ def _event(raw: YValue, ctx: CheckContext, problems: Problems, index: int) -> Sc
             return None
         if value["c"] is None:
             value["c"] = (value["f"] - 32.0) * 5.0 / 9.0
+    if kind == "hear" and not _check_hearing(value, body, folder, problems):
+        return None
     if kind == "cloud":
         if value["args"] is not None and not isinstance(value["args"], dict):
             problems.add(body.mark, "cloud 'args' must be a mapping", "e.g. {text: hello}")
             return None
         value["id"] = value["id"] or f"cmd-{index + 1}"
     return ScenarioEvent(float(at_s), kind, value, raw.mark)
+
+
+def _check_hearing(value: dict[str, Any], body: YValue, folder: Path, problems: Problems) -> bool:
+    """Exactly one of text and wav; a wav that is a file, made absolute."""
+    if (value["text"] is None) == (value["wav"] is None):
+        problems.add(
+            body.mark, "hear takes one of text and wav", "e.g. {text: hello} or {wav: question.wav}"
+        )
+        return False
+    if value["wav"] is not None:
+        wav = folder / value["wav"]
+        if not wav.is_file():
+            problems.add(body.mark, f"no WAV file {wav}", "a path relative to the scenario file")
+            return False
+        value["wav"] = str(wav)
+    return True
 
 
 def _fields(

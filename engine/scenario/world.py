@@ -15,6 +15,7 @@ from engine.blackboard.catalogue import (
     FORCE_LEFT_N,
     FORCE_RIGHT_N,
     GESTURE_LAST,
+    SPEECH_HEARD,
     TOUCH_ANY,
     TOUCH_PADS,
     ULTRASOUND_CM,
@@ -58,7 +59,7 @@ class WorldListener(Protocol):
 
 EVENT_KEYS = {
     "gesture": GESTURE_LAST,
-    "hear": "/speech/heard",
+    "hear": SPEECH_HEARD,
     "cloud": "/iot/inbox",
 }
 

@@ -1,0 +1,114 @@
+"""Hearing: microphone audio -> voice activity -> recognizer -> what was heard.
+
+The microphone hands audio to :meth:`Listener.hear` from its own thread (or, on the
+simulated vest, from a tick hook). Voice activity is found at once (Silero is cheap);
+each finished utterance is recognized in the listener's worker, never in a tick, and
+``on_heard`` gets the text. While the robot speaks, the microphone is ignored
+(:class:`~engine.speech.speaker.SelfHearing`): it never answers its own voice.
+"""
+
+from __future__ import annotations
+
+import logging
+import queue
+import threading
+from collections.abc import Callable
+from dataclasses import dataclass
+
+from engine.clock import Clock
+from engine.speech.audio import Audio
+from engine.speech.recognizer import Recognizer
+from engine.speech.settling import Settling
+from engine.speech.speaker import SelfHearing
+from engine.speech.vad import SpeechDetector, Utterance
+
+log = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True)
+class Heard:
+    """One utterance heard: its text ("" when nothing intelligible), when the person
+    stopped speaking and when the text was ready (clock seconds)."""
+
+    text: str
+    ended_s: float
+    recognized_s: float
+
+
+class Listener:
+    """Cuts the microphone stream into utterances and recognizes each in a worker."""
+
+    def __init__(
+        self,
+        detector: SpeechDetector,
+        recognizer: Recognizer,
+        clock: Clock,
+        on_heard: Callable[[Heard], None],
+        *,
+        self_hearing: SelfHearing | None = None,
+        settling: Settling | None = None,
+    ) -> None:
+        self.detector = detector
+        self.recognizer = recognizer
+        self.clock = clock
+        self.on_heard = on_heard
+        self.self_hearing = self_hearing or SelfHearing()
+        self.settling = settling or Settling()
+        self._working = 0
+        self._lock = threading.Lock()
+        self._queue: queue.Queue[tuple[Utterance, float] | None] = queue.Queue()
+        self._thread: threading.Thread | None = None
+        self.ignored_s = 0.0
+        """Seconds of microphone audio ignored because the robot was speaking."""
+
+    def hear(self, audio: Audio, ends_at_s: float) -> None:
+        """A piece of the microphone stream (16 kHz) that ended at ``ends_at_s``."""
+        starts_at_s = ends_at_s - audio.seconds
+        if self.self_hearing.deaf_at(starts_at_s) or self.self_hearing.deaf_at(ends_at_s):
+            if self.detector.in_speech:
+                self.detector.reset()  # what was being heard ran into the robot's voice
+            self.ignored_s += audio.seconds
+            return
+        for utterance in self.detector.feed(audio.samples):
+            late_s = (self.detector.position - utterance.end_sample) / audio.rate_hz
+            self._submit(utterance, ends_at_s - late_s)
+
+    def settled(self) -> bool:
+        """No utterance waits for recognition."""
+        return self._working == 0
+
+    def _submit(self, utterance: Utterance, ended_s: float) -> None:
+        with self._lock:
+            self._working += 1
+        self._queue.put((utterance, ended_s))
+        if self._thread is None:
+            self.start()
+
+    def start(self) -> None:
+        if self._thread is None:
+            self._thread = threading.Thread(target=self._run, name="listener", daemon=True)
+            self._thread.start()
+
+    def close(self) -> None:
+        if self._thread is not None:
+            self._queue.put(None)
+            self._thread.join(timeout=10.0)
+            self._thread = None
+
+    def _run(self) -> None:
+        while True:
+            item = self._queue.get()
+            if item is None:
+                return
+            utterance, ended_s = item
+            try:
+                text = self.recognizer.transcribe(utterance.audio).text
+            except Exception as error:  # a model that failed on this audio
+                log.warning("recognition failed: %s", error)
+                text = ""
+            try:
+                self.on_heard(Heard(text, ended_s, self.clock.now()))
+            finally:
+                with self._lock:
+                    self._working -= 1
+                self.settling.changed()

@@ -1,0 +1,227 @@
+"""The robot's speech, assembled: voice and speaker, microphone and listener.
+
+On the simulated vest the microphone and speaker are the simulated room's; on a robot
+they are the ALSA devices its config names. A device or model that is missing is named
+in ``problems`` and the rest runs: without a microphone the robot does not hear, and
+without a speaker its answers fail with the reason.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from engine.blackboard.board import Blackboard
+from engine.blackboard.catalogue import SPEECH_HEARD
+from engine.clock import Clock
+from engine.drivers.audio_devices import AlsaMicrophone, AlsaSpeaker, AudioDeviceError
+from engine.drivers.sim.room import RoomSpeaker, SimulatedRoom
+from engine.errors import ConfigError
+from engine.hardware.config import AudioConfig
+from engine.speech.audio import Audio, read_wav, with_noise, write_wav
+from engine.speech.listener import Heard, Listener
+from engine.speech.recognizer import RecognizerError, WhisperRecognizer
+from engine.speech.settling import Settling
+from engine.speech.speaker import Playback, SelfHearing, Speaker, Utterance
+from engine.speech.vad import SileroVad, SpeechDetector
+from engine.speech.voice_models import default_voice
+from engine.speech.voices import EspeakVoice, Voice, VoiceError
+
+log = logging.getLogger(__name__)
+LEAD_S = 0.3
+"""Quiet before a person's scripted utterance starts (noise is mixed over it too)."""
+
+
+class NoPlayback:
+    """A speaker that is not there: every utterance fails with why."""
+
+    def __init__(self, why: str) -> None:
+        self.why = why
+
+    def start(self, audio: Audio, at_s: float) -> None:
+        raise AudioDeviceError(self.why)
+
+    def stop(self) -> None:
+        """Nothing plays."""
+
+
+@dataclass
+class RobotSpeech:
+    """The assembled speech parts and what could not be started."""
+
+    speaker: Speaker
+    listener: Listener | None
+    room: SimulatedRoom | None
+    settling: Settling
+    settle: bool
+    voice: Voice
+    problems: dict[str, str] = field(default_factory=dict)
+    microphone: AlsaMicrophone | None = None
+    closers: list[Callable[[], None]] = field(default_factory=list)
+    _spoken: dict[str, Audio] = field(default_factory=dict)
+    heard: list[Heard] = field(default_factory=list)
+    """Everything heard, for the timeline and the benchmarks."""
+
+    def __call__(self, now_s: float) -> None:
+        """A tick hook: the simulated microphone hears the room up to now; on a virtual
+        clock, wait for speech work (synthesis, recognition) so time cannot race it."""
+        if self.room is not None and self.listener is not None:
+            self.listener.hear(self.room.capture(now_s), now_s)
+        if self.settle:
+            self.settling.wait(self.settled)
+
+    def settled(self) -> bool:
+        listener = self.listener
+        return self.speaker.settled() and (listener is None or listener.settled())
+
+    def person_says(
+        self, text: str | None, wav: str | None, snr_db: float | None, at_s: float
+    ) -> None:
+        """A person in the simulated room says ``text`` (in the robot's voice, the only
+        one installed) or plays ``wav``, with noise ``snr_db`` below it."""
+        if self.room is None:
+            return
+        if wav is not None:
+            spoken = read_wav(Path(wav))
+        else:
+            spoken = self._spoken.get(text or "") or self.prepare(text or "")
+        audio = (
+            Audio.silence(LEAD_S, spoken.rate_hz)
+            .then(spoken)
+            .then(Audio.silence(LEAD_S, spoken.rate_hz))
+        )
+        if snr_db is not None:
+            audio = with_noise(audio, snr_db, seed=round(at_s * 1000))
+        self.room.add(audio.scaled(0.5), at_s)
+
+    def prepare(self, text: str) -> Audio:
+        """Synthesize what a person will say before it is said (a scenario's lines)."""
+        spoken = self._spoken[text] = self.voice.synthesize(text)
+        return spoken
+
+    def hears_into(self, blackboard: Blackboard) -> None:
+        """What the robot hears is staged on ``blackboard`` as a ``/speech/heard`` event."""
+
+        def stage(heard: Heard) -> None:
+            self.heard.append(heard)
+            if heard.text:
+                blackboard.stage_event(SPEECH_HEARD, heard.text)
+
+        if self.listener is not None:
+            self.listener.on_heard = stage
+
+    def world_changed(self, world: object, what: str) -> None:
+        """Nothing the room carries changes with the polled senses."""
+
+    def world_event(self, kind: str, value: Any) -> None:
+        """A scenario's ``hear:`` is said in the room, now."""
+        if kind == "hear":
+            now_s = self.speaker.clock.now()
+            self.person_says(value.get("text"), value.get("wav"), value.get("snr_db"), now_s)
+
+    def close(self) -> None:
+        self.speaker.close()
+        if self.microphone is not None:
+            self.microphone.close()
+        if self.listener is not None:
+            self.listener.close()
+        for close in self.closers:
+            close()
+
+
+def build_speech(
+    audio: AudioConfig,
+    clock: Clock,
+    *,
+    on_heard: Callable[[Heard], None] = lambda heard: None,
+    simulated: bool,
+    phrases: Iterable[str],
+    settle: bool,
+    speed: float = 1.0,
+    volume: float = 1.0,
+    voice_name: str | None = None,
+    on_utterance: Callable[[Utterance], None] | None = None,
+) -> RobotSpeech:
+    """The speech of a robot with ``audio`` devices (on the simulated vest's room when
+    ``simulated``), listening for ``phrases``. ``settle``: the clock is virtual."""
+    problems: dict[str, str] = {}
+    settling = Settling()
+    self_hearing = SelfHearing()
+    voice, why = default_voice(voice_name)
+    if why:
+        problems["voice"] = why
+    room = SimulatedRoom(clock) if simulated else None
+    playback: Playback
+    if room is not None:
+        playback = RoomSpeaker(room)
+    elif audio.speaker is not None:
+        playback = AlsaSpeaker(audio.speaker)
+    else:
+        playback = NoPlayback("the robot config names no speaker (audio: speaker:)")
+    speaker = Speaker(
+        voice,
+        playback,
+        clock,
+        fallback_voice=EspeakVoice() if voice.name != "espeak" else None,
+        self_hearing=self_hearing,
+        speed=speed,
+        volume=volume,
+        on_utterance=on_utterance,
+        settling=settling,
+        instant_synthesis=settle,
+    )
+    listener: Listener | None = None
+    try:
+        recognizer = WhisperRecognizer()
+        recognizer.listen_for(phrases)
+        listener = Listener(
+            SpeechDetector(SileroVad()),
+            recognizer,
+            clock,
+            on_heard,
+            self_hearing=self_hearing,
+            settling=settling,
+        )
+    except (RecognizerError, ImportError) as error:
+        problems["recognizer"] = str(error)
+    speech = RobotSpeech(speaker, listener, room, settling, settle, voice, problems)
+    if isinstance(playback, AlsaSpeaker):
+        speech.closers.append(playback.close)
+    if room is None and audio.microphone is not None and listener is not None:
+        heard_by = listener
+        microphone = AlsaMicrophone(audio.microphone, lambda a: heard_by.hear(a, clock.now()))
+        try:
+            microphone.start()
+            speech.microphone = microphone
+        except AudioDeviceError as error:
+            problems["microphone"] = str(error)
+    return speech
+
+
+__all__ = ["RobotSpeech", "VoiceError", "build_speech"]
+
+
+def audio_folder(folder: Path) -> Callable[[Utterance], None]:
+    """Keeps each utterance as ``NNN-first-words.wav`` in ``folder`` (made if missing);
+    ConfigError when it cannot be made."""
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as error:
+        raise ConfigError(
+            f"--audio-out {folder}: cannot make it ({error.strerror or error})"
+        ) from None
+    count = [0]
+
+    def keep(utterance: Utterance) -> None:
+        count[0] += 1
+        words = "-".join("".join(c for c in w if c.isalnum()) for w in utterance.text.split()[:5])
+        path = folder / f"{count[0]:03d}-{words.lower() or 'utterance'}.wav"
+        try:
+            write_wav(path, utterance.audio)
+        except OSError as error:
+            log.warning("could not write %s: %s", path, error)
+
+    return keep
