@@ -353,8 +353,9 @@ class UnwiredSenses:
 
     def world_event(self, kind: str, value: Any) -> None:
         if kind == "hear" and kind in self.kinds:
-            if value.get("text") is not None:  # a recording cannot be heard without a recognizer
-                self.blackboard.stage_event(EVENT_KEYS[kind], value["text"])
+            text = value.get("text") if isinstance(value, dict) else value
+            if text is not None:  # a recording cannot be heard without a recognizer
+                self.blackboard.stage_event(EVENT_KEYS[kind], text)
         elif kind in self.kinds:
             self.blackboard.stage_event(EVENT_KEYS[kind], value)
 

@@ -14,6 +14,8 @@ from pathlib import Path
 
 from engine.files.problems import LoadError, Mark, Problem, Problems
 from engine.files.yaml_source import YList, YMap, YScalar, YValue, describe, load_yaml
+from engine.files.yaml_values import plain
+from engine.speech.settings import SPEECH_PROFILE_PARAMS, check_speech_params
 from engine.values.params import did_you_mean
 
 _REFERENCE = re.compile(r"\$\{([^}]*)\}")
@@ -169,6 +171,9 @@ def load_profile(path: Path, shown: str | None = None) -> Profile:
         problems.add(raw_name.mark, f"'profile' must be a name, got {describe(raw_name)}")
     description = document.get("description")
     params = read_params(document.get("params"), problems)
+    values = {name: plain(given.value) for name, given in params.items()}
+    for name, message, hint in check_speech_params(values):
+        problems.add(params[name].source, message, hint)
     if document.get("params") is None:
         problems.add(document.mark, "a profile needs 'params:'", "list the values it changes")
     problems.raise_if_any()
@@ -186,5 +191,5 @@ def undeclared_params(profile: Profile, declared: set[str], trees: str) -> list[
             did_you_mean(name, sorted(declared)) or "check the spelling",
         )
         for name, value in profile.params.items()
-        if name not in declared
+        if name not in declared and name not in SPEECH_PROFILE_PARAMS
     ]

@@ -11,7 +11,6 @@ from engine.clock import Clock
 from engine.dialogs.library import DialogLibrary
 from engine.files.problems import LoadError, Mark, Problems
 from engine.files.yaml_source import YMap, load_yaml
-from engine.files.yaml_values import plain
 from engine.loader.substitution import Profile, load_profile, read_params, undeclared_params
 from engine.loader.tree_definition import TreeDefinition
 from engine.loader.tree_file import TreeLoader
@@ -21,7 +20,6 @@ from engine.runtime.scheduler import RunningTree, Scheduler
 from engine.services.actions import ActionLog, TreeActions
 from engine.services.interfaces import Services
 from engine.services.staged_readings import with_staged_readings
-from engine.speech.settings import SPEECH_PROFILE_PARAMS, check_speech_params
 
 
 def tree_files(paths: list[Path]) -> list[Path]:
@@ -99,15 +97,11 @@ def load_behaviors(
     if loaded_profile is not None and profile is not None and definitions and not problems:
         # a profile serves every tree beside it, not only those run now
         declared = set().union(*(d.declared_params for d in definitions))
-        declared |= declared_beside(profile) | set(SPEECH_PROFILE_PARAMS)
+        declared |= declared_beside(profile)
         where = (
             f"{profile.parent.parent}/" if profile.parent.name == "profiles" else "the trees run"
         )
         problems.extend(undeclared_params(loaded_profile, declared, where))
-    if loaded_profile is not None:
-        values = {n: plain(v.value) for n, v in loaded_profile.params.items()}
-        for name, message, hint in check_speech_params(values):
-            problems.add(loaded_profile.params[name].source, message, hint)
     names: dict[str, Path] = {}
     for definition in definitions:
         if definition.name in names:

@@ -28,7 +28,7 @@ from engine.speech.settling import Settling
 from engine.speech.speaker import Playback, SelfHearing, Speaker, Utterance
 from engine.speech.vad import SileroVad, SpeechDetector
 from engine.speech.voice_models import default_voice
-from engine.speech.voices import EspeakVoice, Voice, VoiceError
+from engine.speech.voices import EspeakVoice, NeuralVoice, Voice, VoiceError
 
 log = logging.getLogger(__name__)
 LEAD_S = 0.3
@@ -67,7 +67,10 @@ class RobotSpeech:
 
     def __call__(self, now_s: float) -> None:
         """A tick hook: the simulated microphone hears the room up to now; on a virtual
-        clock, wait for speech work (synthesis, recognition) so time cannot race it."""
+        clock, first let the speaker place what it was asked to say (the microphone must
+        know when the robot speaks), then wait for recognition, so time cannot race them."""
+        if self.settle:
+            self.settling.wait(self.settled)
         if self.room is not None and self.listener is not None:
             self.listener.hear(self.room.capture(now_s), now_s)
         if self.settle:
@@ -99,7 +102,8 @@ class RobotSpeech:
 
     def prepare(self, text: str) -> Audio:
         """Synthesize what a person will say before it is said (a scenario's lines)."""
-        spoken = self._spoken[text] = self.voice.synthesize(text)
+        voice = self.voice.steady() if isinstance(self.voice, NeuralVoice) else self.voice
+        spoken = self._spoken[text] = voice.synthesize(text)
         return spoken
 
     def hears_into(self, blackboard: Blackboard) -> None:
@@ -119,8 +123,9 @@ class RobotSpeech:
     def world_event(self, kind: str, value: Any) -> None:
         """A scenario's ``hear:`` is said in the room, now."""
         if kind == "hear":
+            said: dict[str, Any] = value if isinstance(value, dict) else {"text": str(value)}
             now_s = self.speaker.clock.now()
-            self.person_says(value.get("text"), value.get("wav"), value.get("snr_db"), now_s)
+            self.person_says(said.get("text"), said.get("wav"), said.get("snr_db"), now_s)
 
     def close(self) -> None:
         self.speaker.close()
@@ -153,6 +158,8 @@ def build_speech(
     voice, why = default_voice(voice_name)
     if why:
         problems["voice"] = why
+    if settle and isinstance(voice, NeuralVoice):
+        voice = voice.steady()  # a virtual clock's run is the same every time
     room = SimulatedRoom(clock) if simulated else None
     playback: Playback
     if room is not None:

@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from engine.loader.substitution import Profile
 
 from engine.files.yaml_values import plain
-from engine.loader.substitution import Profile
 
 VOICE_NAMES = ("joe", "espeak")
 SPEECH_PROFILE_PARAMS = ("voice", "speech_rate")

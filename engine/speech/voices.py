@@ -9,6 +9,7 @@ run by ONNX Runtime (MIT). ``speed`` is 1 for the voice's natural rate, 2 for tw
 
 from __future__ import annotations
 
+import copy
 import json
 import re
 import shutil
@@ -133,6 +134,13 @@ class NeuralVoice:
             )
         except Exception as error:  # onnxruntime raises its own untyped errors
             raise VoiceError(f"{files.model}: cannot load the voice ({error})") from None
+
+    def steady(self) -> NeuralVoice:
+        """This voice without its sampling noise: the same text always gives the same
+        audio (for scripted people in scenarios and tests; a little flatter)."""
+        twin = copy.copy(self)
+        twin.noise_scale = twin.noise_w = 0.0
+        return twin
 
     def phonemes(self, sentence: str) -> list[str]:
         """IPA phonemes, one character each (accents decomposed), with the clause marks."""
