@@ -31,8 +31,7 @@ from engine.runtime.robot_factory import build_robot
 from engine.scenario.player import ScenarioPlayer
 from engine.services.interfaces import Speech
 from engine.services.simulated import simulated_services
-from engine.speech.robot_speech import RobotSpeech, audio_folder, build_speech
-from engine.speech.settings import speech_settings
+from engine.speech.robot_speech import RobotSpeech, audio_folder, build_speech, speech_settings
 
 NAME = "run"
 HELP = "run the behaviors (default: the demo scenario on the simulated vest)"

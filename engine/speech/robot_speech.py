@@ -20,10 +20,13 @@ from engine.clock import Clock
 from engine.drivers.audio_devices import AlsaMicrophone, AlsaSpeaker, AudioDeviceError
 from engine.drivers.sim.room import RoomSpeaker, SimulatedRoom
 from engine.errors import ConfigError
+from engine.files.yaml_values import plain
 from engine.hardware.config import AudioConfig
+from engine.loader.substitution import Profile
 from engine.speech.audio import Audio, read_wav, with_noise, write_wav
 from engine.speech.listener import Heard, Listener
 from engine.speech.recognizer import RecognizerError, WhisperRecognizer
+from engine.speech.settings import SPEECH_PROFILE_PARAMS
 from engine.speech.settling import Settling
 from engine.speech.speaker import Playback, SelfHearing, Speaker, Utterance
 from engine.speech.vad import SileroVad, SpeechDetector
@@ -232,3 +235,20 @@ def audio_folder(folder: Path) -> Callable[[Utterance], None]:
             log.warning("could not write %s: %s", path, error)
 
     return keep
+
+
+def speech_settings(profile: Profile | None) -> dict[str, Any]:
+    """The voice and speed a profile asks for, as :func:`build_speech` keywords."""
+    if profile is None:
+        return {}
+    values = {
+        name: plain(profile.params[name].value)
+        for name in SPEECH_PROFILE_PARAMS
+        if name in profile.params
+    }
+    settings: dict[str, Any] = {}
+    if "voice" in values:
+        settings["voice_name"] = str(values["voice"])
+    if "speech_rate" in values:
+        settings["speed"] = float(values["speech_rate"])
+    return settings

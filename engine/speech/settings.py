@@ -2,12 +2,7 @@
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any
-
-if TYPE_CHECKING:
-    from engine.loader.substitution import Profile
-
-from engine.files.yaml_values import plain
+from typing import Any
 
 VOICE_NAMES = ("joe", "espeak")
 SPEECH_PROFILE_PARAMS = ("voice", "speech_rate")
@@ -30,20 +25,3 @@ def check_speech_params(params: dict[str, Any]) -> list[tuple[str, str, str]]:
             ("speech_rate", f"speech_rate must be 0.5..2, got {rate!r}", "1 is natural")
         )
     return problems
-
-
-def speech_settings(profile: Profile | None) -> dict[str, Any]:
-    """The voice and speed a profile asks for, as :func:`build_speech` keywords."""
-    if profile is None:
-        return {}
-    values = {
-        name: plain(profile.params[name].value)
-        for name in SPEECH_PROFILE_PARAMS
-        if name in profile.params
-    }
-    settings: dict[str, Any] = {}
-    if "voice" in values:
-        settings["voice_name"] = str(values["voice"])
-    if "speech_rate" in values:
-        settings["speed"] = float(values["speech_rate"])
-    return settings
