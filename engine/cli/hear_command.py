@@ -1,0 +1,98 @@
+"""Run the robot's hearing on recordings: voice activity, recognition, the dialog's rule.
+
+For each WAV file: what was heard, which rule of the dialog matched and its score, and
+the answer (or the fallback). --json prints one object per file:
+{"file": ..., "heard": text or null, "rule": rule id or null, "score": ..., "answer": ...}.
+--mic listens on the microphone instead (the robot config's, or --device) until Ctrl-C.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+from engine.blackboard.catalogue import default_catalogue
+from engine.cli.output import shown
+from engine.cli.run_inputs import dialogs_folder
+from engine.clock import RealClock
+from engine.dialogs.library import DialogLibrary
+from engine.dialogs.model import Dialog
+from engine.errors import ConfigError
+from engine.speech.audio import read_wav
+from engine.speech.hearing import Hearing, hear
+from engine.speech.recognizer import WhisperRecognizer
+
+NAME = "hear"
+HELP = "run the robot's hearing on WAV files (or the microphone) and show the answers"
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("files", type=Path, nargs="*", metavar="FILE.wav", help="recordings")
+    parser.add_argument("--mic", action="store_true", help="listen on the microphone")
+    parser.add_argument(
+        "--device", default=None, help="ALSA capture device for --mic (default: the config's)"
+    )
+    parser.add_argument(
+        "--hardware",
+        type=Path,
+        default=None,
+        metavar="CONFIG",
+        help="robot config naming the microphone (for --mic; default: the ALSA default)",
+    )
+    parser.add_argument(
+        "--dialogs", type=Path, default=None, help="dialogs folder (default: dialogs/)"
+    )
+    parser.add_argument(
+        "--dialog", default="default", help="which dialog answers (default: default)"
+    )
+    parser.add_argument("--json", action="store_true", help="one JSON object per file")
+
+
+def load_dialog_named(folder: Path | None, name: str) -> tuple[DialogLibrary, Dialog]:
+    """The dialogs of ``folder`` and the one called ``name``; ConfigError when missing."""
+    found = dialogs_folder(folder)
+    if found is None:
+        raise ConfigError("no dialogs/ folder here; give one with --dialogs DIR")
+    library = DialogLibrary.from_folder(found, default_catalogue())
+    dialog = library.get(name)
+    if dialog is None:
+        raise ConfigError(f"no dialog {name!r} in {found}; dialogs: {', '.join(library.names)}")
+    return library, dialog
+
+
+def describe(name: str, hearing: Hearing) -> str:
+    if hearing.heard is None:
+        return f"{name}: heard nothing"
+    line = f"{name}: heard {hearing.heard!r}"
+    verdict = hearing.verdict
+    if verdict is not None and verdict.match is not None:
+        line += f" -> rule {verdict.match.rule.id!r} ({verdict.match.score:.2f})"
+    elif verdict is not None:
+        line += f" -> no rule ({verdict.reason})"
+    if hearing.answer is not None:
+        line += f" -> says {hearing.answer!r}"
+    return line
+
+
+def main(args: argparse.Namespace) -> int:
+    if args.mic == bool(args.files):
+        raise ConfigError("give WAV files, or --mic to listen on the microphone")
+    library, dialog = load_dialog_named(args.dialogs, args.dialog)
+    audio = [(path, read_wav(path)) for path in args.files]  # every file read before any work
+    from engine.speech.vad import SileroVad
+
+    recognizer = WhisperRecognizer()
+    recognizer.listen_for(library.phrases())
+    vad = SileroVad()
+    if args.mic:
+        from engine.cli.hear_live import listen_live
+
+        return listen_live(args, recognizer, dialog, RealClock())
+    for path, recording in audio:
+        hearing = hear(recording, vad, recognizer, dialog)
+        if args.json:
+            print(json.dumps(hearing.as_json(str(path)), ensure_ascii=False))
+        else:
+            print(describe(shown(str(path)), hearing))
+    return 0

@@ -1,0 +1,100 @@
+"""Speak with the robot's voice: on the speaker, or into a WAV file with -o.
+
+The voice is the profile's (--voice joe, the neural voice, or espeak); --rate 1 is its
+natural speed. Sentences are synthesized one by one; the first plays while the next is
+made.
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from engine.clock import RealClock
+from engine.errors import ConfigError, ServiceError
+from engine.speech.audio import Audio, write_wav
+from engine.speech.settings import VOICE_NAMES
+from engine.speech.speaker import Speaker
+from engine.speech.voice_models import load_voice
+from engine.speech.voices import EspeakVoice, sentences
+
+NAME = "say"
+HELP = "speak a text with the robot's voice (or write it to a WAV file)"
+MAX_TEXT_CHARS = 5000
+
+
+def _rate(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be a number, got {text!r}") from None
+    if not 0.5 <= value <= 2.0:
+        raise argparse.ArgumentTypeError(f"must be 0.5..2 (1 is natural), got {text}")
+    return value
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("text", help="what to say")
+    parser.add_argument(
+        "-o",
+        "--output",
+        type=Path,
+        default=None,
+        metavar="OUT.wav",
+        help="write a WAV file instead of playing",
+    )
+    parser.add_argument("--voice", choices=VOICE_NAMES, default="joe", help="default: joe")
+    parser.add_argument("--rate", type=_rate, default=1.0, help="speed, 0.5..2 (default 1)")
+    parser.add_argument(
+        "--device", default=None, help="ALSA playback device (default: the config's)"
+    )
+    parser.add_argument(
+        "--hardware",
+        type=Path,
+        default=None,
+        metavar="CONFIG",
+        help="robot config naming the speaker",
+    )
+
+
+def main(args: argparse.Namespace) -> int:
+    text = args.text.strip()
+    if not text:
+        raise ConfigError("nothing to say: the text is empty")
+    if len(text) > MAX_TEXT_CHARS:
+        raise ConfigError(f"the text has {len(text)} characters; at most {MAX_TEXT_CHARS}")
+    voice = load_voice(args.voice)  # VoiceError (exit 3) when it is not installed
+    if args.output is not None:
+        audio: Audio | None = None
+        for sentence in sentences(text):
+            part = voice.synthesize(sentence, speed=args.rate)
+            audio = part if audio is None else audio.then(part)
+        assert audio is not None
+        try:
+            write_wav(args.output, audio)
+        except OSError as error:
+            raise ConfigError(
+                f"-o {args.output}: cannot write ({error.strerror or error})"
+            ) from None
+        print(f"{args.output}: {audio.seconds:.2f} s at {audio.rate_hz} Hz")
+        return 0
+    from engine.drivers.audio_devices import AlsaSpeaker
+    from engine.hardware.config_file import load_robot_config
+
+    config = load_robot_config(args.hardware) if args.hardware is not None else None
+    device = args.device or (config.audio.speaker if config else None) or "default"
+    clock = RealClock()
+    playback = AlsaSpeaker(device)
+    playback.open(voice.synthesize("a").rate_hz)  # a missing card is named: exit 3
+    speaker = Speaker(voice, playback, clock, fallback_voice=EspeakVoice(), speed=args.rate)
+    try:
+        job = speaker.say(text)
+        while not job.done():
+            clock.sleep(0.05)
+    finally:
+        speaker.close()
+        playback.close()
+    failure = job.error()
+    if failure is not None:
+        raise ServiceError(f"could not say it: {failure}")
+    return 0

@@ -1,0 +1,68 @@
+"""The robot's hearing on a recording, start to end: VAD -> recognizer -> dialog matcher.
+
+``vest hear`` and ``vest dialogs check`` use it; it is the path a microphone takes,
+without the threads.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from engine.dialogs.model import Dialog, FollowUp, Verdict
+from engine.speech.audio import SPEECH_RATE_HZ, Audio
+from engine.speech.recognizer import Recognizer
+from engine.speech.vad import SpeechDetector, SpeechProbability
+
+TRAILING_SILENCE_S = 0.5
+"""Added after a recording, so speech that runs to its very end still ends."""
+
+
+@dataclass(frozen=True)
+class Hearing:
+    """What the robot made of a recording."""
+
+    heard: str | None
+    """The text (utterances joined), None when no speech was found or nothing recognized."""
+    verdict: Verdict | None
+    answer: str | None
+    """The answer's text as written (fields unfilled), or the fallback; None for neither."""
+
+    def as_json(self, name: str) -> dict[str, object]:
+        match = self.verdict.match if self.verdict is not None else None
+        return {
+            "file": name,
+            "heard": self.heard,
+            "rule": match.rule.id if match is not None else None,
+            "score": round(match.score, 3) if match is not None else None,
+            "answer": self.answer,
+        }
+
+
+def utterances(audio: Audio, vad: SpeechProbability) -> list[Audio]:
+    """The utterances Silero finds in ``audio``."""
+    vad.reset()
+    detector = SpeechDetector(vad)
+    samples = audio.resampled(SPEECH_RATE_HZ).then(Audio.silence(TRAILING_SILENCE_S)).samples
+    found = [u.audio for u in detector.feed(samples)]
+    last = detector.flush()
+    return found + ([last.audio] if last is not None else [])
+
+
+def hear(
+    audio: Audio,
+    vad: SpeechProbability,
+    recognizer: Recognizer,
+    dialog: Dialog | None,
+    follow_up: FollowUp | None = None,
+) -> Hearing:
+    """What the robot hears in ``audio`` and how ``dialog`` answers it."""
+    texts = [recognizer.transcribe(part).text for part in utterances(audio, vad)]
+    heard = " ".join(t for t in texts if t) or None
+    if heard is None or dialog is None:
+        return Hearing(heard, None, None)
+    verdict = dialog.judge(heard, follow_up)
+    if verdict.match is not None:
+        return Hearing(heard, verdict, verdict.match.rule.answer.source)
+    otherwise = follow_up.otherwise if follow_up is not None else None
+    said = otherwise or dialog.fallback
+    return Hearing(heard, verdict, said.source if said is not None else None)
