@@ -159,6 +159,7 @@ class Speaker:
         self._waits_until_s: float | None = None
         self._queue: queue.Queue[SpeechJob | None] = queue.Queue()
         self._thread: threading.Thread | None = None
+        self._current: SpeechJob | None = None
         self.said: list[str] = []
 
     def say(self, text: str, *, volume: float | None = None) -> Job:
@@ -175,6 +176,9 @@ class Speaker:
 
     def close(self) -> None:
         """Stop speaking and end the worker; queued utterances are cancelled."""
+        current = self._current
+        if current is not None:
+            current.cancel()
         if self._thread is not None:
             self._queue.put(None)
             self._thread.join(timeout=5.0)
@@ -199,6 +203,7 @@ class Speaker:
     def _run(self) -> None:
         while True:
             job = self._queue.get()
+            self._current = job
             if job is None:
                 self._queue.task_done()
                 return

@@ -1,0 +1,90 @@
+"""vest hear, vest say -o and vest dialogs check, as a therapist or developer uses them."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from engine.cli import main
+from engine.speech.audio import Audio, read_wav, write_wav
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+@pytest.fixture(autouse=True)
+def in_repo(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.chdir(ROOT)
+
+
+def test_say_writes_the_robot_s_voice_to_a_wav(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "hello.wav"
+    assert main(["say", "Hello. I am the robot.", "-o", str(out)]) == 0
+    audio = read_wav(out)
+    assert audio.rate_hz == 22050 and 1.0 < audio.seconds < 4.0
+
+
+def test_hear_says_what_it_heard_the_rule_and_the_answer_per_file(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    question, silence = tmp_path / "question.wav", tmp_path / "silence.wav"
+    assert main(["say", "What is the temperature?", "-o", str(question)]) == 0
+    write_wav(silence, Audio.silence(2.0))
+    capsys.readouterr()
+    assert main(["hear", "--json", str(question), str(silence)]) == 0
+    first, second = (json.loads(line) for line in capsys.readouterr().out.splitlines())
+    assert first == {
+        "file": str(question),
+        "heard": "What is the temperature?",
+        "rule": "temperature",
+        "score": 1.0,
+        "answer": "The temperature is {temperature_f:.0f} degrees",
+    }
+    assert second == {
+        "file": str(silence),
+        "heard": None,
+        "rule": None,
+        "score": None,
+        "answer": None,
+    }
+
+
+def test_hear_refuses_a_file_that_is_not_a_wav(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    text = tmp_path / "notes.wav"
+    text.write_text("not audio")
+    assert main(["hear", str(text)]) == 1
+    assert f"{text}: not a WAV file" in capsys.readouterr().err
+
+
+def test_dialogs_check_finds_a_phrase_another_rule_takes(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    (tmp_path / "play.yaml").write_text(
+        """\
+dialog: play
+rules:
+  - id: play
+    hear: ["do you want to play"]
+    say: "Yes!"
+  - id: play_ball
+    hear: ["do you want to play ball", "ball"]
+    say: "Throw it!"
+""",
+        encoding="utf-8",
+    )
+    assert main(["dialogs", "check", str(tmp_path), "--quick"]) == 1
+    out = capsys.readouterr().out
+    assert "rule 'play_ball': phrase 'do you want to play ball' as written -> ambiguous" in out
+    assert "problem(s)" in out.splitlines()[-1]
+
+
+def test_dialogs_check_passes_the_default_dialog_quickly(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    assert main(["dialogs", "check", "--quick"]) == 0
+    assert "0 problem(s)" in capsys.readouterr().out
