@@ -1,4 +1,5 @@
-"""List the robot's configured devices, probe each, and show its identity and one reading.
+"""List the robot's configured devices, probe each, and show its identity and one reading;
+then the sound devices and the speech models (each loaded once: a few seconds).
 
 On the simulated vest (the default config) it works the same as on the robot: the real
 drivers talk to register-level chip models. Exits 1 when a device does not answer as the
@@ -32,6 +33,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         metavar="CONFIG",
         help="robot config (default: examples/robots/sim.yaml, the simulated vest)",
     )
+    parser.add_argument(
+        "--no-speech", action="store_true", help="leave out the sound devices and speech models"
+    )
 
 
 def main(args: argparse.Namespace) -> int:
@@ -43,6 +47,10 @@ def main(args: argparse.Namespace) -> int:
         if vest is not None:
             vest.clock.sleep(SIMULATED_WARM_UP_S)
         rows = describe_devices(hardware)
+        if not args.no_speech:
+            from engine.speech.speech_report import describe_speech
+
+            rows += describe_speech(config.audio, config.simulated)
     finally:
         hardware.close()
         if vest is not None:

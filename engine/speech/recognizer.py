@@ -36,8 +36,9 @@ keeps. A wrong answer becomes "I did not understand"; a right one stays."""
 
 
 SEGMENT_BELOW = 0.3
-"""A segment whose words average less probability than this is dropped: Whisper invents
-a closing line after short clips ("...then we'll see you next time", 0.01-0.3 a word)."""
+"""A segment after the first whose words average less probability than this is dropped:
+Whisper invents a closing line after short clips ("...then we'll see you next time",
+0.01-0.3 a word)."""
 
 
 NO_SPEECH_AFTER = 0.4
@@ -177,9 +178,12 @@ class WhisperRecognizer:
         no_speech, log_prob = 0.0, 0.0
         for index, segment in enumerate(segments):
             said = [Word(w.word.strip(), float(w.probability)) for w in segment.words or ()]
-            if not said or sum(w.probability for w in said) / len(said) < SEGMENT_BELOW:
-                continue  # "and then we'll see you in the next video": made up after the end
-            if index > 0 and segment.no_speech_prob > NO_SPEECH_AFTER:
+            if not said:
+                continue
+            if index > 0 and (  # "and then we'll see you in the next video": made up
+                sum(w.probability for w in said) / len(said) < SEGMENT_BELOW
+                or segment.no_speech_prob > NO_SPEECH_AFTER
+            ):
                 continue
             words += said
             no_speech = max(no_speech, segment.no_speech_prob)
