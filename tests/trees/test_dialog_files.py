@@ -174,3 +174,92 @@ def test_a_dialog_whose_phrases_together_expand_too_far_is_refused_at_the_phrase
         "d.yaml:32:12: the dialog's phrases expand to more than 2000 phrases by here "
         "(use fewer ~concepts, or split the dialog in two)"
     ]
+
+
+# -- follow-ups and rule ids ---------------------------------------------------------------
+def test_a_follow_up_that_is_not_a_mapping_is_named_where_it_is(tmp_path: Path) -> None:
+    problems = dialog_problems(
+        tmp_path,
+        """\
+        dialog: d
+        rules:
+          - hear: ["do you like animals"]
+            say: "Do you have a pet?"
+            then: ["yes"]
+        """,
+    )
+    assert problems == [
+        "d.yaml:5:11: 'then' is a mapping with 'rules:' (and 'listen_s', 'otherwise')"
+    ]
+
+
+def test_a_follow_up_s_listening_time_must_be_a_positive_number(tmp_path: Path) -> None:
+    problems = dialog_problems(
+        tmp_path,
+        """\
+        dialog: d
+        rules:
+          - hear: ["do you like animals"]
+            say: "Do you have a pet?"
+            then:
+              listen_s: -1
+              rules:
+                - hear: ["yes"]
+                  say: "Lovely"
+        """,
+    )
+    assert len(problems) == 1
+    assert problems[0].startswith("d.yaml:6:17: 'listen_s' must be a number above 0")
+
+
+def test_two_rules_with_one_id_are_named_with_both_lines(tmp_path: Path) -> None:
+    problems = dialog_problems(
+        tmp_path,
+        """\
+        dialog: d
+        rules:
+          - id: pets
+            hear: ["do you like animals"]
+            say: "Do you have a pet?"
+            then:
+              rules:
+                - id: pets
+                  hear: ["yes"]
+                  say: "Lovely"
+        """,
+    )
+    assert problems == [
+        "d.yaml:8:11: two rules have the id 'pets' (also line 3) (give one of them another 'id:')"
+    ]
+
+
+def test_follow_ups_nest_at_most_five_deep(tmp_path: Path) -> None:
+    rule = 'hear: ["x{n}"]\n{pad}say: "y"\n{pad}then:\n{pad}  rules:\n{pad}    - '
+    text, pad = "dialog: d\nrules:\n  - ", "    "
+    for n in range(7):
+        text += rule.format(n=n, pad=pad)
+        pad += "      "
+    text += 'hear: ["last"]\n' + pad + 'say: "end"\n'
+    problems = dialog_problems(tmp_path, text)
+    assert len(problems) == 1 and "follow-ups nest deeper than 5" in problems[0]
+
+
+def test_a_follow_up_is_kept_for_the_next_utterance_only(tmp_path: Path) -> None:
+    robot = robot_with(
+        tmp_path,
+        """\
+        dialog: default
+        rules:
+          - hear: ["do you like animals"]
+            say: "Do you have a pet?"
+            then:
+              rules:
+                - hear: ["yes"]
+                  say: "Lovely"
+        fallback: "Pardon?"
+        """,
+    )
+    for utterance in ("do you like animals", "banana", "yes"):
+        robot.set("/speech/heard", utterance)
+        robot.advance(1.0)
+    assert robot.said == ["Do you have a pet?", "Pardon?", "Pardon?"]
