@@ -136,14 +136,16 @@ def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--quick", action="store_true", help="two ways of speaking instead of five")
     parser.add_argument("--verbose", action="store_true", help="also list the rejected phrases")
+    parser.add_argument("--beam", type=int, default=None, help="Whisper's beam size (default 1)")
     args = parser.parse_args()
     dialog = load_dialog(ROOT / "dialogs" / "default.yaml", default_catalogue())
     joe = load_voice("joe")
     assert isinstance(joe, NeuralVoice)
     voices: dict[str, Voice] = {"joe": joe.steady(), "espeak": load_voice("espeak")}
-    recognizer = WhisperRecognizer()
+    recognizer = WhisperRecognizer(beam_size=args.beam)
     recognizer.listen_for(dialog.phrases)
     vad = SileroVad()
+    print(f"recognizer: {recognizer.name}")
     ways = QUICK_WAYS if args.quick else WAYS
 
     clips: list[Clip] = []
