@@ -8,6 +8,7 @@ does not answer and runs on without speech.
 
 from __future__ import annotations
 
+import queue
 import shutil
 import subprocess
 import threading
@@ -96,13 +97,15 @@ def probe(role: str, device: str) -> AudioDeviceStatus:
 
 class AlsaSpeaker:
     """Plays audio on an ALSA device. ``start`` queues audio behind what is playing and
-    returns at once (a writer thread feeds ``aplay``); ``stop`` silences it now."""
+    returns at once (one writer thread feeds ``aplay``, in order); ``stop`` silences it now."""
 
     def __init__(self, device: str = "default") -> None:
         self.device = device
         self._process: subprocess.Popen[bytes] | None = None
         self._rate_hz = 0
         self._lock = threading.Lock()
+        self._pieces: queue.Queue[tuple[subprocess.Popen[bytes], bytes] | None] = queue.Queue()
+        self._writer: threading.Thread | None = None
 
     def _open(self, rate_hz: int) -> subprocess.Popen[bytes]:
         if self._process is not None and self._process.poll() is None and rate_hz == self._rate_hz:
@@ -135,17 +138,20 @@ class AlsaSpeaker:
         """Queue ``audio`` behind what is playing (``at_s`` is the speaker's own reckoning)."""
         with self._lock:
             process = self._open(audio.rate_hz)
-        data = audio.pcm16()
-        threading.Thread(target=self._write, args=(process, data), daemon=True).start()
+            if self._writer is None:
+                self._writer = threading.Thread(target=self._write, name="speaker", daemon=True)
+                self._writer.start()
+        self._pieces.put((process, audio.pcm16()))
 
-    @staticmethod
-    def _write(process: subprocess.Popen[bytes], data: bytes) -> None:
-        try:
-            if process.stdin is not None:
-                process.stdin.write(data)
-                process.stdin.flush()
-        except (BrokenPipeError, ValueError, OSError):
-            pass  # stopped while writing
+    def _write(self) -> None:
+        while (piece := self._pieces.get()) is not None:
+            process, data = piece
+            try:
+                if process.stdin is not None and process.poll() is None:
+                    process.stdin.write(data)
+                    process.stdin.flush()
+            except (BrokenPipeError, ValueError, OSError):
+                pass  # stopped while writing: the next piece goes to the new process
 
     def stop(self) -> None:
         with self._lock:
@@ -159,6 +165,10 @@ class AlsaSpeaker:
 
     def close(self) -> None:
         self.stop()
+        if self._writer is not None:
+            self._pieces.put(None)
+            self._writer.join(timeout=2.0)
+            self._writer = None
 
 
 class AlsaMicrophone:

@@ -51,6 +51,21 @@ class NoPlayback:
         """Nothing plays."""
 
 
+class BothPlaybacks:
+    """The simulated room (which the microphone hears) and a real speaker (for people)."""
+
+    def __init__(self, *parts: Playback) -> None:
+        self.parts = parts
+
+    def start(self, audio: Audio, at_s: float) -> None:
+        for part in self.parts:
+            part.start(audio, at_s)
+
+    def stop(self) -> None:
+        for part in self.parts:
+            part.stop()
+
+
 @dataclass
 class RobotSpeech:
     """The assembled speech parts and what could not be started."""
@@ -165,10 +180,16 @@ def build_speech(
         voice = voice.steady()  # a virtual clock's run is the same every time
     room = SimulatedRoom(clock) if simulated else None
     playback: Playback
-    if room is not None:
+    if audio.speaker is not None:
+        card = AlsaSpeaker(audio.speaker)
+        try:
+            card.open(voice.synthesize("a").rate_hz)
+            playback = card if room is None else BothPlaybacks(RoomSpeaker(room), card)
+        except AudioDeviceError as error:  # said at start-up; each answer tries it again
+            problems["speaker"] = str(error)
+            playback = RoomSpeaker(room) if room is not None else card
+    elif room is not None:
         playback = RoomSpeaker(room)
-    elif audio.speaker is not None:
-        playback = AlsaSpeaker(audio.speaker)
     else:
         playback = NoPlayback("the robot config names no speaker (audio: speaker:)")
     speaker = Speaker(
@@ -198,8 +219,9 @@ def build_speech(
     except (RecognizerError, ImportError) as error:
         problems["recognizer"] = str(error)
     speech = RobotSpeech(speaker, listener, room, settling, settle, voice, problems)
-    if isinstance(playback, AlsaSpeaker):
-        speech.closers.append(playback.close)
+    for part in (playback, *getattr(playback, "parts", ())):
+        if isinstance(part, AlsaSpeaker):
+            speech.closers.append(part.close)
     if room is None and audio.microphone is not None and listener is not None:
         heard_by = listener
         microphone = AlsaMicrophone(audio.microphone, lambda a: heard_by.hear(a, clock.now()))
