@@ -108,6 +108,8 @@ class Listener:
                 text = ""
             try:
                 self.on_heard(Heard(text, ended_s, self.clock.now()))
+            except Exception:  # whoever listens must not stop the robot hearing
+                log.exception("handling what was heard failed")
             finally:
                 with self._lock:
                     self._working -= 1

@@ -9,6 +9,7 @@ without a speaker its answers fail with the reason.
 from __future__ import annotations
 
 import logging
+from collections import deque
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -34,6 +35,7 @@ from engine.speech.voice_models import default_voice
 from engine.speech.voices import EspeakVoice, NeuralVoice, Voice, VoiceError
 
 log = logging.getLogger(__name__)
+HEARD_KEPT = 100
 LEAD_S = 0.3
 """Quiet before a person's scripted utterance starts (noise is mixed over it too)."""
 
@@ -80,8 +82,8 @@ class RobotSpeech:
     microphone: AlsaMicrophone | None = None
     closers: list[Callable[[], None]] = field(default_factory=list)
     _spoken: dict[str, Audio] = field(default_factory=dict)
-    heard: list[Heard] = field(default_factory=list)
-    """Everything heard, for the timeline and the benchmarks."""
+    heard: deque[Heard] = field(default_factory=lambda: deque(maxlen=HEARD_KEPT))
+    """The last utterances heard (text and times), for whoever inspects the robot."""
 
     def __call__(self, now_s: float) -> None:
         """A tick hook: the simulated microphone hears the room up to now; on a virtual

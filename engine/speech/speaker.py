@@ -160,7 +160,6 @@ class Speaker:
         self._queue: queue.Queue[SpeechJob | None] = queue.Queue()
         self._thread: threading.Thread | None = None
         self._current: SpeechJob | None = None
-        self.said: list[str] = []
 
     def say(self, text: str, *, volume: float | None = None) -> Job:
         job = SpeechJob(text, self.volume if volume is None else volume, self.clock)
@@ -255,7 +254,6 @@ class Speaker:
         finally:
             if said:
                 self.self_hearing.quiet(min(ends_s, self.clock.now()))
-        self.said.append(job.text)
         if self.on_utterance is not None and said:
             audio = said[0]
             for more in said[1:]:
