@@ -12,6 +12,10 @@ class VestError(Exception):
     """Root of every error raised by vest."""
 
 
+class UsageError(VestError, ValueError):
+    """The command line is wrong in a way argparse cannot see (exit 2)."""
+
+
 class ConfigError(VestError, ValueError):
     """A person's input (a YAML file, a CLI argument, a config) is wrong."""
 

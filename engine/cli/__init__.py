@@ -138,7 +138,7 @@ def _handled(argv: Sequence[str] | None, signals: StopSignals, out: WatchedOutpu
 
 def _refused(command: str, error: VestError) -> int:
     """Tell what was wrong with the input or the machine; the exit code says which."""
-    from engine.errors import DeviceError
+    from engine.errors import DeviceError, UsageError
     from engine.files.problems import LoadError
 
     if isinstance(error, LoadError):
@@ -146,6 +146,8 @@ def _refused(command: str, error: VestError) -> int:
         tell(f"{error}\n{count} problem{'s' if count != 1 else ''}")
         return EXIT_PROBLEMS
     tell(f"{command}: {error}")
+    if isinstance(error, UsageError):
+        return EXIT_USAGE
     if isinstance(error, DeviceError):  # a bus, port or chip this machine does not have
         return EXIT_MISSING
     return EXIT_PROBLEMS

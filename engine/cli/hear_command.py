@@ -1,7 +1,10 @@
 """Run the robot's hearing on recordings: voice activity, recognition, the dialog's rule.
 
 For each WAV file: what was heard, which rule of the dialog matched and its score, and
-the answer (or the fallback). --json prints one object per file:
+the answer (or the fallback; [name] is a value the robot fills in from its sensors). A
+recording with several utterances is heard as a conversation: one line each, and an
+answer that asks a question (then:) hears the next utterance as its reply. --json prints
+one object per utterance (per file, for a file of one question):
 {"file": ..., "heard": text or null, "rule": rule id or null, "score": ..., "answer": ...}.
 --mic listens on the microphone instead (the robot config's, or --device) until Ctrl-C.
 """
@@ -18,9 +21,9 @@ from engine.cli.run_inputs import dialogs_folder
 from engine.clock import RealClock
 from engine.dialogs.library import DialogLibrary
 from engine.dialogs.model import Dialog
-from engine.errors import ConfigError
+from engine.errors import ConfigError, UsageError
 from engine.speech.audio import read_wav
-from engine.speech.hearing import Hearing, hear
+from engine.speech.hearing import Hearing, conversation
 from engine.speech.recognizer import WhisperRecognizer
 
 NAME = "hear"
@@ -76,8 +79,10 @@ def describe(name: str, hearing: Hearing) -> str:
 
 
 def main(args: argparse.Namespace) -> int:
-    if args.mic == bool(args.files):
-        raise ConfigError("give WAV files, or --mic to listen on the microphone")
+    if args.mic and args.files:
+        raise UsageError("give WAV files or --mic, not both")
+    if not args.mic and not args.files:
+        raise UsageError("give WAV files to hear, or --mic to listen on the microphone")
     library, dialog = load_dialog_named(args.dialogs, args.dialog)
     audio = [(path, read_wav(path)) for path in args.files]  # every file read before any work
     from engine.speech.vad import SileroVad
@@ -90,9 +95,9 @@ def main(args: argparse.Namespace) -> int:
 
         return listen_live(args, recognizer, dialog, RealClock())
     for path, recording in audio:
-        hearing = hear(recording, vad, recognizer, dialog)
-        if args.json:
-            print(json.dumps(hearing.as_json(str(path)), ensure_ascii=False))
-        else:
-            print(describe(shown(str(path)), hearing))
+        for hearing in conversation(recording, vad, recognizer, dialog):
+            if args.json:
+                print(json.dumps(hearing.as_json(str(path)), ensure_ascii=False))
+            else:
+                print(describe(shown(str(path)), hearing))
     return 0

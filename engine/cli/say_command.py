@@ -11,7 +11,7 @@ import argparse
 from pathlib import Path
 
 from engine.clock import RealClock
-from engine.errors import ConfigError, ServiceError
+from engine.errors import ConfigError, ServiceError, UsageError
 from engine.speech.audio import Audio, write_wav
 from engine.speech.settings import VOICE_NAMES
 from engine.speech.speaker import Speaker
@@ -59,10 +59,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def main(args: argparse.Namespace) -> int:
     text = args.text.strip()
-    if not text:
-        raise ConfigError("nothing to say: the text is empty")
+    if not any(c.isalnum() for c in text):
+        raise UsageError("nothing to say: the text has no letters or digits")
     if len(text) > MAX_TEXT_CHARS:
-        raise ConfigError(f"the text has {len(text)} characters; at most {MAX_TEXT_CHARS}")
+        raise UsageError(f"the text has {len(text)} characters; at most {MAX_TEXT_CHARS}")
     voice = load_voice(args.voice)  # VoiceError (exit 3) when it is not installed
     if args.output is not None:
         audio: Audio | None = None

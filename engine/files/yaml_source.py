@@ -263,10 +263,17 @@ def _read_at_most(path: Path, max_bytes: int) -> bytes:
         os.close(fd)
 
 
-def read_text(path: Path, shown: str | None = None, *, max_bytes: int = MAX_FILE_BYTES) -> str:
-    """The file's text, or a LoadError: missing, unreadable, too big, not UTF-8, not a
-    regular file (a folder, a FIFO, a device), or a path that names no file (a file as a
-    folder, too long, a link loop, a NUL character). Every person's file is read here."""
+def read_bytes(
+    path: Path,
+    shown: str | None = None,
+    *,
+    max_bytes: int = MAX_FILE_BYTES,
+    kind: str = "vest YAML file",
+    too_big_hint: str = "split it into subtrees",
+) -> bytes:
+    """The file's bytes, or a LoadError: missing, unreadable, too big, not a regular file
+    (a folder, a FIFO, a device), or a path that names no file (a file as a folder, too
+    long, a link loop, a NUL character). Every person's file is read here."""
     name = (shown or str(path)).replace("\0", "\\0")
     start = Mark(name, 1, 1)
     if "\0" in str(path):  # the OS cannot even be asked about such a name
@@ -293,11 +300,18 @@ def read_text(path: Path, shown: str | None = None, *, max_bytes: int = MAX_FILE
             [
                 Problem(
                     start,
-                    f"file is more than the {max_bytes // 1024} KiB a vest YAML file may be",
-                    "split it into subtrees",
+                    f"file is more than the {max_bytes // 1024} KiB a {kind} may be",
+                    too_big_hint,
                 )
             ]
         )
+    return data
+
+
+def read_text(path: Path, shown: str | None = None, *, max_bytes: int = MAX_FILE_BYTES) -> str:
+    """The file's text (see :func:`read_bytes`), or a LoadError, also when it is not UTF-8."""
+    name = (shown or str(path)).replace("\0", "\\0")
+    data = read_bytes(path, shown, max_bytes=max_bytes)
     try:
         return data.decode("utf-8")
     except UnicodeDecodeError as error:

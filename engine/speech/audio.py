@@ -15,6 +15,7 @@ import numpy as np
 import numpy.typing as npt
 
 from engine.errors import VestError
+from engine.files.yaml_source import read_bytes
 
 Samples = npt.NDArray[np.float32]
 SPEECH_RATE_HZ = 16000
@@ -91,32 +92,40 @@ def write_wav(path: Path, audio: Audio) -> None:
     path.write_bytes(audio.wav_bytes())
 
 
+MAX_WAV_BYTES = 200 * 1024 * 1024
+"""The largest WAV file read (10 minutes of 48 kHz 16-bit stereo fit four times over)."""
+
+
 def read_wav(path: Path) -> Audio:
-    """A WAV file (8/16/32-bit PCM, any rate, channels mixed to mono); AudioFileError
-    with the path and why when it is not one."""
-    try:
-        with path.open("rb") as file:
-            return wav_from_bytes(file.read(int(MAX_WAV_S * 48000 * 4 * 2) + 1024), str(path))
-    except OSError as error:
-        raise AudioFileError(f"{path}: cannot read ({error.strerror or error})") from None
+    """A WAV file (8/16/32-bit PCM, any rate, channels mixed to mono). A LoadError when it
+    cannot be read as a file (missing, a folder, a FIFO: never waited on), AudioFileError
+    with the path and why when it is not a WAV we can use."""
+    data = read_bytes(
+        path, max_bytes=MAX_WAV_BYTES, kind="WAV file", too_big_hint="cut it to the utterance"
+    )
+    return wav_from_bytes(data, str(path))
 
 
 def wav_from_bytes(data: bytes, name: str) -> Audio:
+    """The audio of a WAV file's bytes. A header whose length is wrong (a recording made
+    to a pipe says "as long as possible") is read for what the data holds."""
+    if not data:
+        raise AudioFileError(f"{name}: not a WAV file (it is empty)")
     try:
         with wave.open(io.BytesIO(data), "rb") as wav:
             channels, width, rate = wav.getnchannels(), wav.getsampwidth(), wav.getframerate()
-            frames = wav.getnframes()
-            if rate <= 0 or frames / rate > MAX_WAV_S:
-                raise AudioFileError(
-                    f"{name}: {frames / max(rate, 1):.0f} s of audio, more than {MAX_WAV_S:.0f} s"
-                )
-            raw = wav.readframes(frames)
+            if rate < 1000 or rate > 384000:
+                raise AudioFileError(f"{name}: sample rate {rate} Hz; use 8000 to 384000 Hz")
+            raw = wav.readframes(round(MAX_WAV_S * rate) + 1)
     except (wave.Error, EOFError) as error:
-        raise AudioFileError(f"{name}: not a WAV file ({error})") from None
+        raise AudioFileError(f"{name}: not a WAV file ({error or 'cut short'})") from None
     dtypes: dict[int, str] = {1: "u1", 2: "<i2", 4: "<i4"}
     if width not in dtypes:
         raise AudioFileError(f"{name}: {8 * width}-bit samples; use 8, 16 or 32-bit PCM")
-    usable = len(raw) - len(raw) % (width * channels)
+    frames = len(raw) // (width * channels)
+    if frames > MAX_WAV_S * rate:
+        raise AudioFileError(f"{name}: more than {MAX_WAV_S:.0f} s of audio")
+    usable = frames * width * channels
     ints = np.frombuffer(raw[:usable], dtype=dtypes[width]).astype(np.float32)
     scale = {1: 128.0, 2: 32768.0, 4: 2147483648.0}[width]
     samples = (ints - 128.0) / scale if width == 1 else ints / scale

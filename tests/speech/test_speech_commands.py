@@ -41,7 +41,7 @@ def test_hear_says_what_it_heard_the_rule_and_the_answer_per_file(
         "heard": "What is the temperature?",
         "rule": "temperature",
         "score": 1.0,
-        "answer": "The temperature is {temperature_f:.0f} degrees",
+        "answer": "The temperature is [temperature_f] degrees",
     }
     assert second == {
         "file": str(silence),
@@ -88,3 +88,33 @@ def test_dialogs_check_passes_the_default_dialog_quickly(
 ) -> None:
     assert main(["dialogs", "check", "--quick"]) == 0
     assert "0 problem(s)" in capsys.readouterr().out
+
+
+def test_hear_follows_a_conversation_in_one_recording(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from engine.speech.voice_models import load_voice
+
+    joe = load_voice("joe")
+    pause = Audio.silence(1.0, 22050)
+    question = joe.synthesize("Do you like animals?")
+    answer = joe.synthesize("No.")
+    write_wav(tmp_path / "talk.wav", pause.then(question).then(pause).then(answer).then(pause))
+    assert main(["hear", "--json", str(tmp_path / "talk.wav")]) == 0
+    rules = [json.loads(line)["rule"] for line in capsys.readouterr().out.splitlines()]
+    assert rules == ["pets", "no_pet"]
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["hear"], "give WAV files to hear, or --mic"),
+        (["hear", "--mic", "x.wav"], "give WAV files or --mic, not both"),
+        (["say", "  ...  "], "nothing to say"),
+    ],
+)
+def test_a_wrong_command_line_exits_2(
+    args: list[str], message: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    assert main(args) == 2
+    assert message in capsys.readouterr().err
