@@ -22,8 +22,9 @@ from pathlib import Path
 from typing import Any
 
 from engine.blackboard.catalogue import default_catalogue
-from engine.files.problems import Mark, Problems
+from engine.files.problems import LoadError, Mark, Problems
 from engine.files.yaml_source import YList, YMap, YValue, describe, load_yaml, plain
+from engine.speech.audio import AudioFileError, read_wav
 from engine.values.params import (
     REQUIRED,
     SECONDS,
@@ -262,16 +263,26 @@ def _event(
 
 
 def _check_hearing(value: dict[str, Any], body: YValue, folder: Path, problems: Problems) -> bool:
-    """Exactly one of text and wav; a wav that is a file, made absolute."""
+    """Exactly one of text (with words) and wav; a wav that is a WAV file we can use (read
+    now, so a bad one is named before the run), made absolute."""
     if (value["text"] is None) == (value["wav"] is None):
         problems.add(
             body.mark, "hear takes one of text and wav", "e.g. {text: hello} or {wav: question.wav}"
         )
         return False
+    if value["text"] is not None and not any(c.isalnum() for c in value["text"]):
+        problems.add(body.mark, "hear has no words to say", "write what the person says")
+        return False
     if value["wav"] is not None:
         wav = folder / value["wav"]
-        if not wav.is_file():
-            problems.add(body.mark, f"no WAV file {wav}", "a path relative to the scenario file")
+        try:
+            read_wav(wav)
+        except LoadError as error:
+            why = error.problems[0].message
+            problems.add(body.mark, f"{wav}: {why}", "a path relative to the scenario file")
+            return False
+        except AudioFileError as error:
+            problems.add(body.mark, str(error), "a 16-bit PCM WAV file works everywhere")
             return False
         value["wav"] = str(wav)
     return True
