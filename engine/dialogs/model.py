@@ -14,12 +14,21 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
-from engine.dialogs.words import QUESTION_WORDS, is_function_word, same_word, weight, words
+from engine.dialogs.words import (
+    PERSON_WORDS,
+    QUESTION_WORDS,
+    is_function_word,
+    same_word,
+    weight,
+    words,
+)
 from engine.files.problems import Mark
 from engine.values.templates import CompiledTemplate
 
-EXTRA_WORD_FACTOR = 0.85
-"""The score is multiplied by this for each meaning word heard that the phrase lacks."""
+EXTRA_WORD_FACTOR = 0.6
+"""The score is multiplied by this for each meaning word heard that the phrase lacks: one
+is enough to refuse a phrase ("my dog *died*" is not "my dog", "I do *not* like animals" is
+not "I like animals"). List the longer ways of saying it as phrases of their own."""
 AMBIGUITY_MARGIN = 0.1
 """Two rules scoring within this of each other cannot be told apart: neither matches.
 Nor can two that both reach ``min_score`` ("what is your name and your favorite color")."""
@@ -34,7 +43,7 @@ class Phrase:
     text: str
     words: tuple[str, ...]
     required: frozenset[str]
-    """Meaning words and question words; every word when the phrase has no meaning word."""
+    """Meaning, question and person words; every word when the phrase has no meaning word."""
     only_function_words: bool
     total_weight: float
 
@@ -42,7 +51,7 @@ class Phrase:
     def of(cls, text: str) -> Phrase:
         said = words(text)
         meaning = frozenset(w for w in said if not is_function_word(w))
-        asks = frozenset(w for w in said if w in QUESTION_WORDS)
+        asks = frozenset(w for w in said if w in QUESTION_WORDS or w in PERSON_WORDS)
         return cls(
             text=text,
             words=said,
@@ -58,10 +67,12 @@ class Phrase:
         found = [w for w in self.words if any(same_word(h, w) for h in heard)]
         if any(w not in found for w in self.required):
             return 0.0
+        persons = {PERSON_WORDS[w] for w in self.words if w in PERSON_WORDS}
         extra = [
             h
             for h in heard
-            if not is_function_word(h) and not any(same_word(h, w) for w in self.words)
+            if (not is_function_word(h) or PERSON_WORDS.get(h, "") not in persons | {""})
+            and not any(same_word(h, w) for w in self.words)
         ]
         if extra and self.only_function_words:
             return 0.0

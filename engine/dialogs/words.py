@@ -54,6 +54,7 @@ _FUNCTION_WORD_LINES = (
     "to of in on at for with about from by as into over",
     "and or but so if then than just really very too also",
     "please hey hi hello oh um uh er ah okay ok well robot tell say let know",
+    "today now right again actually maybe still anyway though",
 )
 FUNCTION_WORDS = frozenset(" ".join(_FUNCTION_WORD_LINES).split())
 """Words that shape a question without saying what it is about. Negations ("no", "not",
@@ -70,6 +71,17 @@ QUESTION_WORDS = {
 }
 """Question words, by what they ask: a phrase's question word must be heard ("what are you
 doing" is not "how are you doing"); "which" asks what "what" asks."""
+
+PERSON_WORDS = {
+    **dict.fromkeys(("i", "me", "my", "mine", "myself"), "me"),
+    **dict.fromkeys(("you", "your", "yours", "yourself"), "you"),
+    **dict.fromkeys(("he", "him", "his", "himself"), "he"),
+    **dict.fromkeys(("she", "her", "hers", "herself"), "she"),
+    **dict.fromkeys(("we", "us", "our", "ours"), "we"),
+    **dict.fromkeys(("they", "them", "their", "theirs"), "they"),
+}
+"""Whom a sentence is about: "what is *my* name" is not "what is *your* name". A phrase's
+person must be heard, and another person heard counts as a meaning word the phrase lacks."""
 
 FUNCTION_WEIGHT = 0.3
 """How much a function word counts towards a phrase's coverage (a meaning word counts 1)."""
@@ -92,10 +104,13 @@ def normalize(text: str) -> str:
 
 
 def stem(word: str) -> str:
-    """A plural's singular ("colors" -> "color", "puppies" -> "puppy"); other words as they are."""
+    """A plural's singular ("colors" -> "color", "puppies" -> "puppy"); other words (and
+    function words: "does", "always") as they are."""
+    if word in FUNCTION_WORDS or word.endswith(("ss", "us", "is", "ys")):
+        return word
     if len(word) > 4 and word.endswith("ies"):
         return word[:-3] + "y"
-    if len(word) > 3 and word.endswith("s") and not word.endswith(("ss", "us", "is")):
+    if len(word) > 3 and word.endswith("s"):
         return word[:-1]
     return word
 
@@ -116,6 +131,8 @@ def same_word(heard: str, expected: str) -> bool:
         return True
     if expected in QUESTION_WORDS:
         return QUESTION_WORDS.get(heard) == QUESTION_WORDS[expected]
+    if expected in PERSON_WORDS:
+        return PERSON_WORDS.get(heard) == PERSON_WORDS[expected]
     if min(len(heard), len(expected)) < 6:
         return False
     return difflib.SequenceMatcher(None, heard, expected).ratio() >= 0.85

@@ -120,6 +120,16 @@ def _unsure(word: Word) -> bool:
     return word.probability < UNSURE_BELOW and any(not is_function_word(w) for w in said)
 
 
+def _sentences(said: tuple[Word, ...]) -> list[list[Word]]:
+    """The words cut after each one that ends a sentence (". ? !")."""
+    found: list[list[Word]] = [[]]
+    for word in said:
+        found[-1].append(word)
+        if word.text.endswith((".", "?", "!")):
+            found.append([])
+    return [sentence for sentence in found if sentence]
+
+
 class WhisperRecognizer:
     """Whisper tiny.en, one utterance at a time."""
 
@@ -155,16 +165,18 @@ class WhisperRecognizer:
     def transcribe(self, audio: Audio) -> Transcript:
         samples = audio.resampled(SPEECH_RATE_HZ).samples
         heard = self._decode(samples)
-        if not any(w.probability < UNSURE_BELOW for w in heard.words):
+        if not any(_unsure(w) for w in heard.words):
             return heard
-        plain = self._decode(samples, prompted=False)
-        confirmed = set(words_of(plain.text))
-        kept = [
-            w
-            for w in heard.words
-            if w.probability >= UNSURE_BELOW or set(words_of(w.text)) <= confirmed
-        ]
-        text = " ".join(w.text for w in kept if w.text) if heard.text or kept else ""
+        confirmed = set(words_of(self._decode(samples, prompted=False).text))
+        kept: list[Word] = []
+        for index, sentence in enumerate(_sentences(heard.words)):
+            doubtful = [
+                w for w in sentence if _unsure(w) and not set(words_of(w.text)) <= confirmed
+            ]
+            if doubtful and index > 0:
+                continue  # a sentence after the first with a made-up word ("Thank you.")
+            kept += [w for w in sentence if w not in doubtful]
+        text = " ".join(w.text for w in kept if w.text)
         return Transcript(text, heard.words, heard.no_speech, heard.log_prob)
 
     def _decode(self, samples: Samples, *, prompted: bool = True) -> Transcript:

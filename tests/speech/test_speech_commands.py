@@ -69,17 +69,17 @@ def test_dialogs_check_finds_a_phrase_another_rule_takes(
 dialog: play
 rules:
   - id: play
-    hear: ["do you want to play"]
+    hear: ["do you want to play", "let us play"]
     say: "Yes!"
   - id: play_ball
-    hear: ["do you want to play ball", "ball"]
+    hear: ["do you want to play ball", "let us play"]
     say: "Throw it!"
 """,
         encoding="utf-8",
     )
     assert main(["dialogs", "check", str(tmp_path), "--quick"]) == 1
     out = capsys.readouterr().out
-    assert "rule 'play_ball': phrase 'do you want to play ball' as written -> ambiguous" in out
+    assert "rule 'play': phrase 'let us play' as written -> ambiguous" in out
     assert "problem(s)" in out.splitlines()[-1]
 
 

@@ -29,7 +29,7 @@ def scenario_problems(tmp_path: Path, event: str) -> list[str]:
         ('{at: 1, hear: {text: "hi", wav: "a.wav"}}', "hear takes one of text and wav"),
         ("{at: 1, hear: {snr_db: 10}}", "hear takes one of text and wav"),
         ("{at: 1, hear: {wav: missing.wav}}", "missing.wav: file not found"),
-        ("{at: 1, hear: \"  \"}", "hear has no words to say"),
+        ('{at: 1, hear: "  "}', "hear has no words to say"),
         ('{at: 1, hear: {text: "hi", snr_db: 99}}', "'snr_db'"),
         ('{at: 1, hear: {text: "hi", loud: 3}}', "loud"),
         ("{at: 1, hear: [a, b]}", "must be text"),

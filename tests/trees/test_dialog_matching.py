@@ -37,6 +37,8 @@ def rule_for(dialog: Dialog, utterance: str) -> str | None:
         ("what is your favourite color", "color"),
         ("what's the temperature", "temperature"),
         ("is it cold in here", "temperature"),
+        ("is it cold today", "temperature"),
+        ("hello", "greeting"),
         ("how are you", "how_are_you"),
         ("do you like animals", "pets"),
         ("do you like dogs", "pets"),
@@ -68,9 +70,35 @@ def test_questions_the_dialog_does_not_answer_get_no_rule(dialog: Dialog, uttera
 
 
 def test_a_question_that_asks_two_things_is_not_half_answered(dialog: Dialog) -> None:
-    verdict = dialog.judge("what is your name and your favorite color")
-    assert verdict.match is None
-    assert "ambiguous" in verdict.reason
+    assert dialog.judge("what is your name and your favorite color").match is None
+
+
+@pytest.mark.parametrize(
+    "utterance",
+    [
+        "what is my name",  # someone else's
+        "what is her name",
+        "what is your dog's name",
+        "what is my favorite color",
+        "which color do you not like",  # turned around
+        "I do not like animals",
+        "how warm is the water",  # not the room
+        "how hot is the oven",
+        "i do not know your name",
+    ],
+)
+def test_a_question_about_someone_or_something_else_is_not_answered(
+    dialog: Dialog, utterance: str
+) -> None:
+    assert rule_for(dialog, utterance) is None
+
+
+@pytest.mark.parametrize("answer", ["my dog died", "i never had a dog", "sure not", "no i do"])
+def test_a_reply_that_turns_the_answer_around_is_not_taken_for_yes_or_no(
+    dialog: Dialog, answer: str
+) -> None:
+    pets = next(rule for rule in dialog.rules if rule.id == "pets")
+    assert dialog.judge(answer, pets.follow_up).match is None
 
 
 def test_the_verdict_says_why_nothing_matched(dialog: Dialog) -> None:
