@@ -218,6 +218,7 @@ def _rules(
     problems: Problems,
     budget: _Budget,
     depth: int,
+    parent: str = "",
 ) -> tuple[DialogRule, ...]:
     if raw_rules is None:
         problems.add(where, "a dialog needs 'rules:'", "add a list of hear/say rules")
@@ -225,7 +226,10 @@ def _rules(
     if not isinstance(raw_rules, YList):
         problems.add(raw_rules.mark, f"'rules' must be a list, got {describe(raw_rules)}")
         return ()
-    rules = (_rule(raw, concepts, ctx, problems, budget, depth) for raw in raw_rules)
+    if not raw_rules.items:
+        problems.add(raw_rules.mark, "'rules' is empty", "add a hear/say rule")
+        return ()
+    rules = (_rule(raw, concepts, ctx, problems, budget, depth, parent) for raw in raw_rules)
     return tuple(rule for rule in rules if rule is not None)
 
 
@@ -247,13 +251,23 @@ def _check_ids(rules: tuple[DialogRule, ...], problems: Problems) -> None:
 
 
 def _number(
-    raw: YValue, problems: Problems, what: str, low: float, high: float, default: float
+    raw: YValue,
+    problems: Problems,
+    what: str,
+    low: float,
+    high: float,
+    default: float,
+    from_low: bool = False,
 ) -> float:
+    """A number in (low, high], or [low, high] with ``from_low``; else a problem."""
     value = raw.value if isinstance(raw, YScalar) else None
-    if isinstance(value, bool) or not isinstance(value, int | float) or not low < value <= high:
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        value = float("nan")  # refused below, as every comparison with NaN fails
+    if not (low <= value if from_low else low < value) or not value <= high:
+        lowest = f"at least {low:g}" if from_low else f"above {low:g}"
         problems.add(
             raw.mark,
-            f"{what!r} must be a number above {low:g} and at most {high:g}, got {describe(raw)}",
+            f"{what!r} must be a number {lowest} and at most {high:g}, got {describe(raw)}",
         )
         return default
     return float(value)
@@ -266,6 +280,7 @@ def _follow_up(
     problems: Problems,
     budget: _Budget,
     depth: int,
+    parent: str,
 ) -> FollowUp | None:
     if not isinstance(raw, YMap):
         problems.add(raw.mark, "'then' is a mapping with 'rules:' (and 'listen_s', 'otherwise')")
@@ -278,11 +293,11 @@ def _follow_up(
         )
         return None
     problems.unknown_fields(raw.key_marks, _FOLLOW_UP_KEYS, "follow-up")
-    rules = _rules(raw.get("rules"), raw.mark, concepts, ctx, problems, budget, depth + 1)
+    rules = _rules(raw.get("rules"), raw.mark, concepts, ctx, problems, budget, depth + 1, parent)
     listen_s = DEFAULT_LISTEN_S
     raw_listen = raw.get("listen_s")
     if raw_listen is not None:
-        listen_s = _number(raw_listen, problems, "listen_s", 0.0, 3600.0, DEFAULT_LISTEN_S)
+        listen_s = _number(raw_listen, problems, "listen_s", 1.0, 3600.0, DEFAULT_LISTEN_S, True)
     raw_otherwise = raw.get("otherwise")
     otherwise = _template(raw_otherwise, ctx, problems) if raw_otherwise is not None else None
     return FollowUp(rules, listen_s, otherwise)
@@ -295,6 +310,7 @@ def _rule(
     problems: Problems,
     budget: _Budget,
     depth: int,
+    parent: str,
 ) -> DialogRule | None:
     if not isinstance(raw, YMap):
         problems.add(raw.mark, "each rule is a mapping with 'hear:' and 'say:'")
@@ -306,6 +322,8 @@ def _rule(
         problems.add(raw.mark, "rule has no 'hear:'", "list the phrases that trigger it")
     else:
         items = hear.items if isinstance(hear, YList) else [hear]
+        if not items:
+            problems.add(hear.mark, "'hear' is empty", "list the phrases that trigger the rule")
         for item in items:
             if not isinstance(item, YScalar) or not isinstance(item.value, str) or not item.value:
                 problems.add(item.mark, f"a phrase must be text, got {describe(item)}")
@@ -342,16 +360,18 @@ def _rule(
                 did_you_mean(read, ON_REQUEST_SENSORS) or "use " + " or ".join(ON_REQUEST_SENSORS),
             )
             read = None
+    unique = tuple(dict.fromkeys(phrases))
+    rule_id = _text(raw.get("id"), problems, "id")
+    if rule_id is None and unique:  # a follow-up's rule is named under its question's
+        rule_id = f"{parent}/{unique[0]}" if parent else unique[0]
     raw_then = raw.get("then")
     follow_up = None
     if raw_then is not None:
-        follow_up = _follow_up(raw_then, concepts, ctx, problems, budget, depth)
-    rule_id = _text(raw.get("id"), problems, "id")
-    if answer is None or not phrases:
+        follow_up = _follow_up(raw_then, concepts, ctx, problems, budget, depth, rule_id or "?")
+    if answer is None or not unique or rule_id is None:
         return None
-    unique = tuple(dict.fromkeys(phrases))
     return DialogRule(
-        id=rule_id or unique[0],
+        id=rule_id,
         phrases=tuple(Phrase.of(text) for text in unique),
         answer=answer,
         read=read,

@@ -209,7 +209,7 @@ def test_a_follow_up_s_listening_time_must_be_a_positive_number(tmp_path: Path) 
         """,
     )
     assert len(problems) == 1
-    assert problems[0].startswith("d.yaml:6:17: 'listen_s' must be a number above 0")
+    assert problems[0].startswith("d.yaml:6:17: 'listen_s' must be a number at least 1 ")
 
 
 def test_two_rules_with_one_id_are_named_with_both_lines(tmp_path: Path) -> None:
@@ -263,3 +263,44 @@ def test_a_follow_up_is_kept_for_the_next_utterance_only(tmp_path: Path) -> None
         robot.set("/speech/heard", utterance)
         robot.advance(1.0)
     assert robot.said == ["Do you have a pet?", "Pardon?", "Pardon?"]
+
+
+def test_empty_lists_of_rules_or_phrases_are_named(tmp_path: Path) -> None:
+    problems = dialog_problems(
+        tmp_path,
+        """\
+        dialog: d
+        rules:
+          - hear: []
+            say: "Hi"
+            then: {rules: []}
+        """,
+    )
+    assert problems == [
+        "d.yaml:3:11: 'hear' is empty (list the phrases that trigger the rule)",
+        "d.yaml:5:19: 'rules' is empty (add a hear/say rule)",
+    ]
+
+
+def test_follow_up_rules_without_ids_are_named_under_their_question(tmp_path: Path) -> None:
+    path = write(
+        tmp_path,
+        "d.yaml",
+        """\
+        dialog: d
+        rules:
+          - hear: ["do you like animals"]
+            say: "Do you have a pet?"
+            then: {rules: [{hear: ["yes"], say: "Lovely"}]}
+          - hear: ["do you like music"]
+            say: "Do you play an instrument?"
+            then: {rules: [{hear: ["yes"], say: "Great"}]}
+        """,
+    )
+    dialog = load_dialog(path, default_catalogue(), "d.yaml")
+    assert [rule.id for rule in dialog.all_rules()] == [
+        "do you like animals",
+        "do you like music",
+        "do you like animals/yes",
+        "do you like music/yes",
+    ]
