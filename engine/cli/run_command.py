@@ -4,10 +4,11 @@ Without arguments: every tree in trees/ on examples/scenarios/demo.yaml, in real
 through the simulated vest (examples/robots/sim.yaml): the scenario moves register-level
 chip models that the real drivers read. --hardware CONFIG names a robot config; on a robot
 (e.g. examples/robots/hbs2.yaml) the same drivers read the real chips.
-Speech goes through the real models: a scenario's ``hear:`` is spoken into the simulated
+Speech goes through the real models: a scenario's hear: is spoken into the simulated
 room, heard by Silero VAD and Whisper, and the answers are synthesized (--audio-out DIR
-keeps a WAV per utterance); ``--speech text`` skips the models and hands the trees the
-text. --fast runs on a virtual clock as fast as the machine allows; --json prints one JSON
+keeps a WAV per utterance, replacing those of an earlier run); --speech text skips the
+models, hands the trees the text and gives each spoken word 0.3 s.
+--fast runs on a virtual clock as fast as the machine allows; --json prints one JSON
 object per robot action: {"t": seconds, "tree": name, "action": ..., "args": {...}}.
 In real time, a changed tree file is reloaded between ticks (an invalid change keeps the
 running tree); Ctrl-C or SIGTERM stops cleanly at any moment, start-up included. The

@@ -158,6 +158,13 @@ class ConfigChecker:
         for field in ("microphone", "speaker"):
             if field in audio:
                 name = self.convert(Text(), audio.entries[field], field)
+                if name is not None and (not name.strip() or name != name.strip()):
+                    self.problems.add(
+                        audio.entries[field].mark,
+                        f"{field} {name!r} is not an ALSA device name",
+                        "e.g. default, plughw:1,0 or none",
+                    )
+                    name = None
                 found[field] = None if name in (None, "none") else name
             else:
                 found[field] = getattr(default, field)
