@@ -1,18 +1,22 @@
 """Speak with the robot's voice: on the speaker, or into a WAV file with -o.
 
-The voice is the profile's (--voice joe, the neural voice, or espeak); --rate 1 is its
-natural speed. Sentences are synthesized one by one; the first plays while the next is
-made.
+The voice and speed are a profile's (--profile child), or --voice (joe, the neural voice,
+or espeak) and --rate (1 is the voice's natural speed). Sentences are synthesized one
+by one; the first plays while the next is made.
 """
 
 from __future__ import annotations
 
 import argparse
 from pathlib import Path
+from typing import Any
 
+from engine.cli.run_inputs import resolve_profile
 from engine.clock import RealClock
 from engine.errors import ConfigError, ServiceError, UsageError
+from engine.loader.substitution import load_profile
 from engine.speech.audio import Audio, write_wav
+from engine.speech.robot_speech import speech_settings
 from engine.speech.settings import VOICE_NAMES
 from engine.speech.speaker import Speaker
 from engine.speech.voice_models import load_voice
@@ -43,8 +47,17 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         metavar="OUT.wav",
         help="write a WAV file instead of playing",
     )
-    parser.add_argument("--voice", choices=VOICE_NAMES, default="joe", help="default: joe")
-    parser.add_argument("--rate", type=_rate, default=1.0, help="speed, 0.5..2 (default 1)")
+    parser.add_argument(
+        "--profile",
+        default=None,
+        help="a profile (name in trees/profiles/ or path): its voice and speech_rate",
+    )
+    parser.add_argument(
+        "--voice", choices=VOICE_NAMES, default=None, help="default: the profile's, or joe"
+    )
+    parser.add_argument(
+        "--rate", type=_rate, default=None, help="speed, 0.5..2 (default: the profile's, or 1)"
+    )
     parser.add_argument(
         "--device", default=None, help="ALSA playback device (default: the config's)"
     )
@@ -63,6 +76,12 @@ def main(args: argparse.Namespace) -> int:
         raise UsageError("nothing to say: the text has no letters or digits")
     if len(text) > MAX_TEXT_CHARS:
         raise UsageError(f"the text has {len(text)} characters; at most {MAX_TEXT_CHARS}")
+    settings: dict[str, Any] = {}
+    if args.profile is not None:
+        path = resolve_profile(args.profile, [Path("trees")])
+        settings = speech_settings(load_profile(path)) if path is not None else {}
+    args.voice = args.voice or settings.get("voice_name", "joe")
+    args.rate = args.rate or settings.get("speed", 1.0)
     voice = load_voice(args.voice)  # VoiceError (exit 3) when it is not installed
     if args.output is not None:
         audio: Audio | None = None
