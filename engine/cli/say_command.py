@@ -82,6 +82,8 @@ def main(args: argparse.Namespace) -> int:
         settings = speech_settings(load_profile(path)) if path is not None else {}
     args.voice = args.voice or settings.get("voice_name", "joe")
     args.rate = args.rate or settings.get("speed", 1.0)
+    if args.output is not None and args.output.suffix.lower() != ".wav":
+        raise UsageError(f"-o {args.output}: vest writes WAV files; name it .wav")
     voice = load_voice(args.voice)  # VoiceError (exit 3) when it is not installed
     if args.output is not None:
         audio: Audio | None = None
