@@ -1,6 +1,9 @@
-"""The clean-house refactoring changed no behaviour: every example scenario, with every
-profile, gives the timeline and the JSON actions it gave before (tests/golden_timelines/,
-recorded with `vest run --fast` on the commit before the refactoring)."""
+"""Refactoring changes no behaviour: every example scenario, with every profile, gives the
+timeline and the JSON actions recorded in tests/golden_timelines/ with `vest run --fast`.
+
+The demo's questions go through the real speech models, deterministically on the virtual
+clock. The recognizer is prompted with the dialogs' phrases, so what it writes can change
+when dialogs/default.yaml does: re-record the demo's files then, and read the diff."""
 
 from __future__ import annotations
 

@@ -23,13 +23,13 @@ from engine.hardware.chips import ChipRegistry, default_chips
 from engine.hardware.chips.fields import ChipFields, number_text
 from engine.hardware.config import (
     COMMON_FIELDS,
-    AudioConfig,
     BusConfig,
     ChipSpec,
     DeviceConfig,
     RobotConfig,
     hex_address,
 )
+from engine.hardware.config_audio import check_audio
 from engine.hardware.config_buses import check_buses
 from engine.hardware.config_cross_checks import CrossChecks
 from engine.values.params import (
@@ -129,7 +129,7 @@ class ConfigChecker:
             self.unknown_fields(gpio, ("chip",), "gpio")
             if "chip" in gpio:
                 gpio_chip = self.convert(Text(), gpio.entries["chip"], "chip") or gpio_chip
-        audio = self._audio(document, simulated)
+        audio = check_audio(self, document, simulated)
         buses = check_buses(self, document)
         devices = self._devices(document, buses)
         self.problems.raise_if_any()
@@ -143,32 +143,6 @@ class ConfigChecker:
             description=description,
             audio=audio,
         )
-
-    def _audio(self, document: YMap, simulated: bool) -> AudioConfig:
-        """The ALSA devices: ``default`` on a robot; none on the simulated vest (its room
-        carries the sound) unless named."""
-        default = AudioConfig.for_simulation() if simulated else AudioConfig()
-        audio = self.mapping(
-            document.get("audio"), "'audio'", "e.g. audio: {microphone: default, speaker: default}"
-        )
-        if audio is None:
-            return default
-        self.unknown_fields(audio, ("microphone", "speaker"), "audio")
-        found: dict[str, str | None] = {}
-        for field in ("microphone", "speaker"):
-            if field in audio:
-                name = self.convert(Text(), audio.entries[field], field)
-                if name is not None and (not name.strip() or name != name.strip()):
-                    self.problems.add(
-                        audio.entries[field].mark,
-                        f"{field} {name!r} is not an ALSA device name",
-                        "e.g. default, plughw:1,0 or none",
-                    )
-                    name = None
-                found[field] = None if name in (None, "none") else name
-            else:
-                found[field] = getattr(default, field)
-        return AudioConfig(microphone=found["microphone"], speaker=found["speaker"])
 
     def _text(self, document: YMap, key: str, default: str) -> str:
         raw = document.get(key)
