@@ -8,6 +8,7 @@ does not answer and runs on without speech.
 
 from __future__ import annotations
 
+import logging
 import queue
 import shutil
 import subprocess
@@ -18,6 +19,7 @@ from dataclasses import dataclass
 from engine.errors import DeviceError
 from engine.speech.audio import SPEECH_RATE_HZ, Audio
 
+log = logging.getLogger(__name__)
 CAPTURE_CHUNK_S = 0.064
 """The microphone hands over audio in pieces this long (two VAD frames)."""
 
@@ -211,9 +213,10 @@ class AlsaMicrophone:
             if not data:
                 break
             self.on_audio(Audio.from_pcm16(data, SPEECH_RATE_HZ))
-        if process.poll() not in (None, -9):
+        if process.wait() != -9:  # not closed by us: the card went away
             why = process.stderr.read().decode(errors="replace") if process.stderr else ""
             self.error = f"microphone {self.device!r} stopped: {_first_line(why)}"
+            log.warning("%s; the robot no longer hears", self.error)
 
     def close(self) -> None:
         if self._process is not None:

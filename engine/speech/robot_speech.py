@@ -32,7 +32,7 @@ from engine.speech.settling import Settling
 from engine.speech.speaker import Playback, SelfHearing, Speaker, Utterance
 from engine.speech.vad import SileroVad, SpeechDetector
 from engine.speech.voice_models import default_voice
-from engine.speech.voices import EspeakVoice, NeuralVoice, Voice, VoiceError
+from engine.speech.voices import EspeakVoice, NeuralVoice, Voice
 
 log = logging.getLogger(__name__)
 HEARD_KEPT = 100
@@ -233,9 +233,6 @@ def build_speech(
         except AudioDeviceError as error:
             problems["microphone"] = str(error)
     return speech
-
-
-__all__ = ["RobotSpeech", "VoiceError", "build_speech"]
 
 
 def audio_folder(folder: Path) -> Callable[[Utterance], None]:

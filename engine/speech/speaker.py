@@ -242,9 +242,10 @@ class Speaker:
                 ready_s = job.requested_s if self.instant_synthesis else self.clock.now()
                 if not said:
                     started_s = ends_s = max(ready_s, self._free_from_s)
-                    self.self_hearing.speaking(started_s)
                 at_s = max(ends_s, ready_s)
                 self.playback.start(audio, at_s)  # the next is synthesized while it plays
+                if not said:  # only sound that really plays makes the microphone deaf
+                    self.self_hearing.speaking(started_s)
                 said.append(audio)
                 ends_s = at_s + audio.seconds
                 if index == len(parts) - 1:

@@ -97,3 +97,24 @@ def test_the_microphone_is_deaf_while_the_robot_speaks_and_a_tail_after() -> Non
     assert hearing.deaf_at(0.5) and hearing.deaf_at(1.3)
     assert not hearing.deaf_at(1.5)
     speaker.close()
+
+
+class Unplugged:
+    """A speaker whose card is gone."""
+
+    def start(self, audio: Audio, at_s: float) -> None:
+        raise RuntimeError("speaker 'hw:1,0' cannot be opened")
+
+    def stop(self) -> None:
+        """Nothing plays."""
+
+
+def test_an_answer_the_speaker_cannot_play_fails_and_the_robot_still_listens() -> None:
+    clock = VirtualClock()
+    hearing = SelfHearing(tail_s=0.4)
+    speaker = Speaker(WordVoice(), Unplugged(), clock, self_hearing=hearing, instant_synthesis=True)
+    job = speaker.say("hello there")
+    settle(speaker)
+    assert job.done() and "hw:1,0" in str(job.error())
+    assert not hearing.deaf_at(0.0) and not hearing.deaf_at(5.0)
+    speaker.close()
