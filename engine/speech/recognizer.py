@@ -113,11 +113,14 @@ def prompt_for(phrases: Iterable[str]) -> str:
     return prompt
 
 
+def _meaningful(word: Word) -> bool:
+    return any(not is_function_word(w) for w in words_of(word.text))
+
+
 def _unsure(word: Word) -> bool:
     """A meaning word below :data:`UNSURE_BELOW` (function words shape the question but
     no rule hangs on one alone, and a misheard "who" is still better kept)."""
-    said = words_of(word.text)
-    return word.probability < UNSURE_BELOW and any(not is_function_word(w) for w in said)
+    return word.probability < UNSURE_BELOW and _meaningful(word)
 
 
 def _sentences(said: tuple[Word, ...]) -> list[list[Word]]:
@@ -165,6 +168,13 @@ class WhisperRecognizer:
     def transcribe(self, audio: Audio) -> Transcript:
         samples = audio.resampled(SPEECH_RATE_HZ).samples
         heard = self._decode(samples)
+        if not any(_meaningful(w) for w in heard.words):
+            # function words only ("hi, hello?" for an unclear "how are you"): a phrase
+            # of them matches only as a whole, so the whole must be heard twice
+            if all(w.probability >= UNSURE_BELOW for w in heard.words):
+                return heard
+            again = words_of(self._decode(samples, prompted=False).text)
+            return heard if again == words_of(heard.text) else Transcript("", heard.words)
         if not any(_unsure(w) for w in heard.words):
             return heard
         confirmed = set(words_of(self._decode(samples, prompted=False).text))
