@@ -1,7 +1,7 @@
 """Speech: accuracy, latency, real-time factors and idle CPU, on the real models.
 
 Run: ``.venv/bin/python bench/bench_speech.py`` (``--quick`` for a smaller clip set;
-``--help``); about 3 minutes (``--quick`` about 40 s).
+``--help``); about 6 minutes on 2 cores (``--quick`` about a minute).
 
 Clip set (not the tests' clips): every phrase of every rule of dialogs/default.yaml, all
 ``~concept`` expansions, follow-up answers heard in their follow-up, spoken by the joe
