@@ -1,0 +1,226 @@
+"""The command ledger: every command an operator sends, persisted before it is
+acknowledged, delivered at least once under a lease, finished exactly once.
+
+States: QUEUED -> IN_PROGRESS (claimed by the robot, under a lease) -> SUCCEEDED or FAILED
+(the robot's report); CANCELED by the operator before it finished; TIMED_OUT past its
+``timeout_s``. A lease that runs out puts the command back to QUEUED: it is delivered
+again, and the robot, which remembers what it carried out, reports the result it had.
+``version`` grows with every change.
+"""
+
+from __future__ import annotations
+
+import uuid
+from dataclasses import dataclass
+from typing import Any
+
+from sqlalchemy import select
+from sqlalchemy.exc import IntegrityError
+
+from cloud.store.database import Database
+from cloud.store.tables import CommandRow
+from engine.clock import Clock
+from engine.errors import VestError
+
+QUEUED, IN_PROGRESS = "QUEUED", "IN_PROGRESS"
+SUCCEEDED, FAILED, TIMED_OUT, CANCELED = "SUCCEEDED", "FAILED", "TIMED_OUT", "CANCELED"
+FINISHED = frozenset({SUCCEEDED, FAILED, TIMED_OUT, CANCELED})
+REPORTS = (SUCCEEDED, FAILED)
+DEFAULT_LEASE_S = 30.0
+DEFAULT_TIMEOUT_S = 300.0
+
+
+class ConflictError(VestError, ValueError):
+    """A report that contradicts how the command already finished (HTTP 409)."""
+
+
+@dataclass(frozen=True)
+class Command:
+    """One command as the ledger holds it."""
+
+    id: str
+    robot_id: int
+    type: str
+    args: dict[str, Any]
+    state: str
+    version: int
+    result: Any
+    idempotency_key: str | None
+    created_s: float
+    updated_s: float
+    timeout_at_s: float
+    deliveries: int
+
+    @classmethod
+    def of(cls, row: CommandRow) -> Command:
+        return cls(
+            row.id,
+            row.robot_id,
+            row.type,
+            dict(row.args),
+            row.state,
+            row.version,
+            row.result,
+            row.idempotency_key,
+            row.created_s,
+            row.updated_s,
+            row.timeout_at_s,
+            row.deliveries,
+        )
+
+
+class CommandLedger:
+    """Commands in ``db``, on ``clock``; ``lease_s``: how long a claimed command waits for
+    its report before it is delivered again."""
+
+    def __init__(
+        self,
+        db: Database,
+        clock: Clock,
+        *,
+        lease_s: float = DEFAULT_LEASE_S,
+        default_timeout_s: float = DEFAULT_TIMEOUT_S,
+    ) -> None:
+        self.db = db
+        self.clock = clock
+        self.lease_s = lease_s
+        self.default_timeout_s = default_timeout_s
+
+    def submit(
+        self,
+        robot_id: int,
+        type: str,
+        args: dict[str, Any],
+        *,
+        idempotency_key: str | None = None,
+        timeout_s: float | None = None,
+    ) -> tuple[Command, bool]:
+        """The command, QUEUED and committed, and True; or, for an ``idempotency_key``
+        already used for this robot, the command it made, and False."""
+        if idempotency_key is not None:
+            known = self._by_key(robot_id, idempotency_key)
+            if known is not None:
+                return known, False
+        now = self.clock.now()
+        row = CommandRow(
+            id=str(uuid.uuid4()),
+            robot_id=robot_id,
+            type=type,
+            args=args,
+            state=QUEUED,
+            version=1,
+            result=None,
+            idempotency_key=idempotency_key,
+            created_s=now,
+            updated_s=now,
+            timeout_at_s=now + (timeout_s or self.default_timeout_s),
+            lease_until_s=None,
+            deliveries=0,
+        )
+        try:
+            with self.db.transaction() as session:
+                session.add(row)
+        except IntegrityError:  # the same key, sent twice at once: the other one won
+            known = self._by_key(robot_id, idempotency_key or "")
+            if known is None:
+                raise
+            return known, False
+        return Command.of(row), True
+
+    def get(self, robot_id: int, command_id: str) -> Command | None:
+        """The command, only if it is this robot's."""
+        self.expire()
+        with self.db.transaction() as session:
+            row = session.get(CommandRow, command_id)
+            return Command.of(row) if row is not None and row.robot_id == robot_id else None
+
+    def recent(self, robot_id: int, limit: int = 50) -> list[Command]:
+        """This robot's commands, newest first."""
+        self.expire()
+        with self.db.transaction() as session:
+            rows = session.scalars(
+                select(CommandRow)
+                .where(CommandRow.robot_id == robot_id)
+                .order_by(CommandRow.created_s.desc(), CommandRow.id)
+                .limit(limit)
+            )
+            return [Command.of(row) for row in rows]
+
+    def cancel(self, robot_id: int, command_id: str) -> Command | None:
+        """CANCELED if it had not finished (a finished command stays as it is)."""
+        with self.db.transaction() as session:
+            row = session.get(CommandRow, command_id)
+            if row is None or row.robot_id != robot_id:
+                return None
+            if row.state not in FINISHED:
+                self._change(row, CANCELED)
+            return Command.of(row)
+
+    def claim_next(self, robot_id: int) -> Command | None:
+        """The oldest QUEUED command of this robot, now IN_PROGRESS under a lease."""
+        self.expire()
+        with self.db.transaction() as session:
+            row = session.scalar(
+                select(CommandRow)
+                .where(CommandRow.robot_id == robot_id, CommandRow.state == QUEUED)
+                .order_by(CommandRow.created_s, CommandRow.id)
+                .limit(1)
+                .with_for_update(skip_locked=True)
+            )
+            if row is None:
+                return None
+            self._change(row, IN_PROGRESS)
+            row.lease_until_s = self.clock.now() + self.lease_s
+            row.deliveries += 1
+            return Command.of(row)
+
+    def report(self, robot_id: int, command_id: str, status: str, result: Any) -> Command | None:
+        """The robot's report: SUCCEEDED or FAILED with its result. The same report again
+        changes nothing; a different one for a finished command is a ConflictError. None when
+        the command is not this robot's."""
+        if status not in REPORTS:
+            raise ValueError(f"status must be SUCCEEDED or FAILED, got {status!r}")
+        with self.db.transaction() as session:
+            row = session.get(CommandRow, command_id)
+            if row is None or row.robot_id != robot_id:
+                return None
+            if row.state in FINISHED:
+                if row.state == status and row.result == result:
+                    return Command.of(row)
+                raise ConflictError(f"command {command_id} already ended {row.state}")
+            self._change(row, status)
+            row.result = result
+            row.lease_until_s = None
+            return Command.of(row)
+
+    def expire(self) -> None:
+        """Leases that ran out go back to QUEUED; commands past their timeout, TIMED_OUT."""
+        now = self.clock.now()
+        with self.db.transaction() as session:
+            late = session.scalars(
+                select(CommandRow).where(
+                    CommandRow.state.in_((QUEUED, IN_PROGRESS)),
+                    (CommandRow.timeout_at_s <= now)
+                    | ((CommandRow.state == IN_PROGRESS) & (CommandRow.lease_until_s <= now)),
+                )
+            )
+            for row in late:
+                if row.timeout_at_s <= now:
+                    self._change(row, TIMED_OUT)
+                else:
+                    self._change(row, QUEUED)
+                row.lease_until_s = None
+
+    def _by_key(self, robot_id: int, key: str) -> Command | None:
+        with self.db.transaction() as session:
+            row = session.scalar(
+                select(CommandRow).where(
+                    CommandRow.robot_id == robot_id, CommandRow.idempotency_key == key
+                )
+            )
+            return Command.of(row) if row is not None else None
+
+    def _change(self, row: CommandRow, state: str) -> None:
+        row.state = state
+        row.version += 1
+        row.updated_s = self.clock.now()

@@ -1,0 +1,71 @@
+"""The database tables. Times are clock seconds (floats); JSON columns hold command
+arguments, results and telemetry values."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from sqlalchemy import JSON, Float, ForeignKey, Integer, String, UniqueConstraint
+from sqlalchemy.orm import DeclarativeBase, Mapped, mapped_column
+
+
+class Table(DeclarativeBase):
+    pass
+
+
+class OperatorRow(Table):
+    __tablename__ = "operators"
+
+    id: Mapped[int] = mapped_column(Integer, primary_key=True)
+    name: Mapped[str] = mapped_column(String(64), unique=True)
+    token_digest: Mapped[str] = mapped_column(String(64), unique=True)
+    revoked: Mapped[bool] = mapped_column(default=False)
+
+
+class RobotRow(Table):
+    __tablename__ = "robots"
+
+    id: Mapped[int] = mapped_column(Integer, primary_key=True)
+    name: Mapped[str] = mapped_column(String(64), unique=True)
+    token_digest: Mapped[str] = mapped_column(String(64), unique=True)
+    revoked: Mapped[bool] = mapped_column(default=False)
+    last_seen_s: Mapped[float | None] = mapped_column(Float, default=None)
+
+
+class GrantRow(Table):
+    """Operator ``operator_id`` may see and command robot ``robot_id``."""
+
+    __tablename__ = "grants"
+
+    operator_id: Mapped[int] = mapped_column(ForeignKey("operators.id"), primary_key=True)
+    robot_id: Mapped[int] = mapped_column(ForeignKey("robots.id"), primary_key=True)
+
+
+class CommandRow(Table):
+    __tablename__ = "commands"
+    __table_args__ = (UniqueConstraint("robot_id", "idempotency_key"),)
+
+    id: Mapped[str] = mapped_column(String(36), primary_key=True)
+    robot_id: Mapped[int] = mapped_column(ForeignKey("robots.id"), index=True)
+    type: Mapped[str] = mapped_column(String(64))
+    args: Mapped[dict[str, Any]] = mapped_column(JSON)
+    state: Mapped[str] = mapped_column(String(16), index=True)
+    version: Mapped[int] = mapped_column(Integer, default=1)
+    result: Mapped[Any] = mapped_column(JSON, default=None)
+    idempotency_key: Mapped[str | None] = mapped_column(String(128), default=None)
+    created_s: Mapped[float] = mapped_column(Float)
+    updated_s: Mapped[float] = mapped_column(Float)
+    timeout_at_s: Mapped[float] = mapped_column(Float)
+    lease_until_s: Mapped[float | None] = mapped_column(Float, default=None)
+    deliveries: Mapped[int] = mapped_column(Integer, default=0)
+
+
+class TelemetryRow(Table):
+    """The latest value of one key of one robot, and when it was sent."""
+
+    __tablename__ = "telemetry"
+
+    robot_id: Mapped[int] = mapped_column(ForeignKey("robots.id"), primary_key=True)
+    key: Mapped[str] = mapped_column(String(200), primary_key=True)
+    value: Mapped[Any] = mapped_column(JSON)
+    at_s: Mapped[float] = mapped_column(Float)

@@ -1,0 +1,62 @@
+"""Operators and robots get a token once; only its digest is kept; grants say who sees what."""
+
+from __future__ import annotations
+
+import pytest
+from sqlalchemy import select
+
+from cloud.store.database import Database
+from cloud.store.directory import Directory
+from cloud.store.tables import OperatorRow, RobotRow
+from engine.errors import ConfigError
+
+
+def test_a_token_is_shown_once_and_only_its_digest_is_kept(
+    directory: Directory, db: Database
+) -> None:
+    token = directory.add_operator("ana")
+    with db.transaction() as session:
+        stored = session.scalars(select(OperatorRow)).one()
+    assert token not in stored.token_digest and len(stored.token_digest) == 64
+    assert directory.authenticate(token).name == "ana"  # type: ignore[union-attr]
+
+
+def test_a_robot_is_granted_to_its_operator_and_others_do_not_see_it(directory: Directory) -> None:
+    directory.add_operator("ana")
+    directory.add_operator("ben")
+    robot_token = directory.add_robot("hbs2", operator="ana")
+    ana = directory.authenticate(directory.add_operator("cara"))
+    assert ana is not None
+    principal = directory.authenticate(robot_token)
+    assert principal is not None and (principal.kind, principal.name) == ("robot", "hbs2")
+    with directory.db.transaction() as session:
+        ids = {row.name: row.id for row in session.scalars(select(OperatorRow))}
+    assert [r.name for r in directory.robots_of(ids["ana"])] == ["hbs2"]
+    assert directory.robots_of(ids["ben"]) == []
+    directory.grant("ben", "hbs2")
+    directory.grant("ben", "hbs2")  # again: nothing changes
+    assert [r.name for r in directory.robots_of(ids["ben"])] == ["hbs2"]
+
+
+def test_a_revoked_or_unknown_token_is_nobody(directory: Directory) -> None:
+    directory.add_operator("ana")
+    token = directory.add_robot("hbs2", operator="ana")
+    directory.revoke("robot", "hbs2")
+    assert directory.authenticate(token) is None
+    assert directory.authenticate("not a token") is None
+
+
+@pytest.mark.parametrize("name", ["", "a b", "x" * 65, "ünïcode", "../etc"])
+def test_names_that_would_not_sit_in_a_url_are_refused(directory: Directory, name: str) -> None:
+    with pytest.raises(ConfigError, match="use 1 to 64 letters"):
+        directory.add_operator(name)
+
+
+def test_two_of_one_name_or_an_unknown_operator_are_refused_by_name(directory: Directory) -> None:
+    directory.add_operator("ana")
+    with pytest.raises(ConfigError, match="already an operator 'ana'"):
+        directory.add_operator("ana")
+    with pytest.raises(ConfigError, match="no operator 'bob'"):
+        directory.add_robot("hbs2", operator="bob")
+    with directory.db.transaction() as session:
+        assert session.scalars(select(RobotRow)).all() == []
