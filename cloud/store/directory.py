@@ -102,6 +102,16 @@ class Directory:
             )
             return list(session.scalars(query))
 
+    def granted_robot(self, operator_id: int, name: str) -> RobotRow | None:
+        """The robot called ``name`` if it is granted to the operator, else None (the
+        caller cannot tell a robot it may not see from one that does not exist)."""
+        with self.db.transaction() as session:
+            return session.scalar(
+                select(RobotRow)
+                .join(GrantRow, GrantRow.robot_id == RobotRow.id)
+                .where(GrantRow.operator_id == operator_id, RobotRow.name == name)
+            )
+
     @staticmethod
     def _operator(session: Session, name: str) -> OperatorRow:
         row = session.scalar(select(OperatorRow).where(OperatorRow.name == name))

@@ -1,0 +1,57 @@
+"""Operators: send commands to a robot, follow them, cancel them."""
+
+from __future__ import annotations
+
+from fastapi import APIRouter, HTTPException, Response, status
+
+from cloud.api.deps import CurrentOperator, StoreDep
+from cloud.api.robots import granted
+from cloud.api.schemas import CommandCreate, CommandPublic
+
+router = APIRouter(prefix="/robots/{robot}/commands", tags=["operator"])
+
+
+@router.post("", status_code=status.HTTP_201_CREATED)
+def send_command(
+    robot: str, body: CommandCreate, store: StoreDep, operator: CurrentOperator, response: Response
+) -> CommandPublic:
+    """QUEUED and committed before the 201; the same idempotency_key again: 200, the same
+    command."""
+    row = granted(store, operator, robot)
+    command, created = store.ledger.submit(
+        row.id, body.type, body.args, idempotency_key=body.idempotency_key, timeout_s=body.timeout_s
+    )
+    if created:
+        store.doorbell.ring(row.id)
+    else:
+        response.status_code = status.HTTP_200_OK
+    return CommandPublic.of(command, row.name)
+
+
+@router.get("")
+def list_commands(robot: str, store: StoreDep, operator: CurrentOperator) -> list[CommandPublic]:
+    """Newest first (the last 50)."""
+    row = granted(store, operator, robot)
+    return [CommandPublic.of(c, row.name) for c in store.ledger.recent(row.id)]
+
+
+@router.get("/{command_id}")
+def get_command(
+    robot: str, command_id: str, store: StoreDep, operator: CurrentOperator
+) -> CommandPublic:
+    row = granted(store, operator, robot)
+    command = store.ledger.get(row.id, command_id)
+    if command is None:
+        raise HTTPException(status.HTTP_404_NOT_FOUND, f"no command {command_id!r}")
+    return CommandPublic.of(command, row.name)
+
+
+@router.post("/{command_id}/cancel")
+def cancel_command(
+    robot: str, command_id: str, store: StoreDep, operator: CurrentOperator
+) -> CommandPublic:
+    row = granted(store, operator, robot)
+    command = store.ledger.cancel(row.id, command_id)
+    if command is None:
+        raise HTTPException(status.HTTP_404_NOT_FOUND, f"no command {command_id!r}")
+    return CommandPublic.of(command, row.name)

@@ -1,0 +1,53 @@
+"""Robots: claim their next command (long-poll), report results, push telemetry."""
+
+from __future__ import annotations
+
+from typing import Annotated
+
+from fastapi import APIRouter, HTTPException, Query, Response, status
+
+from cloud.api.deps import CurrentRobot, StoreDep
+from cloud.api.schemas import CommandPublic, ResultReport, TelemetryReport
+from cloud.store.ledger import ConflictError
+
+router = APIRouter(prefix="/robot", tags=["robot"])
+
+
+@router.get("/commands/next", response_model=None)
+def next_command(
+    store: StoreDep,
+    robot: CurrentRobot,
+    wait_s: Annotated[float, Query(ge=0, le=60)] = 0.0,
+) -> CommandPublic | Response:
+    """The next command, now IN_PROGRESS under a lease; 204 when none came within
+    ``wait_s`` (at most the service's max_wait_s)."""
+    store.telemetry.seen(robot.id)
+    deadline_s = store.clock.now() + min(wait_s, store.settings.max_wait_s)
+    while True:
+        command = store.ledger.claim_next(robot.id)
+        if command is not None:
+            return CommandPublic.of(command, robot.name)
+        left_s = deadline_s - store.clock.now()
+        if left_s <= 0:
+            return Response(status_code=status.HTTP_204_NO_CONTENT)
+        store.doorbell.wait(robot.id, min(left_s, store.settings.recheck_s))
+
+
+@router.post("/commands/{command_id}/result")
+def report_result(
+    command_id: str, body: ResultReport, store: StoreDep, robot: CurrentRobot
+) -> CommandPublic:
+    """200 (also for the same report again); 409 for a different report of a finished
+    command; 404 for a command that is not this robot's."""
+    try:
+        command = store.ledger.report(robot.id, command_id, body.status, body.result)
+    except ConflictError as error:
+        raise HTTPException(status.HTTP_409_CONFLICT, str(error)) from None
+    if command is None:
+        raise HTTPException(status.HTTP_404_NOT_FOUND, f"no command {command_id!r}")
+    return CommandPublic.of(command, robot.name)
+
+
+@router.post("/telemetry", status_code=status.HTTP_204_NO_CONTENT)
+def push_telemetry(body: TelemetryReport, store: StoreDep, robot: CurrentRobot) -> None:
+    store.telemetry.put(robot.id, body.values)

@@ -1,0 +1,52 @@
+"""The service: ``create_app(settings)`` builds it, with its store, on a clock."""
+
+from __future__ import annotations
+
+from collections.abc import Awaitable, Callable
+
+from fastapi import FastAPI, Request, Response, status
+from fastapi.exceptions import RequestValidationError
+from fastapi.responses import JSONResponse
+
+from cloud.api import commands, robot_side, robots
+from cloud.services import CloudStore
+from cloud.settings import Settings
+from engine.clock import Clock, RealClock
+
+API = "/api/v1"
+
+
+def create_app(
+    settings: Settings, *, clock: Clock | None = None, store: CloudStore | None = None
+) -> FastAPI:
+    """The FastAPI app; ``store`` is opened from ``settings`` unless given."""
+    store = store or CloudStore.open(settings, clock or RealClock())
+    app = FastAPI(title="vest cloud", version="1")
+    app.state.store = store
+    for router in (robots.router, commands.router, robot_side.router):
+        app.include_router(router, prefix=API)
+
+    @app.middleware("http")
+    async def limit_body(
+        request: Request, call_next: Callable[[Request], Awaitable[Response]]
+    ) -> Response:
+        length = request.headers.get("content-length")
+        if length is not None and (not length.isdigit() or int(length) > settings.max_body_bytes):
+            return JSONResponse(
+                {"detail": f"the body is over {settings.max_body_bytes} bytes"},
+                status_code=status.HTTP_413_CONTENT_TOO_LARGE,
+            )
+        return await call_next(request)
+
+    @app.exception_handler(RequestValidationError)
+    async def bad_body(request: Request, error: RequestValidationError) -> JSONResponse:
+        problems = [
+            {
+                "field": ".".join(str(part) for part in item["loc"][1:]) or "body",
+                "message": item["msg"],
+            }
+            for item in error.errors()
+        ]
+        return JSONResponse({"detail": problems}, status_code=422)
+
+    return app

@@ -1,0 +1,33 @@
+"""The service's settings, checked when it starts."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from engine.errors import ConfigError
+
+DEFAULT_DB = "sqlite:///vest-cloud.db"
+
+
+@dataclass(frozen=True)
+class Settings:
+    """``db_url``: SQLite file or PostgreSQL URL; ``lease_s``: how long a robot has to
+    report a claimed command; ``max_wait_s``: the longest long-poll; ``recheck_s``: how
+    often a long-poll looks at the ledger again; ``max_body_bytes``: larger bodies get 413."""
+
+    db_url: str = DEFAULT_DB
+    lease_s: float = 30.0
+    default_timeout_s: float = 300.0
+    max_wait_s: float = 30.0
+    recheck_s: float = 1.0
+    max_body_bytes: int = 64 * 1024
+
+    def __post_init__(self) -> None:
+        for name in ("lease_s", "default_timeout_s", "max_wait_s", "recheck_s"):
+            value = getattr(self, name)
+            if not 0 < value <= 86400:
+                raise ConfigError(f"setting {name} must be above 0 and at most a day, got {value}")
+        if not 1024 <= self.max_body_bytes <= 16 * 1024 * 1024:
+            raise ConfigError(
+                f"setting max_body_bytes must be 1 KiB..16 MiB, got {self.max_body_bytes}"
+            )
