@@ -8,7 +8,7 @@ from contextlib import contextmanager
 from typing import Any
 
 from sqlalchemy import Engine, create_engine, event
-from sqlalchemy.exc import ArgumentError
+from sqlalchemy.exc import ArgumentError, DBAPIError
 from sqlalchemy.orm import Session, sessionmaker
 
 from cloud.store.tables import Table
@@ -25,7 +25,11 @@ class Database:
             raise ConfigError(f"--db {url}: not a database URL we can open ({error})") from None
         if self.engine.dialect.name == "sqlite":
             event.listen(self.engine, "connect", _sqlite_pragmas)
-        Table.metadata.create_all(self.engine)
+        try:
+            Table.metadata.create_all(self.engine)
+        except DBAPIError as error:
+            self.engine.dispose()
+            raise ConfigError(f"--db {url}: cannot open it ({error.orig})") from None
         self._sessions = sessionmaker(self.engine, expire_on_commit=False)
 
     @contextmanager

@@ -34,6 +34,7 @@ machine"""
 
 def build_parser() -> argparse.ArgumentParser:
     from engine.cli import (
+        cloud_command,
         devices_command,
         dialogs_command,
         hear_command,
@@ -64,6 +65,7 @@ def build_parser() -> argparse.ArgumentParser:
         hear_command,
         say_command,
         dialogs_command,
+        cloud_command,
     ):
         sub = commands.add_parser(
             module.NAME,

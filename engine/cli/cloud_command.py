@@ -1,0 +1,80 @@
+"""Run the cloud service and manage who may use it.
+
+  vest cloud serve [--db URL] [--host H] [--port P]
+  vest cloud add-operator NAME          prints the operator's token alone (shown once)
+  vest cloud add-robot NAME --operator NAME   prints the robot's token alone (shown once)
+  vest cloud grant OPERATOR ROBOT
+  vest cloud revoke operator|robot NAME
+Every one takes --db URL: a SQLite file (default sqlite:///vest-cloud.db) or postgresql://...
+"""
+
+from __future__ import annotations
+
+import argparse
+
+from engine.clock import RealClock
+
+NAME = "cloud"
+HELP = "run the cloud service; add operators and robots, grant, revoke"
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    from cloud.settings import DEFAULT_DB
+
+    actions = parser.add_subparsers(dest="action", metavar="ACTION", required=True)
+
+    def action(name: str, help: str) -> argparse.ArgumentParser:
+        sub = actions.add_parser(name, help=help, description=help)
+        sub.add_argument("--db", default=DEFAULT_DB, metavar="URL", help=f"default {DEFAULT_DB}")
+        return sub
+
+    serve = action("serve", "run the service (HTTP, /api/v1)")
+    serve.add_argument("--host", default="127.0.0.1", help="default 127.0.0.1")
+    serve.add_argument("--port", type=int, default=8080, help="default 8080")
+    action("add-operator", "add an operator; prints its token").add_argument("name")
+    robot = action("add-robot", "add a robot, granted to an operator; prints its token")
+    robot.add_argument("name")
+    robot.add_argument("--operator", required=True, help="the operator who commands it")
+    grant = action("grant", "let an operator see and command a robot")
+    grant.add_argument("operator")
+    grant.add_argument("robot")
+    revoke = action("revoke", "make an operator's or robot's token stop working")
+    revoke.add_argument("kind", choices=("operator", "robot"))
+    revoke.add_argument("name")
+
+
+def main(args: argparse.Namespace) -> int:
+    from cloud.services import CloudStore
+    from cloud.settings import Settings
+
+    settings = Settings(db_url=args.db)
+    if args.action == "serve":
+        return _serve(settings, args.host, args.port)
+    store = CloudStore.open(settings, RealClock())
+    try:
+        if args.action == "add-operator":
+            print(store.directory.add_operator(args.name))
+        elif args.action == "add-robot":
+            print(store.directory.add_robot(args.name, operator=args.operator))
+        elif args.action == "grant":
+            store.directory.grant(args.operator, args.robot)
+        elif args.action == "revoke":
+            store.directory.revoke(args.kind, args.name)
+    finally:
+        store.close()
+    return 0
+
+
+def _serve(settings: object, host: str, port: int) -> int:
+    import uvicorn
+
+    from cloud.app import create_app
+    from cloud.settings import Settings
+
+    assert isinstance(settings, Settings)
+    if not 1 <= port <= 65535:
+        from engine.errors import UsageError
+
+        raise UsageError(f"--port {port}: use 1..65535")
+    uvicorn.run(create_app(settings), host=host, port=port, log_level="info")
+    return 0

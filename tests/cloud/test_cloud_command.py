@@ -1,0 +1,57 @@
+"""An admin adds operators and robots from the command line; tokens come alone on stdout."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from cloud.services import CloudStore
+from cloud.settings import Settings
+from engine.cli import main
+from engine.clock import RealClock
+
+
+def test_an_admin_adds_an_operator_and_a_robot_and_scripts_capture_the_tokens(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    db = f"sqlite:///{tmp_path / 'c.db'}"
+    assert main(["cloud", "add-operator", "ana", "--db", db]) == 0
+    operator_token = capsys.readouterr().out.strip()
+    assert main(["cloud", "add-robot", "hbs2", "--operator", "ana", "--db", db]) == 0
+    robot_token = capsys.readouterr().out.strip()
+    store = CloudStore.open(Settings(db_url=db), RealClock())
+    try:
+        assert store.directory.authenticate(operator_token).name == "ana"  # type: ignore[union-attr]
+        assert store.directory.authenticate(robot_token).name == "hbs2"  # type: ignore[union-attr]
+    finally:
+        store.close()
+    assert main(["cloud", "revoke", "robot", "hbs2", "--db", db]) == 0
+    store = CloudStore.open(Settings(db_url=db), RealClock())
+    try:
+        assert store.directory.authenticate(robot_token) is None
+    finally:
+        store.close()
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["add-robot", "r", "--operator", "bob"], "no operator 'bob'"),
+        (["add-operator", "a b"], "use 1 to 64 letters"),
+        (["grant", "ana", "nosuch"], "no robot 'nosuch'"),
+    ],
+)
+def test_a_mistake_is_named_and_exits_1(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], args: list[str], message: str
+) -> None:
+    db = f"sqlite:///{tmp_path / 'c.db'}"
+    main(["cloud", "add-operator", "ana", "--db", db])
+    capsys.readouterr()
+    assert main(["cloud", *args, "--db", db]) == 1
+    assert message in capsys.readouterr().err
+
+
+def test_a_database_that_cannot_be_opened_is_named(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["cloud", "add-operator", "ana", "--db", "sqlite:////no/such/dir/c.db"]) == 1
+    assert "cannot open it" in capsys.readouterr().err
