@@ -32,6 +32,7 @@ TEMPERATURE_C = "/sensors/temperature/c"
 TEMPERATURE_F = "/sensors/temperature/f"
 ULTRASOUND_CM = "/sensors/ultrasound/cm"
 SPEECH_HEARD = "/speech/heard"
+IOT_INBOX = "/iot/inbox"
 
 
 def force_key(pad: str) -> str:
@@ -237,7 +238,7 @@ def default_catalogue() -> KeyCatalogue:
                 kind="event",
             ),
             KeySpec(
-                "/iot/inbox",
+                IOT_INBOX,
                 dict,
                 "",
                 "IoT client",

@@ -26,10 +26,13 @@ from engine.cli.output import shown, tell
 from engine.cli.run_inputs import DEFAULT_HARDWARE, load_run_inputs
 from engine.cli.timeline import Timeline
 from engine.clock import Clock, RealClock, VirtualClock
-from engine.errors import ConfigError
+from engine.errors import ConfigError, UsageError
+from engine.files.problems import LoadError
+from engine.files.yaml_source import read_text
 from engine.runtime.reload import TreeReloader
 from engine.runtime.robot_factory import build_robot
 from engine.scenario.player import ScenarioPlayer
+from engine.services.cloud_link import CloudLink
 from engine.services.interfaces import Speech
 from engine.services.simulated import simulated_services
 from engine.speech.robot_speech import RobotSpeech, audio_folder, build_speech, speech_settings
@@ -88,6 +91,16 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="write what the robot says as a WAV file per utterance into DIR",
     )
     parser.add_argument(
+        "--cloud", default=None, metavar="URL", help="take commands from the cloud service at URL"
+    )
+    parser.add_argument(
+        "--token-file",
+        type=Path,
+        default=None,
+        metavar="FILE",
+        help="the robot's token for --cloud (finished commands are kept in FILE.done.json)",
+    )
+    parser.add_argument(
         "--hardware",
         type=Path,
         default=DEFAULT_HARDWARE,
@@ -106,6 +119,27 @@ def _positive_seconds(text: str) -> float:
     return value
 
 
+def _cloud_link(args: argparse.Namespace) -> CloudLink | None:
+    """The link to the cloud for --cloud URL --token-file FILE; ConfigError or UsageError
+    for what is wrong with them."""
+    if args.cloud is None and args.token_file is None:
+        return None
+    if args.cloud is None or args.token_file is None:
+        raise UsageError("--cloud URL and --token-file FILE go together")
+    if not args.cloud.startswith(("http://", "https://")):
+        raise UsageError(f"--cloud {args.cloud}: give an http:// or https:// URL")
+    if args.fast:
+        raise UsageError("--cloud runs in real time: leave out --fast")
+    try:
+        token = read_text(args.token_file, max_bytes=4096).strip()
+    except LoadError as error:
+        raise ConfigError(f"--token-file {error.problems[0]}") from None
+    if not token or any(c.isspace() for c in token):
+        raise ConfigError(f"--token-file {args.token_file}: holds no token (one line, no spaces)")
+    done_file = args.token_file.with_name(args.token_file.name + ".done.json")
+    return CloudLink(args.cloud, token, RealClock(), done_file=done_file)
+
+
 def main(args: argparse.Namespace) -> int:
     # the same checks as `vest validate`: every problem of every file, before anything starts
     inputs = load_run_inputs(
@@ -118,7 +152,10 @@ def main(args: argparse.Namespace) -> int:
     behaviors, config, scenario = inputs.behaviors, inputs.config, inputs.scenario
     if args.fast and not config.simulated:
         raise ConfigError(f"{args.hardware}: --fast needs a simulated vest (simulated: true)")
+    link = _cloud_link(args)
     clock: Clock = VirtualClock() if args.fast else RealClock()
+    if link is not None:
+        link.clock = clock
     simulated = simulated_services(clock, realistic=True)
     speech: Speech | RobotSpeech = simulated.speech
     if args.speech == "models":
@@ -139,7 +176,7 @@ def main(args: argparse.Namespace) -> int:
         config,
         clock=clock,
         speech=speech,
-        iot=simulated.iot,
+        iot=link if link is not None else simulated.iot,
         fallback=simulated,
     )
     robot, blackboard = assembled.robot, assembled.blackboard
@@ -172,9 +209,14 @@ def main(args: argparse.Namespace) -> int:
         timeline.start()
         first_tick_s = clock.now()
         assembled.start(origin_s=first_tick_s)  # readings staged just before each tick
+        if link is not None:
+            link.bind(blackboard)
+            link.start()
         robot.scheduler.run(until_s=start_s + duration, start_s=first_tick_s)
         timeline.summary(robot.trees)
     finally:
+        if link is not None:
+            link.stop()
         if reloader is not None:
             reloader.stop()
         assembled.close()

@@ -1,0 +1,99 @@
+"""A robot on the simulated vest takes a command from the cloud, carries it out once, and
+reports it; it keeps behaving while the service is away."""
+
+from __future__ import annotations
+
+import socket
+import threading
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+import uvicorn
+
+from cloud.app import create_app
+from cloud.services import CloudStore
+from cloud.settings import Settings
+from cloud.store.ledger import SUCCEEDED
+from engine.cli import main
+from engine.clock import RealClock
+from engine.services.cloud_link import DoneCommands
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+@pytest.fixture
+def cloud(tmp_path: Path) -> Iterator[tuple[str, CloudStore]]:
+    settings = Settings(db_url=f"sqlite:///{tmp_path / 'c.db'}", max_wait_s=1.0, recheck_s=0.2)
+    store = CloudStore.open(settings, RealClock())
+    sock = socket.socket()
+    sock.bind(("127.0.0.1", 0))
+    sock.listen(64)
+    server = uvicorn.Server(uvicorn.Config(create_app(settings, store=store), log_level="warning"))
+    thread = threading.Thread(target=server.run, kwargs={"sockets": [sock]}, daemon=True)
+    thread.start()
+    yield f"http://127.0.0.1:{sock.getsockname()[1]}", store
+    server.should_exit = True
+    thread.join(timeout=10)
+    sock.close()
+    store.close()
+
+
+def test_vest_run_carries_out_a_say_from_the_cloud_and_reports_it(
+    cloud: tuple[str, CloudStore], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    url, store = cloud
+    store.directory.add_operator("ana")
+    token_file = tmp_path / "robot.token"
+    token_file.write_text(store.directory.add_robot("hbs2", operator="ana") + "\n")
+    robot_id = store.directory.authenticate(token_file.read_text().strip()).id  # type: ignore[union-attr]
+    command, _ = store.ledger.submit(robot_id, "say", {"text": "hello from the page"})
+    (tmp_path / "quiet.yaml").write_text("duration_s: 3\nevents: []\n")
+    monkeypatch.chdir(ROOT)
+    code = main(
+        [
+            "run",
+            "--trees",
+            "trees/iot_command.yaml",
+            "--scenario",
+            str(tmp_path / "quiet.yaml"),
+            "--speech",
+            "text",
+            "--cloud",
+            url,
+            "--token-file",
+            str(token_file),
+            "--json",
+        ]
+    )
+    assert code == 0
+    finished = store.ledger.get(robot_id, command.id)
+    assert finished is not None and finished.state == SUCCEEDED
+    assert DoneCommands(tmp_path / "robot.token.done.json").get(command.id) is not None
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["--cloud", "http://x"], "go together"),
+        (["--cloud", "ftp://x", "--token-file", "t"], "http:// or https://"),
+        (["--cloud", "http://x", "--token-file", "/no/such/token"], "file not found"),
+    ],
+)
+def test_wrong_cloud_options_are_named(
+    args: list[str],
+    message: str,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    monkeypatch.chdir(ROOT)
+    assert main(["run", "--speech", "text", *args]) in (1, 2)
+    assert message in capsys.readouterr().err
+
+
+def test_finished_commands_are_remembered_across_a_restart(tmp_path: Path) -> None:
+    done = DoneCommands(tmp_path / "done.json")
+    done.add("c-1", {"status": "SUCCEEDED", "result": {"said": "hi"}})
+    again = DoneCommands(tmp_path / "done.json")  # the robot restarted
+    assert again.get("c-1") == {"status": "SUCCEEDED", "result": {"said": "hi"}}
+    assert again.get("c-2") is None
