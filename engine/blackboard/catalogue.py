@@ -17,6 +17,8 @@ from typing import Any, Literal
 Kind = Literal["state", "event"]
 
 VARIABLES_PREFIX = "/vars/"
+SENSORS_PREFIX = "/sensors/"
+DEVICES_PREFIX = "/devices/"
 
 
 # -- every sensor key's name, defined once (the catalogue below describes each) ----------------

@@ -26,14 +26,14 @@ from typing import Any
 import requests
 
 from engine.blackboard.board import Blackboard
-from engine.blackboard.catalogue import IOT_INBOX
+from engine.blackboard.catalogue import DEVICES_PREFIX, IOT_INBOX, SENSORS_PREFIX
 from engine.clock import Clock
 from engine.services.jobs import ImmediateJob, Job
 
 log = logging.getLogger(__name__)
 FIRST_BACKOFF_S, MAX_BACKOFF_S = 0.5, 30.0
 TELEMETRY_EVERY_S = 1.0
-TELEMETRY_PREFIXES = ("/sensors/", "/devices/")
+TELEMETRY_PREFIXES = (SENSORS_PREFIX, DEVICES_PREFIX)
 DONE_KEPT = 1000
 
 
