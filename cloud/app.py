@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
-from collections.abc import Awaitable, Callable
+from collections.abc import AsyncIterator, Awaitable, Callable
+from contextlib import asynccontextmanager
 
+import anyio.to_thread
 from fastapi import FastAPI, Request, Response, status
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse
@@ -11,7 +13,8 @@ from fastapi.responses import JSONResponse
 from cloud.api import commands, robot_side, robots
 from cloud.services import CloudStore
 from cloud.settings import Settings
-from engine.clock import Clock, RealClock
+from cloud.store.writer import TelemetryWriter
+from engine.clock import Clock, EpochClock
 
 API = "/api/v1"
 
@@ -19,9 +22,24 @@ API = "/api/v1"
 def create_app(
     settings: Settings, *, clock: Clock | None = None, store: CloudStore | None = None
 ) -> FastAPI:
-    """The FastAPI app; ``store`` is opened from ``settings`` unless given."""
-    store = store or CloudStore.open(settings, clock or RealClock())
-    app = FastAPI(title="vest cloud", version="1")
+    """The FastAPI app; ``store`` is opened from ``settings`` unless given (and then closed
+    with the app). While the app runs, telemetry is written every ``settings.flush_s``."""
+    owned = store is None
+    store = store or CloudStore.open(settings, clock or EpochClock())
+
+    @asynccontextmanager
+    async def lifespan(app: FastAPI) -> AsyncIterator[None]:
+        # endpoints run in threads; a long-poll holds one while it waits
+        anyio.to_thread.current_default_thread_limiter().total_tokens = settings.threads
+        writer = TelemetryWriter(store.telemetry, store.clock, settings.flush_s)
+        try:
+            yield
+        finally:
+            writer.close()
+            if owned:
+                store.close()
+
+    app = FastAPI(title="vest cloud", version="1", lifespan=lifespan)
     app.state.store = store
     for router in (robots.router, commands.router, robot_side.router):
         app.include_router(router, prefix=API)

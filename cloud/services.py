@@ -9,6 +9,7 @@ from cloud.store.database import Database
 from cloud.store.directory import Directory
 from cloud.store.doorbell import Doorbell
 from cloud.store.ledger import CommandLedger
+from cloud.store.notifications import PostgresNotifications
 from cloud.store.telemetry import Telemetry
 from engine.clock import Clock
 
@@ -22,10 +23,15 @@ class CloudStore:
     ledger: CommandLedger
     telemetry: Telemetry
     doorbell: Doorbell
+    notifications: PostgresNotifications | None = None
 
     @classmethod
     def open(cls, settings: Settings, clock: Clock) -> CloudStore:
         db = Database(settings.db_url)
+        doorbell = Doorbell(clock)
+        notifications = (
+            PostgresNotifications(db.engine, doorbell, clock) if db.is_postgresql else None
+        )
         return cls(
             settings,
             clock,
@@ -35,8 +41,18 @@ class CloudStore:
                 db, clock, lease_s=settings.lease_s, default_timeout_s=settings.default_timeout_s
             ),
             Telemetry(db, clock),
-            Doorbell(clock),
+            doorbell,
+            notifications,
         )
 
+    def announce(self, robot_id: int) -> None:
+        """Something changed in the robot's commands: wake its long-poll and live pages,
+        in every worker when several share a PostgreSQL database."""
+        self.doorbell.ring(robot_id)
+        if self.notifications is not None:
+            self.notifications.announce(robot_id)
+
     def close(self) -> None:
+        if self.notifications is not None:
+            self.notifications.close()
         self.db.close()

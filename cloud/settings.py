@@ -13,7 +13,9 @@ DEFAULT_DB = "sqlite:///vest-cloud.db"
 class Settings:
     """``db_url``: SQLite file or PostgreSQL URL; ``lease_s``: how long a robot has to
     report a claimed command; ``max_wait_s``: the longest long-poll; ``recheck_s``: how
-    often a long-poll looks at the ledger again; ``max_body_bytes``: larger bodies get 413."""
+    often a long-poll looks at the ledger again; ``max_body_bytes``: larger bodies get 413;
+    ``flush_s``: how often telemetry held in memory is written; ``threads``: requests
+    worked on at once (each waiting long-poll holds one). Times in seconds."""
 
     db_url: str = DEFAULT_DB
     lease_s: float = 30.0
@@ -21,9 +23,11 @@ class Settings:
     max_wait_s: float = 30.0
     recheck_s: float = 1.0
     max_body_bytes: int = 64 * 1024
+    flush_s: float = 1.0
+    threads: int = 1000
 
     def __post_init__(self) -> None:
-        for name in ("lease_s", "default_timeout_s", "max_wait_s", "recheck_s"):
+        for name in ("lease_s", "default_timeout_s", "max_wait_s", "recheck_s", "flush_s"):
             value = getattr(self, name)
             if not 0 < value <= 86400:
                 raise ConfigError(f"setting {name} must be above 0 and at most a day, got {value}")
@@ -31,3 +35,5 @@ class Settings:
             raise ConfigError(
                 f"setting max_body_bytes must be 1 KiB..16 MiB, got {self.max_body_bytes}"
             )
+        if not 4 <= self.threads <= 10000:
+            raise ConfigError(f"setting threads must be 4..10000, got {self.threads}")

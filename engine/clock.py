@@ -95,6 +95,18 @@ class RealClock:
         return True
 
 
+class EpochClock(RealClock):
+    """Seconds since the Unix epoch (UTC): for times that are stored and shown as dates
+    (the cloud service's ledger, a robot's last call). Not monotonic: the machine's time
+    may be set back, so measure durations with :class:`RealClock`."""
+
+    def now(self) -> float:
+        return time.time()
+
+    def sleep_until(self, deadline_s: float, stop: ClockEvent | None = None) -> bool:
+        return super().sleep_until(time.monotonic() + (deadline_s - time.time()), stop)
+
+
 class VirtualClock:
     """A clock that moves only when advanced; sleeping advances it.
 

@@ -21,16 +21,17 @@ def next_command(
 ) -> CommandPublic | Response:
     """The next command, now IN_PROGRESS under a lease; 204 when none came within
     ``wait_s`` (at most the service's max_wait_s)."""
-    store.telemetry.seen(robot.id)
     deadline_s = store.clock.now() + min(wait_s, store.settings.max_wait_s)
-    while True:
-        command = store.ledger.claim_next(robot.id)
-        if command is not None:
-            return CommandPublic.of(command, robot.name)
-        left_s = deadline_s - store.clock.now()
-        if left_s <= 0:
-            return Response(status_code=status.HTTP_204_NO_CONTENT)
-        store.doorbell.wait(robot.id, min(left_s, store.settings.recheck_s))
+    with store.telemetry.polling(robot.id):
+        while True:
+            command = store.ledger.claim_next(robot.id)
+            if command is not None:
+                store.announce(robot.id)  # the operators' live pages
+                return CommandPublic.of(command, robot.name)
+            left_s = deadline_s - store.clock.now()
+            if left_s <= 0:
+                return Response(status_code=status.HTTP_204_NO_CONTENT)
+            store.doorbell.wait(robot.id, min(left_s, store.settings.recheck_s))
 
 
 @router.post("/commands/{command_id}/result")
@@ -45,6 +46,7 @@ def report_result(
         raise HTTPException(status.HTTP_409_CONFLICT, str(error)) from None
     if command is None:
         raise HTTPException(status.HTTP_404_NOT_FOUND, f"no command {command_id!r}")
+    store.announce(robot.id)  # the operators' live pages
     return CommandPublic.of(command, robot.name)
 
 

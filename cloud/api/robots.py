@@ -11,8 +11,9 @@ from cloud.api.schemas import RobotPublic
 from cloud.store.tables import RobotRow
 
 router = APIRouter(prefix="/robots", tags=["operator"])
-ONLINE_WITHIN_S = 60.0
-"""A robot that called in this recently is online (it long-polls at least every 30 s)."""
+ONLINE_WITHIN_S = 15.0
+"""A robot waiting in a long-poll, or that called in this recently, is online (a robot
+pushes telemetry every second and long-polls again as soon as one ends)."""
 
 
 def granted(store: StoreDep, operator: CurrentOperator, robot: str) -> RobotRow:
@@ -25,15 +26,16 @@ def granted(store: StoreDep, operator: CurrentOperator, robot: str) -> RobotRow:
 
 @router.get("")
 def list_robots(store: StoreDep, operator: CurrentOperator) -> list[RobotPublic]:
-    now = store.clock.now()
-    return [
-        RobotPublic(
-            name=row.name,
-            online=row.last_seen_s is not None and now - row.last_seen_s <= ONLINE_WITHIN_S,
-            last_seen_s=row.last_seen_s,
-        )
-        for row in store.directory.robots_of(operator.id)
-    ]
+    return [robot_public(store, row) for row in store.directory.robots_of(operator.id)]
+
+
+def robot_public(store: StoreDep, row: RobotRow) -> RobotPublic:
+    """The robot as its operator sees it: online or not, and when it last called in."""
+    last_seen_s = store.telemetry.last_seen(row.id, row.last_seen_s)
+    online = store.telemetry.is_polling(row.id) or (
+        last_seen_s is not None and store.clock.now() - last_seen_s <= ONLINE_WITHIN_S
+    )
+    return RobotPublic(name=row.name, online=online, last_seen_s=last_seen_s)
 
 
 @router.get("/{robot}/telemetry")

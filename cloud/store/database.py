@@ -1,36 +1,62 @@
 """Opening the database: a SQLite file (WAL mode, one writer at a time) or PostgreSQL by
-URL. The schema is created when missing (migrations come with the service)."""
+URL, brought up to the newest schema by the migrations in cloud/migrations/."""
 
 from __future__ import annotations
 
 from collections.abc import Iterator
 from contextlib import contextmanager
+from pathlib import Path
 from typing import Any
 
-from sqlalchemy import Engine, create_engine, event
+from alembic import command
+from alembic.config import Config
+from sqlalchemy import Connection, Engine, create_engine, event, text
 from sqlalchemy.exc import ArgumentError, DBAPIError
 from sqlalchemy.orm import Session, sessionmaker
 
-from cloud.store.tables import Table
 from engine.errors import ConfigError
+
+MIGRATIONS = Path(__file__).resolve().parent.parent / "migrations"
+MIGRATION_LOCK = 0x7665_7374  # "vest": one process migrates a PostgreSQL database at a time
+
+
+def engine_url(url: str) -> str:
+    """``url`` with PostgreSQL's driver named (psycopg 3): ``postgresql://`` as people
+    write it means ``postgresql+psycopg://`` here."""
+    for scheme in ("postgresql://", "postgres://"):
+        if url.startswith(scheme):
+            return "postgresql+psycopg://" + url.removeprefix(scheme)
+    return url
 
 
 class Database:
     """An engine and its sessions; ``transaction()`` is one short transaction."""
 
     def __init__(self, url: str) -> None:
+        self.url = url
         try:
-            self.engine: Engine = create_engine(url, future=True)
-        except (ArgumentError, ImportError) as error:
+            self.engine: Engine = create_engine(engine_url(url), **_pool_options(url))
+        except (ArgumentError, ImportError, ValueError) as error:
             raise ConfigError(f"--db {url}: not a database URL we can open ({error})") from None
         if self.engine.dialect.name == "sqlite":
             event.listen(self.engine, "connect", _sqlite_pragmas)
         try:
-            Table.metadata.create_all(self.engine)
+            self.migrate()
         except DBAPIError as error:
             self.engine.dispose()
             raise ConfigError(f"--db {url}: cannot open it ({error.orig})") from None
         self._sessions = sessionmaker(self.engine, expire_on_commit=False)
+
+    @property
+    def is_postgresql(self) -> bool:
+        return self.engine.dialect.name == "postgresql"
+
+    def migrate(self) -> None:
+        """Bring the schema up to the newest migration (nothing to do when it is)."""
+        with self.engine.begin() as connection:
+            if self.is_postgresql:  # released when the transaction ends
+                connection.execute(text(f"SELECT pg_advisory_xact_lock({MIGRATION_LOCK})"))
+            command.upgrade(_alembic_config(connection), "head")
 
     @contextmanager
     def transaction(self) -> Iterator[Session]:
@@ -40,6 +66,20 @@ class Database:
 
     def close(self) -> None:
         self.engine.dispose()
+
+
+def _alembic_config(connection: Connection) -> Config:
+    config = Config()
+    config.set_main_option("script_location", str(MIGRATIONS))
+    config.attributes["connection"] = connection
+    return config
+
+
+def _pool_options(url: str) -> dict[str, Any]:
+    if url.startswith("sqlite"):
+        return {}
+    # long-polls hold no connection while they wait, but many robots claim at once
+    return {"pool_size": 10, "max_overflow": 20, "pool_pre_ping": True}
 
 
 def _sqlite_pragmas(connection: Any, _record: Any) -> None:

@@ -28,6 +28,9 @@ FINISHED = frozenset({SUCCEEDED, FAILED, TIMED_OUT, CANCELED})
 REPORTS = (SUCCEEDED, FAILED)
 DEFAULT_LEASE_S = 30.0
 DEFAULT_TIMEOUT_S = 300.0
+EXPIRE_EVERY_S = 0.5
+"""Leases and timeouts are looked at no more often than this (every long-poll's re-check
+would otherwise scan the ledger)."""
 
 
 class ConflictError(VestError, ValueError):
@@ -85,6 +88,7 @@ class CommandLedger:
         self.clock = clock
         self.lease_s = lease_s
         self.default_timeout_s = default_timeout_s
+        self._expired_at_s = float("-inf")
 
     def submit(
         self,
@@ -129,14 +133,14 @@ class CommandLedger:
 
     def get(self, robot_id: int, command_id: str) -> Command | None:
         """The command, only if it is this robot's."""
-        self.expire()
+        self._expire_due()
         with self.db.transaction() as session:
             row = session.get(CommandRow, command_id)
             return Command.of(row) if row is not None and row.robot_id == robot_id else None
 
     def recent(self, robot_id: int, limit: int = 50) -> list[Command]:
         """This robot's commands, newest first."""
-        self.expire()
+        self._expire_due()
         with self.db.transaction() as session:
             rows = session.scalars(
                 select(CommandRow)
@@ -158,11 +162,15 @@ class CommandLedger:
 
     def claim_next(self, robot_id: int) -> Command | None:
         """The oldest QUEUED command of this robot, now IN_PROGRESS under a lease."""
-        self.expire()
+        self._expire_due()
         with self.db.transaction() as session:
             row = session.scalar(
                 select(CommandRow)
-                .where(CommandRow.robot_id == robot_id, CommandRow.state == QUEUED)
+                .where(
+                    CommandRow.robot_id == robot_id,
+                    CommandRow.state == QUEUED,
+                    CommandRow.timeout_at_s > self.clock.now(),
+                )
                 .order_by(CommandRow.created_s, CommandRow.id)
                 .limit(1)
                 .with_for_update(skip_locked=True)
@@ -193,9 +201,13 @@ class CommandLedger:
             row.lease_until_s = None
             return Command.of(row)
 
+    def _expire_due(self) -> None:
+        if self.clock.now() - self._expired_at_s >= EXPIRE_EVERY_S:
+            self.expire()
+
     def expire(self) -> None:
         """Leases that ran out go back to QUEUED; commands past their timeout, TIMED_OUT."""
-        now = self.clock.now()
+        now = self._expired_at_s = self.clock.now()
         with self.db.transaction() as session:
             late = session.scalars(
                 select(CommandRow).where(

@@ -1,16 +1,24 @@
-"""The database tables. Times are clock seconds (floats); JSON columns hold command
+"""The database tables. Times are seconds since the epoch (floats, UTC); JSON columns hold command
 arguments, results and telemetry values."""
 
 from __future__ import annotations
 
 from typing import Any
 
-from sqlalchemy import JSON, Float, ForeignKey, Integer, String, UniqueConstraint
+from sqlalchemy import JSON, Float, ForeignKey, Index, Integer, MetaData, String, UniqueConstraint
 from sqlalchemy.orm import DeclarativeBase, Mapped, mapped_column
+
+NAMING = {
+    "ix": "ix_%(table_name)s_%(column_0_N_name)s",
+    "uq": "uq_%(table_name)s_%(column_0_N_name)s",
+    "fk": "fk_%(table_name)s_%(column_0_name)s_%(referred_table_name)s",
+    "pk": "pk_%(table_name)s",
+}
+"""Every constraint named, so a migration can change it on SQLite (batch mode) too."""
 
 
 class Table(DeclarativeBase):
-    pass
+    metadata = MetaData(naming_convention=NAMING)
 
 
 class OperatorRow(Table):
@@ -43,15 +51,18 @@ class GrantRow(Table):
 
 class CommandRow(Table):
     __tablename__ = "commands"
-    __table_args__ = (UniqueConstraint("robot_id", "idempotency_key"),)
+    __table_args__ = (
+        UniqueConstraint("robot_id", "idempotency_key"),
+        Index("ix_commands_claim", "robot_id", "state", "created_s"),
+    )
 
     id: Mapped[str] = mapped_column(String(36), primary_key=True)
-    robot_id: Mapped[int] = mapped_column(ForeignKey("robots.id"), index=True)
+    robot_id: Mapped[int] = mapped_column(ForeignKey("robots.id"))
     type: Mapped[str] = mapped_column(String(64))
     args: Mapped[dict[str, Any]] = mapped_column(JSON)
     state: Mapped[str] = mapped_column(String(16), index=True)
     version: Mapped[int] = mapped_column(Integer, default=1)
-    result: Mapped[Any] = mapped_column(JSON, default=None)
+    result: Mapped[Any] = mapped_column(JSON, nullable=True, default=None)
     idempotency_key: Mapped[str | None] = mapped_column(String(128), default=None)
     created_s: Mapped[float] = mapped_column(Float)
     updated_s: Mapped[float] = mapped_column(Float)
@@ -67,5 +78,5 @@ class TelemetryRow(Table):
 
     robot_id: Mapped[int] = mapped_column(ForeignKey("robots.id"), primary_key=True)
     key: Mapped[str] = mapped_column(String(200), primary_key=True)
-    value: Mapped[Any] = mapped_column(JSON)
+    value: Mapped[Any] = mapped_column(JSON, nullable=True)
     at_s: Mapped[float] = mapped_column(Float)

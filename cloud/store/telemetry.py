@@ -1,48 +1,144 @@
-"""The latest telemetry of each robot: one value per key, with when it was sent."""
+"""The latest telemetry of each robot, and when each robot last called in.
+
+Robots push every second; writing each push at once would make the database the
+bottleneck (200 robots: 200 transactions a second). The latest values are kept in memory
+and written in one batch by ``flush()`` (the service calls it every ``flush_s``, and when it
+stops). Reads merge memory over the database, so this worker always answers with the newest
+it has heard; another worker sharing a PostgreSQL database sees it after the next flush.
+"""
 
 from __future__ import annotations
 
+import threading
+from collections.abc import Iterator
+from contextlib import contextmanager
 from typing import Any
 
-from sqlalchemy import select
+from sqlalchemy import bindparam, select, update
+from sqlalchemy.dialects import postgresql, sqlite
 
 from cloud.store.database import Database
-from cloud.store.tables import RobotRow, TelemetryRow
+from cloud.store.tables import Table, TelemetryRow
 from engine.clock import Clock
+
+Reading = dict[str, Any]  # {"value": ..., "at_s": seconds since the epoch}
+_robots = Table.metadata.tables["robots"]
+_SEEN = (
+    update(_robots)
+    .where(_robots.c.id == bindparam("robot"))
+    .where(_robots.c.last_seen_s.is_(None) | (_robots.c.last_seen_s < bindparam("at")))
+    .values(last_seen_s=bindparam("at"))
+)
+"""A robot's last_seen_s moves forward only (workers flush in any order)."""
 
 
 class Telemetry:
     def __init__(self, db: Database, clock: Clock) -> None:
         self.db = db
         self.clock = clock
+        self._lock = threading.Lock()
+        self._latest: dict[int, dict[str, Reading]] = {}
+        self._seen: dict[int, float] = {}
+        self._unwritten: dict[int, dict[str, Reading]] = {}
+        self._unwritten_seen: dict[int, float] = {}
+        self._polling: dict[int, int] = {}
 
     def put(self, robot_id: int, values: dict[str, Any]) -> None:
         """Keep ``values`` as the robot's latest, stamped now; the robot was seen now."""
         now = self.clock.now()
-        with self.db.transaction() as session:
+        with self._lock:
+            latest = self._latest.setdefault(robot_id, {})
+            unwritten = self._unwritten.setdefault(robot_id, {})
             for key, value in values.items():
-                row = session.get(TelemetryRow, (robot_id, key))
-                if row is None:
-                    session.add(TelemetryRow(robot_id=robot_id, key=key, value=value, at_s=now))
-                else:
-                    row.value, row.at_s = value, now
-            robot = session.get(RobotRow, robot_id)
-            if robot is not None:
-                robot.last_seen_s = now
+                latest[key] = unwritten[key] = {"value": value, "at_s": now}
+            self._seen[robot_id] = self._unwritten_seen[robot_id] = now
 
     def seen(self, robot_id: int) -> None:
         """The robot called in now (a long-poll counts)."""
-        with self.db.transaction() as session:
-            robot = session.get(RobotRow, robot_id)
-            if robot is not None:
-                robot.last_seen_s = self.clock.now()
+        now = self.clock.now()
+        with self._lock:
+            self._seen[robot_id] = self._unwritten_seen[robot_id] = now
 
-    def latest(self, robot_id: int) -> dict[str, dict[str, Any]]:
-        """key -> {"value", "at_s"}."""
+    @contextmanager
+    def polling(self, robot_id: int) -> Iterator[None]:
+        """The robot is waiting in a long-poll: it is seen when it starts and ends, and
+        online all along."""
+        self.seen(robot_id)
+        with self._lock:
+            self._polling[robot_id] = self._polling.get(robot_id, 0) + 1
+        try:
+            yield
+        finally:
+            with self._lock:
+                self._polling[robot_id] -= 1
+                if not self._polling[robot_id]:
+                    del self._polling[robot_id]
+            self.seen(robot_id)
+
+    def is_polling(self, robot_id: int) -> bool:
+        """True while the robot waits in a long-poll of this worker."""
+        with self._lock:
+            return robot_id in self._polling
+
+    def latest(self, robot_id: int) -> dict[str, Reading]:
+        """key -> {"value", "at_s"}, sorted by key."""
         with self.db.transaction() as session:
-            rows = session.scalars(
-                select(TelemetryRow)
-                .where(TelemetryRow.robot_id == robot_id)
-                .order_by(TelemetryRow.key)
-            )
-            return {row.key: {"value": row.value, "at_s": row.at_s} for row in rows}
+            rows = session.scalars(select(TelemetryRow).where(TelemetryRow.robot_id == robot_id))
+            stored = {row.key: {"value": row.value, "at_s": row.at_s} for row in rows}
+        with self._lock:
+            for key, reading in self._latest.get(robot_id, {}).items():
+                if key not in stored or stored[key]["at_s"] <= reading["at_s"]:
+                    stored[key] = reading
+        return dict(sorted(stored.items()))
+
+    def last_seen(self, robot_id: int, stored_s: float | None) -> float | None:
+        """When the robot last called in: this worker's memory or ``stored_s`` (the
+        database's), whichever is newer."""
+        with self._lock:
+            heard_s = self._seen.get(robot_id)
+        if heard_s is None or (stored_s is not None and stored_s > heard_s):
+            return stored_s
+        return heard_s
+
+    def flush(self) -> int:
+        """Write what came in since the last flush, in one transaction; returns how many
+        values were written."""
+        with self._lock:
+            values, self._unwritten = self._unwritten, {}
+            seen, self._unwritten_seen = self._unwritten_seen, {}
+        rows = [
+            {"robot_id": robot_id, "key": key, "value": reading["value"], "at_s": reading["at_s"]}
+            for robot_id, readings in values.items()
+            for key, reading in readings.items()
+        ]
+        if not rows and not seen:
+            return 0
+        try:
+            with self.db.transaction() as session:
+                if rows:
+                    session.execute(self._upsert(), rows)
+                if seen:
+                    session.connection().execute(
+                        _SEEN, [{"robot": robot, "at": at_s} for robot, at_s in seen.items()]
+                    )
+        except Exception:
+            self._unwrite(values, seen)  # kept for the next flush
+            raise
+        return len(rows)
+
+    def _unwrite(self, values: dict[int, dict[str, Reading]], seen: dict[int, float]) -> None:
+        with self._lock:
+            for robot_id, readings in values.items():
+                newer = self._unwritten.setdefault(robot_id, {})
+                for key, reading in readings.items():
+                    newer.setdefault(key, reading)
+            for robot_id, at_s in seen.items():
+                self._unwritten_seen.setdefault(robot_id, at_s)
+
+    def _upsert(self) -> Any:
+        insert = postgresql.insert if self.db.is_postgresql else sqlite.insert
+        statement = insert(TelemetryRow)
+        return statement.on_conflict_do_update(
+            index_elements=[TelemetryRow.robot_id, TelemetryRow.key],
+            set_={"value": statement.excluded.value, "at_s": statement.excluded.at_s},
+        )

@@ -1,10 +1,21 @@
-"""A fresh SQLite store per test, on a virtual clock."""
+"""The cloud tests' databases: each test that takes ``db_url`` runs twice, on a fresh
+SQLite file and on a fresh database of a throwaway PostgreSQL cluster (Debian's server
+binaries, initdb in a temporary folder, pg_ctl on a free loopback port, stopped and removed
+when the tests end). As root the cluster runs as the ``postgres`` user (the server refuses
+to run as root). A missing PostgreSQL fails the tests: scripts/setup installs it."""
 
 from __future__ import annotations
 
+import glob
+import os
+import shutil
+import socket
+import subprocess
+import tempfile
 from collections.abc import Iterator
 from pathlib import Path
 
+import psycopg
 import pytest
 
 from cloud.store.database import Database
@@ -13,14 +24,108 @@ from cloud.store.ledger import CommandLedger
 from engine.clock import VirtualClock
 
 
+def server_binaries() -> Path:
+    """The folder with initdb and pg_ctl: Debian keeps them out of PATH."""
+    try:
+        folder = subprocess.run(
+            ["pg_config", "--bindir"], capture_output=True, text=True, check=True
+        ).stdout.strip()
+        if (Path(folder) / "initdb").exists():
+            return Path(folder)
+    except (OSError, subprocess.CalledProcessError):
+        pass
+    found = sorted(glob.glob("/usr/lib/postgresql/*/bin/initdb"))
+    if not found:
+        raise RuntimeError("no PostgreSQL server here: run scripts/setup (apt postgresql)")
+    return Path(found[-1]).parent
+
+
+def free_port() -> int:
+    with socket.socket() as sock:
+        sock.bind(("127.0.0.1", 0))
+        return int(sock.getsockname()[1])
+
+
+class PostgresCluster:
+    """``start()`` gives the server's URL; ``new_database()`` a fresh empty database."""
+
+    def __init__(self) -> None:
+        self.binaries = server_binaries()
+        self.folder = Path(tempfile.mkdtemp(prefix="vest-pg-"))
+        self.data = self.folder / "data"
+        self.port = free_port()
+        self._databases = 0
+        self._as_postgres = os.geteuid() == 0
+
+    @property
+    def url(self) -> str:
+        return f"postgresql://vest@127.0.0.1:{self.port}/postgres"
+
+    def start(self) -> str:
+        if self._as_postgres:
+            shutil.chown(self.folder, "postgres")
+        self._run("initdb", "-D", str(self.data), "-U", "vest", "-A", "trust", "-E", "UTF8")
+        self._run(
+            "pg_ctl",
+            "-D",
+            str(self.data),
+            "-l",
+            str(self.folder / "server.log"),
+            "-w",
+            "-o",
+            f"-p {self.port} -k {self.folder} -c listen_addresses=127.0.0.1 -c fsync=off"
+            " -c max_connections=300",
+            "start",
+        )
+        return self.url
+
+    def new_database(self) -> str:
+        """A new empty database's URL (each test gets its own)."""
+        self._databases += 1
+        name = f"test_{self._databases}"
+        with psycopg.connect(self.url, autocommit=True) as db:
+            db.execute(f"CREATE DATABASE {name}")
+        return self.url.rsplit("/", 1)[0] + f"/{name}"
+
+    def stop(self) -> None:
+        try:
+            self._run("pg_ctl", "-D", str(self.data), "-m", "immediate", "stop")
+        finally:
+            shutil.rmtree(self.folder, ignore_errors=True)
+
+    def _run(self, program: str, *args: str) -> None:
+        line = [str(self.binaries / program), *args]
+        if self._as_postgres:
+            line = ["runuser", "-u", "postgres", "--", *line]
+        done = subprocess.run(line, capture_output=True, text=True, cwd=self.folder)
+        if done.returncode != 0:
+            raise RuntimeError(f"{program} failed ({done.returncode}): {done.stderr.strip()}")
+
+
+@pytest.fixture(scope="session")
+def postgres() -> Iterator[PostgresCluster]:
+    cluster = PostgresCluster()
+    cluster.start()
+    yield cluster
+    cluster.stop()
+
+
+@pytest.fixture(params=["sqlite", "postgresql"])
+def db_url(request: pytest.FixtureRequest, tmp_path: Path) -> str:
+    if request.param == "sqlite":
+        return f"sqlite:///{tmp_path / 'cloud.db'}"
+    cluster: PostgresCluster = request.getfixturevalue("postgres")
+    return cluster.new_database()
+
+
 @pytest.fixture
 def clock() -> VirtualClock:
     return VirtualClock(start_s=1000.0)
 
 
 @pytest.fixture
-def db(tmp_path: Path) -> Iterator[Database]:
-    database = Database(f"sqlite:///{tmp_path / 'cloud.db'}")
+def db(db_url: str) -> Iterator[Database]:
+    database = Database(db_url)
     yield database
     database.close()
 

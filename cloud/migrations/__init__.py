@@ -1,0 +1,1 @@
+"""The database's schema history (Alembic); ``Database`` brings any database up to date."""
