@@ -2,15 +2,17 @@
 
 from __future__ import annotations
 
-from collections.abc import AsyncIterator, Awaitable, Callable
+from collections.abc import AsyncIterator
 from contextlib import asynccontextmanager
 
 import anyio.to_thread
-from fastapi import FastAPI, Request, Response, status
+from fastapi import FastAPI, Request
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse
 
-from cloud.api import commands, robot_side, robots
+from cloud.api import commands, events, robot_side, robots
+from cloud.api.body_limit import BodyLimit
+from cloud.api.page import add_page
 from cloud.services import CloudStore
 from cloud.settings import Settings
 from cloud.store.writer import TelemetryWriter
@@ -41,20 +43,11 @@ def create_app(
 
     app = FastAPI(title="vest cloud", version="1", lifespan=lifespan)
     app.state.store = store
-    for router in (robots.router, commands.router, robot_side.router):
+    for router in (robots.router, commands.router, robot_side.router, events.router):
         app.include_router(router, prefix=API)
+    add_page(app)
 
-    @app.middleware("http")
-    async def limit_body(
-        request: Request, call_next: Callable[[Request], Awaitable[Response]]
-    ) -> Response:
-        length = request.headers.get("content-length")
-        if length is not None and (not length.isdigit() or int(length) > settings.max_body_bytes):
-            return JSONResponse(
-                {"detail": f"the body is over {settings.max_body_bytes} bytes"},
-                status_code=status.HTTP_413_CONTENT_TOO_LARGE,
-            )
-        return await call_next(request)
+    app.add_middleware(BodyLimit, max_bytes=settings.max_body_bytes)
 
     @app.exception_handler(RequestValidationError)
     async def bad_body(request: Request, error: RequestValidationError) -> JSONResponse:
@@ -68,3 +61,11 @@ def create_app(
         return JSONResponse({"detail": problems}, status_code=422)
 
     return app
+
+
+def app_from_environment() -> FastAPI:
+    """The app of one worker of ``vest cloud serve --workers N`` (the database URL comes in
+    the VEST_CLOUD_DB environment variable)."""
+    import os
+
+    return create_app(Settings(db_url=os.environ["VEST_CLOUD_DB"]))

@@ -9,6 +9,7 @@ from fastapi import APIRouter, HTTPException, status
 from cloud.api.deps import CurrentOperator, StoreDep
 from cloud.api.schemas import RobotPublic
 from cloud.store.tables import RobotRow
+from engine.nodes.remote import command_catalogue
 
 router = APIRouter(prefix="/robots", tags=["operator"])
 ONLINE_WITHIN_S = 15.0
@@ -36,6 +37,15 @@ def robot_public(store: StoreDep, row: RobotRow) -> RobotPublic:
         last_seen_s is not None and store.clock.now() - last_seen_s <= ONLINE_WITHIN_S
     )
     return RobotPublic(name=row.name, online=online, last_seen_s=last_seen_s)
+
+
+@router.get("/{robot}/command-types")
+def command_types(
+    robot: str, store: StoreDep, operator: CurrentOperator
+) -> dict[str, list[dict[str, Any]]]:
+    """The command types the robot carries out, with each one's arguments (for forms)."""
+    granted(store, operator, robot)
+    return command_catalogue()
 
 
 @router.get("/{robot}/telemetry")

@@ -1,6 +1,6 @@
 """Run the cloud service and manage who may use it.
 
-  vest cloud serve [--db URL] [--host H] [--port P]
+  vest cloud serve [--db URL] [--host H] [--port P] [--workers N]
   vest cloud add-operator NAME          prints the operator's token alone (shown once)
   vest cloud add-robot NAME --operator NAME   prints the robot's token alone (shown once)
   vest cloud grant OPERATOR ROBOT
@@ -11,9 +11,18 @@ Every one takes --db URL: a SQLite file (default sqlite:///vest-cloud.db) or pos
 from __future__ import annotations
 
 import argparse
+import os
+from typing import TYPE_CHECKING, Any
 
-from engine.clock import RealClock
+from engine.clock import EpochClock
+from engine.errors import UsageError
 
+if TYPE_CHECKING:
+    from cloud.settings import Settings
+
+SETTINGS_ENV = "VEST_CLOUD_DB"
+SERVER_OPTIONS: dict[str, Any] = {"log_level": "info", "timeout_graceful_shutdown": 3}
+"""Open live pages are cut after 3 s when the service stops (they reconnect)."""
 NAME = "cloud"
 HELP = "run the cloud service; add operators and robots, grant, revoke"
 
@@ -31,6 +40,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     serve = action("serve", "run the service (HTTP, /api/v1)")
     serve.add_argument("--host", default="127.0.0.1", help="default 127.0.0.1")
     serve.add_argument("--port", type=int, default=8080, help="default 8080")
+    serve.add_argument(
+        "--workers",
+        type=int,
+        default=1,
+        help="service processes (default 1; more than one needs a PostgreSQL --db)",
+    )
     action("add-operator", "add an operator; prints its token").add_argument("name")
     robot = action("add-robot", "add a robot, granted to an operator; prints its token")
     robot.add_argument("name")
@@ -49,8 +64,8 @@ def main(args: argparse.Namespace) -> int:
 
     settings = Settings(db_url=args.db)
     if args.action == "serve":
-        return _serve(settings, args.host, args.port)
-    store = CloudStore.open(settings, RealClock())
+        return _serve(settings, args.host, args.port, args.workers)
+    store = CloudStore.open(settings, EpochClock())
     try:
         if args.action == "add-operator":
             print(store.directory.add_operator(args.name))
@@ -65,16 +80,32 @@ def main(args: argparse.Namespace) -> int:
     return 0
 
 
-def _serve(settings: object, host: str, port: int) -> int:
+def _serve(settings: Settings, host: str, port: int, workers: int) -> int:
     import uvicorn
 
     from cloud.app import create_app
-    from cloud.settings import Settings
+    from cloud.store.database import Database
 
-    assert isinstance(settings, Settings)
     if not 1 <= port <= 65535:
-        from engine.errors import UsageError
-
         raise UsageError(f"--port {port}: use 1..65535")
-    uvicorn.run(create_app(settings), host=host, port=port, log_level="info")
+    if not 1 <= workers <= 64:
+        raise UsageError(f"--workers {workers}: use 1..64")
+    Database(settings.db_url).close()  # a bad URL is named now, the schema brought up to date
+    if workers == 1:
+        uvicorn.run(create_app(settings), host=host, port=port, **SERVER_OPTIONS)
+        return 0
+    if not settings.db_url.startswith(("postgresql", "postgres:")):
+        raise UsageError(
+            f"--workers {workers} needs a PostgreSQL --db (SQLite has one writer, and only "
+            "PostgreSQL tells every worker that a command arrived)"
+        )
+    os.environ[SETTINGS_ENV] = settings.db_url
+    uvicorn.run(
+        "cloud.app:app_from_environment",
+        factory=True,
+        host=host,
+        port=port,
+        workers=workers,
+        **SERVER_OPTIONS,
+    )
     return 0

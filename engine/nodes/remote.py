@@ -153,7 +153,7 @@ class CarryOut(ServiceAction):
             return self.ctx.actions.read_sensor(sensor)
         keys = POLLED_READINGS.get(sensor)
         if keys is None:
-            known = ", ".join(("temperature", "ultrasound", *POLLED_READINGS))
+            known = ", ".join(READABLE_SENSORS)
             raise CommandError(f"unknown sensor {_shown(sensor)} (known: {known})")
         values = {key: self.read(key) for key in keys}
         for key, value in values.items():
@@ -177,6 +177,36 @@ class CarryOut(ServiceAction):
         if status == Status.FAILURE and self.save_result_as:
             self.write(self.save_result_as, {"error": self.feedback_message})
         return status
+
+
+READABLE_SENSORS = ("temperature", "ultrasound", *POLLED_READINGS)
+
+
+def command_catalogue() -> dict[str, list[dict[str, Any]]]:
+    """Each command type's arguments as an operator's page builds its form from them:
+    ``{type: [{"name", "doc", "required", "schema"}]}`` (schema: JSON Schema of a value).
+    The same declarations check the arguments when the robot carries a command out."""
+    catalogue = {
+        kind: [
+            {
+                "name": param.name,
+                "doc": param.doc,
+                "required": param.required,
+                "schema": param.type.json_schema(),
+            }
+            for param in declared_params(node)
+        ]
+        for kind, node in ACTION_NODES.items()
+    }
+    catalogue["read"] = [
+        {
+            "name": "sensor",
+            "doc": "which sensor to read",
+            "required": True,
+            "schema": {"enum": list(READABLE_SENSORS)},
+        }
+    ]
+    return catalogue
 
 
 def _shown(value: Any) -> str:

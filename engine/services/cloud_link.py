@@ -27,6 +27,7 @@ import requests
 
 from engine.blackboard.board import Blackboard
 from engine.blackboard.catalogue import DEVICES_PREFIX, IOT_INBOX, SENSORS_PREFIX
+from engine.blackboard.events import EventLog
 from engine.clock import Clock
 from engine.services.jobs import ImmediateJob, Job
 
@@ -38,7 +39,10 @@ DONE_KEPT = 1000
 
 
 def _json_safe(value: Any) -> Any:
-    """Numbers that JSON cannot carry (NaN, infinity) as None; containers walked."""
+    """Numbers that JSON cannot carry (NaN, infinity) as None; containers walked; an
+    event key as its latest event's value (None before the first)."""
+    if isinstance(value, EventLog):
+        return _json_safe(value.latest.value) if value.latest is not None else None
     if isinstance(value, float) and not math.isfinite(value):
         return None
     if isinstance(value, dict):

@@ -1,0 +1,107 @@
+"""The operator's live stream: server-sent events with what changed on its robots.
+
+``GET /api/v1/events`` (operator token) answers ``text/event-stream``. Events, each a JSON
+``data:`` line:
+
+- ``robots``: every robot granted to the operator (name, online, last_seen_s), first and
+  whenever one of them changes;
+- ``telemetry``: ``{"robot", "values": {key: {"value", "at_s"}}}`` with the keys whose
+  values came in since the last one (all of them first);
+- ``command``: a command (as ``GET .../commands/{id}`` answers it) whenever its version
+  grows; the newest 50 of each robot first.
+
+The stream wakes at once when a robot's commands change (the same doorbell as the
+long-polls) and looks for new telemetry every ``TELEMETRY_EVERY_S``. A comment line every
+``KEEPALIVE_S`` keeps proxies from closing an idle stream. It ends after ``STREAM_S``; the
+page then opens a new one (so a server that stops is never held up by an open page).
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import AsyncIterator
+from typing import Any
+
+from fastapi import APIRouter, Request
+from fastapi.responses import StreamingResponse
+from starlette.concurrency import run_in_threadpool
+
+from cloud.api.deps import CurrentOperator, StoreDep
+from cloud.api.robots import robot_public
+from cloud.api.schemas import CommandPublic
+from cloud.services import CloudStore
+from cloud.store.directory import Principal
+
+router = APIRouter(tags=["operator"])
+TELEMETRY_EVERY_S = 1.0
+KEEPALIVE_S = 15.0
+STREAM_S = 300.0
+
+
+class OperatorView:
+    """What this operator's page was last sent, and what changed since."""
+
+    def __init__(self, store: CloudStore, operator: Principal) -> None:
+        self.store = store
+        self.operator = operator
+        self.robot_ids: list[int] = []
+        self._robots: list[dict[str, Any]] | None = None
+        self._versions: dict[str, int] = {}
+        self._telemetry: dict[tuple[int, str], float] = {}
+
+    def changes(self) -> list[str]:
+        """The events to send now (server-sent event text, one string each)."""
+        rows = self.store.directory.robots_of(self.operator.id)
+        self.robot_ids = [row.id for row in rows]
+        events: list[str] = []
+        robots = [robot_public(self.store, row).model_dump() for row in rows]
+        if robots != self._robots:
+            self._robots = robots
+            events.append(_event("robots", robots))
+        for row in rows:
+            for command in reversed(self.store.ledger.recent(row.id)):
+                if self._versions.get(command.id) != command.version:
+                    self._versions[command.id] = command.version
+                    events.append(
+                        _event("command", CommandPublic.of(command, row.name).model_dump())
+                    )
+            fresh = {
+                key: reading
+                for key, reading in self.store.telemetry.latest(row.id).items()
+                if self._telemetry.get((row.id, key)) != reading["at_s"]
+            }
+            if fresh:
+                self._telemetry.update({(row.id, key): r["at_s"] for key, r in fresh.items()})
+                events.append(_event("telemetry", {"robot": row.name, "values": fresh}))
+        return events
+
+    def wait(self, timeout_s: float) -> bool:
+        """Until a command of one of the robots changes, or ``timeout_s``."""
+        return self.store.doorbell.wait(self.robot_ids, timeout_s)
+
+
+@router.get("/events")
+async def events(request: Request, store: StoreDep, operator: CurrentOperator) -> StreamingResponse:
+    view = OperatorView(store, operator)
+    return StreamingResponse(
+        _stream(request, store, view),
+        media_type="text/event-stream",
+        headers={"Cache-Control": "no-store", "X-Accel-Buffering": "no"},
+    )
+
+
+async def _stream(request: Request, store: CloudStore, view: OperatorView) -> AsyncIterator[str]:
+    started_s = quiet_since_s = store.clock.now()
+    while store.clock.now() - started_s < STREAM_S and not await request.is_disconnected():
+        changes = await run_in_threadpool(view.changes)
+        if changes:
+            quiet_since_s = store.clock.now()
+            yield "".join(changes)
+        elif store.clock.now() - quiet_since_s >= KEEPALIVE_S:
+            quiet_since_s = store.clock.now()
+            yield ": still here\n\n"
+        await run_in_threadpool(view.wait, TELEMETRY_EVERY_S)
+
+
+def _event(name: str, data: Any) -> str:
+    return f"event: {name}\ndata: {json.dumps(data, separators=(',', ':'))}\n\n"

@@ -1,0 +1,278 @@
+// The operator's page: log in with the operator token, see the robots granted to you,
+// their live sensor values, send commands and follow each one to its end.
+
+import { Api, ApiError } from "./api.js";
+import { buildArgs, readCommand, typeOptions } from "./forms.js";
+
+const $ = (selector) => document.querySelector(selector);
+const TOKEN_KEY = "vest-operator-token";
+const FINISHED = new Set(["SUCCEEDED", "FAILED", "TIMED_OUT", "CANCELED"]);
+
+const state = {
+  api: null,
+  robots: [],
+  selected: null,
+  commands: new Map(), // robot -> Map(id -> command)
+  telemetry: new Map(), // robot -> {key: {value, at_s}}
+  catalogues: new Map(), // robot -> {type: [params]}
+  stream: null,
+};
+
+function el(tag, props = {}, ...children) {
+  const node = Object.assign(document.createElement(tag), props);
+  node.append(...children);
+  return node;
+}
+
+const shown = (value) => (typeof value === "string" ? value : JSON.stringify(value));
+const clock = (seconds) => new Date(seconds * 1000).toLocaleTimeString();
+
+function ago(seconds) {
+  if (seconds === null || seconds === undefined) return "never";
+  const s = Math.max(0, Date.now() / 1000 - seconds);
+  if (s < 60) return `${Math.round(s)} s ago`;
+  if (s < 3600) return `${Math.round(s / 60)} min ago`;
+  return new Date(seconds * 1000).toLocaleString();
+}
+
+// -- logging in and out --------------------------------------------------------------------
+
+async function login(token) {
+  const api = new Api(token);
+  try {
+    state.robots = await api.call("GET", "/robots");
+  } catch (error) {
+    sessionStorage.removeItem(TOKEN_KEY);
+    $("#login-error").textContent =
+      error.status === 401 ? "That token is not valid (or it was revoked)." : error.message;
+    return;
+  }
+  sessionStorage.setItem(TOKEN_KEY, token);
+  state.api = api;
+  $("#login").hidden = true;
+  $("#console").hidden = false;
+  $("#logout").hidden = false;
+  $("#login-error").textContent = "";
+  renderRobots();
+  if (state.robots.length) await select(state.robots[0].name);
+  follow();
+}
+
+function logout() {
+  sessionStorage.removeItem(TOKEN_KEY);
+  if (state.stream) state.stream.abort();
+  location.reload();
+}
+
+// -- the live stream -------------------------------------------------------------------------
+
+async function follow() {
+  let backoff_ms = 500;
+  for (;;) {
+    state.stream = new AbortController();
+    try {
+      setLink(true);
+      await state.api.stream(onEvent, state.stream.signal);
+      backoff_ms = 500;
+    } catch (error) {
+      if (state.stream.signal.aborted) return;
+      if (error instanceof ApiError && error.status === 401) return logout();
+      setLink(false);
+      await new Promise((resolve) => setTimeout(resolve, backoff_ms));
+      backoff_ms = Math.min(backoff_ms * 2, 10000);
+    }
+  }
+}
+
+function setLink(up) {
+  $("#link").hidden = up;
+  $("#link").textContent = up ? "" : "reconnecting…";
+}
+
+function onEvent(name, data) {
+  if (name === "robots") {
+    state.robots = data;
+    renderRobots();
+  } else if (name === "command") {
+    if (!state.commands.has(data.robot)) state.commands.set(data.robot, new Map());
+    const known = state.commands.get(data.robot).get(data.id);
+    if (!known || known.version <= data.version) state.commands.get(data.robot).set(data.id, data);
+    if (data.robot === state.selected) renderCommands();
+  } else if (name === "telemetry") {
+    state.telemetry.set(data.robot, { ...(state.telemetry.get(data.robot) || {}), ...data.values });
+    if (data.robot === state.selected) renderTelemetry();
+  }
+}
+
+// -- robots ----------------------------------------------------------------------------------
+
+function renderRobots() {
+  $("#no-robots").hidden = state.robots.length > 0;
+  $("#robots").replaceChildren(
+    ...state.robots.map((robot) => {
+      const button = el(
+        "button",
+        { type: "button", className: robot.online ? "online" : "offline" },
+        el("span", {}, el("span", { className: "dot" }), robot.name),
+        el("span", { className: "seen", textContent: robot.online ? "online" : `offline, seen ${ago(robot.last_seen_s)}` }),
+      );
+      button.dataset.robot = robot.name;
+      button.setAttribute("aria-current", String(robot.name === state.selected));
+      button.addEventListener("click", () => select(robot.name));
+      return el("li", {}, button);
+    }),
+  );
+  renderStatus();
+}
+
+function renderStatus() {
+  const robot = state.robots.find((r) => r.name === state.selected);
+  if (!robot) return;
+  $("#robot-status").textContent = robot.online
+    ? "Online"
+    : `Offline: last seen ${ago(robot.last_seen_s)}. Commands wait for it (until they time out).`;
+}
+
+async function select(name) {
+  state.selected = name;
+  $("#robot").hidden = false;
+  $("#robot-name").textContent = name;
+  renderRobots();
+  if (!state.catalogues.has(name)) {
+    try {
+      state.catalogues.set(name, await state.api.call("GET", `/robots/${encodeURIComponent(name)}/command-types`));
+    } catch (error) {
+      $("#send-error").textContent = error.message;
+      return;
+    }
+  }
+  typeOptions($("#type"), state.catalogues.get(name));
+  buildArgs($("#args"), $("#type").value, state.catalogues.get(name));
+  renderCommands();
+  renderTelemetry();
+}
+
+// -- commands --------------------------------------------------------------------------------
+
+function idempotencyKey() {
+  const bytes = crypto.getRandomValues(new Uint8Array(16));
+  return Array.from(bytes, (b) => b.toString(16).padStart(2, "0")).join("");
+}
+
+async function send(event) {
+  event.preventDefault();
+  const robot = state.selected;
+  const catalogue = state.catalogues.get(robot);
+  $("#send-error").textContent = "";
+  let command;
+  try {
+    command = readCommand($("#args"), $("#type").value, catalogue);
+  } catch (error) {
+    $("#send-error").textContent = error.message;
+    return;
+  }
+  const button = $("#send button[type=submit]");
+  button.disabled = true;
+  try {
+    const sent = await state.api.call("POST", `/robots/${encodeURIComponent(robot)}/commands`, {
+      ...command,
+      idempotency_key: idempotencyKey(),
+    });
+    onEvent("command", sent);
+  } catch (error) {
+    $("#send-error").textContent = error.message;
+  } finally {
+    button.disabled = false;
+  }
+}
+
+async function cancel(command) {
+  try {
+    onEvent("command", await state.api.call("POST", `/robots/${encodeURIComponent(command.robot)}/commands/${command.id}/cancel`));
+  } catch (error) {
+    $("#send-error").textContent = error.message;
+  }
+}
+
+function renderCommands() {
+  const commands = [...(state.commands.get(state.selected) || new Map()).values()].sort(
+    (a, b) => b.created_s - a.created_s,
+  );
+  $("#no-commands").hidden = commands.length > 0;
+  $("#commands tbody").replaceChildren(
+    ...commands.map((c) => {
+      const row = el(
+        "tr",
+        {},
+        el("td", { textContent: clock(c.created_s) }),
+        el("td", {}, el("strong", { textContent: c.type }), " ", el("code", { textContent: shown(c.args) })),
+        el("td", {}, el("span", { className: `state ${c.state}`, textContent: c.state })),
+        el("td", {}, el("pre", { textContent: c.result === null || c.result === undefined ? "" : shown(c.result) })),
+        el("td"),
+      );
+      row.dataset.command = c.id;
+      row.dataset.state = c.state;
+      if (!FINISHED.has(c.state)) {
+        const button = el("button", { type: "button", className: "cancel", textContent: "Cancel" });
+        button.addEventListener("click", () => cancel(c));
+        row.lastChild.append(button);
+      }
+      return row;
+    }),
+  );
+}
+
+// -- telemetry -------------------------------------------------------------------------------
+
+const DEVICE = /^\/devices\/(.+)\/ok$/;
+
+function renderTelemetry() {
+  const values = state.telemetry.get(state.selected) || {};
+  const keys = Object.keys(values).sort();
+  const devices = keys.filter((key) => DEVICE.test(key));
+  const sensors = keys.filter((key) => !DEVICE.test(key));
+  $("#devices").replaceChildren(
+    ...devices.map((key) => {
+      const ok = values[key].value === true;
+      const item = el("li", { className: ok ? "online" : "offline", textContent: `${key.match(DEVICE)[1]}: ${ok ? "ok" : "offline"}` });
+      item.dataset.key = key;
+      return item;
+    }),
+  );
+  $("#no-telemetry").hidden = keys.length > 0;
+  $("#telemetry tbody").replaceChildren(
+    ...sensors.map((key) => {
+      const row = el(
+        "tr",
+        {},
+        el("td", {}, el("code", { textContent: key })),
+        el("td", {}, el("code", { textContent: shown(values[key].value) })),
+        el("td", { className: "age", textContent: ago(values[key].at_s) }),
+      );
+      row.dataset.key = key;
+      return row;
+    }),
+  );
+}
+
+// -- wiring ----------------------------------------------------------------------------------
+
+$("#login").addEventListener("submit", (event) => {
+  event.preventDefault();
+  login($("#token").value.trim());
+});
+$("#logout").addEventListener("click", logout);
+$("#send").addEventListener("submit", send);
+$("#type").addEventListener("change", () => {
+  $("#send-error").textContent = "";
+  buildArgs($("#args"), $("#type").value, state.catalogues.get(state.selected));
+});
+setInterval(() => {
+  if (state.selected) {
+    renderTelemetry();
+    renderStatus();
+  }
+}, 1000);
+
+const saved = sessionStorage.getItem(TOKEN_KEY);
+if (saved) login(saved);
