@@ -2,18 +2,42 @@
 
 from __future__ import annotations
 
-from typing import Any, Literal
+import math
+from typing import Annotated, Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import AfterValidator, BaseModel, ConfigDict, Field, StringConstraints
 
 from cloud.store.ledger import Command
+
+MAX_DEPTH = 16
+
+
+def finite_json(value: Any, depth: int = 0) -> Any:
+    """``value`` if every number in it is finite and it nests at most MAX_DEPTH deep (JSON
+    has no NaN or infinity, and PostgreSQL refuses them)."""
+    if depth > MAX_DEPTH:
+        raise ValueError(f"nests deeper than {MAX_DEPTH} levels")
+    if isinstance(value, float) and not math.isfinite(value):
+        raise ValueError(f"numbers must be finite, got {value}")
+    if isinstance(value, dict):
+        for item in value.values():
+            finite_json(item, depth + 1)
+    elif isinstance(value, list):
+        for item in value:
+            finite_json(item, depth + 1)
+    return value
+
+
+Json = Annotated[Any, AfterValidator(finite_json)]
+JsonObject = Annotated[dict[str, Any], AfterValidator(finite_json)]
+TelemetryKey = Annotated[str, StringConstraints(min_length=1, max_length=200)]
 
 
 class CommandCreate(BaseModel):
     model_config = ConfigDict(extra="forbid")
 
     type: str = Field(min_length=1, max_length=64, pattern=r"^[a-z][a-z0-9_]*$")
-    args: dict[str, Any] = Field(default_factory=dict)
+    args: JsonObject = Field(default_factory=dict)
     idempotency_key: str | None = Field(default=None, min_length=1, max_length=128)
     timeout_s: float | None = Field(default=None, gt=0, le=86400)
 
@@ -50,13 +74,13 @@ class ResultReport(BaseModel):
     model_config = ConfigDict(extra="forbid")
 
     status: Literal["SUCCEEDED", "FAILED"]
-    result: Any = None
+    result: Json = None
 
 
 class TelemetryReport(BaseModel):
     model_config = ConfigDict(extra="forbid")
 
-    values: dict[str, Any] = Field(max_length=500)
+    values: Annotated[dict[TelemetryKey, Any], AfterValidator(finite_json)] = Field(max_length=500)
 
 
 class RobotPublic(BaseModel):

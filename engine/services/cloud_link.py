@@ -109,6 +109,7 @@ class CloudLink:
         self._reports: queue.Queue[tuple[str, dict[str, Any]] | None] = queue.Queue()
         self._stop = clock.event()
         self._threads: list[threading.Thread] = []
+        self._from_cloud: set[str] = set()
         self.reachable = False
 
     def bind(self, blackboard: Blackboard) -> None:
@@ -136,7 +137,11 @@ class CloudLink:
 
     # -- IotResults ------------------------------------------------------------------------
     def report(self, command_id: str, status: str, result: Any = None) -> Job:
-        """Queue the report (it is sent, and retried, by the reporter); done at once."""
+        """Queue the report (it is sent, and retried, by the reporter); done at once. A
+        command that did not come from the cloud (a scenario's, say) is not reported there."""
+        if command_id not in self._from_cloud:
+            log.debug("command %s did not come from the cloud; not reported there", command_id)
+            return ImmediateJob()
         report = {"status": status.upper(), "result": _json_safe(result)}
         self.done.add(command_id, report)
         self._reports.put((command_id, report))
@@ -179,6 +184,7 @@ class CloudLink:
             self._reports.put((command_id, earlier))
             return
         if self.blackboard is not None:
+            self._from_cloud.add(command_id)
             self.blackboard.stage_event(
                 IOT_INBOX,
                 {"id": command_id, "type": command.get("type"), "args": command.get("args") or {}},

@@ -12,16 +12,22 @@ import shutil
 import socket
 import subprocess
 import tempfile
-from collections.abc import Iterator
+import threading
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass
 from pathlib import Path
 
 import psycopg
 import pytest
+import uvicorn
 
+from cloud.app import create_app
+from cloud.services import CloudStore
+from cloud.settings import Settings
 from cloud.store.database import Database
 from cloud.store.directory import Directory
 from cloud.store.ledger import CommandLedger
-from engine.clock import VirtualClock
+from engine.clock import Clock, EpochClock, VirtualClock
 
 
 def server_binaries() -> Path:
@@ -138,3 +144,48 @@ def directory(db: Database) -> Directory:
 @pytest.fixture
 def ledger(db: Database, clock: VirtualClock) -> CommandLedger:
     return CommandLedger(db, clock, lease_s=30.0, default_timeout_s=300.0)
+
+
+@dataclass
+class Running:
+    """A service answering on loopback: its base URL (…/api/v1 is ``api``) and its store."""
+
+    url: str
+    store: CloudStore
+
+    @property
+    def api(self) -> str:
+        return f"{self.url}/api/v1"
+
+
+StartService = Callable[..., Running]
+
+
+@pytest.fixture
+def start_service() -> Iterator[StartService]:
+    """Starts real uvicorn servers on free loopback ports (stopped after the test).
+
+    The socket listens before the server starts, so requests queue until it accepts them
+    and a test never waits for the server to come up."""
+    running: list[tuple[uvicorn.Server, threading.Thread, socket.socket, CloudStore]] = []
+
+    def start(settings: Settings, clock: Clock | None = None) -> Running:
+        store = CloudStore.open(settings, clock or EpochClock())
+        sock = socket.socket()
+        sock.bind(("127.0.0.1", 0))
+        sock.listen(256)
+        config = uvicorn.Config(
+            create_app(settings, store=store), log_level="warning", timeout_graceful_shutdown=1
+        )
+        server = uvicorn.Server(config)
+        thread = threading.Thread(target=server.run, kwargs={"sockets": [sock]}, daemon=True)
+        thread.start()
+        running.append((server, thread, sock, store))
+        return Running(f"http://127.0.0.1:{sock.getsockname()[1]}", store)
+
+    yield start
+    for server, thread, sock, store in running:
+        server.should_exit = True
+        thread.join(timeout=10)
+        sock.close()
+        store.close()

@@ -2,20 +2,17 @@
 
 from __future__ import annotations
 
-import socket
+import json
 import threading
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
-from pathlib import Path
+from typing import Any
 
 import pytest
 import requests
-import uvicorn
 
-from cloud.app import API, create_app
 from cloud.services import CloudStore
 from cloud.settings import Settings
-from engine.clock import RealClock
 
 
 @dataclass
@@ -32,40 +29,17 @@ def bearer(token: str) -> dict[str, str]:
     return {"Authorization": f"Bearer {token}"}
 
 
-def listening_socket() -> socket.socket:
-    """A socket already listening on a free loopback port: requests queue on it until the
-    server accepts them, so the test need not wait for the server to start."""
-    sock = socket.socket()
-    sock.bind(("127.0.0.1", 0))
-    sock.listen(64)
-    return sock
-
-
 @pytest.fixture
-def service(tmp_path: Path) -> Iterator[Service]:
-    settings = Settings(db_url=f"sqlite:///{tmp_path / 'cloud.db'}", max_wait_s=10.0, recheck_s=0.5)
-    store = CloudStore.open(settings, RealClock())
-    ana = store.directory.add_operator("ana")
-    robot = store.directory.add_robot("hbs2", operator="ana")
-    other = store.directory.add_robot("hbs3", operator="ana")
-    stranger = store.directory.add_operator("zed")
-    sock = listening_socket()
-    port = sock.getsockname()[1]
-    server = uvicorn.Server(uvicorn.Config(create_app(settings, store=store), log_level="warning"))
-    thread = threading.Thread(target=server.run, kwargs={"sockets": [sock]}, daemon=True)
-    thread.start()
-    yield Service(
-        f"http://127.0.0.1:{port}{API}",
-        store,
-        bearer(ana),
-        bearer(robot),
-        bearer(other),
-        bearer(stranger),
+def service(db_url: str, start_service: Callable[..., Any]) -> Service:
+    running = start_service(Settings(db_url=db_url, max_wait_s=10.0, recheck_s=0.5))
+    directory = running.store.directory
+    ana = directory.add_operator("ana")
+    robot = directory.add_robot("hbs2", operator="ana")
+    other = directory.add_robot("hbs3", operator="ana")
+    stranger = directory.add_operator("zed")
+    return Service(
+        running.api, running.store, bearer(ana), bearer(robot), bearer(other), bearer(stranger)
     )
-    server.should_exit = True
-    thread.join(timeout=10)
-    sock.close()
-    store.close()
 
 
 def test_an_operator_sends_a_say_and_the_robot_carries_it_out(service: Service) -> None:
@@ -240,3 +214,109 @@ def test_telemetry_pushed_by_the_robot_is_seen_by_its_operator(service: Service)
     assert latest["/sensors/temperature/c"]["value"] == 22.1
     robots = requests.get(f"{service.url}/robots", headers=service.operator, timeout=10).json()
     assert robots[0]["online"] is True and robots[1]["online"] is False
+
+
+def post_raw(service: Service, path: str, raw: bytes | Any, who: dict[str, str]) -> Any:
+    return requests.post(
+        f"{service.url}{path}",
+        data=raw,
+        headers={**who, "Content-Type": "application/json"},
+        timeout=10,
+    )
+
+
+@pytest.mark.parametrize(
+    ("path", "raw", "field"),
+    [
+        ("/robots/hbs2/commands", b'{"type": "move", "args": {"angle_deg": NaN}}', "args"),
+        ("/robot/telemetry", b'{"values": {"/sensors/x": Infinity}}', "values"),
+        ("/robot/telemetry", b'{"values": {"": 1}}', "values"),
+        ("/robot/telemetry", b'{"values": {"' + b"k" * 201 + b'": 1}}', "values"),
+        ("/robot/commands/nope/result", b'{"status": "SUCCEEDED", "result": -Infinity}', "result"),
+        ("/robot/commands/nope/result", b'{"status": "DONE"}', "status"),
+    ],
+)
+def test_numbers_json_cannot_carry_and_odd_keys_are_422(
+    service: Service, path: str, raw: bytes, field: str
+) -> None:
+    who = service.operator if path.startswith("/robots/") else service.robot
+    answer = post_raw(service, path, raw, who)
+    assert answer.status_code == 422
+    assert any(problem["field"].startswith(field) for problem in answer.json()["detail"])
+
+
+def test_a_streamed_body_over_the_limit_is_413_too(service: Service) -> None:
+    def chunks() -> Any:  # no Content-Length: the body arrives chunked
+        yield b'{"type": "say", "args": {"text": "'
+        for _ in range(100):
+            yield b"x" * 1024
+        yield b'"}}'
+
+    answer = post_raw(service, "/robots/hbs2/commands", chunks(), service.operator)
+    assert answer.status_code == 413
+    listed = requests.get(
+        f"{service.url}/robots/hbs2/commands", headers=service.operator, timeout=10
+    )
+    assert listed.json() == []
+
+
+def test_the_command_types_are_those_the_robot_checks(service: Service) -> None:
+    types = requests.get(
+        f"{service.url}/robots/hbs2/command-types", headers=service.operator, timeout=10
+    ).json()
+    assert set(types) == {"say", "led", "move", "read"}
+    move = {arg["name"]: arg for arg in types["move"]}
+    assert move["angle_deg"]["required"] and move["angle_deg"]["schema"]["maximum"] == 180.0
+    hidden = requests.get(
+        f"{service.url}/robots/hbs2/command-types", headers=service.stranger, timeout=10
+    )
+    assert hidden.status_code == 404
+
+
+def server_sent_events(lines: Any) -> Iterator[tuple[str, Any]]:
+    """(event name, data) for each server-sent event in a streamed response's lines."""
+    name = "message"
+    for line in lines:
+        if line.startswith("event:"):
+            name = line.removeprefix("event:").strip()
+        elif line.startswith("data:"):
+            yield name, json.loads(line.removeprefix("data:"))
+
+
+def test_the_live_stream_shows_robots_and_every_change_of_a_command(service: Service) -> None:
+    sent = requests.post(
+        f"{service.url}/robots/hbs2/commands",
+        json={"type": "say", "args": {"text": "hello"}},
+        headers=service.operator,
+        timeout=10,
+    ).json()
+    with requests.get(
+        f"{service.url}/events", headers=service.operator, stream=True, timeout=10
+    ) as stream:
+        assert stream.headers["content-type"].startswith("text/event-stream")
+        events = server_sent_events(stream.iter_lines(chunk_size=1, decode_unicode=True))
+        name, robots = next(events)
+        assert name == "robots" and [robot["name"] for robot in robots] == ["hbs2", "hbs3"]
+        assert next(events) == ("command", {**sent, "robot": "hbs2"})
+        requests.get(f"{service.url}/robot/commands/next", headers=service.robot, timeout=10)
+        states = []
+        for name, data in events:  # a read timeout fails the test if the change never comes
+            if name == "command" and data["id"] == sent["id"]:
+                states.append(data["state"])
+                break
+        assert states == ["IN_PROGRESS"]
+
+
+def test_the_live_stream_needs_an_operator_token(service: Service) -> None:
+    assert requests.get(f"{service.url}/events", timeout=10).status_code == 401
+    assert (
+        requests.get(f"{service.url}/events", headers=service.robot, timeout=10).status_code == 404
+    )
+
+
+def test_the_page_is_served_with_a_strict_content_policy(service: Service) -> None:
+    home = requests.get(service.url.removesuffix("/api/v1") + "/", timeout=10)
+    assert home.status_code == 200 and "<title>vest: robots</title>" in home.text
+    assert "default-src 'self'" in home.headers["content-security-policy"]
+    script = requests.get(service.url.removesuffix("/api/v1") + "/operator/app.js", timeout=10)
+    assert script.status_code == 200 and "javascript" in script.headers["content-type"]

@@ -3,40 +3,26 @@ reports it; it keeps behaving while the service is away."""
 
 from __future__ import annotations
 
-import socket
-import threading
-from collections.abc import Iterator
+from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import pytest
-import uvicorn
 
-from cloud.app import create_app
 from cloud.services import CloudStore
 from cloud.settings import Settings
 from cloud.store.ledger import SUCCEEDED
 from engine.cli import main
-from engine.clock import RealClock
 from engine.services.cloud_link import DoneCommands
 
 ROOT = Path(__file__).resolve().parents[2]
 
 
 @pytest.fixture
-def cloud(tmp_path: Path) -> Iterator[tuple[str, CloudStore]]:
+def cloud(tmp_path: Path, start_service: Callable[..., Any]) -> tuple[str, CloudStore]:
     settings = Settings(db_url=f"sqlite:///{tmp_path / 'c.db'}", max_wait_s=1.0, recheck_s=0.2)
-    store = CloudStore.open(settings, RealClock())
-    sock = socket.socket()
-    sock.bind(("127.0.0.1", 0))
-    sock.listen(64)
-    server = uvicorn.Server(uvicorn.Config(create_app(settings, store=store), log_level="warning"))
-    thread = threading.Thread(target=server.run, kwargs={"sockets": [sock]}, daemon=True)
-    thread.start()
-    yield f"http://127.0.0.1:{sock.getsockname()[1]}", store
-    server.should_exit = True
-    thread.join(timeout=10)
-    sock.close()
-    store.close()
+    running = start_service(settings)
+    return running.url, running.store
 
 
 def test_vest_run_carries_out_a_say_from_the_cloud_and_reports_it(
