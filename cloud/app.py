@@ -19,6 +19,7 @@ from cloud.store.writer import TelemetryWriter
 from engine.clock import Clock, EpochClock
 
 API = "/api/v1"
+SETTINGS_ENV = "VEST_CLOUD_SETTINGS"
 
 
 def create_app(
@@ -64,8 +65,8 @@ def create_app(
 
 
 def app_from_environment() -> FastAPI:
-    """The app of one worker of ``vest cloud serve --workers N`` (the database URL comes in
-    the VEST_CLOUD_DB environment variable)."""
+    """The app of one worker of ``vest cloud serve --workers N`` (its settings come in the
+    VEST_CLOUD_SETTINGS environment variable, as JSON)."""
     import os
 
-    return create_app(Settings(db_url=os.environ["VEST_CLOUD_DB"]))
+    return create_app(Settings.from_json(os.environ[SETTINGS_ENV]))

@@ -2,7 +2,8 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import json
+from dataclasses import asdict, dataclass
 
 from engine.errors import ConfigError
 
@@ -30,10 +31,20 @@ class Settings:
         for name in ("lease_s", "default_timeout_s", "max_wait_s", "recheck_s", "flush_s"):
             value = getattr(self, name)
             if not 0 < value <= 86400:
-                raise ConfigError(f"setting {name} must be above 0 and at most a day, got {value}")
+                raise ConfigError(
+                    f"{name} must be above 0 and at most a day (86400 s), got {value}"
+                )
         if not 1024 <= self.max_body_bytes <= 16 * 1024 * 1024:
             raise ConfigError(
                 f"setting max_body_bytes must be 1 KiB..16 MiB, got {self.max_body_bytes}"
             )
         if not 4 <= self.threads <= 10000:
             raise ConfigError(f"setting threads must be 4..10000, got {self.threads}")
+
+    def to_json(self) -> str:
+        """For handing to worker processes (``from_json`` reads it back, checked again)."""
+        return json.dumps(asdict(self))
+
+    @classmethod
+    def from_json(cls, text: str) -> Settings:
+        return cls(**json.loads(text))

@@ -10,7 +10,7 @@ from typing import Any
 
 from alembic import command
 from alembic.config import Config
-from sqlalchemy import Connection, Engine, create_engine, event, text
+from sqlalchemy import Connection, Engine, create_engine, event, make_url, text
 from sqlalchemy.exc import ArgumentError, DBAPIError
 from sqlalchemy.orm import Session, sessionmaker
 
@@ -29,22 +29,33 @@ def engine_url(url: str) -> str:
     return url
 
 
+def shown_url(url: str) -> str:
+    """``url`` with any password masked, for messages and logs."""
+    try:
+        return make_url(url).render_as_string(hide_password=True)
+    except ArgumentError:
+        return url
+
+
 class Database:
     """An engine and its sessions; ``transaction()`` is one short transaction."""
 
     def __init__(self, url: str) -> None:
-        self.url = url
+        shown = shown_url(url)
         try:
             self.engine: Engine = create_engine(engine_url(url), **_pool_options(url))
         except (ArgumentError, ImportError, ValueError) as error:
-            raise ConfigError(f"--db {url}: not a database URL we can open ({error})") from None
+            raise ConfigError(
+                f"--db {shown}: not a database URL we can open ({error}); use "
+                "sqlite:///FILE or postgresql://USER@HOST/DATABASE"
+            ) from None
         if self.engine.dialect.name == "sqlite":
             event.listen(self.engine, "connect", _sqlite_pragmas)
         try:
             self.migrate()
         except DBAPIError as error:
             self.engine.dispose()
-            raise ConfigError(f"--db {url}: cannot open it ({error.orig})") from None
+            raise ConfigError(f"--db {shown}: cannot open it ({error.orig})") from None
         self._sessions = sessionmaker(self.engine, expire_on_commit=False)
 
     @property

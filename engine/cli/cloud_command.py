@@ -20,7 +20,6 @@ from engine.errors import UsageError
 if TYPE_CHECKING:
     from cloud.settings import Settings
 
-SETTINGS_ENV = "VEST_CLOUD_DB"
 SERVER_OPTIONS: dict[str, Any] = {"log_level": "info", "timeout_graceful_shutdown": 3}
 """Open live pages are cut after 3 s when the service stops (they reconnect)."""
 NAME = "cloud"
@@ -46,6 +45,19 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         default=1,
         help="service processes (default 1; more than one needs a PostgreSQL --db)",
     )
+    serve.add_argument(
+        "--lease-s",
+        type=float,
+        default=30.0,
+        help="seconds a robot has to report a command it took before it is delivered again "
+        "(default 30)",
+    )
+    serve.add_argument(
+        "--timeout-s",
+        type=float,
+        default=300.0,
+        help="seconds a command may wait and run, unless it says otherwise (default 300)",
+    )
     action("add-operator", "add an operator; prints its token").add_argument("name")
     robot = action("add-robot", "add a robot, granted to an operator; prints its token")
     robot.add_argument("name")
@@ -62,7 +74,10 @@ def main(args: argparse.Namespace) -> int:
     from cloud.services import CloudStore
     from cloud.settings import Settings
 
-    settings = Settings(db_url=args.db)
+    if args.action == "serve":
+        settings = Settings(db_url=args.db, lease_s=args.lease_s, default_timeout_s=args.timeout_s)
+    else:
+        settings = Settings(db_url=args.db)
     if args.action == "serve":
         return _serve(settings, args.host, args.port, args.workers)
     store = CloudStore.open(settings, EpochClock())
@@ -99,7 +114,9 @@ def _serve(settings: Settings, host: str, port: int, workers: int) -> int:
             f"--workers {workers} needs a PostgreSQL --db (SQLite has one writer, and only "
             "PostgreSQL tells every worker that a command arrived)"
         )
-    os.environ[SETTINGS_ENV] = settings.db_url
+    from cloud.app import SETTINGS_ENV
+
+    os.environ[SETTINGS_ENV] = settings.to_json()
     uvicorn.run(
         "cloud.app:app_from_environment",
         factory=True,
