@@ -183,6 +183,9 @@ class CloudLink:
         if earlier is not None:  # delivered again: answer as before, never twice
             self._reports.put((command_id, earlier))
             return
+        if command_id in self._from_cloud:  # delivered again while still being carried out
+            log.debug("command %s is still being carried out; its report will follow", command_id)
+            return
         if self.blackboard is not None:
             self._from_cloud.add(command_id)
             self.blackboard.stage_event(
