@@ -25,6 +25,9 @@ class CloudStore:
     doorbell: Doorbell
     notifications: PostgresNotifications | None = None
 
+    def __post_init__(self) -> None:
+        self.closing = self.clock.event()
+
     @classmethod
     def open(cls, settings: Settings, clock: Clock) -> CloudStore:
         db = Database(settings.db_url)
@@ -51,6 +54,11 @@ class CloudStore:
         self.doorbell.ring(robot_id)
         if self.notifications is not None:
             self.notifications.announce(robot_id)
+
+    def begin_closing(self) -> None:
+        """The service is stopping: live streams end now (waiting long-polls answer 204)."""
+        self.closing.set()
+        self.doorbell.ring_everyone()
 
     def close(self) -> None:
         if self.notifications is not None:

@@ -92,7 +92,11 @@ async def events(request: Request, store: StoreDep, operator: CurrentOperator) -
 
 async def _stream(request: Request, store: CloudStore, view: OperatorView) -> AsyncIterator[str]:
     started_s = quiet_since_s = store.clock.now()
-    while store.clock.now() - started_s < STREAM_S and not await request.is_disconnected():
+    while (
+        store.clock.now() - started_s < STREAM_S
+        and not store.closing.is_set()
+        and not await request.is_disconnected()
+    ):
         changes = await run_in_threadpool(view.changes)
         if changes:
             quiet_since_s = store.clock.now()

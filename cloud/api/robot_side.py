@@ -29,7 +29,7 @@ def next_command(
                 store.announce(robot.id)  # the operators' live pages
                 return CommandPublic.of(command, robot.name)
             left_s = deadline_s - store.clock.now()
-            if left_s <= 0:
+            if left_s <= 0 or store.closing.is_set():
                 return Response(status_code=status.HTTP_204_NO_CONTENT)
             store.doorbell.wait(robot.id, min(left_s, store.settings.recheck_s))
 

@@ -27,6 +27,13 @@ class Doorbell:
         for event in waiting:
             event.set()
 
+    def ring_everyone(self) -> None:
+        with self._lock:
+            waiting = [event for events in self._events.values() for event in events]
+            self._events.clear()
+        for event in waiting:
+            event.set()
+
     def wait(self, robot_ids: int | Iterable[int], timeout_s: float) -> bool:
         """Until one of the robots' bells rings or ``timeout_s`` passes; True if one rang."""
         ids = [robot_ids] if isinstance(robot_ids, int) else list(robot_ids)

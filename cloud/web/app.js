@@ -134,10 +134,6 @@ function renderStatus() {
 }
 
 async function select(name) {
-  state.selected = name;
-  $("#robot").hidden = false;
-  $("#robot-name").textContent = name;
-  renderRobots();
   if (!state.catalogues.has(name)) {
     try {
       state.catalogues.set(name, await state.api.call("GET", `/robots/${encodeURIComponent(name)}/command-types`));
@@ -146,8 +142,17 @@ async function select(name) {
       return;
     }
   }
-  typeOptions($("#type"), state.catalogues.get(name));
-  buildArgs($("#args"), $("#type").value, state.catalogues.get(name));
+  const catalogue = state.catalogues.get(name);
+  const chosen = $("#type").value;
+  state.selected = name;
+  $("#robot").hidden = false;
+  $("#robot").dataset.robot = name;
+  $("#robot-name").textContent = name;
+  $("#send-error").textContent = "";
+  typeOptions($("#type"), catalogue);
+  if (chosen && [...$("#type").options].some((option) => option.value === chosen)) $("#type").value = chosen;
+  buildArgs($("#args"), $("#type").value, catalogue);
+  renderRobots();
   renderCommands();
   renderTelemetry();
 }

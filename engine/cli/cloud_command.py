@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import argparse
 import os
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from engine.clock import EpochClock
 from engine.errors import UsageError
@@ -20,8 +20,6 @@ from engine.errors import UsageError
 if TYPE_CHECKING:
     from cloud.settings import Settings
 
-SERVER_OPTIONS: dict[str, Any] = {"log_level": "info", "timeout_graceful_shutdown": 3}
-"""Open live pages are cut after 3 s when the service stops (they reconnect)."""
 NAME = "cloud"
 HELP = "run the cloud service; add operators and robots, grant, revoke"
 
@@ -99,6 +97,7 @@ def _serve(settings: Settings, host: str, port: int, workers: int) -> int:
     import uvicorn
 
     from cloud.app import create_app
+    from cloud.server import GRACE_S, server_for
     from cloud.store.database import Database
 
     if not 1 <= port <= 65535:
@@ -107,7 +106,7 @@ def _serve(settings: Settings, host: str, port: int, workers: int) -> int:
         raise UsageError(f"--workers {workers}: use 1..64")
     Database(settings.db_url).close()  # a bad URL is named now, the schema brought up to date
     if workers == 1:
-        uvicorn.run(create_app(settings), host=host, port=port, **SERVER_OPTIONS)
+        server_for(create_app(settings), host=host, port=port, log_level="info").run()
         return 0
     if not settings.db_url.startswith(("postgresql", "postgres:")):
         raise UsageError(
@@ -123,6 +122,7 @@ def _serve(settings: Settings, host: str, port: int, workers: int) -> int:
         host=host,
         port=port,
         workers=workers,
-        **SERVER_OPTIONS,
+        log_level="info",
+        timeout_graceful_shutdown=GRACE_S,
     )
     return 0

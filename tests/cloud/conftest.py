@@ -7,21 +7,25 @@ to run as root). A missing PostgreSQL fails the tests: scripts/setup installs it
 from __future__ import annotations
 
 import glob
+import json
 import os
 import shutil
 import socket
 import subprocess
+import sys
 import tempfile
 import threading
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import psycopg
 import pytest
 import uvicorn
 
 from cloud.app import create_app
+from cloud.server import server_for
 from cloud.services import CloudStore
 from cloud.settings import Settings
 from cloud.store.database import Database
@@ -174,10 +178,7 @@ def start_service() -> Iterator[StartService]:
         sock = socket.socket()
         sock.bind(("127.0.0.1", 0))
         sock.listen(256)
-        config = uvicorn.Config(
-            create_app(settings, store=store), log_level="warning", timeout_graceful_shutdown=1
-        )
-        server = uvicorn.Server(config)
+        server = server_for(create_app(settings, store=store), log_level="warning")
         thread = threading.Thread(target=server.run, kwargs={"sockets": [sock]}, daemon=True)
         thread.start()
         running.append((server, thread, sock, store))
@@ -189,3 +190,70 @@ def start_service() -> Iterator[StartService]:
         thread.join(timeout=10)
         sock.close()
         store.close()
+
+
+VEST = [sys.executable, "-c", "from engine.cli import main; raise SystemExit(main())"]
+ROOT = Path(__file__).resolve().parents[2]
+
+
+class Robot:
+    """`vest run --cloud` on the simulated vest, its timeline read line by line."""
+
+    def __init__(self, url: str, token_file: Path, scenario: Path, trees: list[str]) -> None:
+        self.process = subprocess.Popen(
+            [
+                *VEST,
+                "run",
+                "--trees",
+                *trees,
+                "--scenario",
+                str(scenario),
+                "--speech",
+                "text",
+                "--cloud",
+                url,
+                "--token-file",
+                str(token_file),
+                "--json",
+            ],
+            cwd=ROOT,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.DEVNULL,
+            text=True,
+        )
+        self.actions: list[dict[str, Any]] = []
+
+    def until(self, wanted: Any) -> dict[str, Any]:
+        """Reads the timeline until an action for which ``wanted(action)`` is true."""
+        assert self.process.stdout is not None
+        for line in self.process.stdout:
+            action = json.loads(line)
+            self.actions.append(action)
+            if wanted(action):
+                return action
+        raise AssertionError(f"the robot ended first; it did {self.actions}")
+
+    def finish(self) -> list[dict[str, Any]]:
+        out, _ = self.process.communicate(timeout=60)
+        self.actions += [json.loads(line) for line in out.splitlines() if line.strip()]
+        assert self.process.returncode == 0
+        return self.actions
+
+    def said(self) -> list[str]:
+        return [a["args"]["text"] for a in self.actions if a["action"] == "say"]
+
+
+@pytest.fixture
+def start_robot() -> Iterator[Callable[..., Robot]]:
+    """Starts `vest run --cloud` robots on the simulated vest (stopped after the test)."""
+    robots: list[Robot] = []
+
+    def start(url: str, token_file: Path, scenario: Path, trees: list[str]) -> Robot:
+        robots.append(Robot(url, token_file, scenario, trees))
+        return robots[-1]
+
+    yield start
+    for robot in robots:
+        if robot.process.poll() is None:
+            robot.process.kill()
+            robot.process.wait()

@@ -15,7 +15,7 @@ import socket
 import subprocess
 import sys
 import threading
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
@@ -112,53 +112,6 @@ class Operator:
         raise AssertionError(f"the stream ended before {command_id} finished")
 
 
-class Robot:
-    """`vest run --cloud` on the simulated vest, its timeline read line by line."""
-
-    def __init__(self, url: str, token_file: Path, scenario: Path, trees: list[str]) -> None:
-        self.process = subprocess.Popen(
-            [
-                *VEST,
-                "run",
-                "--trees",
-                *trees,
-                "--scenario",
-                str(scenario),
-                "--speech",
-                "text",
-                "--cloud",
-                url,
-                "--token-file",
-                str(token_file),
-                "--json",
-            ],
-            cwd=ROOT,
-            stdout=subprocess.PIPE,
-            stderr=subprocess.DEVNULL,
-            text=True,
-        )
-        self.actions: list[dict[str, Any]] = []
-
-    def until(self, wanted: Any) -> dict[str, Any]:
-        """Reads the timeline until an action for which ``wanted(action)`` is true."""
-        assert self.process.stdout is not None
-        for line in self.process.stdout:
-            action = json.loads(line)
-            self.actions.append(action)
-            if wanted(action):
-                return action
-        raise AssertionError(f"the robot ended first; it did {self.actions}")
-
-    def finish(self) -> list[dict[str, Any]]:
-        out, _ = self.process.communicate(timeout=60)
-        self.actions += [json.loads(line) for line in out.splitlines() if line.strip()]
-        assert self.process.returncode == 0
-        return self.actions
-
-    def said(self) -> list[str]:
-        return [a["args"]["text"] for a in self.actions if a["action"] == "say"]
-
-
 @pytest.fixture
 def setup(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> Iterator[dict[str, Any]]:
     db_url = f"sqlite:///{tmp_path / 'cloud.db'}"
@@ -184,7 +137,7 @@ def robot_claims(service: ServiceProcess, token_file: Path) -> dict[str, Any]:
 
 
 def test_a_killed_service_loses_no_command_and_none_is_carried_out_twice(
-    setup: dict[str, Any], tmp_path: Path
+    setup: dict[str, Any], tmp_path: Path, start_robot: Callable[..., Any]
 ) -> None:
     service, operator, token_file = setup["service"], setup["operator"], setup["token"]
     done = DoneCommands(Path(f"{token_file}.done.json"))
@@ -213,7 +166,9 @@ def test_a_killed_service_loses_no_command_and_none_is_carried_out_twice(
     assert operator.command(delta)["state"] == "QUEUED"
 
     (tmp_path / "quiet.yaml").write_text("duration_s: 60\nevents: []\n")
-    robot = Robot(service.url, token_file, tmp_path / "quiet.yaml", ["trees/iot_command.yaml"])
+    robot = start_robot(
+        service.url, token_file, tmp_path / "quiet.yaml", ["trees/iot_command.yaml"]
+    )
     try:
         for command in (bravo, charlie, delta):
             assert operator.until_finished(command)["state"] == "SUCCEEDED"
@@ -226,7 +181,7 @@ def test_a_killed_service_loses_no_command_and_none_is_carried_out_twice(
 
 
 def test_a_robot_whose_service_went_away_keeps_behaving_and_catches_up(
-    setup: dict[str, Any], tmp_path: Path
+    setup: dict[str, Any], tmp_path: Path, start_robot: Callable[..., Any]
 ) -> None:
     service, operator, token_file = setup["service"], setup["operator"], setup["token"]
     scenario = tmp_path / "pats.yaml"
@@ -234,7 +189,7 @@ def test_a_robot_whose_service_went_away_keeps_behaving_and_catches_up(
         "duration_s: 120\nevents:\n"
         + "".join(f"  - {{at: {t}, touch: {{pad: 3, seconds: 0.3}}}}\n" for t in range(5, 120, 5))
     )
-    robot = Robot(
+    robot = start_robot(
         service.url, token_file, scenario, ["trees/iot_command.yaml", "trees/touch_thanks.yaml"]
     )
     try:
