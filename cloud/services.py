@@ -10,6 +10,7 @@ from cloud.store.directory import Directory
 from cloud.store.doorbell import Doorbell
 from cloud.store.ledger import CommandLedger
 from cloud.store.notifications import PostgresNotifications
+from cloud.store.principal_cache import PrincipalCache
 from cloud.store.telemetry import Telemetry
 from engine.clock import Clock
 
@@ -27,6 +28,7 @@ class CloudStore:
 
     def __post_init__(self) -> None:
         self.closing = self.clock.event()
+        self.principals = PrincipalCache(self.directory, self.clock)
 
     @classmethod
     def open(cls, settings: Settings, clock: Clock) -> CloudStore:

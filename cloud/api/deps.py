@@ -21,7 +21,7 @@ StoreDep = Annotated[CloudStore, Depends(get_store)]
 def _caller(request: Request, store: StoreDep) -> Principal:
     header = request.headers.get("authorization", "")
     scheme, _, token = header.partition(" ")
-    principal = store.directory.authenticate(token.strip()) if scheme.lower() == "bearer" else None
+    principal = store.principals.authenticate(token.strip()) if scheme.lower() == "bearer" else None
     if principal is None:
         raise HTTPException(
             status.HTTP_401_UNAUTHORIZED,

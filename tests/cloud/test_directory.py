@@ -7,7 +7,9 @@ from sqlalchemy import select
 
 from cloud.store.database import Database
 from cloud.store.directory import Directory
+from cloud.store.principal_cache import PrincipalCache
 from cloud.store.tables import OperatorRow, RobotRow
+from engine.clock import VirtualClock
 from engine.errors import ConfigError
 
 
@@ -60,3 +62,18 @@ def test_two_of_one_name_or_an_unknown_operator_are_refused_by_name(directory: D
         directory.add_robot("hbs2", operator="bob")
     with directory.db.transaction() as session:
         assert session.scalars(select(RobotRow)).all() == []
+
+
+def test_a_token_revoked_elsewhere_stops_working_within_the_cache_time(
+    directory: Directory, clock: VirtualClock
+) -> None:
+    directory.add_operator("ana")
+    token = directory.add_robot("hbs2", operator="ana")
+    principals = PrincipalCache(directory, clock, ttl_s=5.0)
+    assert principals.authenticate(token) is not None
+    directory.revoke("robot", "hbs2")  # as `vest cloud revoke` does, from another process
+    clock.advance(4.9)
+    assert principals.authenticate(token) is not None  # still trusted, for a moment
+    clock.advance(0.2)
+    assert principals.authenticate(token) is None
+    assert principals.authenticate("a guess") is None

@@ -1,0 +1,42 @@
+"""Remembering who a token belongs to for a few seconds.
+
+Every request carries a token, and looking it up costs the database one or two queries:
+more than the rest of a telemetry post. A token found valid is trusted for ``ttl_s``; a
+token revoked (by `vest cloud revoke`, in another process) stops working within that time.
+Unknown tokens are never remembered, so guessing cannot fill the memory.
+"""
+
+from __future__ import annotations
+
+import threading
+
+from cloud.store.directory import Directory, Principal
+from cloud.store.tokens import digest
+from engine.clock import Clock
+
+TTL_S = 5.0
+
+
+class PrincipalCache:
+    def __init__(self, directory: Directory, clock: Clock, ttl_s: float = TTL_S) -> None:
+        self.directory = directory
+        self.clock = clock
+        self.ttl_s = ttl_s
+        self._known: dict[str, tuple[Principal, float]] = {}
+        self._lock = threading.Lock()
+
+    def authenticate(self, token: str) -> Principal | None:
+        """The operator or robot whose token this is, or None (unknown or revoked)."""
+        key = digest(token)
+        now = self.clock.now()
+        with self._lock:
+            known = self._known.get(key)
+        if known is not None and now < known[1]:
+            return known[0]
+        principal = self.directory.authenticate(token)
+        with self._lock:
+            if principal is None:
+                self._known.pop(key, None)
+            else:
+                self._known[key] = (principal, now + self.ttl_s)
+        return principal
