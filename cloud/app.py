@@ -69,4 +69,8 @@ def app_from_environment() -> FastAPI:
     VEST_CLOUD_SETTINGS environment variable, as JSON)."""
     import os
 
-    return create_app(Settings.from_json(os.environ[SETTINGS_ENV]))
+    from cloud.server import tune_garbage_collector
+
+    app = create_app(Settings.from_json(os.environ[SETTINGS_ENV]))
+    tune_garbage_collector()
+    return app

@@ -22,7 +22,7 @@ class Settings:
     lease_s: float = 30.0
     default_timeout_s: float = 300.0
     max_wait_s: float = 30.0
-    recheck_s: float = 1.0
+    recheck_s: float = 5.0
     max_body_bytes: int = 64 * 1024
     flush_s: float = 1.0
     threads: int = 1000

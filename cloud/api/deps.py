@@ -5,12 +5,13 @@ from __future__ import annotations
 from typing import Annotated
 
 from fastapi import Depends, HTTPException, Request, status
+from starlette.concurrency import run_in_threadpool
 
 from cloud.services import CloudStore
 from cloud.store.directory import Principal
 
 
-def get_store(request: Request) -> CloudStore:
+async def get_store(request: Request) -> CloudStore:
     store: CloudStore = request.app.state.store
     return store
 
@@ -18,10 +19,17 @@ def get_store(request: Request) -> CloudStore:
 StoreDep = Annotated[CloudStore, Depends(get_store)]
 
 
-def _caller(request: Request, store: StoreDep) -> Principal:
+async def _caller(request: Request, store: StoreDep) -> Principal:
+    """The token's owner; a token seen lately is answered from memory, on the event loop
+    (dependencies declared ``def`` would each cost a hop to a worker thread)."""
     header = request.headers.get("authorization", "")
     scheme, _, token = header.partition(" ")
-    principal = store.principals.authenticate(token.strip()) if scheme.lower() == "bearer" else None
+    token = token.strip()
+    principal = None
+    if scheme.lower() == "bearer" and token:
+        principal = store.principals.remembered(token) or await run_in_threadpool(
+            store.principals.authenticate, token
+        )
     if principal is None:
         raise HTTPException(
             status.HTTP_401_UNAUTHORIZED,
@@ -31,13 +39,13 @@ def _caller(request: Request, store: StoreDep) -> Principal:
     return principal
 
 
-def _operator(caller: Annotated[Principal, Depends(_caller)]) -> Principal:
+async def _operator(caller: Annotated[Principal, Depends(_caller)]) -> Principal:
     if caller.kind != "operator":
         raise HTTPException(status.HTTP_404_NOT_FOUND, "not found")
     return caller
 
 
-def _robot(caller: Annotated[Principal, Depends(_caller)]) -> Principal:
+async def _robot(caller: Annotated[Principal, Depends(_caller)]) -> Principal:
     if caller.kind != "robot":
         raise HTTPException(status.HTTP_404_NOT_FOUND, "not found")
     return caller

@@ -51,5 +51,6 @@ def report_result(
 
 
 @router.post("/telemetry", status_code=status.HTTP_204_NO_CONTENT)
-def push_telemetry(body: TelemetryReport, store: StoreDep, robot: CurrentRobot) -> None:
+async def push_telemetry(body: TelemetryReport, store: StoreDep, robot: CurrentRobot) -> None:
+    """Kept in memory (written in batches): no database, so no worker thread."""
     store.telemetry.put(robot.id, body.values)

@@ -67,7 +67,7 @@ class Database:
         with self.engine.begin() as connection:
             if self.is_postgresql:  # released when the transaction ends
                 connection.execute(text(f"SELECT pg_advisory_xact_lock({MIGRATION_LOCK})"))
-            command.upgrade(_alembic_config(connection), "head")
+            command.upgrade(alembic_config(connection), "head")
 
     @contextmanager
     def transaction(self) -> Iterator[Session]:
@@ -79,7 +79,8 @@ class Database:
         self.engine.dispose()
 
 
-def _alembic_config(connection: Connection) -> Config:
+def alembic_config(connection: Connection) -> Config:
+    """Alembic's configuration for running the migrations on ``connection``."""
     config = Config()
     config.set_main_option("script_location", str(MIGRATIONS))
     config.attributes["connection"] = connection

@@ -25,14 +25,20 @@ class PrincipalCache:
         self._known: dict[str, tuple[Principal, float]] = {}
         self._lock = threading.Lock()
 
+    def remembered(self, token: str) -> Principal | None:
+        """The token's owner if it was found valid within ``ttl_s``; None means "ask
+        ``authenticate``" (no database is touched here: safe on the event loop)."""
+        with self._lock:
+            known = self._known.get(digest(token))
+        return known[0] if known is not None and self.clock.now() < known[1] else None
+
     def authenticate(self, token: str) -> Principal | None:
         """The operator or robot whose token this is, or None (unknown or revoked)."""
+        remembered = self.remembered(token)
+        if remembered is not None:
+            return remembered
         key = digest(token)
         now = self.clock.now()
-        with self._lock:
-            known = self._known.get(key)
-        if known is not None and now < known[1]:
-            return known[0]
         principal = self.directory.authenticate(token)
         with self._lock:
             if principal is None:

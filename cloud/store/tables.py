@@ -72,11 +72,12 @@ class CommandRow(Table):
 
 
 class TelemetryRow(Table):
-    """The latest value of one key of one robot, and when it was sent."""
+    """The latest telemetry of one robot: ``readings`` is {key: {"value", "at_s"}}, and
+    ``at_s`` when the newest of them came (one row a robot: a batch writes one row per
+    robot that pushed, not one per value)."""
 
-    __tablename__ = "telemetry"
+    __tablename__ = "robot_telemetry"
 
     robot_id: Mapped[int] = mapped_column(ForeignKey("robots.id"), primary_key=True)
-    key: Mapped[str] = mapped_column(String(200), primary_key=True)
-    value: Mapped[Any] = mapped_column(JSON, nullable=True)
+    readings: Mapped[dict[str, Any]] = mapped_column(JSON)
     at_s: Mapped[float] = mapped_column(Float)

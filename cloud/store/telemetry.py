@@ -3,8 +3,10 @@
 Robots push every second; writing each push at once would make the database the
 bottleneck (200 robots: 200 transactions a second). The latest values are kept in memory
 and written in one batch by ``flush()`` (the service calls it every ``flush_s``, and when it
-stops). Reads merge memory over the database, so this worker always answers with the newest
-it has heard; another worker sharing a PostgreSQL database sees it after the next flush.
+stops): one row per robot that pushed, holding all its keys. Reads merge memory over the
+database, so this worker always answers with the newest it has heard; another worker
+sharing a PostgreSQL database sees it after the next flush (robots push every key every
+second, so a worker's batch is never more than a push behind).
 """
 
 from __future__ import annotations
@@ -14,7 +16,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from typing import Any
 
-from sqlalchemy import bindparam, select, update
+from sqlalchemy import bindparam, update
 from sqlalchemy.dialects import postgresql, sqlite
 
 from cloud.store.database import Database
@@ -45,6 +47,9 @@ class Telemetry:
 
     def put(self, robot_id: int, values: dict[str, Any]) -> None:
         """Keep ``values`` as the robot's latest, stamped now; the robot was seen now."""
+        if not values:
+            self.seen(robot_id)
+            return
         now = self.clock.now()
         with self._lock:
             latest = self._latest.setdefault(robot_id, {})
@@ -83,8 +88,8 @@ class Telemetry:
     def latest(self, robot_id: int) -> dict[str, Reading]:
         """key -> {"value", "at_s"}, sorted by key."""
         with self.db.transaction() as session:
-            rows = session.scalars(select(TelemetryRow).where(TelemetryRow.robot_id == robot_id))
-            stored = {row.key: {"value": row.value, "at_s": row.at_s} for row in rows}
+            row = session.get(TelemetryRow, robot_id)
+            stored = dict(row.readings) if row is not None else {}
         with self._lock:
             for key, reading in self._latest.get(robot_id, {}).items():
                 if key not in stored or stored[key]["at_s"] <= reading["at_s"]:
@@ -101,16 +106,20 @@ class Telemetry:
         return heard_s
 
     def flush(self) -> int:
-        """Write what came in since the last flush, in one transaction; returns how many
-        values were written."""
+        """Write what came in since the last flush, in one transaction: each robot that
+        pushed gets its row rewritten with every key this worker holds for it. Returns how
+        many new values went in."""
         with self._lock:
             values, self._unwritten = self._unwritten, {}
             seen, self._unwritten_seen = self._unwritten_seen, {}
-        rows = [
-            {"robot_id": robot_id, "key": key, "value": reading["value"], "at_s": reading["at_s"]}
-            for robot_id, readings in values.items()
-            for key, reading in readings.items()
-        ]
+            rows = [
+                {
+                    "robot_id": robot_id,
+                    "readings": dict(self._latest[robot_id]),
+                    "at_s": max(r["at_s"] for r in self._latest[robot_id].values()),
+                }
+                for robot_id in values
+            ]
         if not rows and not seen:
             return 0
         try:
@@ -124,7 +133,7 @@ class Telemetry:
         except Exception:
             self._unwrite(values, seen)  # kept for the next flush
             raise
-        return len(rows)
+        return sum(len(readings) for readings in values.values())
 
     def _unwrite(self, values: dict[int, dict[str, Reading]], seen: dict[int, float]) -> None:
         with self._lock:
@@ -139,6 +148,6 @@ class Telemetry:
         insert = postgresql.insert if self.db.is_postgresql else sqlite.insert
         statement = insert(TelemetryRow)
         return statement.on_conflict_do_update(
-            index_elements=[TelemetryRow.robot_id, TelemetryRow.key],
-            set_={"value": statement.excluded.value, "at_s": statement.excluded.at_s},
+            index_elements=[TelemetryRow.robot_id],
+            set_={"readings": statement.excluded.readings, "at_s": statement.excluded.at_s},
         )

@@ -97,7 +97,7 @@ def _serve(settings: Settings, host: str, port: int, workers: int) -> int:
     import uvicorn
 
     from cloud.app import create_app
-    from cloud.server import GRACE_S, server_for
+    from cloud.server import GRACE_S, server_for, tune_garbage_collector
     from cloud.store.database import Database
 
     if not 1 <= port <= 65535:
@@ -106,7 +106,9 @@ def _serve(settings: Settings, host: str, port: int, workers: int) -> int:
         raise UsageError(f"--workers {workers}: use 1..64")
     Database(settings.db_url).close()  # a bad URL is named now, the schema brought up to date
     if workers == 1:
-        server_for(create_app(settings), host=host, port=port, log_level="info").run()
+        server = server_for(create_app(settings), host=host, port=port, log_level="info")
+        tune_garbage_collector()
+        server.run()
         return 0
     if not settings.db_url.startswith(("postgresql", "postgres:")):
         raise UsageError(
