@@ -4,7 +4,8 @@ from __future__ import annotations
 
 from typing import Annotated
 
-from fastapi import APIRouter, HTTPException, Query, Response, status
+from fastapi import APIRouter, HTTPException, Query, Request, Response, status
+from starlette.concurrency import run_in_threadpool
 
 from cloud.api.deps import CurrentRobot, StoreDep
 from cloud.api.schemas import CommandPublic, ResultReport, TelemetryReport
@@ -14,24 +15,33 @@ router = APIRouter(prefix="/robot", tags=["robot"])
 
 
 @router.get("/commands/next", response_model=None)
-def next_command(
+async def next_command(
+    request: Request,
     store: StoreDep,
     robot: CurrentRobot,
     wait_s: Annotated[float, Query(ge=0, le=60)] = 0.0,
 ) -> CommandPublic | Response:
     """The next command, now IN_PROGRESS under a lease; 204 when none came within
-    ``wait_s`` (at most the service's max_wait_s)."""
+    ``wait_s`` (at most the service's max_wait_s).
+
+    A command is only taken for a caller still there: a long-poll whose client went away,
+    or that the same robot replaced with a newer one, ends without taking anything (else the
+    command would wait out its lease before the robot saw it)."""
     deadline_s = store.clock.now() + min(wait_s, store.settings.max_wait_s)
-    with store.telemetry.polling(robot.id):
-        while True:
-            command = store.ledger.claim_next(robot.id)
+    with store.telemetry.polling(robot.id) as superseded:
+        store.doorbell.ring(robot.id)  # an older long-poll of this robot wakes and ends
+        while not (superseded() or store.closing.is_set() or await request.is_disconnected()):
+            command = await run_in_threadpool(store.ledger.claim_next, robot.id)
             if command is not None:
-                store.announce(robot.id)  # the operators' live pages
+                await run_in_threadpool(store.announce, robot.id)  # the operators' pages
                 return CommandPublic.of(command, robot.name)
             left_s = deadline_s - store.clock.now()
-            if left_s <= 0 or store.closing.is_set():
-                return Response(status_code=status.HTTP_204_NO_CONTENT)
-            store.doorbell.wait(robot.id, min(left_s, store.settings.recheck_s))
+            if left_s <= 0:
+                break
+            await run_in_threadpool(
+                store.doorbell.wait, robot.id, min(left_s, store.settings.recheck_s)
+            )
+    return Response(status_code=status.HTTP_204_NO_CONTENT)
 
 
 @router.post("/commands/{command_id}/result")

@@ -12,7 +12,7 @@ second, so a worker's batch is never more than a push behind).
 from __future__ import annotations
 
 import threading
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from typing import Any
 
@@ -44,6 +44,7 @@ class Telemetry:
         self._unwritten: dict[int, dict[str, Reading]] = {}
         self._unwritten_seen: dict[int, float] = {}
         self._polling: dict[int, int] = {}
+        self._newest_poll: dict[int, int] = {}
 
     def put(self, robot_id: int, values: dict[str, Any]) -> None:
         """Keep ``values`` as the robot's latest, stamped now; the robot was seen now."""
@@ -65,14 +66,16 @@ class Telemetry:
             self._seen[robot_id] = self._unwritten_seen[robot_id] = now
 
     @contextmanager
-    def polling(self, robot_id: int) -> Iterator[None]:
+    def polling(self, robot_id: int) -> Iterator[Callable[[], bool]]:
         """The robot is waiting in a long-poll: it is seen when it starts and ends, and
-        online all along."""
+        online all along. Yields ``superseded()``: True once the same robot started a newer
+        long-poll in this worker (this one's client gave up: it must not take a command)."""
         self.seen(robot_id)
         with self._lock:
             self._polling[robot_id] = self._polling.get(robot_id, 0) + 1
+            self._newest_poll[robot_id] = poll = self._newest_poll.get(robot_id, 0) + 1
         try:
-            yield
+            yield lambda: self._newest_poll.get(robot_id) != poll
         finally:
             with self._lock:
                 self._polling[robot_id] -= 1

@@ -6,6 +6,7 @@ import json
 import threading
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 import pytest
@@ -13,6 +14,7 @@ import requests
 
 from cloud.services import CloudStore
 from cloud.settings import Settings
+from engine.clock import VirtualClock
 
 
 @dataclass
@@ -320,3 +322,36 @@ def test_the_page_is_served_with_a_strict_content_policy(service: Service) -> No
     assert "default-src 'self'" in home.headers["content-security-policy"]
     script = requests.get(service.url.removesuffix("/api/v1") + "/operator/app.js", timeout=10)
     assert script.status_code == 200 and "javascript" in script.headers["content-type"]
+
+
+def test_a_long_poll_replaced_by_a_newer_one_of_the_same_robot_takes_nothing(
+    tmp_path: Path, start_service: Callable[..., Any]
+) -> None:
+    clock = VirtualClock(start_s=1000.0)  # long-polls wait until woken: nothing times out
+    running = start_service(Settings(db_url=f"sqlite:///{tmp_path / 'c.db'}"), clock)
+    operator = bearer(running.store.directory.add_operator("ana"))
+    robot = bearer(running.store.directory.add_robot("hbs2", operator="ana"))
+    answers: dict[str, requests.Response] = {}
+
+    def poll(name: str) -> None:
+        answers[name] = requests.get(
+            f"{running.api}/robot/commands/next?wait_s=30", headers=robot, timeout=30
+        )
+
+    stale = threading.Thread(target=poll, args=("stale",))
+    stale.start()
+    # the service's telemetry writer waits on the clock too: two waiters = the poll waits
+    assert clock.until_waiting(2)  # the first long-poll waits (its robot lost the reply)
+    fresh = threading.Thread(target=poll, args=("fresh",))
+    fresh.start()
+    stale.join(timeout=30)
+    assert answers["stale"].status_code == 204  # replaced: it ends, taking nothing
+    assert clock.until_waiting(2)
+    sent = requests.post(
+        f"{running.api}/robots/hbs2/commands",
+        json={"type": "say", "args": {"text": "hi"}},
+        headers=operator,
+        timeout=10,
+    ).json()
+    fresh.join(timeout=30)
+    assert answers["fresh"].status_code == 200 and answers["fresh"].json()["id"] == sent["id"]
