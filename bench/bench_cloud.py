@@ -339,59 +339,71 @@ def line(label: str, results: Results, sent: int) -> str:
     )
 
 
-async def run(quick: bool) -> None:
+async def on_sqlite(folder: str, seconds: float) -> float:
+    """Question 1 on SQLite, with the polling baseline; returns the telemetry rate."""
+    sqlite = f"sqlite:///{folder}/bench.db"
+    tokens = prepare(sqlite)
+    service = Service(sqlite, workers=1)
+    service.start()
+    try:
+        base, base_sent = await command_phase(
+            service.port, tokens, seconds, with_telemetry=False, short_poll_s=1.0
+        )
+        print(line("baseline: polling once a second, SQLite", base, base_sent))
+        for with_telemetry in (False, True):
+            results, sent = await command_phase(
+                service.port, tokens, seconds, with_telemetry=with_telemetry
+            )
+            label = "long-poll, SQLite, 1 worker" + (", telemetry 1/s" if with_telemetry else "")
+            print(line(label, results, sent))
+            if not with_telemetry:
+                ratio = statistics.median(base.latencies_ms) / statistics.median(
+                    results.latencies_ms
+                )
+                print(f"{'':<48} {ratio:.0f} x sooner than polling (p50)")
+        return await telemetry_rate(service.port, tokens[1][0], seconds / 2)
+    finally:
+        service.stop()
+
+
+async def on_postgresql(seconds: float) -> float:
+    """Question 1 on PostgreSQL with 2 workers; returns the telemetry rate."""
+    cluster = PostgresCluster()
+    cluster.start()
+    try:
+        postgres = cluster.new_database()
+        tokens = prepare(postgres)
+        service = Service(postgres, workers=2)
+        service.start()
+        try:
+            for with_telemetry in (False, True):
+                results, sent = await command_phase(
+                    service.port, tokens, seconds, with_telemetry=with_telemetry
+                )
+                label = "long-poll, PostgreSQL, 2 workers" + (
+                    ", telemetry 1/s" if with_telemetry else ""
+                )
+                print(line(label, results, sent))
+            return await telemetry_rate(service.port, tokens[1][0], seconds / 2)
+        finally:
+            service.stop()
+    finally:
+        cluster.stop()
+
+
+async def run(quick: bool, only: str | None) -> None:
     seconds = 8.0 if quick else 20.0
     print(
         f"{ROBOTS} robots, {COMMANDS_PER_S:g} commands/s for {seconds:g} s per phase; "
         f"{os.cpu_count()} cores shared by the service and this load\n"
     )
     print("Question 1: command -> the robot has it")
+    rates: dict[str, float] = {}
     with tempfile.TemporaryDirectory() as folder:
-        sqlite = f"sqlite:///{folder}/bench.db"
-        tokens = prepare(sqlite)
-        service = Service(sqlite, workers=1)
-        service.start()
-        try:
-            base, base_sent = await command_phase(
-                service.port, tokens, seconds, with_telemetry=False, short_poll_s=1.0
-            )
-            print(line("baseline: polling once a second, SQLite", base, base_sent))
-            for with_telemetry in (False, True):
-                results, sent = await command_phase(
-                    service.port, tokens, seconds, with_telemetry=with_telemetry
-                )
-                label = f"long-poll, SQLite, 1 worker{', telemetry 1/s' if with_telemetry else ''}"
-                print(line(label, results, sent))
-                if not with_telemetry:
-                    ratio = statistics.median(base.latencies_ms) / statistics.median(
-                        results.latencies_ms
-                    )
-                    print(f"{'':<48} {ratio:.0f} x sooner than polling (p50)")
-            rate = await telemetry_rate(service.port, tokens[1][0], seconds / 2)
-        finally:
-            service.stop()
-
-        cluster = PostgresCluster()
-        cluster.start()
-        try:
-            postgres = cluster.new_database()
-            tokens = prepare(postgres)
-            service = Service(postgres, workers=2)
-            service.start()
-            try:
-                for with_telemetry in (False, True):
-                    results, sent = await command_phase(
-                        service.port, tokens, seconds, with_telemetry=with_telemetry
-                    )
-                    label = "long-poll, PostgreSQL, 2 workers" + (
-                        ", telemetry 1/s" if with_telemetry else ""
-                    )
-                    print(line(label, results, sent))
-                pg_rate = await telemetry_rate(service.port, tokens[1][0], seconds / 2)
-            finally:
-                service.stop()
-        finally:
-            cluster.stop()
+        if only in (None, "sqlite"):
+            rates["SQLite, 1 worker"] = await on_sqlite(folder, seconds)
+        if only in (None, "postgresql"):
+            rates["PostgreSQL, 2 workers"] = await on_postgresql(seconds)
 
         print("\nQuestion 2: telemetry posts answered per second (64 clients)")
         bare, port = bare_server(Path(folder))
@@ -401,11 +413,11 @@ async def run(quick: bool) -> None:
         finally:
             bare.terminate()
             bare.wait(timeout=10)
-        print(f"{'bare uvicorn app answering 204 (baseline)':<48} {bare_rate:7.0f} /s")
-        for label, value in (("SQLite, 1 worker", rate), ("PostgreSQL, 2 workers", pg_rate)):
-            name = f"vest cloud, {label}"
-            print(f"{name:<48} {value:7.0f} /s  ({value / bare_rate:.2f} x baseline)")
-        print(f"{ROBOTS} robots pushing once a second need {ROBOTS} posts/s")
+    print(f"{'bare uvicorn app answering 204 (baseline)':<48} {bare_rate:7.0f} /s")
+    for label, value in rates.items():
+        name = f"vest cloud, {label}"
+        print(f"{name:<48} {value:7.0f} /s  ({value / bare_rate:.2f} x baseline)")
+    print(f"{ROBOTS} robots pushing once a second need {ROBOTS} posts/s")
 
 
 def main() -> None:
@@ -413,7 +425,9 @@ def main() -> None:
         description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
     )
     parser.add_argument("--quick", action="store_true", help="8 s phases instead of 20 s")
-    asyncio.run(run(parser.parse_args().quick))
+    parser.add_argument("--only", choices=("sqlite", "postgresql"), help="one database")
+    args = parser.parse_args()
+    asyncio.run(run(args.quick, args.only))
 
 
 if __name__ == "__main__":

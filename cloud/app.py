@@ -19,7 +19,6 @@ from cloud.store.writer import TelemetryWriter
 from engine.clock import Clock, EpochClock
 
 API = "/api/v1"
-SETTINGS_ENV = "VEST_CLOUD_SETTINGS"
 
 
 def create_app(
@@ -61,16 +60,4 @@ def create_app(
         ]
         return JSONResponse({"detail": problems}, status_code=422)
 
-    return app
-
-
-def app_from_environment() -> FastAPI:
-    """The app of one worker of ``vest cloud serve --workers N`` (its settings come in the
-    VEST_CLOUD_SETTINGS environment variable, as JSON)."""
-    import os
-
-    from cloud.server import tune_garbage_collector
-
-    app = create_app(Settings.from_json(os.environ[SETTINGS_ENV]))
-    tune_garbage_collector()
     return app

@@ -11,7 +11,6 @@ Every one takes --db URL: a SQLite file (default sqlite:///vest-cloud.db) or pos
 from __future__ import annotations
 
 import argparse
-import os
 from typing import TYPE_CHECKING
 
 from engine.clock import EpochClock
@@ -94,37 +93,21 @@ def main(args: argparse.Namespace) -> int:
 
 
 def _serve(settings: Settings, host: str, port: int, workers: int) -> int:
-    import uvicorn
-
-    from cloud.app import create_app
-    from cloud.server import GRACE_S, server_for, tune_garbage_collector
+    from cloud.server import serve, serve_workers
     from cloud.store.database import Database
 
     if not 1 <= port <= 65535:
         raise UsageError(f"--port {port}: use 1..65535")
     if not 1 <= workers <= 64:
         raise UsageError(f"--workers {workers}: use 1..64")
-    Database(settings.db_url).close()  # a bad URL is named now, the schema brought up to date
-    if workers == 1:
-        server = server_for(create_app(settings), host=host, port=port, log_level="info")
-        tune_garbage_collector()
-        server.run()
-        return 0
-    if not settings.db_url.startswith(("postgresql", "postgres:")):
+    if workers > 1 and not settings.db_url.startswith(("postgresql", "postgres:")):
         raise UsageError(
             f"--workers {workers} needs a PostgreSQL --db (SQLite has one writer, and only "
             "PostgreSQL tells every worker that a command arrived)"
         )
-    from cloud.app import SETTINGS_ENV
-
-    os.environ[SETTINGS_ENV] = settings.to_json()
-    uvicorn.run(
-        "cloud.app:app_from_environment",
-        factory=True,
-        host=host,
-        port=port,
-        workers=workers,
-        log_level="info",
-        timeout_graceful_shutdown=GRACE_S,
-    )
+    Database(settings.db_url).close()  # a bad URL is named now, the schema brought up to date
+    if workers == 1:
+        serve(settings, host, port)
+    else:
+        serve_workers(settings, host, port, workers)
     return 0

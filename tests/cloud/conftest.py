@@ -20,7 +20,7 @@ import pytest
 import uvicorn
 
 from cloud.app import create_app
-from cloud.server import server_for
+from cloud.server import listening_socket, server_for
 from cloud.services import CloudStore
 from cloud.settings import Settings
 from cloud.store.database import Database
@@ -93,9 +93,7 @@ def start_service() -> Iterator[StartService]:
 
     def start(settings: Settings, clock: Clock | None = None) -> Running:
         store = CloudStore.open(settings, clock or EpochClock())
-        sock = socket.socket()
-        sock.bind(("127.0.0.1", 0))
-        sock.listen(256)
+        sock = listening_socket("127.0.0.1", 0, shared=False)
         server = server_for(create_app(settings, store=store), log_level="warning")
         thread = threading.Thread(target=server.run, kwargs={"sockets": [sock]}, daemon=True)
         thread.start()

@@ -51,7 +51,7 @@ class ServiceProcess:
         )
         assert self.process.stderr is not None
         for text in self.process.stderr:  # blocks until the server says it listens
-            if "Uvicorn running on" in text:
+            if "Application startup complete" in text:
                 break
         else:
             raise AssertionError(f"vest cloud serve ended: {self.process.wait()}")
