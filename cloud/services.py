@@ -9,7 +9,7 @@ from cloud.store.database import Database
 from cloud.store.directory import Directory
 from cloud.store.doorbell import Doorbell
 from cloud.store.ledger import CommandLedger
-from cloud.store.notifications import PostgresNotifications
+from cloud.store.notifications import Announcer, PostgresListener
 from cloud.store.principal_cache import PrincipalCache
 from cloud.store.telemetry import Telemetry
 from engine.clock import Clock
@@ -24,7 +24,7 @@ class CloudStore:
     ledger: CommandLedger
     telemetry: Telemetry
     doorbell: Doorbell
-    notifications: PostgresNotifications | None = None
+    listener: PostgresListener | None = None
 
     def __post_init__(self) -> None:
         self.closing = self.clock.event()
@@ -34,28 +34,17 @@ class CloudStore:
     def open(cls, settings: Settings, clock: Clock) -> CloudStore:
         db = Database(settings.db_url)
         doorbell = Doorbell(clock)
-        notifications = (
-            PostgresNotifications(db.engine, doorbell, clock) if db.is_postgresql else None
-        )
-        return cls(
-            settings,
-            clock,
+        ledger = CommandLedger(
             db,
-            Directory(db),
-            CommandLedger(
-                db, clock, lease_s=settings.lease_s, default_timeout_s=settings.default_timeout_s
-            ),
-            Telemetry(db, clock),
-            doorbell,
-            notifications,
+            clock,
+            lease_s=settings.lease_s,
+            default_timeout_s=settings.default_timeout_s,
+            listener=Announcer(doorbell, postgresql=db.is_postgresql),
         )
-
-    def announce(self, robot_id: int) -> None:
-        """Something changed in the robot's commands: wake its long-poll and live pages,
-        in every worker when several share a PostgreSQL database."""
-        self.doorbell.ring(robot_id)
-        if self.notifications is not None:
-            self.notifications.announce(robot_id)
+        listener = PostgresListener(db.engine, doorbell, clock) if db.is_postgresql else None
+        return cls(
+            settings, clock, db, Directory(db), ledger, Telemetry(db, clock), doorbell, listener
+        )
 
     def begin_closing(self) -> None:
         """The service is stopping: live streams end now (waiting long-polls answer 204)."""
@@ -63,6 +52,6 @@ class CloudStore:
         self.doorbell.ring_everyone()
 
     def close(self) -> None:
-        if self.notifications is not None:
-            self.notifications.close()
+        if self.listener is not None:
+            self.listener.close()
         self.db.close()

@@ -21,9 +21,7 @@ def send_command(
     command, created = store.ledger.submit(
         row.id, body.type, body.args, idempotency_key=body.idempotency_key, timeout_s=body.timeout_s
     )
-    if created:
-        store.announce(row.id)
-    else:
+    if not created:
         response.status_code = status.HTTP_200_OK
     return CommandPublic.of(command, row.name)
 
@@ -54,5 +52,4 @@ def cancel_command(
     command = store.ledger.cancel(row.id, command_id)
     if command is None:
         raise HTTPException(status.HTTP_404_NOT_FOUND, f"no command {command_id!r}")
-    store.announce(row.id)
     return CommandPublic.of(command, row.name)

@@ -33,7 +33,6 @@ async def next_command(
         while not (superseded() or store.closing.is_set() or await request.is_disconnected()):
             command = await run_in_threadpool(store.ledger.claim_next, robot.id)
             if command is not None:
-                await run_in_threadpool(store.announce, robot.id)  # the operators' pages
                 return CommandPublic.of(command, robot.name)
             left_s = deadline_s - store.clock.now()
             if left_s <= 0:
@@ -56,7 +55,6 @@ def report_result(
         raise HTTPException(status.HTTP_409_CONFLICT, str(error)) from None
     if command is None:
         raise HTTPException(status.HTTP_404_NOT_FOUND, f"no command {command_id!r}")
-    store.announce(robot.id)  # the operators' live pages
     return CommandPublic.of(command, robot.name)
 
 

@@ -11,11 +11,14 @@ again, and the robot, which remembers what it carried out, reports the result it
 from __future__ import annotations
 
 import uuid
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Protocol
 
 from sqlalchemy import select
 from sqlalchemy.exc import IntegrityError
+from sqlalchemy.orm import Session
 
 from cloud.store.database import Database
 from cloud.store.tables import CommandRow
@@ -31,6 +34,15 @@ DEFAULT_TIMEOUT_S = 300.0
 EXPIRE_EVERY_S = 0.5
 """Leases and timeouts are looked at no more often than this (every long-poll's re-check
 would otherwise scan the ledger)."""
+
+
+class ChangeListener(Protocol):
+    """Told of every change to a robot's commands: ``within`` inside the transaction that
+    makes it (a PostgreSQL NOTIFY goes out when it commits), ``after`` once committed."""
+
+    def within(self, session: Session, robot_id: int) -> None: ...
+
+    def after(self, robot_id: int) -> None: ...
 
 
 class ConflictError(VestError, ValueError):
@@ -83,12 +95,28 @@ class CommandLedger:
         *,
         lease_s: float = DEFAULT_LEASE_S,
         default_timeout_s: float = DEFAULT_TIMEOUT_S,
+        listener: ChangeListener | None = None,
     ) -> None:
         self.db = db
         self.clock = clock
         self.lease_s = lease_s
         self.default_timeout_s = default_timeout_s
+        self.listener = listener
         self._expired_at_s = float("-inf")
+
+    @contextmanager
+    def _changing(self) -> Iterator[tuple[Session, set[int]]]:
+        """A transaction, and the set to put the id of each robot whose commands it changes
+        in: they are announced within it and again after it commits."""
+        changed: set[int] = set()
+        with self.db.transaction() as session:
+            yield session, changed
+            if self.listener is not None:
+                for robot_id in changed:
+                    self.listener.within(session, robot_id)
+        if self.listener is not None:
+            for robot_id in changed:
+                self.listener.after(robot_id)
 
     def submit(
         self,
@@ -122,8 +150,9 @@ class CommandLedger:
             deliveries=0,
         )
         try:
-            with self.db.transaction() as session:
+            with self._changing() as (session, changed):
                 session.add(row)
+                changed.add(robot_id)
         except IntegrityError:  # the same key, sent twice at once: the other one won
             known = self._by_key(robot_id, idempotency_key or "")
             if known is None:
@@ -152,18 +181,19 @@ class CommandLedger:
 
     def cancel(self, robot_id: int, command_id: str) -> Command | None:
         """CANCELED if it had not finished (a finished command stays as it is)."""
-        with self.db.transaction() as session:
+        with self._changing() as (session, changed):
             row = session.get(CommandRow, command_id)
             if row is None or row.robot_id != robot_id:
                 return None
             if row.state not in FINISHED:
                 self._change(row, CANCELED)
+                changed.add(robot_id)
             return Command.of(row)
 
     def claim_next(self, robot_id: int) -> Command | None:
         """The oldest QUEUED command of this robot, now IN_PROGRESS under a lease."""
         self._expire_due()
-        with self.db.transaction() as session:
+        with self._changing() as (session, changed):
             row = session.scalar(
                 select(CommandRow)
                 .where(
@@ -180,6 +210,7 @@ class CommandLedger:
             self._change(row, IN_PROGRESS)
             row.lease_until_s = self.clock.now() + self.lease_s
             row.deliveries += 1
+            changed.add(robot_id)
             return Command.of(row)
 
     def report(self, robot_id: int, command_id: str, status: str, result: Any) -> Command | None:
@@ -188,7 +219,7 @@ class CommandLedger:
         the command is not this robot's."""
         if status not in REPORTS:
             raise ValueError(f"status must be SUCCEEDED or FAILED, got {status!r}")
-        with self.db.transaction() as session:
+        with self._changing() as (session, changed):
             row = session.get(CommandRow, command_id)
             if row is None or row.robot_id != robot_id:
                 return None
@@ -199,6 +230,7 @@ class CommandLedger:
             self._change(row, status)
             row.result = result
             row.lease_until_s = None
+            changed.add(robot_id)
             return Command.of(row)
 
     def _expire_due(self) -> None:
@@ -208,7 +240,7 @@ class CommandLedger:
     def expire(self) -> None:
         """Leases that ran out go back to QUEUED; commands past their timeout, TIMED_OUT."""
         now = self._expired_at_s = self.clock.now()
-        with self.db.transaction() as session:
+        with self._changing() as (session, changed):
             late = session.scalars(
                 select(CommandRow).where(
                     CommandRow.state.in_((QUEUED, IN_PROGRESS)),
@@ -220,8 +252,9 @@ class CommandLedger:
                 if row.timeout_at_s <= now:
                     self._change(row, TIMED_OUT)
                 else:
-                    self._change(row, QUEUED)
+                    self._change(row, QUEUED)  # its robot's long-poll takes it again
                 row.lease_until_s = None
+                changed.add(row.robot_id)
 
     def _by_key(self, robot_id: int, key: str) -> Command | None:
         with self.db.transaction() as session:

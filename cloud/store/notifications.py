@@ -1,8 +1,9 @@
 """Ringing every worker's doorbell through PostgreSQL's LISTEN/NOTIFY.
 
 With several service processes on one PostgreSQL database, a command queued in one worker
-must wake the robot's long-poll in another. ``announce`` sends a notification; a listener
-thread in each worker rings its local doorbell for each one it receives. A lost
+must wake the robot's long-poll in another. The ledger sends a notification within each
+transaction that changes a robot's commands (``Announcer``); a listener thread in each
+worker rings its local doorbell for each one it receives. A lost
 notification (the listener reconnecting, say) costs only time: waiters re-check the ledger.
 """
 
@@ -13,6 +14,7 @@ import threading
 
 import psycopg
 from sqlalchemy import Engine, text
+from sqlalchemy.orm import Session
 
 from cloud.store.doorbell import Doorbell
 from engine.clock import Clock
@@ -24,11 +26,29 @@ POLL_S = 0.5
 """How long the listener waits for a notification before it looks at its stop flag."""
 
 
-class PostgresNotifications:
-    """Announces robot changes to every worker and rings ``doorbell`` for each heard."""
+class Announcer:
+    """The ledger's ChangeListener: rings this worker's doorbell once a change is committed,
+    and (``postgresql``) notifies every worker within the change's transaction."""
+
+    def __init__(self, doorbell: Doorbell, *, postgresql: bool) -> None:
+        self.doorbell = doorbell
+        self.postgresql = postgresql
+
+    def within(self, session: Session, robot_id: int) -> None:
+        if self.postgresql:
+            session.execute(
+                text("SELECT pg_notify(:channel, :robot)"),
+                {"channel": CHANNEL, "robot": str(robot_id)},
+            )
+
+    def after(self, robot_id: int) -> None:
+        self.doorbell.ring(robot_id)
+
+
+class PostgresListener:
+    """Rings ``doorbell`` for every notification another worker (or this one) sends."""
 
     def __init__(self, engine: Engine, doorbell: Doorbell, clock: Clock) -> None:
-        self.engine = engine
         self.dsn = engine.url.set(drivername="postgresql").render_as_string(hide_password=False)
         self.doorbell = doorbell
         self.clock = clock
@@ -36,14 +56,6 @@ class PostgresNotifications:
         self._listening = threading.Event()
         self._thread = threading.Thread(target=self._listen, name="pg-listen", daemon=True)
         self._thread.start()
-
-    def announce(self, robot_id: int) -> None:
-        """Ring ``robot_id``'s doorbell in every worker, this one included."""
-        with self.engine.begin() as connection:
-            connection.execute(
-                text("SELECT pg_notify(:channel, :robot)"),
-                {"channel": CHANNEL, "robot": str(robot_id)},
-            )
 
     def wait_listening(self, timeout_s: float) -> bool:
         """True once the listener has subscribed (tests wait for it before notifying)."""

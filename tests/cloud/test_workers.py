@@ -30,13 +30,12 @@ def test_a_command_queued_in_one_worker_wakes_the_long_poll_in_another(
     first.directory.add_operator("ana")
     robot = first.directory.authenticate(first.directory.add_robot("hbs2", operator="ana"))
     assert robot is not None
-    assert second.notifications is not None and second.notifications.wait_listening(10.0)
+    assert second.listener is not None and second.listener.wait_listening(10.0)
     woken: list[bool] = []
     waiter = threading.Thread(target=lambda: woken.append(second.doorbell.wait(robot.id, 30.0)))
     waiter.start()
     assert isinstance(second.clock, VirtualClock) and second.clock.until_waiting(1)
-    first.ledger.submit(robot.id, "say", {"text": "hi"})
-    first.announce(robot.id)
+    first.ledger.submit(robot.id, "say", {"text": "hi"})  # notifies every worker
     waiter.join(timeout=30.0)
     assert woken == [True]  # the virtual clock never moved: only the notification woke it
     assert second.ledger.claim_next(robot.id) is not None
@@ -45,6 +44,6 @@ def test_a_command_queued_in_one_worker_wakes_the_long_poll_in_another(
 def test_sqlite_has_no_notifications_to_listen_for(tmp_path: object) -> None:
     store = CloudStore.open(Settings(db_url=f"sqlite:///{tmp_path}/c.db"), EpochClock())
     try:
-        assert store.notifications is None
+        assert store.listener is None
     finally:
         store.close()
