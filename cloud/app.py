@@ -6,9 +6,11 @@ from collections.abc import AsyncIterator
 from contextlib import asynccontextmanager
 
 import anyio.to_thread
-from fastapi import FastAPI, Request
+from fastapi import FastAPI, Request, Response
+from fastapi.exception_handlers import http_exception_handler
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse
+from starlette.exceptions import HTTPException as StarletteHTTPException
 
 from cloud.api import commands, events, robot_side, robots
 from cloud.api.body_limit import BodyLimit
@@ -59,5 +61,12 @@ def create_app(
             for item in error.errors()
         ]
         return JSONResponse({"detail": problems}, status_code=422)
+
+    @app.exception_handler(StarletteHTTPException)
+    async def http_error(request: Request, error: StarletteHTTPException) -> Response:
+        if error.status_code == 400:  # JSON that parses nowhere: nested too deep, huge numbers
+            problem = {"field": "body", "message": "not JSON this service reads (too deep?)"}
+            return JSONResponse({"detail": [problem]}, status_code=422)
+        return await http_exception_handler(request, error)
 
     return app

@@ -12,25 +12,38 @@ from cloud.store.ledger import Command
 MAX_DEPTH = 16
 
 
-def finite_json(value: Any, depth: int = 0) -> Any:
-    """``value`` if every number in it is finite and it nests at most MAX_DEPTH deep (JSON
-    has no NaN or infinity, and PostgreSQL refuses them)."""
+def checked_json(value: Any, depth: int = 0) -> Any:
+    """``value`` if every number in it is finite, every text (keys included) is valid
+    Unicode, and it nests at most MAX_DEPTH deep. JSON has no NaN or infinity; a lone
+    surrogate (``"\\ud800"``) parses but can be neither stored in PostgreSQL nor sent back."""
     if depth > MAX_DEPTH:
         raise ValueError(f"nests deeper than {MAX_DEPTH} levels")
     if isinstance(value, float) and not math.isfinite(value):
         raise ValueError(f"numbers must be finite, got {value}")
-    if isinstance(value, dict):
-        for item in value.values():
-            finite_json(item, depth + 1)
+    if isinstance(value, str):
+        valid_text(value)
+    elif isinstance(value, dict):
+        for key, item in value.items():
+            valid_text(key)
+            checked_json(item, depth + 1)
     elif isinstance(value, list):
         for item in value:
-            finite_json(item, depth + 1)
+            checked_json(item, depth + 1)
     return value
 
 
-Json = Annotated[Any, AfterValidator(finite_json)]
-JsonObject = Annotated[dict[str, Any], AfterValidator(finite_json)]
+def valid_text(text: str) -> str:
+    try:
+        text.encode("utf-8")
+    except UnicodeEncodeError:
+        raise ValueError("text must be valid Unicode (a lone surrogate is not)") from None
+    return text
+
+
+Json = Annotated[Any, AfterValidator(checked_json)]
+JsonObject = Annotated[dict[str, Any], AfterValidator(checked_json)]
 TelemetryKey = Annotated[str, StringConstraints(min_length=1, max_length=200)]
+Key = Annotated[str, StringConstraints(min_length=1, max_length=128), AfterValidator(valid_text)]
 
 
 class CommandCreate(BaseModel):
@@ -38,7 +51,7 @@ class CommandCreate(BaseModel):
 
     type: str = Field(min_length=1, max_length=64, pattern=r"^[a-z][a-z0-9_]*$")
     args: JsonObject = Field(default_factory=dict)
-    idempotency_key: str | None = Field(default=None, min_length=1, max_length=128)
+    idempotency_key: Key | None = None
     timeout_s: float | None = Field(default=None, gt=0, le=86400)
 
 
@@ -80,7 +93,7 @@ class ResultReport(BaseModel):
 class TelemetryReport(BaseModel):
     model_config = ConfigDict(extra="forbid")
 
-    values: Annotated[dict[TelemetryKey, Any], AfterValidator(finite_json)] = Field(max_length=500)
+    values: Annotated[dict[TelemetryKey, Any], AfterValidator(checked_json)] = Field(max_length=500)
 
 
 class RobotPublic(BaseModel):

@@ -236,9 +236,21 @@ def post_raw(service: Service, path: str, raw: bytes | Any, who: dict[str, str])
         ("/robot/telemetry", b'{"values": {"' + b"k" * 201 + b'": 1}}', "values"),
         ("/robot/commands/nope/result", b'{"status": "SUCCEEDED", "result": -Infinity}', "result"),
         ("/robot/commands/nope/result", b'{"status": "DONE"}', "status"),
+        # a lone surrogate parses, but can be neither stored in PostgreSQL nor sent back
+        ("/robot/commands/nope/result", b'{"status": "FAILED", "result": "\\ud800"}', "result"),
+        ("/robots/hbs2/commands", b'{"type": "say", "args": {"\\udfff": 1}}', "args"),
+        ("/robots/hbs2/commands", b'{"type": "say", "idempotency_key": "\\ud800"}', "idem"),
+        ("/robot/telemetry", b'{"values": {"/s/\\ud800": 1}}', "values"),
+        # JSON no parser here reads: nested past Python's recursion, a 5,000-digit number
+        (
+            "/robots/hbs2/commands",
+            b'{"type": "say", "args": {"a": ' + b"[" * 5000 + b"]" * 5000 + b"}}",
+            "body",
+        ),
+        ("/robot/telemetry", b'{"values": {"/x": 1' + b"0" * 5000 + b"}}", "body"),
     ],
 )
-def test_numbers_json_cannot_carry_and_odd_keys_are_422(
+def test_what_json_cannot_carry_and_odd_keys_are_422(
     service: Service, path: str, raw: bytes, field: str
 ) -> None:
     who = service.operator if path.startswith("/robots/") else service.robot
