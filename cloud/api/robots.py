@@ -8,6 +8,7 @@ from fastapi import APIRouter, HTTPException, status
 
 from cloud.api.deps import CurrentOperator, StoreDep
 from cloud.api.schemas import RobotPublic
+from cloud.services import CloudStore
 from cloud.store.tables import RobotRow
 from engine.nodes.remote import command_catalogue
 
@@ -30,7 +31,7 @@ def list_robots(store: StoreDep, operator: CurrentOperator) -> list[RobotPublic]
     return [robot_public(store, row) for row in store.directory.robots_of(operator.id)]
 
 
-def robot_public(store: StoreDep, row: RobotRow) -> RobotPublic:
+def robot_public(store: CloudStore, row: RobotRow) -> RobotPublic:
     """The robot as its operator sees it: online or not, and when it last called in."""
     last_seen_s = store.telemetry.last_seen(row.id, row.last_seen_s)
     online = store.telemetry.is_polling(row.id) or (

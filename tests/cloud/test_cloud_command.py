@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import socket
 from pathlib import Path
 
 import pytest
@@ -55,3 +56,33 @@ def test_a_mistake_is_named_and_exits_1(
 def test_a_database_that_cannot_be_opened_is_named(capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["cloud", "add-operator", "ana", "--db", "sqlite:////no/such/dir/c.db"]) == 1
     assert "cannot open it" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(
+    ("args", "code", "message"),
+    [
+        (["--workers", "2"], 2, "needs a PostgreSQL --db"),
+        (["--port", "0"], 2, "--port 0: use 1..65535"),
+        (["--workers", "0"], 2, "--workers 0: use 1..64"),
+        (["--lease-s", "nan"], 1, "lease_s must be above 0"),
+        (["--db", "nonsense"], 1, "use sqlite:///FILE or postgresql://"),
+        (["--db", "postgresql://ana:secret@127.0.0.1:1/vest"], 1, "ana:***@"),
+    ],
+)
+def test_a_service_that_cannot_start_says_why(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], args: list[str], code: int, message: str
+) -> None:
+    db = ["--db", f"sqlite:///{tmp_path / 'c.db'}"]
+    assert main(["cloud", "serve", *db, *args]) == code
+    error = capsys.readouterr().err
+    assert message in error and "secret" not in error
+
+
+def test_a_port_already_taken_is_named(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    with socket.socket() as taken:
+        taken.bind(("127.0.0.1", 0))
+        taken.listen(1)
+        port = taken.getsockname()[1]
+        db = f"sqlite:///{tmp_path / 'c.db'}"
+        assert main(["cloud", "serve", "--db", db, "--port", str(port)]) == 1
+    assert f"--port {port}: cannot listen there" in capsys.readouterr().err
