@@ -12,8 +12,9 @@
 
 The stream wakes at once when a robot's commands change (the same doorbell as the
 long-polls) and looks for new telemetry every ``TELEMETRY_EVERY_S``. A comment line every
-``KEEPALIVE_S`` keeps proxies from closing an idle stream. It ends after ``STREAM_S``; the
-page then opens a new one (so a server that stops is never held up by an open page).
+``KEEPALIVE_S`` keeps proxies from closing an idle stream. It ends after ``STREAM_S`` (the
+page then opens a new one), when the service stops, and when the operator's token is
+revoked.
 """
 
 from __future__ import annotations
@@ -91,11 +92,14 @@ async def events(request: Request, store: StoreDep, operator: CurrentOperator) -
 
 
 async def _stream(request: Request, store: CloudStore, view: OperatorView) -> AsyncIterator[str]:
+    token = request.headers.get("authorization", "").partition(" ")[2].strip()
     started_s = quiet_since_s = store.clock.now()
     while (
         store.clock.now() - started_s < STREAM_S
         and not store.closing.is_set()
         and not await request.is_disconnected()
+        # a token revoked meanwhile ends the stream (within the cache's 5 s)
+        and await run_in_threadpool(store.principals.authenticate, token) is not None
     ):
         changes = await run_in_threadpool(view.changes)
         if changes:
