@@ -109,7 +109,8 @@ class CloudLink:
         self._reports: queue.Queue[tuple[str, dict[str, Any]] | None] = queue.Queue()
         self._stop = clock.event()
         self._threads: list[threading.Thread] = []
-        self._from_cloud: set[str] = set()
+        self._from_cloud: set[str] = set()  # received, being carried out
+        self._carrying_out = threading.Lock()
         self.reachable = False
 
     def bind(self, blackboard: Blackboard) -> None:
@@ -139,11 +140,13 @@ class CloudLink:
     def report(self, command_id: str, status: str, result: Any = None) -> Job:
         """Queue the report (it is sent, and retried, by the reporter); done at once. A
         command that did not come from the cloud (a scenario's, say) is not reported there."""
-        if command_id not in self._from_cloud:
-            log.debug("command %s did not come from the cloud; not reported there", command_id)
-            return ImmediateJob()
         report = {"status": status.upper(), "result": _json_safe(result)}
-        self.done.add(command_id, report)
+        with self._carrying_out:
+            if command_id not in self._from_cloud:
+                log.debug("command %s did not come from the cloud; not reported there", command_id)
+                return ImmediateJob()
+            self.done.add(command_id, report)  # a delivery again is answered from here on
+            self._from_cloud.discard(command_id)
         self._reports.put((command_id, report))
         return ImmediateJob()
 
@@ -179,15 +182,18 @@ class CloudLink:
 
     def _received(self, command: dict[str, Any]) -> None:
         command_id = str(command.get("id"))
-        earlier = self.done.get(command_id)
+        with self._carrying_out:  # a report between these checks would let it run twice
+            earlier = self.done.get(command_id)
+            running = command_id in self._from_cloud
+            if earlier is None and not running and self.blackboard is not None:
+                self._from_cloud.add(command_id)
         if earlier is not None:  # delivered again: answer as before, never twice
             self._reports.put((command_id, earlier))
             return
-        if command_id in self._from_cloud:  # delivered again while still being carried out
+        if running:  # delivered again while still being carried out
             log.debug("command %s is still being carried out; its report will follow", command_id)
             return
         if self.blackboard is not None:
-            self._from_cloud.add(command_id)
             self.blackboard.stage_event(
                 IOT_INBOX,
                 {"id": command_id, "type": command.get("type"), "args": command.get("args") or {}},
