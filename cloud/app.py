@@ -55,7 +55,9 @@ def create_app(
     async def bad_body(request: Request, error: RequestValidationError) -> JSONResponse:
         problems = [
             {
-                "field": ".".join(str(part) for part in item["loc"][1:]) or "body",
+                "field": "body"  # its location is a character offset, not a field
+                if item["type"] == "json_invalid"
+                else ".".join(str(part) for part in item["loc"][1:]) or "body",
                 "message": item["msg"],
             }
             for item in error.errors()

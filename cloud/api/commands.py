@@ -7,6 +7,8 @@ from fastapi import APIRouter, HTTPException, Response, status
 from cloud.api.deps import CurrentOperator, StoreDep
 from cloud.api.robots import granted
 from cloud.api.schemas import CommandCreate, CommandPublic
+from cloud.store.ledger import ConflictError
+from engine.nodes.remote import command_problem
 
 router = APIRouter(prefix="/robots/{robot}/commands", tags=["operator"])
 
@@ -16,11 +18,24 @@ def send_command(
     robot: str, body: CommandCreate, store: StoreDep, operator: CurrentOperator, response: Response
 ) -> CommandPublic:
     """QUEUED and committed before the 201; the same idempotency_key again: 200, the same
-    command."""
+    command (409 if it named another). Arguments of built-in types are checked here as the
+    robot checks them (422); what only the robot knows (its joints) is checked there."""
     row = granted(store, operator, robot)
-    command, created = store.ledger.submit(
-        row.id, body.type, body.args, idempotency_key=body.idempotency_key, timeout_s=body.timeout_s
-    )
+    problem = command_problem(body.type, body.args)
+    if problem is not None:  # as the robot would find it, but now
+        raise HTTPException(
+            status.HTTP_422_UNPROCESSABLE_CONTENT, [{"field": "args", "message": problem}]
+        )
+    try:
+        command, created = store.ledger.submit(
+            row.id,
+            body.type,
+            body.args,
+            idempotency_key=body.idempotency_key,
+            timeout_s=body.timeout_s,
+        )
+    except ConflictError as error:
+        raise HTTPException(status.HTTP_409_CONFLICT, str(error)) from None
     if not created:
         response.status_code = status.HTTP_200_OK
     return CommandPublic.of(command, row.name)

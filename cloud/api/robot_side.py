@@ -8,7 +8,7 @@ from fastapi import APIRouter, HTTPException, Query, Request, Response, status
 from starlette.concurrency import run_in_threadpool
 
 from cloud.api.deps import CurrentRobot, StoreDep
-from cloud.api.schemas import CommandPublic, ResultReport, TelemetryReport
+from cloud.api.schemas import ClaimedCommand, CommandPublic, ResultReport, TelemetryReport
 from cloud.store.ledger import ConflictError
 
 router = APIRouter(prefix="/robot", tags=["robot"])
@@ -20,8 +20,8 @@ async def next_command(
     store: StoreDep,
     robot: CurrentRobot,
     wait_s: Annotated[float, Query(ge=0, le=60)] = 0.0,
-) -> CommandPublic | Response:
-    """The next command, now IN_PROGRESS under a lease; 204 when none came within
+) -> ClaimedCommand | Response:
+    """The next command, now IN_PROGRESS under a lease of ``lease_s``; 204 when none came within
     ``wait_s`` (at most the service's max_wait_s).
 
     A command is only taken for a caller still there: a long-poll whose client went away,
@@ -33,7 +33,8 @@ async def next_command(
         while not (superseded() or store.closing.is_set() or await request.is_disconnected()):
             command = await run_in_threadpool(store.ledger.claim_next, robot.id)
             if command is not None:
-                return CommandPublic.of(command, robot.name)
+                public = CommandPublic.of(command, robot.name)
+                return ClaimedCommand(**public.model_dump(), lease_s=store.ledger.lease_s)
             left_s = deadline_s - store.clock.now()
             if left_s <= 0:
                 break
@@ -41,6 +42,17 @@ async def next_command(
                 store.doorbell.wait, robot.id, min(left_s, store.settings.recheck_s)
             )
     return Response(status_code=status.HTTP_204_NO_CONTENT)
+
+
+@router.post("/commands/{command_id}/progress")
+def report_progress(command_id: str, store: StoreDep, robot: CurrentRobot) -> CommandPublic:
+    """The robot is still carrying the command out: its lease starts again. 200 with the
+    command (CANCELED: the operator no longer wants it); 404 for one that is not this
+    robot's."""
+    command = store.ledger.extend_lease(robot.id, command_id)
+    if command is None:
+        raise HTTPException(status.HTTP_404_NOT_FOUND, f"no command {command_id!r}")
+    return CommandPublic.of(command, robot.name)
 
 
 @router.post("/commands/{command_id}/result")

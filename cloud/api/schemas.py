@@ -83,6 +83,13 @@ class CommandPublic(BaseModel):
         )
 
 
+class ClaimedCommand(CommandPublic):
+    """A command as the robot takes it: ``lease_s`` is how long it has to report it, or to
+    say it is still at it (``POST .../progress``), before it is delivered again."""
+
+    lease_s: float
+
+
 class ResultReport(BaseModel):
     model_config = ConfigDict(extra="forbid")
 

@@ -3,7 +3,8 @@ acknowledged, delivered at least once under a lease, finished exactly once.
 
 States: QUEUED -> IN_PROGRESS (claimed by the robot, under a lease) -> SUCCEEDED or FAILED
 (the robot's report); CANCELED by the operator before it finished; TIMED_OUT past its
-``timeout_s``. A lease that runs out puts the command back to QUEUED: it is delivered
+``timeout_s``. A robot still carrying a command out extends its lease; a lease that runs
+out (the robot died, or lost its link) puts the command back to QUEUED: it is delivered
 again, and the robot, which remembers what it carried out, reports the result it had.
 ``version`` grows with every change.
 """
@@ -128,11 +129,12 @@ class CommandLedger:
         timeout_s: float | None = None,
     ) -> tuple[Command, bool]:
         """The command, QUEUED and committed, and True; or, for an ``idempotency_key``
-        already used for this robot, the command it made, and False."""
+        already used for this robot, the command it made, and False (a ConflictError when
+        that command was a different one: a key names one command)."""
         if idempotency_key is not None:
             known = self._by_key(robot_id, idempotency_key)
             if known is not None:
-                return known, False
+                return _same_command(known, type, args), False
         now = self.clock.now()
         row = CommandRow(
             id=str(uuid.uuid4()),
@@ -157,7 +159,7 @@ class CommandLedger:
             known = self._by_key(robot_id, idempotency_key or "")
             if known is None:
                 raise
-            return known, False
+            return _same_command(known, type, args), False
         return Command.of(row), True
 
     def get(self, robot_id: int, command_id: str) -> Command | None:
@@ -211,6 +213,23 @@ class CommandLedger:
             row.lease_until_s = self.clock.now() + self.lease_s
             row.deliveries += 1
             changed.add(robot_id)
+            return Command.of(row)
+
+    def extend_lease(self, robot_id: int, command_id: str) -> Command | None:
+        """The robot is still carrying the command out: its lease runs ``lease_s`` from now
+        (one that ran out meanwhile and is QUEUED again is taken back). A finished command is
+        answered as it is (CANCELED: the operator no longer wants it). None when the command
+        is not this robot's."""
+        self._expire_due()
+        with self._changing() as (session, changed):
+            row = session.get(CommandRow, command_id)
+            if row is None or row.robot_id != robot_id:
+                return None
+            if row.state == QUEUED:
+                self._change(row, IN_PROGRESS)
+                changed.add(robot_id)
+            if row.state == IN_PROGRESS:
+                row.lease_until_s = self.clock.now() + self.lease_s
             return Command.of(row)
 
     def report(self, robot_id: int, command_id: str, status: str, result: Any) -> Command | None:
@@ -269,3 +288,12 @@ class CommandLedger:
         row.state = state
         row.version += 1
         row.updated_s = self.clock.now()
+
+
+def _same_command(known: Command, type: str, args: dict[str, Any]) -> Command:
+    if (known.type, known.args) != (type, args):
+        raise ConflictError(
+            f"idempotency_key {known.idempotency_key!r} was used for another command "
+            f"({known.type} {known.args}); use a new key for a new command"
+        )
+    return known

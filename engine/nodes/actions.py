@@ -94,7 +94,7 @@ class SetLed(ServiceAction):
         "seconds",
         SECONDS,
         None,
-        "how long to keep it lit; empty: until another SetLed",
+        "how long to keep it lit; empty: until the next color",
     )
 
     def start(self) -> Job:

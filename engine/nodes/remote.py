@@ -25,6 +25,7 @@ from engine.blackboard.catalogue import (
     RANGE_RIGHT_MM,
     TOUCH_ANY,
     TOUCH_PADS,
+    default_catalogue,
 )
 from engine.blackboard.events import EventLog
 from engine.errors import ServiceError
@@ -180,6 +181,23 @@ class CarryOut(ServiceAction):
 
 
 READABLE_SENSORS = ("temperature", "ultrasound", *POLLED_READINGS)
+
+
+def command_problem(kind: str, args: Mapping[str, Any]) -> str | None:
+    """What is wrong with a command's arguments, checked as the robot will check them
+    (the service answers 422 at once instead of the robot FAILED later); None when they
+    are fine, or when ``kind`` is not built in (the robot decides). What only the robot
+    knows (its joints and their limits) is checked there."""
+    try:
+        if kind in ACTION_NODES:
+            checked_args(kind, args, CheckContext(default_catalogue()))
+        elif kind == "read":
+            sensor = args.get("sensor")
+            if sensor not in READABLE_SENSORS or set(args) - {"sensor"}:
+                return f"read takes 'sensor', one of {', '.join(READABLE_SENSORS)}"
+    except CommandError as error:
+        return str(error)
+    return None
 
 
 def command_catalogue() -> dict[str, list[dict[str, Any]]]:

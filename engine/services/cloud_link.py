@@ -34,8 +34,22 @@ from engine.services.jobs import ImmediateJob, Job
 log = logging.getLogger(__name__)
 FIRST_BACKOFF_S, MAX_BACKOFF_S = 0.5, 30.0
 TELEMETRY_EVERY_S = 1.0
+BUSY_AT_MOST_S = 65.0
+"""The robot takes one command at a time: the next long-poll waits until the one taken is
+reported, or this long (CarryOut gives up on a command after 60 s), so a command that waits
+in the service stays QUEUED, and an operator can still cancel it. Meanwhile the robot
+extends the lease of the one it carries out three times a lease (``lease_s`` comes with
+the command), so the service neither delivers it again nor shows it QUEUED."""
+DEFAULT_LEASE_S = 30.0
 TELEMETRY_PREFIXES = (SENSORS_PREFIX, DEVICES_PREFIX)
 DONE_KEPT = 1000
+
+
+def _positive(value: Any, default: float) -> float:
+    """``value`` as a positive number of seconds, else ``default``."""
+    if isinstance(value, int | float) and not isinstance(value, bool) and value > 0:
+        return float(value)
+    return default
 
 
 def _json_safe(value: Any) -> Any:
@@ -111,6 +125,9 @@ class CloudLink:
         self._threads: list[threading.Thread] = []
         self._from_cloud: set[str] = set()  # received, being carried out
         self._carrying_out = threading.Lock()
+        self._idle = clock.event()
+        self._idle.set()
+        self._lease_s = DEFAULT_LEASE_S
         self.reachable = False
 
     def bind(self, blackboard: Blackboard) -> None:
@@ -147,6 +164,8 @@ class CloudLink:
                 return ImmediateJob()
             self.done.add(command_id, report)  # a delivery again is answered from here on
             self._from_cloud.discard(command_id)
+            if not self._from_cloud:
+                self._idle.set()
         self._reports.put((command_id, report))
         return ImmediateJob()
 
@@ -158,6 +177,9 @@ class CloudLink:
     def _poll(self) -> None:
         delay_s = FIRST_BACKOFF_S
         while not self._stop.is_set():
+            if not self._idle.is_set():  # one command at a time
+                self._wait_idle()
+                continue
             try:
                 answer = self.http.get(
                     f"{self.api}/robot/commands/next",
@@ -187,6 +209,8 @@ class CloudLink:
             running = command_id in self._from_cloud
             if earlier is None and not running and self.blackboard is not None:
                 self._from_cloud.add(command_id)
+                self._idle.clear()
+                self._lease_s = _positive(command.get("lease_s"), DEFAULT_LEASE_S)
         if earlier is not None:  # delivered again: answer as before, never twice
             self._reports.put((command_id, earlier))
             return
@@ -198,6 +222,40 @@ class CloudLink:
                 IOT_INBOX,
                 {"id": command_id, "type": command.get("type"), "args": command.get("args") or {}},
             )
+
+    def _wait_idle(self) -> None:
+        """Until the command being carried out is reported (or BUSY_AT_MOST_S passed: a
+        robot without the iot_command tree must not stop taking commands for good)."""
+        deadline_s = self.clock.now() + BUSY_AT_MOST_S
+        extend_every_s = self._lease_s / 3
+        extend_at_s = self.clock.now() + extend_every_s
+        while not self._idle.is_set() and not self._stop.is_set():
+            now_s = self.clock.now()
+            if now_s >= deadline_s:
+                log.warning("no report after %.0f s; taking the next command", BUSY_AT_MOST_S)
+                self._idle.set()
+                return
+            if now_s >= extend_at_s:
+                self._extend_leases()
+                extend_at_s = now_s + extend_every_s
+            # looks at the stop flag at least each second
+            self.clock.wait(self._idle, min(deadline_s - now_s, extend_at_s - now_s, 1.0))
+
+    def _extend_leases(self) -> None:
+        """Tells the service the robot is still carrying its commands out (one that fails is
+        tried again at the next turn; a lease that ran out meanwhile is taken back then)."""
+        with self._carrying_out:
+            running = sorted(self._from_cloud)
+        for command_id in running:
+            try:
+                answer = self.http.post(
+                    f"{self.api}/robot/commands/{command_id}/progress", timeout=5.0
+                )
+            except requests.RequestException as error:
+                self._unreachable(error)
+                continue
+            if answer.status_code == 200 and answer.json().get("state") == "CANCELED":
+                log.info("command %s was canceled while the robot carried it out", command_id)
 
     def _send_reports(self) -> None:
         delay_s = FIRST_BACKOFF_S

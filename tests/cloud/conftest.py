@@ -7,6 +7,7 @@ to run as root). A missing PostgreSQL fails the tests: scripts/setup installs it
 from __future__ import annotations
 
 import json
+import queue
 import socket
 import subprocess
 import sys
@@ -113,7 +114,9 @@ ROOT = Path(__file__).resolve().parents[2]
 
 
 class Robot:
-    """`vest run --cloud` on the simulated vest, its timeline read line by line."""
+    """`vest run --cloud` on the simulated vest, its timeline read line by line (on a thread
+    of its own, so a test that does not read it never leaves the robot blocked on a full
+    pipe)."""
 
     def __init__(self, url: str, token_file: Path, scenario: Path, trees: list[str]) -> None:
         self.process = subprocess.Popen(
@@ -138,20 +141,32 @@ class Robot:
             text=True,
         )
         self.actions: list[dict[str, Any]] = []
+        self._lines: queue.Queue[str | None] = queue.Queue()
+        self._reader = threading.Thread(target=self._read, daemon=True)
+        self._reader.start()
+
+    def _read(self) -> None:
+        assert self.process.stdout is not None
+        for line in self.process.stdout:
+            self._lines.put(line)
+        self._lines.put(None)
 
     def until(self, wanted: Any) -> dict[str, Any]:
         """Reads the timeline until an action for which ``wanted(action)`` is true."""
-        assert self.process.stdout is not None
-        for line in self.process.stdout:
+        while (line := self._lines.get(timeout=120)) is not None:
             action = json.loads(line)
             self.actions.append(action)
             if wanted(action):
                 return action
+        self._lines.put(None)  # the end stays the end for a later call
         raise AssertionError(f"the robot ended first; it did {self.actions}")
 
     def finish(self) -> list[dict[str, Any]]:
-        out, _ = self.process.communicate(timeout=60)
-        self.actions += [json.loads(line) for line in out.splitlines() if line.strip()]
+        self.process.wait(timeout=60)
+        self._reader.join(timeout=10)
+        while (line := self._lines.get_nowait()) is not None:
+            if line.strip():
+                self.actions.append(json.loads(line))
         assert self.process.returncode == 0
         return self.actions
 

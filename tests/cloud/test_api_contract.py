@@ -59,6 +59,17 @@ def test_an_operator_sends_a_say_and_the_robot_carries_it_out(service: Service) 
         f"{service.url}/robot/commands/next?wait_s=1", headers=service.robot, timeout=10
     )
     assert claimed.status_code == 200 and claimed.json()["state"] == "IN_PROGRESS"
+    assert claimed.json()["lease_s"] == service.store.ledger.lease_s
+    still_at_it = requests.post(
+        f"{service.url}/robot/commands/{command['id']}/progress", headers=service.robot, timeout=10
+    )
+    assert still_at_it.status_code == 200 and still_at_it.json()["state"] == "IN_PROGRESS"
+    not_its_own = requests.post(
+        f"{service.url}/robot/commands/{command['id']}/progress",
+        headers=service.other_robot,
+        timeout=10,
+    )
+    assert not_its_own.status_code == 404
     reported = requests.post(
         f"{service.url}/robot/commands/{command['id']}/result",
         json={"status": "SUCCEEDED", "result": {"said": "hello"}},
@@ -123,12 +134,17 @@ def test_the_same_idempotency_key_returns_the_same_command(service: Service) -> 
     )
     assert (first.status_code, second.status_code) == (201, 200)
     assert first.json()["id"] == second.json()["id"]
+    other = {"type": "led", "args": {"color": "blue"}, "idempotency_key": "k-1"}
+    reused = requests.post(
+        f"{service.url}/robots/hbs2/commands", json=other, headers=service.operator, timeout=10
+    )
+    assert reused.status_code == 409 and "use a new key" in reused.json()["detail"]
 
 
 def test_what_a_caller_may_not_see_answers_404_and_no_token_401(service: Service) -> None:
     sent = requests.post(
         f"{service.url}/robots/hbs2/commands",
-        json={"type": "say", "args": {}},
+        json={"type": "say", "args": {"text": "hi"}},
         headers=service.operator,
         timeout=10,
     ).json()
@@ -177,6 +193,12 @@ def test_what_a_caller_may_not_see_answers_404_and_no_token_401(service: Service
         ({"type": "Say!", "args": {}}, "type"),
         ({"type": "say", "timeout_s": -1}, "timeout_s"),
         ({"type": "say", "colour": "red"}, "colour"),
+        # arguments of built-in types, checked as the robot checks them
+        ({"type": "say", "args": {"text": "hi", "volume": 5}}, "args"),
+        ({"type": "say", "args": {}}, "args"),
+        ({"type": "move", "args": {"joint": "neck", "angle_deg": 500}}, "args"),
+        ({"type": "led", "args": {"color": "#zz"}}, "args"),
+        ({"type": "read", "args": {"sensor": "smell"}}, "args"),
     ],
 )
 def test_a_bad_body_is_422_naming_the_field(service: Service, body: dict, field: str) -> None:
@@ -200,6 +222,7 @@ def test_a_body_over_the_limit_is_413_and_broken_json_422(service: Service) -> N
         timeout=10,
     )
     assert broken.status_code == 422
+    assert broken.json()["detail"][0]["field"] == "body"  # not the character offset
 
 
 def test_telemetry_pushed_by_the_robot_is_seen_by_its_operator(service: Service) -> None:

@@ -75,9 +75,12 @@ class Operator:
         self.headers = {"Authorization": f"Bearer {token}"}
 
     def send(self, text: str) -> str:
+        return self.send_command("say", {"text": text}, key=text)
+
+    def send_command(self, kind: str, args: dict[str, Any], key: str | None = None) -> str:
         answer = requests.post(
             f"{self.service.url}/api/v1/robots/hbs2/commands",
-            json={"type": "say", "args": {"text": text}, "idempotency_key": text},
+            json={"type": kind, "args": args, "idempotency_key": key},
             headers=self.headers,
             timeout=10,
         )
@@ -95,6 +98,10 @@ class Operator:
 
     def until_finished(self, command_id: str) -> dict[str, Any]:
         """The command once it ended, watched on the live stream (read timeout: 30 s)."""
+        return self.until_state(command_id, "SUCCEEDED", "FAILED", "TIMED_OUT", "CANCELED")
+
+    def until_state(self, command_id: str, *states: str) -> dict[str, Any]:
+        """The command once it is in one of ``states``, watched on the live stream."""
         with requests.get(
             f"{self.service.url}/api/v1/events", headers=self.headers, stream=True, timeout=30
         ) as stream:
@@ -104,12 +111,9 @@ class Operator:
                     name = line.removeprefix("event:").strip()
                 elif line.startswith("data:") and name == "command":
                     command = json.loads(line.removeprefix("data:"))
-                    if command["id"] == command_id and command["state"] not in (
-                        "QUEUED",
-                        "IN_PROGRESS",
-                    ):
+                    if command["id"] == command_id and command["state"] in states:
                         return dict(command)
-        raise AssertionError(f"the stream ended before {command_id} finished")
+        raise AssertionError(f"the stream ended before {command_id} was {states}")
 
 
 @pytest.fixture
@@ -210,3 +214,32 @@ def test_a_robot_whose_service_went_away_keeps_behaving_and_catches_up(
     robot.finish()
     assert robot.said().count("before the outage") == 1
     assert robot.said().count("after the outage") == 1
+
+
+def test_a_robot_takes_one_command_at_a_time_so_a_waiting_one_can_still_be_canceled(
+    setup: dict[str, Any], tmp_path: Path, start_robot: Callable[..., Any]
+) -> None:
+    service, operator, token_file = setup["service"], setup["operator"], setup["token"]
+    quiet = tmp_path / "quiet.yaml"
+    quiet.write_text("duration_s: 60\nevents: []\n")
+    robot = start_robot(service.url, token_file, quiet, ["trees/iot_command.yaml"])
+    try:
+        slow = operator.send_command("move", {"joint": "neck", "angle_deg": 50, "speed_dps": 10})
+        operator.until_state(slow, "IN_PROGRESS")  # the neck turns for 5 s
+        waiting = operator.send("not now")
+        assert operator.command(waiting)["state"] == "QUEUED"  # not taken while busy
+        canceled = requests.post(
+            f"{service.url}/api/v1/robots/hbs2/commands/{waiting}/cancel",
+            headers=operator.headers,
+            timeout=10,
+        ).json()
+        assert canceled["state"] == "CANCELED"
+        finished = operator.until_finished(slow)
+        # five seconds of turning on a one-second lease: extended, never delivered again
+        assert (finished["state"], finished["deliveries"]) == ("SUCCEEDED", 1)
+        after = operator.send("after the move")
+        assert operator.until_finished(after)["state"] == "SUCCEEDED"
+    finally:
+        robot.process.send_signal(signal.SIGTERM)
+    robot.finish()
+    assert robot.said() == ["after the move"]  # the canceled one was never said

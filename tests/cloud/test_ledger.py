@@ -100,6 +100,36 @@ def test_a_lease_that_runs_out_delivers_the_command_again(
     assert ledger.report(one, command.id, SUCCEEDED, {"said": True}).version == again.version + 1  # type: ignore[union-attr]
 
 
+def test_a_robot_still_at_a_command_keeps_it_by_extending_its_lease(
+    ledger: CommandLedger, robots: tuple[int, int], clock: VirtualClock
+) -> None:
+    one, two = robots
+    command, _ = ledger.submit(one, "move", {"joint": "neck", "angle_deg": 50})
+    ledger.claim_next(one)
+    for _ in range(4):  # a minute and a half of turning, the lease extended every 20 s
+        clock.advance(20.0)
+        kept = ledger.extend_lease(one, command.id)
+        assert kept is not None and kept.state == IN_PROGRESS
+    assert ledger.claim_next(one) is None  # never delivered again
+    assert ledger.extend_lease(two, command.id) is None  # not another robot's to keep
+
+
+def test_a_lease_extended_late_takes_the_command_back_and_a_canceled_one_says_so(
+    ledger: CommandLedger, robots: tuple[int, int], clock: VirtualClock
+) -> None:
+    one, _ = robots
+    late, _ = ledger.submit(one, "say", {"text": "late"})
+    ledger.claim_next(one)
+    clock.advance(31.0)  # the link was down: the lease ran out
+    ledger.expire()
+    assert ledger.get(one, late.id).state == QUEUED  # type: ignore[union-attr]
+    taken_back = ledger.extend_lease(one, late.id)
+    assert taken_back is not None and taken_back.state == IN_PROGRESS
+    assert taken_back.deliveries == 1  # it was never delivered twice
+    ledger.cancel(one, late.id)
+    assert ledger.extend_lease(one, late.id).state == CANCELED  # type: ignore[union-attr]
+
+
 def test_a_different_report_for_a_finished_command_is_a_conflict(
     ledger: CommandLedger, robots: tuple[int, int]
 ) -> None:
