@@ -35,6 +35,9 @@ TEMPERATURE_F = "/sensors/temperature/f"
 ULTRASOUND_CM = "/sensors/ultrasound/cm"
 SPEECH_HEARD = "/speech/heard"
 IOT_INBOX = "/iot/inbox"
+HAND_FINGERS = "/vision/hand/fingers"
+HAND_CONFIDENCE = "/vision/hand/confidence"
+HAND_SHOWN = "/vision/hand/shown"
 
 
 def force_key(pad: str) -> str:
@@ -245,6 +248,32 @@ def default_catalogue() -> KeyCatalogue:
                 "",
                 "IoT client",
                 "a remote command: {id, type, args}",
+                kind="event",
+            ),
+            KeySpec(
+                HAND_FINGERS,
+                int,
+                "",
+                "vision worker (camera + finger-count CNN)",
+                "fingers the hand in the camera's window shows, 0..5; absent when no hand "
+                "is seen or the network is not sure",
+                alias="hand_fingers",
+            ),
+            KeySpec(
+                HAND_CONFIDENCE,
+                float,
+                "",
+                "vision worker (camera + finger-count CNN)",
+                "how sure the network is of the newest frame's count, 0..1",
+                alias="hand_confidence",
+            ),
+            KeySpec(
+                HAND_SHOWN,
+                int,
+                "",
+                "vision worker (camera + finger-count CNN)",
+                "a hand showing this many fingers, 0..5: once when the count changes and "
+                "holds for the camera's steady_frames",
                 kind="event",
             ),
             KeySpec(

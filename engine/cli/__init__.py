@@ -37,6 +37,7 @@ def build_parser() -> argparse.ArgumentParser:
         cloud_command,
         devices_command,
         dialogs_command,
+        gesture_command,
         hear_command,
         keys_command,
         nodes_command,
@@ -66,6 +67,7 @@ def build_parser() -> argparse.ArgumentParser:
         say_command,
         dialogs_command,
         cloud_command,
+        gesture_command,
     ):
         sub = commands.add_parser(
             module.NAME,
@@ -104,8 +106,10 @@ def _handled(argv: Sequence[str] | None, signals: StopSignals, out: WatchedOutpu
 
     command = "vest"
     try:
+        from engine.cli.gesture_command import with_action
+
         parser = build_parser()
-        args = parser.parse_args(argv)
+        args = parser.parse_args(with_action(sys.argv[1:] if argv is None else argv))
         if args.command is None:
             parser.print_help()
             sys.stdout.flush()

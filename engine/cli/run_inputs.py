@@ -19,6 +19,7 @@ from engine.errors import ConfigError
 from engine.files.problems import LoadError, Problem, Problems
 from engine.hardware.chips import default_chips
 from engine.hardware.config import RobotConfig
+from engine.hardware.config_camera import CAMERA_NAME
 from engine.hardware.config_file import load_robot_config
 from engine.hardware.sim_vest import check_fault_events
 from engine.loader.tree_definition import NodeDefinition, TreeDefinition
@@ -75,7 +76,8 @@ def dialogs_folder(given: Path | None) -> Path | None:
 def robot_catalogue(
     config: RobotConfig | None, registry: NodeRegistry | None = None
 ) -> KeyCatalogue:
-    """The key catalogue of one robot: ``/devices/NAME/ok`` for each of its devices only
+    """The key catalogue of one robot: ``/devices/NAME/ok`` for each of its devices (and
+    its camera) only
     (the default catalogue, without a robot, accepts any NAME), and the keys the
     registry's plugins add."""
     catalogue = registry.catalogue() if registry is not None else default_catalogue()
@@ -88,7 +90,7 @@ def robot_catalogue(
             KeySpec(
                 f"/devices/{name}/ok", pattern.value_type, "", pattern.writer, pattern.description
             )
-            for name in config.devices
+            for name in [*config.devices, *([CAMERA_NAME] if config.camera else [])]
         ]
     return KeyCatalogue(specs)
 
@@ -138,9 +140,18 @@ def _nodes(node: NodeDefinition) -> Iterator[NodeDefinition]:
 
 def check_scenario_events(events: Iterable[ScenarioEvent], config: RobotConfig) -> list[Problem]:
     """The scenario's faults name devices of ``config``; its remote commands are of a type
-    the robot carries out."""
+    the robot carries out; a hand is shown only to a simulated camera."""
     problems = check_fault_events(events, config)
     for event in events:
+        if event.kind == "show_hand" and (config.camera is None or not config.camera.simulated):
+            problems.append(
+                Problem(
+                    event.mark,
+                    f"show_hand needs a simulated camera, and {config.path} has "
+                    + ("none" if config.camera is None else "a real one"),
+                    "run it on a simulated vest whose config does not say camera: none",
+                )
+            )
         if event.kind == "cloud" and event.value["type"] not in COMMAND_TYPES:
             kind = event.value["type"]
             problems.append(

@@ -32,11 +32,14 @@ from __future__ import annotations
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from engine.drivers.servo_joints import Joint
 from engine.errors import ConfigError
 from engine.files.problems import Mark
+
+if TYPE_CHECKING:
+    from engine.hardware.config_camera import CameraConfig
 from engine.values.params import (
     Param,
     did_you_mean,
@@ -227,6 +230,7 @@ class RobotConfig:
     gpio_chip: str = "/dev/gpiochip0"
     description: str = ""
     audio: AudioConfig = field(default_factory=AudioConfig)
+    camera: CameraConfig | None = None
 
     def device(self, name: str) -> DeviceConfig:
         """The device called ``name``; ConfigError naming the nearest and the known ones."""

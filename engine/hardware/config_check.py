@@ -31,6 +31,7 @@ from engine.hardware.config import (
 )
 from engine.hardware.config_audio import check_audio
 from engine.hardware.config_buses import check_buses
+from engine.hardware.config_camera import check_camera
 from engine.hardware.config_cross_checks import CrossChecks
 from engine.values.params import (
     RATE_HZ,
@@ -45,7 +46,16 @@ from engine.values.params import (
     did_you_mean,
 )
 
-TOP_FIELDS = ("name", "description", "simulated", "buses", "gpio", "audio", "devices")
+TOP_FIELDS = (
+    "name",
+    "description",
+    "simulated",
+    "buses",
+    "gpio",
+    "audio",
+    "camera",
+    "devices",
+)
 DEVICE_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 """A device name: it names ``/devices/<name>/ok`` and is written in trees, so an identifier."""
 # Options whose YAML value is a number but which the drivers take from a fixed set.
@@ -130,6 +140,7 @@ class ConfigChecker:
             if "chip" in gpio:
                 gpio_chip = self.convert(Text(), gpio.entries["chip"], "chip") or gpio_chip
         audio = check_audio(self, document, simulated)
+        camera = check_camera(self, document, simulated, self.path.parent)
         buses = check_buses(self, document)
         devices = self._devices(document, buses)
         self.problems.raise_if_any()
@@ -142,6 +153,7 @@ class ConfigChecker:
             gpio_chip=gpio_chip,
             description=description,
             audio=audio,
+            camera=camera,
         )
 
     def _text(self, document: YMap, key: str, default: str) -> str:

@@ -48,6 +48,7 @@ from engine.files.problems import Problem
 from engine.hardware.branching_clock import BranchingClock
 from engine.hardware.chips import ChipRegistry, default_chips
 from engine.hardware.config import BusConfig, DeviceConfig, RobotConfig
+from engine.hardware.config_camera import CAMERA_NAME
 from engine.scenario.world import EVENT_KEYS, World
 from engine.values.params import did_you_mean
 
@@ -314,6 +315,8 @@ class SimVest:
                     if self.unplugged(device.name):
                         continue  # a chip without power sees no hand
                     self.chips[device.name].perform(WAVE_AS if value == "wave" else value)
+            elif kind in ("unplug", "fault") and value["device"] not in self.config.devices:
+                return  # the camera: it hears the world itself
             elif kind == "unplug":
                 self.unplug(value["device"], value["seconds"])
             elif kind == "fault":
@@ -374,6 +377,12 @@ def check_fault_events(events: Iterable[Any], config: RobotConfig) -> list[Probl
             continue
         name = event.value["device"]
         device = config.devices.get(name)
+        if device is None and config.camera is not None and name == CAMERA_NAME:
+            if event.value.get("kind", "unplugged") != "unplugged":
+                problems.append(
+                    Problem(event.mark, f"the {name} can be unplugged, not {event.value['kind']!r}")
+                )
+            continue
         if device is None:
             hint = did_you_mean(name, list(config.devices))
             known = "devices: " + ", ".join(config.devices)

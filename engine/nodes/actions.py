@@ -15,6 +15,7 @@ from engine.blackboard.catalogue import RANGE_CENTER_MM, RANGE_LEFT_MM, RANGE_RI
 from engine.colors import NAMED_COLORS, parse_color
 from engine.errors import ServiceError
 from engine.nodes.base import Leaf, ServiceAction
+from engine.nodes.event_reader import EventReader
 from engine.services.interfaces import ON_REQUEST_SENSORS
 from engine.services.jobs import ImmediateJob, Job
 from engine.values.params import (
@@ -25,11 +26,13 @@ from engine.values.params import (
     CheckContext,
     Choice,
     Key,
+    ListOf,
     Number,
     Param,
     ParamIssue,
     ParamProblem,
     ParamType,
+    Scalar,
     Text,
     did_you_mean,
 )
@@ -199,6 +202,52 @@ class Wait(Leaf):
         return Status.SUCCESS if self.now() >= self.until_s else Status.RUNNING
 
 
+class WaitForEvent(Leaf):
+    """Wait for the next event on a key (a hand shown, an utterance), then go on.
+
+    Only events that come after it starts count (those matching ``equals`` / ``one_of``
+    when given). RUNNING until one comes; SUCCESS then, its value written to ``save_as``;
+    FAILURE when ``seconds`` pass first (never, when not given).
+    """
+
+    key = Param("key", Key(kinds=("event",)), doc="the event key, e.g. /vision/hand/shown")
+    equals = Param("equals", Scalar(), None, "only events with this value count")
+    one_of = Param(
+        "one_of", ListOf(Scalar(), 1), None, "only events with one of these values count"
+    )
+    save_as = Param(
+        "save_as", Key(access="write"), None, "a /vars/ key to keep the event's value in"
+    )
+    seconds = Param("seconds", SECONDS, None, "how long to wait at most")
+
+    @classmethod
+    def check_params(cls, args: Mapping[str, Any], ctx: CheckContext) -> list[ParamIssue]:
+        if args.get("equals") is not None and args.get("one_of") is not None:
+            return [ParamIssue("one_of", "give equals or one_of, not both")]
+        return []
+
+    def __init__(self, *a: Any) -> None:
+        super().__init__(*a)
+        wanted = self.one_of or ([self.equals] if self.equals is not None else None)
+        self.events = EventReader(self, self.key, wanted)
+        self.until_s: float | None = None
+
+    def initialise(self) -> None:
+        self.events.skip_past()
+        self.until_s = None if self.seconds is None else self.now() + self.seconds
+
+    def update(self) -> Status:
+        found, value = self.events.take()
+        if found:
+            if self.save_as is not None:
+                self.write(self.save_as, value)
+            return Status.SUCCESS
+        if self.until_s is not None and self.now() >= self.until_s:
+            self.feedback_message = f"no event on {self.key} within {self.seconds:g} s"
+            return Status.FAILURE
+        return Status.RUNNING
+
+
 class SetValue(Leaf):
     """Set one of the tree's variables (``/vars/...``).
 
@@ -286,4 +335,14 @@ class ReportResult(ServiceAction):
         return self.ctx.actions.report_result(str(command["id"]), self.args.status, result)
 
 
-ACTIONS = (Say, SetLed, MoveServo, LookToward, Wait, SetValue, ReadSensor, ReportResult)
+ACTIONS = (
+    Say,
+    SetLed,
+    MoveServo,
+    LookToward,
+    Wait,
+    WaitForEvent,
+    SetValue,
+    ReadSensor,
+    ReportResult,
+)

@@ -7,8 +7,8 @@ from collections.abc import Callable, Mapping
 from typing import Any
 
 from engine.blackboard.catalogue import VARIABLES_PREFIX, KeySpec
-from engine.blackboard.events import EVENT_LOG_LENGTH, EventLog
-from engine.nodes.base import Condition, node_path
+from engine.nodes.base import Condition
+from engine.nodes.event_reader import EventReader
 from engine.values.params import (
     SECONDS,
     CheckContext,
@@ -207,31 +207,14 @@ class OnEvent(Condition):
 
     def __init__(self, *a: Any) -> None:
         super().__init__(*a)
-        self.handled_seq = self.ctx.blackboard.event_log(self.key).last_seq
         wanted = self.one_of or ([self.equals] if self.equals is not None else None)
-        self._wanted = None if wanted is None else list(wanted)
+        self.events = EventReader(self, self.key, wanted)
 
     def check(self) -> bool:
-        log = self.read(self.key)
-        if not isinstance(log, EventLog) or log.last_seq <= self.handled_seq:
-            return False
-        events = log.after(self.handled_seq)
-        missed = events[0].seq - self.handled_seq - 1 if events else 0
-        if missed > 0:
-            self.ctx.on_node_warning(
-                self.ctx.tree,
-                node_path(self),
-                f"missed {missed} event{'s' if missed != 1 else ''} on {self.key}: "
-                f"more than the {EVENT_LOG_LENGTH} a key keeps came before this node read them",
-            )
-        for event in events:
-            self.handled_seq = event.seq
-            if self._wanted is None or event.value in self._wanted:
-                if self.save_as is not None:
-                    self.write(self.save_as, event.value)
-                self.feedback_message = f"event {event.seq}: {event.value!r}"
-                return True
-        return False
+        found, value = self.events.take()
+        if found and self.save_as is not None:
+            self.write(self.save_as, value)
+        return found
 
 
 CONDITIONS = (Check, Fresh, OnEvent)

@@ -3,7 +3,8 @@
 :func:`build_robot` wires what a robot config and the validated behaviors describe: one
 blackboard (with the catalogue the trees were checked against), the world a simulated vest
 answers to, the bus managers, drivers, pollers and hardware services, and the trees on a
-scheduler whose hooks poll the devices. The caller hands in the speech (the assembled
+scheduler whose hooks poll the devices, and the camera's vision worker when the config
+has a camera. The caller hands in the speech (the assembled
 :class:`~engine.speech.robot_speech.RobotSpeech`, or any Speech service, e.g. a recording
 fake, with heard text then staged as text) and the cloud's service. The caller adds its
 own hooks (a scenario player goes first: the world moves, then the pollers read it, then
@@ -25,6 +26,7 @@ from engine.scenario.world import World
 from engine.services.actions import ActionLog
 from engine.services.interfaces import IotResults, Services, Speech
 from engine.speech.robot_speech import RobotSpeech
+from engine.vision.robot_vision import RobotVision, build_vision
 
 
 @dataclass
@@ -38,16 +40,23 @@ class AssembledRobot:
     hardware: Hardware
     vest: SimVest | None
     speech: RobotSpeech | None = None
+    vision: RobotVision | None = None
 
     def start(self, origin_s: float) -> None:
-        """Start the poller threads (real time), phased on the trees' first deadline (s)."""
+        """Start the poller threads (real time), phased on the trees' first deadline (s),
+        and the vision worker."""
         self.hardware.start(origin_s=origin_s)
+        if self.vision is not None and self.hardware.threaded:
+            self.vision.start()
 
     def close(self) -> None:
-        """Stop the pollers and bus workers, close the buses and the simulated vest."""
+        """Stop the pollers, bus workers and the vision worker, close the buses, the camera
+        and the simulated vest."""
         try:
             if self.speech is not None:
                 self.speech.close()
+            if self.vision is not None:
+                self.vision.close()
             self.hardware.close()
         finally:
             if self.vest is not None:
@@ -94,4 +103,9 @@ def build_robot(
     robot.scheduler.hooks.extend(hardware.hooks)
     if robot_speech is not None:  # the microphone hears the room the world just changed
         robot.scheduler.hooks.append(robot_speech)
-    return AssembledRobot(robot, clock, blackboard, world, hardware, vest, robot_speech)
+    vision = None
+    if config.camera is not None:  # the camera sees the world just changed, as the chips do
+        vision = build_vision(config.camera, world, clock, blackboard)
+        if vision.watcher is not None and not hardware.threaded:
+            robot.scheduler.hooks.append(vision.watcher)
+    return AssembledRobot(robot, clock, blackboard, world, hardware, vest, robot_speech, vision)

@@ -8,7 +8,7 @@ from collections.abc import Callable
 from typing import Any
 
 from engine.scenario.scenario_file import Scenario, ScenarioEvent
-from engine.scenario.world import SIDES, World
+from engine.scenario.world import SIDES, ShownHand, World
 
 Change = Callable[[World], None]
 
@@ -81,6 +81,11 @@ def changes_of(event: ScenarioEvent) -> list[tuple[float, Change]]:
         return [(at, _happen(event.kind, dict(value)))]
     if event.kind == "hear":
         return [(at, _happen("hear", value))]
+    if event.kind == "show_hand":
+        seed = round(at * 1000) * 8 + (value["fingers"] if value["fingers"] is not None else 7)
+        hand = ShownHand(value["fingers"], value["image"], value["video"], seed)
+        gone = at + value["seconds"]
+        return [(at, _set("hand", hand, "hand")), (gone, _set("hand", None, "hand"))]
     if event.kind == "cloud":
         command = {"id": value["id"], "type": value["type"], "args": value["args"] or {}}
         return [(at, _happen("cloud", command))]

@@ -13,6 +13,9 @@
       - {at: 12.5, hear: {text: "what is your name", snr_db: 10}}   # in a noisy room
       - {at: 13.5, hear: {wav: recordings/question.wav}}             # beside the scenario
       - {at: 14.0, cloud: {type: say, args: {text: "hello from the cloud"}}}
+      - {at: 15.0, show_hand: {fingers: 3, seconds: 2}}   # to the simulated camera
+      - {at: 18.0, show_hand: {image: pictures/two.png}}  # beside the scenario
+      - {at: 21.0, show_hand: {video: clips/counting.avi}}
 """
 
 from __future__ import annotations
@@ -94,6 +97,12 @@ EVENT_FIELDS: dict[str, tuple[Param[Any], ...] | ParamType[Any]] = {
         ),
         Param("seconds", _SECONDS, 1.0, "how long"),
     ),
+    "show_hand": (
+        Param("fingers", Integer(0, 5), None, "a drawn hand showing 0..5 fingers"),
+        Param("image", Text(), None, "a picture (relative to the scenario file)"),
+        Param("video", Text(), None, "a video, played from this moment"),
+        Param("seconds", _SECONDS, 2.0, "how long it is held in front of the camera"),
+    ),
     "cloud": (
         Param("type", Text(), REQUIRED, "command type: say, led, move, read"),
         Param("args", AnyValue(), None, "the command's arguments"),
@@ -138,6 +147,13 @@ class ScenarioEvent:
             said = repr(value["text"]) if value["text"] is not None else value["wav"]
             noise = f" at {value['snr_db']:g} dB SNR" if value["snr_db"] is not None else ""
             return f"someone says {said}{noise}"
+        if self.kind == "show_hand":
+            if value["fingers"] is not None:
+                count = value["fingers"]
+                shown = f"a hand showing {count} finger{'' if count == 1 else 's'}"
+            else:
+                shown = Path(value["image"] or value["video"]).name
+            return f"{shown} in front of the camera for {value['seconds']:g} s"
         if self.kind == "cloud":
             return f"operator sends {value['type']} {value['args'] or {}}"
         return f"{self.kind} {value}"
@@ -254,6 +270,8 @@ def _event(
             value["c"] = (value["f"] - 32.0) * 5.0 / 9.0
     if kind == "hear" and not _check_hearing(value, body, folder, problems):
         return None
+    if kind == "show_hand" and not _check_showing(value, body, folder, problems):
+        return None
     if kind == "cloud":
         if value["args"] is not None and not isinstance(value["args"], dict):
             problems.add(body.mark, "cloud 'args' must be a mapping", "e.g. {text: hello}")
@@ -285,6 +303,30 @@ def _check_hearing(value: dict[str, Any], body: YValue, folder: Path, problems: 
             problems.add(body.mark, str(error), "a 16-bit PCM WAV file works everywhere")
             return False
         value["wav"] = str(wav)
+    return True
+
+
+def _check_showing(value: dict[str, Any], body: YValue, folder: Path, problems: Problems) -> bool:
+    """Exactly one of fingers, image and video; a picture or video that OpenCV reads (now,
+    so a bad one is named before the run), made absolute."""
+    given = [name for name in ("fingers", "image", "video") if value[name] is not None]
+    if len(given) != 1:
+        problems.add(
+            body.mark,
+            "show_hand takes one of fingers, image and video",
+            "e.g. {fingers: 3} or {image: two_fingers.png}",
+        )
+        return False
+    if given[0] == "fingers":
+        return True
+    from engine.vision.media import check_media  # OpenCV: only for scenarios that need it
+
+    path = folder / value[given[0]]
+    why = check_media(path, video=given[0] == "video")
+    if why is not None:
+        problems.add(body.mark, why, "a path relative to the scenario file")
+        return False
+    value[given[0]] = str(path)
     return True
 
 

@@ -27,6 +27,17 @@ PADS = 12
 SIDES = ("left", "center", "right")
 
 
+@dataclass(frozen=True)
+class ShownHand:
+    """What is held in front of the simulated camera: a drawn hand showing ``fingers``
+    (None: an empty view), or a picture, or a video (absolute paths)."""
+
+    fingers: int | None = None
+    image: str | None = None
+    video: str | None = None
+    seed: int = 0
+
+
 @dataclass
 class World:
     """Physical state, in SI-ish units: newtons, millimetres, degrees Celsius, centimetres."""
@@ -36,6 +47,7 @@ class World:
     range_mm: dict[str, float | None] = field(default_factory=lambda: dict.fromkeys(SIDES))
     temperature_c: float = 22.0
     ultrasound_cm: float | None = None
+    hand: ShownHand | None = None
     listeners: list[WorldListener] = field(default_factory=list)
 
     def changed(self, what: str) -> None:
@@ -49,7 +61,7 @@ class World:
 
 class WorldListener(Protocol):
     def world_changed(self, world: World, what: str) -> None:
-        """``what`` changed: touch, force, range, temperature or ultrasound."""
+        """``what`` changed: touch, force, range, temperature, ultrasound or hand."""
         ...
 
     def world_event(self, kind: str, value: Any) -> None:

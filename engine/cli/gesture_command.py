@@ -1,0 +1,244 @@
+"""Count the fingers in pictures, and make a lab's own finger-count model.
+
+  vest gesture IMAGE... [--model FILE] [--json] [--crop X,Y,W]
+      how many fingers each picture shows (the paper's crop: the centred 128 x 128 px
+      window, or the window W px wide at X,Y, scaled to 128)
+  vest gesture record DATA --label N [--frames K] [--camera DEV]   K frames from the camera
+  vest gesture record DATA [--camera DEV]      a frame each time you type its label + Enter
+  vest gesture record DATA --label N --from FOLDER       pictures you already have
+  vest gesture generate DATA --count N [--seed S] [--style studio|variant]
+  vest gesture train DATA -o MODEL.onnx [--epochs E] [--split session|file]
+  vest gesture eval DATA --model MODEL.onnx [--json]
+
+DATA is a folder with 0/ .. 5/ (pictures showing that many fingers) and none/ (no hand).
+Training needs PyTorch: ``pip install -e .[train]`` (docs/vision.md).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from collections.abc import Sequence
+from pathlib import Path
+
+NAME = "gesture"
+HELP = "count fingers in pictures; record, generate, train and check a hand model"
+ACTIONS = ("classify", "record", "generate", "train", "eval")
+
+
+def with_action(argv: Sequence[str]) -> list[str]:
+    """``vest gesture IMAGE...`` is ``vest gesture classify IMAGE...``."""
+    words = list(argv)
+    if len(words) >= 2 and words[0] == NAME and words[1] not in (*ACTIONS, "-h", "--help"):
+        words.insert(1, "classify")
+    return words
+
+
+def _crop(text: str) -> tuple[int, int, int]:
+    parts = text.split(",")
+    try:
+        x, y, w = (int(part) for part in parts)
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"must be X,Y,W in px (e.g. 256,116,128), got {text!r}"
+        ) from None
+    if x < 0 or y < 0 or w < 8:
+        raise argparse.ArgumentTypeError(
+            f"X and Y must be 0 or more and W at least 8, got {text!r}"
+        )
+    return x, y, w
+
+
+def _positive(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be a whole number, got {text!r}") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"must be 1 or more, got {value}")
+    return value
+
+
+def _share(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be a number, got {text!r}") from None
+    if not 0.0 < value < 1.0:
+        raise argparse.ArgumentTypeError(f"must be between 0 and 1, got {text}")
+    return value
+
+
+def _label(text: str) -> str:
+    from engine.vision.dataset import FOLDERS
+
+    if text not in FOLDERS:
+        raise argparse.ArgumentTypeError(f"must be one of {', '.join(FOLDERS)}, got {text!r}")
+    return text
+
+
+def _model_argument(parser: argparse.ArgumentParser, required: bool = False) -> None:
+    parser.add_argument(
+        "--model",
+        type=Path,
+        default=None,
+        required=required,
+        metavar="FILE.onnx",
+        help="a model (its .json beside it)" + ("" if required else "; default: the project's"),
+    )
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    actions = parser.add_subparsers(dest="action", metavar="ACTION")
+    classify = actions.add_parser("classify", help="count the fingers in pictures (the default)")
+    classify.add_argument("images", nargs="+", type=Path, metavar="IMAGE")
+    _model_argument(classify)
+    classify.add_argument("--json", action="store_true", help="one JSON object per picture")
+    classify.add_argument(
+        "--crop",
+        type=_crop,
+        default=None,
+        metavar="X,Y,W",
+        help="the window (default: centred 128)",
+    )
+
+    record = actions.add_parser("record", help="add labelled pictures to a data folder")
+    record.add_argument("data", type=Path, metavar="DATA")
+    record.add_argument("--label", type=_label, default=None, help="0..5 or none")
+    record.add_argument("--frames", type=_positive, default=None, help="frames to take")
+    record.add_argument("--camera", default="0", help="an index or a path (default: 0)")
+    record.add_argument(
+        "--from", dest="source", type=Path, default=None, metavar="FOLDER", help="pictures to add"
+    )
+    record.add_argument("--session", default=None, help="the session's name (default: the time)")
+
+    generate = actions.add_parser("generate", help="draw labelled hands (the project's data)")
+    generate.add_argument("data", type=Path, metavar="DATA")
+    generate.add_argument("--count", type=_positive, required=True)
+    generate.add_argument("--seed", type=int, default=1)
+    generate.add_argument("--style", choices=("studio", "variant"), default="studio")
+
+    train = actions.add_parser("train", help="train the table-2 network (needs .[train])")
+    train.add_argument("data", type=Path, metavar="DATA")
+    train.add_argument("-o", "--output", type=Path, required=True, metavar="MODEL.onnx")
+    train.add_argument("--epochs", type=_positive, default=16)
+    train.add_argument("--batch", type=_positive, default=64)
+    train.add_argument("--seed", type=int, default=1)
+    train.add_argument("--held-out", type=_share, default=0.15, help="share held out (0..1)")
+    train.add_argument("--split", choices=("session", "file"), default="session")
+    train.add_argument("--threads", type=_positive, default=2, help="CPU threads")
+    train.add_argument("--matrix", type=Path, default=None, help="confusion matrix PNG")
+
+    evaluate = actions.add_parser("eval", help="measure a model on labelled pictures")
+    evaluate.add_argument("data", type=Path, metavar="DATA")
+    _model_argument(evaluate, required=True)
+    evaluate.add_argument("--json", action="store_true")
+    evaluate.add_argument("--matrix", type=Path, default=None, help="confusion matrix PNG")
+
+
+def main(args: argparse.Namespace) -> int:
+    from engine.errors import UsageError
+
+    if args.action is None:
+        raise UsageError("name pictures to classify, or an action: " + ", ".join(ACTIONS[1:]))
+    if args.action == "classify":
+        return _classify(args)
+    if args.action == "record":
+        from engine.cli.gesture_record import record
+
+        return record(args)
+    if args.action == "generate":
+        return _generate(args)
+    if args.action == "train":
+        return _train(args)
+    return _evaluate(args)
+
+
+def _classify(args: argparse.Namespace) -> int:
+    from engine.cli.output import shown, tell
+    from engine.vision.classifier import DEFAULT_MODEL, HandModel
+    from engine.vision.preprocess import read_image, scaled_window
+
+    model = HandModel.load(args.model or DEFAULT_MODEL)
+    side = model.settings.side_px
+    failed = 0
+    for path in args.images:
+        try:
+            image = read_image(path)
+            if args.crop is not None:
+                image = scaled_window(image, *args.crop, side_px=side)
+            reading = model.read(image)
+        except ValueError as error:
+            text = str(error)
+            tell(text if str(path) in text else f"{path}: {text}")
+            failed += 1
+            continue
+        if args.json:
+            print(json.dumps({"file": str(path), **reading.to_json()}))
+        else:
+            said = (
+                "not sure"
+                if reading.fingers is None
+                else f"{reading.fingers} finger" + ("" if reading.fingers == 1 else "s")
+            )
+            print(f"{shown(str(path))}: {said} ({reading.confidence:.0%})")
+    return 1 if failed else 0
+
+
+def _generate(args: argparse.Namespace) -> int:
+    from engine.vision.synthetic_hands import write_dataset
+
+    written = write_dataset(args.data, args.count, args.seed, style=args.style)
+    print(f"{written} pictures ({args.style}, seed {args.seed}) in {args.data}")
+    return 0
+
+
+def _train(args: argparse.Namespace) -> int:
+    from engine.errors import ConfigError, DeviceError
+
+    try:
+        import torch  # noqa: F401
+    except ImportError:
+        raise DeviceError(
+            None, "training needs PyTorch: pip install -e '.[train]' (see docs/vision.md)"
+        ) from None
+    from engine.vision.training import TrainingSettings, train
+
+    if args.output.suffix != ".onnx":
+        raise ConfigError(f"{args.output}: the model's file name must end in .onnx")
+    settings = TrainingSettings(
+        epochs=args.epochs,
+        batch=args.batch,
+        seed=args.seed,
+        held_out=args.held_out,
+        split_by=args.split,
+        threads=args.threads,
+    )
+    result = train(args.data, args.output, settings, lambda line: print(line, flush=True))
+    print(result.evaluation.table())
+    print(f"held out: {result.evaluation.summary()}")
+    matrix = args.matrix or args.output.with_suffix(".matrix.png")
+    result.evaluation.write_png(matrix, f"{args.output.name}: held out ({result.split})")
+    print(
+        f"model: {args.output} (settings in {args.output.with_suffix('.json')}); matrix: {matrix}"
+    )
+    return 0
+
+
+def _evaluate(args: argparse.Namespace) -> int:
+    from engine.vision.classifier import HandModel
+    from engine.vision.dataset import find_pictures
+    from engine.vision.training import evaluate_pictures
+
+    model = HandModel.load(args.model)
+    evaluation = evaluate_pictures(model, find_pictures(args.data))
+    if args.json:
+        print(json.dumps(evaluation.to_json()))
+    else:
+        print(evaluation.table())
+        print(evaluation.summary())
+    if args.matrix is not None:
+        evaluation.write_png(args.matrix, f"{args.model.name} on {args.data.name}")
+    sys.stdout.flush()
+    return 0

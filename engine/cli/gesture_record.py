@@ -1,0 +1,142 @@
+"""``vest gesture record``: labelled pictures into a data folder, for training on a lab's
+own hands.
+
+From the camera, either ``--label N --frames K`` (K frames in a row, a few frames apart
+so they are not all the same) or, without ``--label``, one frame each time a label is
+typed (``0``..``5``, ``n`` for no hand, then Enter; ``q`` or end of input stops). From a
+folder with ``--from``: every picture in it, checked and stored as PNG. Files are named
+``<session>-<n>.png``: training holds whole sessions out, so record each child or each
+sitting as its own session (``--session``, by default the date and time).
+"""
+
+from __future__ import annotations
+
+import argparse
+import datetime
+import re
+import sys
+from pathlib import Path
+
+import cv2
+
+from engine.drivers.camera import CameraError, OpenCvCamera
+from engine.errors import ConfigError, DeviceError
+from engine.vision.dataset import IMAGE_SUFFIXES
+from engine.vision.preprocess import SIDE_PX, Frame, read_image
+from engine.vision.synthetic_hands import NO_HAND
+
+SESSION = re.compile(r"[A-Za-z0-9_.]+")
+FRAMES_APART = 3
+"""In a burst, frames skipped between two kept (at 15 fps, five pictures a second)."""
+KEYS = {**{str(n): str(n) for n in range(6)}, "n": NO_HAND, "none": NO_HAND}
+
+
+def record(args: argparse.Namespace) -> int:
+    session = args.session or datetime.datetime.now().strftime("%Y%m%d_%H%M%S")
+    if not SESSION.fullmatch(session):
+        raise ConfigError(
+            f"--session {session!r}: use letters, digits, '_' and '.' (no '-': it ends a session)"
+        )
+    if args.source is not None:
+        if args.label is None:
+            raise ConfigError("--from needs --label: the pictures in a folder show one count")
+        return _from_folder(args.data, args.source, args.label, session)
+    camera = OpenCvCamera(int(args.camera) if args.camera.isdigit() else args.camera)
+    try:
+        camera.open()
+    except CameraError as error:
+        raise DeviceError(None, str(error)) from None
+    try:
+        if args.label is not None:
+            return _burst(camera, args.data, args.label, session, args.frames or 50)
+        if args.frames is not None:
+            raise ConfigError("--frames needs --label (without it, type a label per frame)")
+        return _by_key(camera, args.data, session)
+    finally:
+        camera.close()
+
+
+class Recorder:
+    """Writes ``DATA/<label>/<session>-<n>.png``, numbering after what is already there."""
+
+    def __init__(self, data: Path, session: str) -> None:
+        self.data, self.session = data, session
+        self.saved = 0
+
+    def save(self, frame: Frame, label: str) -> Path:
+        if frame.shape[0] < SIDE_PX or frame.shape[1] < SIDE_PX:
+            raise ConfigError(
+                f"a {frame.shape[1]}x{frame.shape[0]} picture is smaller than the "
+                f"{SIDE_PX}x{SIDE_PX} window"
+            )
+        folder = self.data / label
+        folder.mkdir(parents=True, exist_ok=True)
+        number = len(list(folder.glob(f"{self.session}-*.png")))
+        path = folder / f"{self.session}-{number:05d}.png"
+        while path.exists():
+            number += 1
+            path = folder / f"{self.session}-{number:05d}.png"
+        if not cv2.imwrite(str(path), frame):
+            raise OSError(f"{path}: cannot be written")
+        self.saved += 1
+        return path
+
+
+def _burst(camera: OpenCvCamera, data: Path, label: str, session: str, frames: int) -> int:
+    recorder = Recorder(data, session)
+    read = 0
+    while recorder.saved < frames:
+        try:
+            frame = camera.read()
+        except CameraError as error:
+            if recorder.saved == 0:
+                raise DeviceError(None, str(error)) from None
+            print(f"{camera.name} stopped after {recorder.saved} frames: {error}")
+            break
+        if read % FRAMES_APART == 0:
+            recorder.save(frame, label)
+        read += 1
+    print(f"{recorder.saved} pictures of {label} in {data / label} (session {session})")
+    return 0
+
+
+def _by_key(camera: OpenCvCamera, data: Path, session: str) -> int:
+    recorder = Recorder(data, session)
+    print("type a label and Enter to keep the newest frame: 0..5, n (no hand); q stops")
+    for line in sys.stdin:
+        key = line.strip().lower()
+        if key in ("q", "quit"):
+            break
+        if key not in KEYS:
+            print(f"{key!r}: not a label (0..5, n, or q)")
+            continue
+        try:
+            frame = camera.read()
+        except CameraError as error:
+            print(f"{error}; kept {recorder.saved} pictures")
+            return 1
+        print(f"kept {recorder.save(frame, KEYS[key])}")
+    print(f"{recorder.saved} pictures in {data} (session {session})")
+    return 0
+
+
+def _from_folder(data: Path, source: Path, label: str, session: str) -> int:
+    if not source.is_dir():
+        raise ConfigError(f"{source}: no such folder")
+    recorder = Recorder(data, session)
+    skipped = 0
+    for path in sorted(source.iterdir()):
+        if path.suffix.lower() not in IMAGE_SUFFIXES:
+            continue
+        try:
+            recorder.save(read_image(path), label)
+        except (ValueError, ConfigError) as error:
+            print(f"skipped {path}: {error}")
+            skipped += 1
+    if recorder.saved == 0:
+        raise ConfigError(f"{source}: no picture that could be used")
+    print(
+        f"{recorder.saved} pictures of {label} in {data / label}"
+        + (f"; {skipped} skipped" if skipped else "")
+    )
+    return 0

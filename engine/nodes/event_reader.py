@@ -1,0 +1,46 @@
+"""Reading one event key in order, for the nodes that react to events (OnEvent, WaitForEvent)."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+from engine.blackboard.events import EVENT_LOG_LENGTH, EventLog
+from engine.nodes.base import Leaf, node_path
+
+
+class EventReader:
+    """The events on ``key`` a node has not handled yet, oldest first; those matching
+    ``wanted`` (any, when None) count. A key keeps its last 32 events: when more arrive
+    before the node reads them, the oldest are missed and the node warns how many."""
+
+    def __init__(self, node: Leaf, key: str, wanted: Sequence[Any] | None) -> None:
+        self.node, self.key = node, key
+        self.wanted = None if wanted is None else list(wanted)
+        self.handled_seq = 0
+        self.skip_past()
+
+    def skip_past(self) -> None:
+        """Forget the events already on the key: only later ones count."""
+        self.handled_seq = self.node.ctx.blackboard.event_log(self.key).last_seq
+
+    def take(self) -> tuple[bool, Any]:
+        """(True, value) of the oldest new event that counts, or (False, None)."""
+        log = self.node.read(self.key)
+        if not isinstance(log, EventLog) or log.last_seq <= self.handled_seq:
+            return False, None
+        events = log.after(self.handled_seq)
+        missed = events[0].seq - self.handled_seq - 1 if events else 0
+        if missed > 0:
+            self.node.ctx.on_node_warning(
+                self.node.ctx.tree,
+                node_path(self.node),
+                f"missed {missed} event{'s' if missed != 1 else ''} on {self.key}: "
+                f"more than the {EVENT_LOG_LENGTH} a key keeps came before this node read them",
+            )
+        for event in events:
+            self.handled_seq = event.seq
+            if self.wanted is None or event.value in self.wanted:
+                self.node.feedback_message = f"event {event.seq}: {event.value!r}"
+                return True, event.value
+        return False, None

@@ -1,0 +1,28 @@
+"""Pictures and videos a person names (a scenario's ``show_hand``): checked before a run."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import cv2
+
+from engine.vision.preprocess import read_image
+
+
+def check_media(path: Path, *, video: bool) -> str | None:
+    """Why ``path`` cannot be shown to the camera (a picture, or a video when ``video``),
+    or None when it can: the file is there and OpenCV reads a frame of it."""
+    if not path.is_file():
+        return f"{path}: no such file"
+    if not video:
+        try:
+            read_image(path)
+        except ValueError as error:
+            return str(error)
+        return None
+    capture = cv2.VideoCapture(str(path))
+    try:
+        ok = capture.isOpened() and capture.read()[0]
+    finally:
+        capture.release()
+    return None if ok else f"{path}: not a video OpenCV can play"

@@ -1,0 +1,176 @@
+"""The paper's preprocessing (section 4.4), written once for training, inference and the
+simulated camera: a frame is cropped to a square window without scaling (128 x 128 px),
+turned grayscale, blurred (Gaussian, 3 x 3, sigma 7) and thresholded adaptively (Gaussian
+weights over an 11 x 11 window) into a binary edge image the network reads as 0.0 / 1.0.
+
+The settings travel beside a model (``model.json`` next to ``model.onnx``), so a model
+retrained with other settings carries its own. What the paper leaves open and we chose:
+the crop window is centred in the frame; the threshold constant is 2 (grey levels below
+the weighted local mean); the network reads edge pixels (black in the thresholded image)
+as 1.0 and the rest as 0.0: a sparse input the network learns from much sooner than the
+mostly-white image read as it is.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import asdict, dataclass, replace
+from pathlib import Path
+from typing import Any
+
+import cv2
+import numpy as np
+import numpy.typing as npt
+
+from engine.errors import ConfigError
+
+Frame = npt.NDArray[np.uint8]
+"""An image as OpenCV holds it: rows x columns (x 3 for BGR colour), uint8."""
+
+SIDE_PX = 128
+LABELS = (0, 1, 2, 3, 4, 5)
+"""What the network tells apart: how many fingers a hand shows."""
+
+
+@dataclass(frozen=True)
+class Preprocessing:
+    """How a frame becomes the network's input.
+
+    ``crop_x``/``crop_y``: the window's top-left corner in px, or None to centre it;
+    ``side_px``: the window's side (the network's input, 128); ``blur_px``/``blur_sigma``:
+    the Gaussian blur's kernel side (odd) and sigma; ``block_px``: the adaptive threshold's
+    window side (odd); ``threshold_c``: subtracted from the weighted local mean (grey
+    levels)."""
+
+    crop_x: int | None = None
+    crop_y: int | None = None
+    side_px: int = SIDE_PX
+    blur_px: int = 3
+    blur_sigma: float = 7.0
+    block_px: int = 11
+    threshold_c: float = 2.0
+
+    def __post_init__(self) -> None:
+        if self.side_px < 8:
+            raise ValueError(f"side_px must be at least 8, got {self.side_px}")
+        for name in ("blur_px", "block_px"):
+            value = getattr(self, name)
+            if value < 1 or value % 2 == 0:
+                raise ValueError(f"{name} must be a positive odd number of px, got {value}")
+        if self.block_px < 3:
+            raise ValueError(f"block_px must be at least 3, got {self.block_px}")
+        for name in ("crop_x", "crop_y"):
+            value = getattr(self, name)
+            if value is not None and value < 0:
+                raise ValueError(f"{name} must be 0 or more px, got {value}")
+
+    def with_crop(self, x: int | None, y: int | None) -> Preprocessing:
+        return replace(self, crop_x=x, crop_y=y)
+
+    def window(self, height_px: int, width_px: int) -> tuple[int, int]:
+        """The window's top-left corner (x, y) in a frame of this size; ValueError when the
+        window does not fit in it."""
+        side = self.side_px
+        if height_px < side or width_px < side:
+            raise ValueError(
+                f"a {width_px}x{height_px} image is smaller than the {side}x{side} window"
+            )
+        x = (width_px - side) // 2 if self.crop_x is None else self.crop_x
+        y = (height_px - side) // 2 if self.crop_y is None else self.crop_y
+        if x + side > width_px or y + side > height_px:
+            raise ValueError(
+                f"the {side}x{side} window at x={x}, y={y} does not fit a "
+                f"{width_px}x{height_px} image"
+            )
+        return x, y
+
+    def to_json(self) -> dict[str, Any]:
+        return asdict(self)
+
+    @classmethod
+    def from_json(cls, data: Any, where: str) -> Preprocessing:
+        """Settings read from a model's JSON; ConfigError naming ``where`` when wrong."""
+        if not isinstance(data, dict):
+            raise ConfigError(f"{where}: 'preprocessing' must be a mapping")
+        known = set(asdict(cls()))
+        unknown = sorted(set(data) - known)
+        if unknown:
+            raise ConfigError(f"{where}: unknown preprocessing field {unknown[0]!r}")
+        try:
+            return cls(**data)
+        except (TypeError, ValueError) as error:
+            raise ConfigError(f"{where}: {error}") from None
+
+
+def crop(frame: Frame, settings: Preprocessing) -> Frame:
+    """The square window of ``frame`` (no scaling), as a copy."""
+    x, y = settings.window(frame.shape[0], frame.shape[1])
+    side = settings.side_px
+    return frame[y : y + side, x : x + side].copy()
+
+
+def scaled_window(frame: Frame, x: int, y: int, width_px: int, *, side_px: int) -> Frame:
+    """The square ``width_px`` wide at (x, y) (px), scaled to ``side_px``: for a picture
+    whose hand is not where the paper's crop looks, or bigger than its window. ValueError
+    when the square does not fit in ``frame``."""
+    height, width = frame.shape[:2]
+    if x + width_px > width or y + width_px > height:
+        raise ValueError(
+            f"the window {width_px}x{width_px} at {x},{y} does not fit a {width}x{height} image"
+        )
+    square = frame[y : y + width_px, x : x + width_px]
+    if width_px == side_px:
+        return square.copy()
+    scaled = cv2.resize(square, (side_px, side_px), interpolation=cv2.INTER_AREA)
+    return np.asarray(scaled, dtype=np.uint8)
+
+
+def edges(window: Frame, settings: Preprocessing) -> Frame:
+    """Grayscale, blurred, adaptively thresholded: a binary image, 0 or 255 (uint8)."""
+    gray = cv2.cvtColor(window, cv2.COLOR_BGR2GRAY) if window.ndim == 3 else window
+    blurred = cv2.GaussianBlur(gray, (settings.blur_px, settings.blur_px), settings.blur_sigma)
+    binary = cv2.adaptiveThreshold(
+        blurred,
+        255,
+        cv2.ADAPTIVE_THRESH_GAUSSIAN_C,
+        cv2.THRESH_BINARY,
+        settings.block_px,
+        settings.threshold_c,
+    )
+    return np.asarray(binary, dtype=np.uint8)
+
+
+def as_input(binary: Frame) -> npt.NDArray[np.float32]:
+    """A thresholded window as the network reads it: 1.0 on edges (black, 0), else 0.0."""
+    result: npt.NDArray[np.float32] = (binary == 0).astype(np.float32)
+    return result
+
+
+def network_input(frame: Frame, settings: Preprocessing) -> npt.NDArray[np.float32]:
+    """What the network reads for ``frame``: the edge image of its window as float32
+    1.0 (edge) / 0.0, shape (1, side, side)."""
+    return as_input(edges(crop(frame, settings), settings))[np.newaxis]
+
+
+def read_image(path: Path) -> Frame:
+    """An image file as a BGR frame; ValueError naming the file when it cannot be read."""
+    data = np.fromfile(str(path), dtype=np.uint8) if path.is_file() else None
+    if data is None:
+        raise ValueError(f"{path}: no such file")
+    image = cv2.imdecode(data, cv2.IMREAD_COLOR) if data.size else None
+    if image is None:
+        raise ValueError(f"{path}: not an image OpenCV can read")
+    return np.asarray(image, dtype=np.uint8)
+
+
+def load_settings(path: Path) -> dict[str, Any]:
+    """A model's JSON sidecar as a mapping; ConfigError naming the file when unreadable."""
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise ConfigError(f"{path}: no such file (a model's settings sit beside it)") from None
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as error:
+        raise ConfigError(f"{path}: not readable JSON ({error})") from None
+    if not isinstance(data, dict):
+        raise ConfigError(f"{path}: must hold a JSON object")
+    return data

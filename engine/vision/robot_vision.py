@@ -1,0 +1,101 @@
+"""The robot's sight, built from its config's ``camera:`` section.
+
+The camera (a webcam through OpenCV, or the simulated vest's camera looking at the
+simulated world), the hand model named there (the project's by default) and the vision
+worker that joins them. A model that is missing or broken is said once, clearly, at
+start-up, and the robot runs without counting fingers (``/devices/camera/ok`` stays
+False); the rest of the robot is not held up by its eyes.
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass
+
+from engine.blackboard.board import Blackboard
+from engine.clock import Clock
+from engine.drivers.camera import Camera, OpenCvCamera
+from engine.drivers.sim.camera import SimulatedCamera
+from engine.errors import ConfigError
+from engine.hardware.config_camera import CAMERA_NAME, CameraConfig
+from engine.hardware.device_health import DeviceHealth
+from engine.scenario.world import World
+from engine.vision.classifier import DEFAULT_MODEL, HandModel
+from engine.vision.hand_watcher import HandWatcher
+
+log = logging.getLogger(__name__)
+
+
+@dataclass
+class RobotVision:
+    """The camera, its health, and the worker (None when the model could not be loaded:
+    ``problem`` says why)."""
+
+    camera: Camera
+    health: DeviceHealth
+    watcher: HandWatcher | None
+    problem: str | None = None
+
+    def start(self) -> None:
+        """On a real clock: start the worker thread."""
+        if self.watcher is not None:
+            self.watcher.start()
+
+    def close(self) -> None:
+        if self.watcher is not None:
+            self.watcher.stop()
+        else:
+            self.camera.close()
+
+
+def load_hand_model(config: CameraConfig) -> HandModel:
+    """The config's model (the project's by default); ConfigError naming the file."""
+    return HandModel.load(
+        config.model or DEFAULT_MODEL,
+        threads=config.threads,
+        providers=config.providers,
+        min_confidence=config.min_confidence,
+    )
+
+
+def open_camera(config: CameraConfig, world: World, clock: Clock) -> Camera:
+    """The config's camera, not yet opened; the simulated one listens to ``world``."""
+    if config.simulated:
+        camera = SimulatedCamera(
+            world,
+            clock,
+            width=config.width,
+            height=config.height,
+            window=config.crop,
+            name=CAMERA_NAME,
+        )
+        world.listeners.append(camera)
+        return camera
+    return OpenCvCamera(config.device, width=config.width, height=config.height, fps=config.fps)
+
+
+def build_vision(
+    config: CameraConfig, world: World, clock: Clock, blackboard: Blackboard
+) -> RobotVision:
+    """The robot's sight; never raises for a bad model (see the module's doc)."""
+    camera = open_camera(config, world, clock)
+    health = DeviceHealth(CAMERA_NAME, blackboard)
+    try:
+        model = load_hand_model(config)
+    except ConfigError as error:
+        problem = f"{error}; the robot runs without counting fingers"
+        log.error("camera: %s", problem)
+        health.driver_status(False, problem)
+        return RobotVision(camera, health, None, problem)
+    if config.crop is not None:
+        model.settings = model.settings.with_crop(*config.crop)
+    watcher = HandWatcher(
+        camera,
+        model,
+        blackboard,
+        clock,
+        health,
+        fps=config.fps,
+        steady_frames=config.steady_frames,
+    )
+    return RobotVision(camera, health, watcher)

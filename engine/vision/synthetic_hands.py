@@ -1,0 +1,365 @@
+"""Procedurally drawn hands showing 0..5 fingers: the data the shipped model learns from.
+
+No package ships real finger-count pictures, so the project draws its own and publishes
+how (this module, the seeds and the training command in docs/vision-model-card.md), so
+anyone can rebuild the model and check its accuracy. A hand is a palm, a forearm leaving
+the window at the bottom, and five digits each extended or folded, in any combination
+that shows the asked count; pose, scale, rotation, mirroring, skin tone, lighting,
+clutter, blur, noise and JPEG vary with the seed.
+
+Two styles are drawn by different code, so a model trained on one can be checked on the
+other: ``studio`` (the training style: round-ended fingers, an elliptic palm, plain,
+graded or cluttered backgrounds) and ``variant`` (never trained on: tapered fingers, a
+polygonal palm, a sleeve, striped, checked or textured backgrounds). Everything is drawn
+in the 128 x 128 px window the paper crops; :func:`render_frame` places it in a full
+640 x 360 frame for the simulated camera.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from itertools import combinations
+from pathlib import Path
+
+import cv2
+import numpy as np
+import numpy.typing as npt
+
+from engine.vision.preprocess import SIDE_PX, Frame
+
+STYLES = ("studio", "variant")
+NO_HAND = "none"
+"""The folder name of frames with no hand in them (trained towards "not sure")."""
+Random = np.random.Generator
+Point = tuple[float, float]
+
+# The digits of a right hand seen from the palm side, from the thumb: where each sits on
+# the palm (fraction of the palm's half-width, fraction of its half-height, negative is
+# up), its direction (degrees from straight up, positive to the right of the picture),
+# its length and width (fractions of the palm's half-height).
+DIGITS = (
+    ("thumb", -1.0, 0.15, -52.0, 0.95, 0.40),
+    ("index", -0.62, -0.85, -9.0, 1.35, 0.34),
+    ("middle", -0.18, -0.97, -1.0, 1.48, 0.35),
+    ("ring", 0.27, -0.93, 7.0, 1.36, 0.33),
+    ("little", 0.68, -0.78, 17.0, 1.08, 0.29),
+)
+SKIN_TONES_BGR = (
+    (197, 224, 255),
+    (170, 205, 240),
+    (140, 180, 225),
+    (105, 150, 200),
+    (80, 120, 170),
+    (60, 90, 140),
+    (45, 65, 105),
+    (35, 50, 80),
+)
+
+
+@dataclass(frozen=True)
+class HandPose:
+    """Where and how a hand is drawn in the window: palm centre (px), palm half-height
+    (px), rotation (degrees, clockwise), mirrored (a left hand), which digits are up."""
+
+    centre: Point
+    palm_px: float
+    angle_deg: float
+    mirrored: bool
+    extended: tuple[bool, ...]
+
+    @property
+    def fingers(self) -> int:
+        return sum(self.extended)
+
+
+def extended_digits(fingers: int, rng: Random) -> tuple[bool, ...]:
+    """Which of the five digits are up for a hand showing ``fingers``: any combination,
+    with the common ones (the first fingers, then the thumb) more often."""
+    if not 0 <= fingers <= 5:
+        raise ValueError(f"a hand shows 0..5 fingers, not {fingers}")
+    if fingers in (0, 5) or rng.random() < 0.5:
+        common = [1, 2, 3, 4, 0][:fingers] if rng.random() < 0.6 else [0, 1, 2, 3, 4][:fingers]
+        chosen = set(common)
+    else:
+        options = list(combinations(range(5), fingers))
+        chosen = set(options[int(rng.integers(len(options)))])
+    return tuple(digit in chosen for digit in range(5))
+
+
+def random_pose(fingers: int, rng: Random, side_px: int = SIDE_PX) -> HandPose:
+    """A pose that keeps the hand mostly inside the central 128 x 128 px of a picture
+    ``side_px`` square (the hand keeps its size whatever the picture's)."""
+    palm = float(rng.uniform(17.0, 26.0))
+    centre = (
+        side_px / 2 + float(rng.normal(0.0, 7.0)),
+        side_px / 2 + 15.0 + float(rng.normal(0.0, 6.0)),
+    )
+    return HandPose(
+        centre=centre,
+        palm_px=palm,
+        angle_deg=float(rng.normal(0.0, 13.0)),
+        mirrored=bool(rng.random() < 0.5),
+        extended=extended_digits(fingers, rng),
+    )
+
+
+def _place(pose: HandPose, x: float, y: float) -> Point:
+    """A point given in palm units (x right, y down, palm half-height 1) in window px."""
+    if pose.mirrored:
+        x = -x
+    angle = math.radians(pose.angle_deg)
+    cos, sin = math.cos(angle), math.sin(angle)
+    return (
+        pose.centre[0] + pose.palm_px * (x * cos - y * sin),
+        pose.centre[1] + pose.palm_px * (x * sin + y * cos),
+    )
+
+
+def _digit_line(
+    pose: HandPose, digit: int, length_scale: float, rng: Random
+) -> tuple[Point, Point, float]:
+    """A digit's base and tip (window px) and its width (px)."""
+    _, bx, by, direction, length, width = DIGITS[digit]
+    bx, by = bx * 0.78, by * 0.95
+    direction += float(rng.normal(0.0, 5.0))
+    length *= length_scale * float(rng.uniform(0.9, 1.1))
+    tip_x = bx + length * math.sin(math.radians(direction))
+    tip_y = by - length * math.cos(math.radians(direction))
+    return _place(pose, bx, by), _place(pose, tip_x, tip_y), width * pose.palm_px
+
+
+def _shade(colour: Sequence[int], factor: float) -> tuple[int, int, int]:
+    b, g, r = (int(np.clip(c * factor, 0, 255)) for c in colour)
+    return b, g, r
+
+
+def _px(point: Point) -> tuple[int, int]:
+    return round(point[0] * 16), round(point[1] * 16)
+
+
+def _capsule(image: Frame, start: Point, end: Point, width: float, colour: Sequence[int]) -> None:
+    """A round-ended stroke (the studio style's finger)."""
+    cv2.line(image, _px(start), _px(end), _shade(colour, 1.0), max(2, round(width)), cv2.LINE_AA, 4)
+
+
+def _tapered(image: Frame, start: Point, end: Point, width: float, colour: Sequence[int]) -> None:
+    """A finger narrowing to a rounded tip (the variant style's finger)."""
+    dx, dy = end[0] - start[0], end[1] - start[1]
+    norm = math.hypot(dx, dy) or 1.0
+    nx, ny = -dy / norm, dx / norm
+    base, tip = width / 2, width * 0.3
+    polygon = np.array(
+        [
+            (start[0] + nx * base, start[1] + ny * base),
+            (end[0] + nx * tip, end[1] + ny * tip),
+            (end[0] - nx * tip, end[1] - ny * tip),
+            (start[0] - nx * base, start[1] - ny * base),
+        ]
+    )
+    cv2.fillPoly(
+        image, [np.round(polygon * 16).astype(np.int32)], _shade(colour, 1.0), cv2.LINE_AA, 4
+    )
+    cv2.circle(image, _px(end), max(1, round(tip * 16)), _shade(colour, 1.0), -1, cv2.LINE_AA, 4)
+
+
+def draw_hand(image: Frame, pose: HandPose, rng: Random, *, style: str) -> None:
+    """The hand in ``pose`` drawn onto ``image`` (BGR, in place)."""
+    skin = np.array(SKIN_TONES_BGR[int(rng.integers(len(SKIN_TONES_BGR)))], dtype=float)
+    skin = skin * rng.uniform(0.85, 1.15, size=3)
+    colour = tuple(int(c) for c in np.clip(skin, 0, 255))
+    outline = rng.random() < 0.35
+    dark = _shade(colour, float(rng.uniform(0.55, 0.8)))
+    finger = _capsule if style == "studio" else _tapered
+
+    # The forearm (or, in the variant style, a sleeve) leaves the window at the bottom.
+    forearm = [
+        _place(pose, -0.8, 0.6),
+        _place(pose, 0.8, 0.6),
+        _place(pose, 1.0, 4.5),
+        _place(pose, -1.0, 4.5),
+    ]
+    arm_colour = (
+        colour
+        if style == "studio" or rng.random() < 0.4
+        else tuple(int(c) for c in rng.integers(0, 256, 3))
+    )
+    cv2.fillPoly(
+        image, [np.round(np.array(forearm) * 16).astype(np.int32)], arm_colour, cv2.LINE_AA, 4
+    )
+
+    # Folded digits first (the knuckles show above the palm), the palm, then the digits up.
+    for digit in range(5):
+        if not pose.extended[digit]:
+            scale = 0.35 if digit == 0 else float(rng.uniform(0.15, 0.3))
+            base, tip, width = _digit_line(pose, digit, scale, rng)
+            finger(image, base, tip, width * 1.05, _shade(colour, 0.93))
+    if style == "studio":
+        axes = (pose.palm_px * 0.95, pose.palm_px * 1.05)
+        cv2.ellipse(
+            image,
+            _px(pose.centre),
+            (round(axes[0] * 16), round(axes[1] * 16)),
+            pose.angle_deg,
+            0,
+            360,
+            colour,
+            -1,
+            cv2.LINE_AA,
+            4,
+        )
+    else:
+        corners = [(-0.9, -0.95), (0.85, -0.85), (1.0, 0.4), (0.7, 1.0), (-0.7, 1.0), (-1.0, 0.3)]
+        polygon = np.array([_place(pose, x, y) for x, y in corners])
+        cv2.fillPoly(image, [np.round(polygon * 16).astype(np.int32)], colour, cv2.LINE_AA, 4)
+    if not pose.extended[0]:
+        # A folded thumb lies across the palm.
+        start, end = _place(pose, -0.9, 0.3), _place(pose, 0.1, -0.1)
+        finger(image, start, end, pose.palm_px * 0.38, _shade(colour, 0.9))
+    for digit in range(5):
+        if pose.extended[digit]:
+            base, tip, width = _digit_line(pose, digit, 1.0, rng)
+            if outline:
+                finger(image, base, tip, width + 2.0, dark)
+            finger(image, base, tip, width, colour)
+
+
+def _background(height: int, width: int, rng: Random, style: str) -> Frame:
+    """A background: plain, graded or cluttered (studio); striped, checked or textured
+    (variant)."""
+    base = rng.integers(0, 256, size=3).astype(float)
+    other = rng.integers(0, 256, size=3).astype(float)
+    ys, xs = np.mgrid[0:height, 0:width].astype(np.float32)
+    if style == "studio":
+        angle = rng.uniform(0, 2 * np.pi)
+        ramp = (np.cos(angle) * xs + np.sin(angle) * ys) / max(height, width)
+        ramp = (ramp - ramp.min()) / (np.ptp(ramp) or 1.0) * rng.uniform(0.0, 1.0)
+        image = base + (other - base) * ramp[..., np.newaxis]
+        image = np.clip(image, 0, 255).astype(np.uint8)
+        for _ in range(int(rng.integers(0, 7))):
+            colour = tuple(int(c) for c in rng.integers(0, 256, 3))
+            centre = (int(rng.integers(0, width)), int(rng.integers(0, height)))
+            if rng.random() < 0.5:
+                axes = (int(rng.integers(4, width // 3)), int(rng.integers(4, height // 3)))
+                cv2.ellipse(
+                    image, centre, axes, float(rng.uniform(0, 180)), 0, 360, colour, -1, cv2.LINE_AA
+                )
+            elif rng.random() < 0.5:
+                corner = (
+                    centre[0] + int(rng.integers(5, width // 2)),
+                    centre[1] + int(rng.integers(5, height // 2)),
+                )
+                cv2.rectangle(image, centre, corner, colour, -1)
+            else:
+                end = (int(rng.integers(0, width)), int(rng.integers(0, height)))
+                cv2.line(image, centre, end, colour, int(rng.integers(1, 4)), cv2.LINE_AA)
+        return np.asarray(image, dtype=np.uint8)
+    kind = rng.integers(3)
+    if kind == 0:  # stripes at any angle
+        angle = rng.uniform(0, np.pi)
+        period = rng.uniform(6.0, 30.0)
+        phase = (np.cos(angle) * xs + np.sin(angle) * ys) / period
+        mix = (
+            (np.sin(2 * np.pi * phase) > 0).astype(np.float32)
+            if rng.random() < 0.5
+            else 0.5 + 0.5 * np.sin(2 * np.pi * phase)
+        )
+    elif kind == 1:  # a checkerboard
+        cell = rng.uniform(6.0, 24.0)
+        mix = ((xs // cell + ys // cell) % 2).astype(np.float32)
+    else:  # a texture: smooth noise upscaled
+        coarse = rng.random((int(rng.integers(3, 12)), int(rng.integers(3, 12)))).astype(np.float32)
+        mix = cv2.resize(coarse, (width, height), interpolation=cv2.INTER_CUBIC)
+        mix = np.clip(mix, 0.0, 1.0) + rng.normal(0.0, 0.08, (height, width)).astype(np.float32)
+    image = base + (other - base) * np.clip(mix, 0.0, 1.0)[..., np.newaxis]
+    return np.asarray(np.clip(image, 0, 255), dtype=np.uint8)
+
+
+def _camera_effects(image: Frame, rng: Random) -> Frame:
+    """Lighting, blur, sensor noise and JPEG, as a webcam adds them."""
+    height, width = image.shape[:2]
+    light = rng.uniform(0.55, 1.3)
+    ys, xs = np.mgrid[0:height, 0:width].astype(np.float32)
+    angle = rng.uniform(0, 2 * np.pi)
+    ramp = (np.cos(angle) * xs + np.sin(angle) * ys) / max(height, width)
+    gain = light * (1.0 + rng.uniform(-0.3, 0.3) * ramp)
+    lit = image.astype(np.float32) * gain[..., np.newaxis]
+    if rng.random() < 0.5:
+        sigma = rng.uniform(0.3, 1.4)
+        lit = cv2.GaussianBlur(lit, (0, 0), sigma)
+    lit += rng.normal(0.0, rng.uniform(0.0, 8.0), lit.shape).astype(np.float32)
+    out = np.clip(lit, 0, 255).astype(np.uint8)
+    if rng.random() < 0.5:
+        ok, encoded = cv2.imencode(
+            ".jpg", out, [cv2.IMWRITE_JPEG_QUALITY, int(rng.integers(35, 95))]
+        )
+        if ok:
+            out = cv2.imdecode(encoded, cv2.IMREAD_COLOR)
+    return np.asarray(out, dtype=np.uint8)
+
+
+def _check_style(style: str) -> None:
+    if style not in STYLES:
+        raise ValueError(f"style must be one of {', '.join(STYLES)}, not {style!r}")
+
+
+def render_window(
+    fingers: int | None, rng: Random, *, style: str = "studio", side_px: int = SIDE_PX
+) -> Frame:
+    """A window-sized (``side_px`` square) BGR picture of a hand showing ``fingers``, or
+    of no hand when ``fingers`` is None."""
+    _check_style(style)
+    image = _background(side_px, side_px, rng, style)
+    if fingers is not None:
+        draw_hand(image, random_pose(fingers, rng, side_px), rng, style=style)
+    return _camera_effects(image, rng)
+
+
+def render_frame(
+    fingers: int | None,
+    rng: Random,
+    *,
+    style: str = "studio",
+    width_px: int = 640,
+    height_px: int = 360,
+    window: tuple[int, int] | None = None,
+) -> Frame:
+    """A full camera frame with the hand (or no hand) in the crop window, whose top-left
+    corner is ``window`` (None: centred), and the rest of the frame background."""
+    _check_style(style)
+    x, y = window if window is not None else ((width_px - SIDE_PX) // 2, (height_px - SIDE_PX) // 2)
+    frame = _background(height_px, width_px, rng, style)
+    if fingers is not None:
+        window_view = frame[y : y + SIDE_PX, x : x + SIDE_PX]
+        draw_hand(window_view, random_pose(fingers, rng), rng, style=style)
+    return _camera_effects(frame, rng)
+
+
+def write_dataset(
+    out: Path, count: int, seed: int, *, style: str = "studio", empty_share: float = 0.1
+) -> int:
+    """``count`` labelled pictures written as ``out/<fingers>/<style>-<seed>-<i>.png`` (and
+    ``out/none/`` for frames with no hand, ``empty_share`` of them), 16 px wider than the
+    window on each side so training can shift the crop. Returns how many were written."""
+    _check_style(style)
+    rng = np.random.default_rng(seed)
+    side = SIDE_PX + 32
+    for index in range(count):
+        fingers: int | None = None if rng.random() < empty_share else int(index % 6)
+        folder = out / (NO_HAND if fingers is None else str(fingers))
+        folder.mkdir(parents=True, exist_ok=True)
+        image = render_window(fingers, rng, style=style, side_px=side)
+        cv2.imwrite(str(folder / f"{style}-{seed}-{index:06d}.png"), image)
+    return count
+
+
+def labelled_windows(
+    count: int, seed: int, *, style: str = "studio"
+) -> tuple[npt.NDArray[np.uint8], npt.NDArray[np.int64]]:
+    """``count`` window-sized pictures with a hand (labels cycle 0..5), in memory: for
+    tests and benchmarks that need a held-out set without files."""
+    rng = np.random.default_rng(seed)
+    labels = np.arange(count, dtype=np.int64) % 6
+    images = np.stack([render_window(int(label), rng, style=style) for label in labels])
+    return images, labels
