@@ -1,5 +1,6 @@
 """List the robot's configured devices, probe each, and show its identity and one reading;
-then the sound devices and the speech models (each loaded once: a few seconds).
+then the camera and the hand model (one frame through the network), the sound devices
+and the speech models (each loaded once: a few seconds).
 
 On the simulated vest (the default config) it works the same as on the robot: the real
 drivers talk to register-level chip models. Exits 1 when a device does not answer as the
@@ -34,6 +35,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="robot config (default: examples/robots/sim.yaml, the simulated vest)",
     )
     parser.add_argument(
+        "--no-camera", action="store_true", help="leave out the camera and the hand model"
+    )
+    parser.add_argument(
         "--no-speech", action="store_true", help="leave out the sound devices and speech models"
     )
 
@@ -47,6 +51,10 @@ def main(args: argparse.Namespace) -> int:
         if vest is not None:
             vest.clock.sleep(SIMULATED_WARM_UP_S)
         rows = describe_devices(hardware)
+        if config.camera is not None and not args.no_camera:
+            from engine.vision.vision_report import describe_vision
+
+            rows += describe_vision(config.camera, clock)
         if not args.no_speech:
             from engine.speech.speech_report import describe_speech
 

@@ -19,6 +19,7 @@ from pathlib import Path
 
 import cv2
 
+from engine.clock import EpochClock
 from engine.drivers.camera import CameraError, OpenCvCamera
 from engine.errors import ConfigError, DeviceError
 from engine.vision.dataset import IMAGE_SUFFIXES
@@ -32,7 +33,8 @@ KEYS = {**{str(n): str(n) for n in range(6)}, "n": NO_HAND, "none": NO_HAND}
 
 
 def record(args: argparse.Namespace) -> int:
-    session = args.session or datetime.datetime.now().strftime("%Y%m%d_%H%M%S")
+    now = datetime.datetime.fromtimestamp(EpochClock().now())
+    session = args.session or now.strftime("%Y%m%d_%H%M%S")
     if not SESSION.fullmatch(session):
         raise ConfigError(
             f"--session {session!r}: use letters, digits, '_' and '.' (no '-': it ends a session)"

@@ -18,8 +18,7 @@ from engine.blackboard.catalogue import KeyCatalogue, KeySpec, default_catalogue
 from engine.errors import ConfigError
 from engine.files.problems import LoadError, Problem, Problems
 from engine.hardware.chips import default_chips
-from engine.hardware.config import RobotConfig
-from engine.hardware.config_camera import CAMERA_NAME
+from engine.hardware.config import CAMERA_NAME, RobotConfig
 from engine.hardware.config_file import load_robot_config
 from engine.hardware.sim_vest import check_fault_events
 from engine.loader.tree_definition import NodeDefinition, TreeDefinition

@@ -32,14 +32,11 @@ from __future__ import annotations
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from engine.drivers.servo_joints import Joint
 from engine.errors import ConfigError
 from engine.files.problems import Mark
-
-if TYPE_CHECKING:
-    from engine.hardware.config_camera import CameraConfig
 from engine.values.params import (
     Param,
     did_you_mean,
@@ -216,6 +213,33 @@ class AudioConfig:
     @classmethod
     def for_simulation(cls) -> AudioConfig:
         return cls(microphone=None, speaker=None)
+
+
+SIMULATED_CAMERA = "simulated"
+CAMERA_NAME = "camera"
+"""The camera's device name: ``/devices/camera/ok``, ``unplug: {device: camera}``."""
+
+
+@dataclass(frozen=True)
+class CameraConfig:
+    """A checked ``camera:`` section. ``device``: an index, a path, or ``simulated``;
+    ``crop``: the window's top-left (x, y) in px, or None to centre it; ``model``: a file,
+    or None for the project's; ``providers``: None for the automatic choice."""
+
+    device: int | str = SIMULATED_CAMERA
+    width: int = 640
+    height: int = 360
+    fps: float = 15.0
+    crop: tuple[int, int] | None = None
+    model: Path | None = None
+    threads: int = 1
+    providers: tuple[str, ...] | None = None
+    min_confidence: float = 0.6
+    steady_frames: int = 3
+
+    @property
+    def simulated(self) -> bool:
+        return self.device == SIMULATED_CAMERA
 
 
 @dataclass(frozen=True)

@@ -21,17 +21,14 @@ the section names one.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from engine.files.yaml_source import YMap, YValue, plain
 from engine.hardware.chips.fields import ConfigChecks
+from engine.hardware.config import SIMULATED_CAMERA, CameraConfig
 from engine.values.params import Integer, Number, Param, Text
 
-SIMULATED_CAMERA = "simulated"
-CAMERA_NAME = "camera"
-"""The camera's device name: ``/devices/camera/ok``, ``unplug: {device: camera}``."""
 OWN_CHECKS = ("device", "crop", "providers")
 """Fields checked here rather than by a parameter type (they take more than one shape)."""
 FIELDS: tuple[Param[Any], ...] = (
@@ -44,28 +41,6 @@ FIELDS: tuple[Param[Any], ...] = (
     Param("steady_frames", Integer(1, 100), 3, "frames a count must hold"),
 )
 PROVIDERS = ("TensorrtExecutionProvider", "CUDAExecutionProvider", "CPUExecutionProvider")
-
-
-@dataclass(frozen=True)
-class CameraConfig:
-    """A checked ``camera:`` section. ``device``: an index, a path, or ``simulated``;
-    ``crop``: the window's top-left (x, y) in px, or None to centre it; ``model``: a file,
-    or None for the project's; ``providers``: None for the automatic choice."""
-
-    device: int | str = SIMULATED_CAMERA
-    width: int = 640
-    height: int = 360
-    fps: float = 15.0
-    crop: tuple[int, int] | None = None
-    model: Path | None = None
-    threads: int = 1
-    providers: tuple[str, ...] | None = None
-    min_confidence: float = 0.6
-    steady_frames: int = 3
-
-    @property
-    def simulated(self) -> bool:
-        return self.device == SIMULATED_CAMERA
 
 
 def check_camera(

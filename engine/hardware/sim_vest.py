@@ -47,8 +47,7 @@ from engine.drivers.sim.tca9548a import SimTCA9548A
 from engine.files.problems import Problem
 from engine.hardware.branching_clock import BranchingClock
 from engine.hardware.chips import ChipRegistry, default_chips
-from engine.hardware.config import BusConfig, DeviceConfig, RobotConfig
-from engine.hardware.config_camera import CAMERA_NAME
+from engine.hardware.config import CAMERA_NAME, BusConfig, DeviceConfig, RobotConfig
 from engine.scenario.world import EVENT_KEYS, World
 from engine.values.params import did_you_mean
 

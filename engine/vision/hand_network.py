@@ -13,6 +13,7 @@ He initialisation (for ReLU) lets it learn.
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 
 import torch
@@ -82,13 +83,15 @@ def export_onnx(network: HandNetwork, path: Path) -> None:
     shipped = WithSoftmax(network).eval()
     example = torch.zeros(1, 1, SIDE_PX, SIDE_PX)
     path.parent.mkdir(parents=True, exist_ok=True)
-    torch.onnx.export(
-        shipped,
-        (example,),
-        str(path),
-        input_names=[INPUT_NAME],
-        output_names=[OUTPUT_NAME],
-        dynamic_axes={INPUT_NAME: {0: "batch"}, OUTPUT_NAME: {0: "batch"}},
-        opset_version=17,
-        dynamo=False,  # the TorchScript exporter: one self-contained file
-    )
+    with warnings.catch_warnings():  # it says it is the older exporter: we chose it
+        warnings.simplefilter("ignore", DeprecationWarning)
+        torch.onnx.export(
+            shipped,
+            (example,),
+            str(path),
+            input_names=[INPUT_NAME],
+            output_names=[OUTPUT_NAME],
+            dynamic_axes={INPUT_NAME: {0: "batch"}, OUTPUT_NAME: {0: "batch"}},
+            opset_version=17,
+            dynamo=False,  # the TorchScript exporter: one self-contained file
+        )

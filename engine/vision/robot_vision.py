@@ -17,7 +17,7 @@ from engine.clock import Clock
 from engine.drivers.camera import Camera, OpenCvCamera
 from engine.drivers.sim.camera import SimulatedCamera
 from engine.errors import ConfigError
-from engine.hardware.config_camera import CAMERA_NAME, CameraConfig
+from engine.hardware.config import CAMERA_NAME, CameraConfig
 from engine.hardware.device_health import DeviceHealth
 from engine.scenario.world import World
 from engine.vision.classifier import DEFAULT_MODEL, HandModel

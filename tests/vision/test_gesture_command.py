@@ -1,0 +1,164 @@
+"""`vest gesture`: count fingers in pictures, and make a lab's own model from recordings."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pytest
+
+from engine.cli import main
+from engine.vision.synthetic_hands import render_frame
+
+
+def exit_code(args: list[str]) -> int | str | None:
+    """What `vest` exits with (argparse exits on its own for a wrong command line)."""
+    try:
+        return main(args)
+    except SystemExit as done:
+        return done.code
+
+
+def picture(folder: Path, name: str, fingers: int | None, seed: int) -> Path:
+    path = folder / name
+    cv2.imwrite(str(path), render_frame(fingers, np.random.default_rng(seed)))
+    return path
+
+
+def test_pictures_are_counted_one_json_line_each(tmp_path: Path, capsys) -> None:
+    three = picture(tmp_path, "three.png", 3, seed=11)
+    five = picture(tmp_path, "five.png", 5, seed=12)
+    assert main(["gesture", str(three), str(five), "--json"]) == 0
+    lines = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
+    assert [(line["file"], line["fingers"]) for line in lines] == [(str(three), 3), (str(five), 5)]
+    assert all(0.6 <= line["confidence"] <= 1.0 for line in lines)
+
+
+def test_a_picture_reads_as_words_without_json(tmp_path: Path, capsys) -> None:
+    two = picture(tmp_path, "two.png", 2, seed=13)
+    assert main(["gesture", str(two)]) == 0
+    out = capsys.readouterr().out
+    assert out.startswith(f"{two}: 2 fingers (") and out.rstrip().endswith("%)")
+
+
+def test_a_window_elsewhere_is_given_with_crop(tmp_path: Path, capsys) -> None:
+    frame = np.full((400, 400, 3), 90, np.uint8)
+    hand = render_frame(4, np.random.default_rng(14))[116:244, 256:384]  # the hand's window
+    frame[10:138, 20:148] = hand
+    path = tmp_path / "corner.png"
+    cv2.imwrite(str(path), frame)
+    assert main(["gesture", str(path), "--crop", "20,10,128", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["fingers"] == 4
+
+
+def test_bad_pictures_are_named_and_the_others_still_counted(tmp_path: Path, capsys) -> None:
+    good = picture(tmp_path, "good.png", 1, seed=15)
+    (tmp_path / "notes.png").write_text("not a picture")
+    tiny = tmp_path / "tiny.png"
+    cv2.imwrite(str(tiny), np.zeros((50, 50, 3), np.uint8))
+    args = [
+        "gesture",
+        str(tmp_path / "notes.png"),
+        str(good),
+        str(tiny),
+        str(tmp_path / "gone.png"),
+    ]
+    assert main(args) == 1
+    captured = capsys.readouterr()
+    assert captured.out.startswith(f"{good}: 1 finger (")
+    assert "notes.png: not an image OpenCV can read" in captured.err
+    assert "tiny.png: a 50x50 image is smaller than the 128x128 window" in captured.err
+    assert "gone.png: no such file" in captured.err
+    assert "Traceback" not in captured.err
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["--crop", "1,2"], "must be X,Y,W in px"),
+        (["--crop", "-5,0,128"], "X and Y must be 0 or more"),
+        (["--model", "nowhere/kids.onnx"], "kids.onnx: no such model file"),
+    ],
+)
+def test_a_wrong_option_is_said_in_one_line(tmp_path: Path, capsys, args, message) -> None:
+    image = picture(tmp_path, "a.png", 0, seed=16)
+    assert exit_code(["gesture", str(image), *args]) in (1, 2)
+    err = capsys.readouterr().err
+    assert message in err and "Traceback" not in err
+
+
+def test_a_lab_generates_trains_and_checks_its_own_model(tmp_path: Path, capsys) -> None:
+    pytest.importorskip("torch", reason="training needs the train extra")
+    data, model = tmp_path / "data", tmp_path / "lab.onnx"
+    assert main(["gesture", "generate", str(data), "--count", "36", "--seed", "4"]) == 0
+    assert sum(1 for _ in data.rglob("*.png")) == 36
+    args = ["gesture", "train", str(data), "-o", str(model), "--epochs", "1", "--split", "file"]
+    assert main([*args, "--threads", "1"]) == 0
+    out = capsys.readouterr().out
+    assert "epoch 1/1: loss" in out and "shows \\ said" in out and "held out: accuracy" in out
+    assert model.is_file() and model.with_suffix(".json").is_file()
+    assert model.with_suffix(".matrix.png").is_file()
+
+    assert main(["gesture", "eval", str(data), "--model", str(model), "--json"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert sum(map(sum, report["matrix"])) == 36
+    assert report["columns"][-1] == "not sure"
+
+
+def test_training_on_a_folder_that_is_not_labelled_is_refused(tmp_path: Path, capsys) -> None:
+    pytest.importorskip("torch", reason="training needs the train extra")
+    (tmp_path / "data" / "seven").mkdir(parents=True)
+    args = ["gesture", "train", str(tmp_path / "data"), "-o", str(tmp_path / "m.onnx")]
+    assert main(args) == 1
+    err = capsys.readouterr().err
+    assert "seven: not a label folder (they are 0, 1, 2, 3, 4, 5, none)" in err
+
+
+def test_record_takes_frames_from_a_camera_into_a_labelled_session(tmp_path: Path, capsys) -> None:
+    """A video file stands in for the webcam: OpenCV opens both the same way."""
+    video = tmp_path / "webcam.avi"
+    writer = cv2.VideoWriter(str(video), cv2.VideoWriter.fourcc(*"MJPG"), 15.0, (640, 360))
+    rng = np.random.default_rng(5)
+    for _ in range(30):
+        writer.write(render_frame(2, rng))
+    writer.release()
+    data = tmp_path / "data"
+    args = ["gesture", "record", str(data), "--camera", str(video), "--label", "2"]
+    assert main([*args, "--frames", "5", "--session", "anna_1"]) == 0
+    saved = sorted(p.name for p in (data / "2").iterdir())
+    assert saved == [f"anna_1-{n:05d}.png" for n in range(5)]
+    assert "5 pictures of 2" in capsys.readouterr().out
+
+    assert main([*args, "--frames", "2", "--session", "anna_1"]) == 0  # numbered after those
+    assert len(list((data / "2").iterdir())) == 7
+
+
+def test_record_adds_pictures_from_a_folder_and_skips_what_it_cannot_use(
+    tmp_path: Path, capsys
+) -> None:
+    source = tmp_path / "empty_room"
+    source.mkdir()
+    picture(source, "a.png", None, seed=6)
+    (source / "b.png").write_text("broken")
+    data = tmp_path / "data"
+    args = ["gesture", "record", str(data), "--label", "none", "--from", str(source)]
+    assert main([*args, "--session", "room"]) == 0
+    assert [p.name for p in (data / "none").iterdir()] == ["room-00000.png"]
+    assert "skipped" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["--label", "7"], "must be one of 0, 1, 2, 3, 4, 5, none"),
+        (["--from", "x"], "--from needs --label"),
+        (["--label", "2", "--session", "a-b"], "no '-': it ends a session"),
+        (["--label", "2", "--camera", "/dev/video63"], "camera /dev/video63: cannot be opened"),
+    ],
+)
+def test_record_says_what_is_wrong_in_one_line(tmp_path: Path, capsys, args, message) -> None:
+    assert exit_code(["gesture", "record", str(tmp_path / "data"), *args]) in (1, 2, 3)
+    err = capsys.readouterr().err
+    assert message in err and "Traceback" not in err

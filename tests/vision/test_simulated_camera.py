@@ -1,0 +1,127 @@
+"""The simulated vest's camera: what a scenario holds up to it (a drawn hand, a picture,
+a video) becomes frames; it can be unplugged; bad show_hand events are named."""
+
+from __future__ import annotations
+
+import textwrap
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pytest
+
+from engine.clock import VirtualClock
+from engine.drivers.camera import CameraError
+from engine.drivers.sim.camera import SimulatedCamera
+from engine.files.problems import LoadError
+from engine.scenario.player import ScenarioPlayer
+from engine.scenario.scenario_file import load_scenario
+from engine.scenario.world import World
+
+WINDOW = (slice(116, 244), slice(256, 384))  # the centred 128 x 128 window of 640 x 360
+
+
+def scenario_file(tmp_path: Path, events: str, duration_s: float = 10) -> Path:
+    path = tmp_path / "scene.yaml"
+    path.write_text(f"duration_s: {duration_s}\nevents:\n" + textwrap.dedent(events))
+    return path
+
+
+def camera_on(tmp_path: Path, events: str) -> tuple[SimulatedCamera, ScenarioPlayer, VirtualClock]:
+    clock = VirtualClock()
+    world = World()
+    camera = SimulatedCamera(world, clock)
+    world.listeners.append(camera)
+    player = ScenarioPlayer(load_scenario(scenario_file(tmp_path, events)), world)
+    camera.open()
+    return camera, player, clock
+
+
+def at(player: ScenarioPlayer, clock: VirtualClock, seconds: float) -> None:
+    clock.advance(seconds - clock.now())
+    player.advance_to(clock.now())
+
+
+def test_a_drawn_hand_is_in_the_window_while_it_is_held_up(tmp_path: Path) -> None:
+    camera, player, clock = camera_on(
+        tmp_path, "  - {at: 1.0, show_hand: {fingers: 3, seconds: 2}}\n"
+    )
+    room = camera.read()
+    assert room.shape == (360, 640, 3)
+    at(player, clock, 1.5)
+    held = camera.read()
+    assert np.abs(held[WINDOW].astype(int) - room[WINDOW].astype(int)).mean() > 10
+    assert np.array_equal(camera.read(), held)  # a still hand: the same pose each frame
+    at(player, clock, 3.5)
+    assert np.array_equal(camera.read(), room)
+
+
+def test_a_picture_is_placed_in_the_frame_unscaled(tmp_path: Path) -> None:
+    picture = np.zeros((128, 128, 3), np.uint8)
+    picture[:, :, 2] = 200  # red
+    cv2.imwrite(str(tmp_path / "red.png"), picture)
+    camera, player, clock = camera_on(tmp_path, "  - {at: 1.0, show_hand: {image: red.png}}\n")
+    at(player, clock, 1.0)
+    frame = camera.read()
+    assert (frame[WINDOW][:, :, 2] == 200).all() and (frame[WINDOW][:, :, 0] == 0).all()
+
+
+def test_a_video_plays_on_the_robot_s_clock_from_when_it_is_shown(tmp_path: Path) -> None:
+    video = tmp_path / "clip.avi"
+    writer = cv2.VideoWriter(str(video), cv2.VideoWriter.fourcc(*"MJPG"), 10.0, (640, 360))
+    for level in (0, 60, 120, 180, 240):
+        writer.write(np.full((360, 640, 3), level, np.uint8))
+    writer.release()
+    camera, player, clock = camera_on(
+        tmp_path, "  - {at: 2.0, show_hand: {video: clip.avi, seconds: 5}}\n"
+    )
+    levels = []
+    for second in (2.0, 2.1, 2.25, 2.45, 4.0):
+        at(player, clock, second)
+        levels.append(round(float(camera.read().mean()), -1))
+    assert levels == [0, 60, 120, 240, 240]  # 10 fps; after its end, its last frame
+
+
+def test_an_unplugged_camera_gives_no_frames_until_it_is_back(tmp_path: Path) -> None:
+    camera, player, clock = camera_on(
+        tmp_path, "  - {at: 1.0, unplug: {device: camera, seconds: 2}}\n"
+    )
+    at(player, clock, 1.0)
+    with pytest.raises(CameraError, match="unplugged"):
+        camera.read()
+    with pytest.raises(CameraError, match="cannot be opened"):
+        camera.open()
+    at(player, clock, 3.0)
+    camera.open()
+    assert camera.read().shape == (360, 640, 3)
+
+
+def problems(tmp_path: Path, events: str) -> list[str]:
+    with pytest.raises(LoadError) as caught:
+        load_scenario(scenario_file(tmp_path, events), "scene.yaml")
+    return [str(problem) for problem in caught.value.problems]
+
+
+def test_show_hand_takes_one_thing_to_show(tmp_path: Path) -> None:
+    [problem] = problems(tmp_path, "  - {at: 1.0, show_hand: {fingers: 2, image: a.png}}\n")
+    assert problem.startswith("scene.yaml:3:")
+    assert "show_hand takes one of fingers, image and video" in problem
+
+
+def test_a_count_beyond_a_hand_is_named(tmp_path: Path) -> None:
+    [problem] = problems(tmp_path, "  - {at: 1.0, show_hand: {fingers: 6}}\n")
+    assert "scene.yaml:3:" in problem and "'fingers'" in problem and "5" in problem
+
+
+def test_a_missing_picture_and_a_file_that_is_no_video_are_named_before_the_run(
+    tmp_path: Path,
+) -> None:
+    (tmp_path / "notes.avi").write_text("not a video")
+    found = problems(
+        tmp_path,
+        "  - {at: 1.0, show_hand: {image: gone.png}}\n"
+        "  - {at: 2.0, show_hand: {video: notes.avi}}\n",
+    )
+    assert len(found) == 2
+    assert "scene.yaml:3:" in found[0] and "gone.png: no such file" in found[0]
+    assert "scene.yaml:4:" in found[1] and "notes.avi: not a video OpenCV can play" in found[1]
