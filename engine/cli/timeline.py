@@ -13,7 +13,7 @@ import json
 from collections.abc import Callable
 from typing import Any, TextIO
 
-from engine.blackboard.catalogue import SPEECH_HEARD
+from engine.blackboard.catalogue import HAND_SHOWN, SPEECH_HEARD
 from engine.cli.output import discard, finite_json, reason, shown, tell
 from engine.runtime.scheduler import RunningTree
 from engine.scenario.scenario_file import ScenarioEvent
@@ -96,10 +96,13 @@ class Timeline:
             self._line(at_s, "world", event.describe())
 
     def blackboard_write(self, key: str, value: Any, at_s: float) -> None:
-        """Show what the robot heard, and a device going offline or coming back
-        (``/devices/<name>/ok`` changing)."""
+        """Show what the robot heard, the fingers it saw held up, and a device going
+        offline or coming back (``/devices/<name>/ok`` changing)."""
         if key == SPEECH_HEARD and not self.as_json:
             self._line(at_s, "vest", f"hears {value!r}")
+            return
+        if key == HAND_SHOWN and not self.as_json:
+            self._line(at_s, "vest", f"sees {value} finger{'' if value == 1 else 's'} held up")
             return
         if self.as_json or not (key.startswith("/devices/") and key.endswith("/ok")):
             return

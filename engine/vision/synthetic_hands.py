@@ -91,7 +91,7 @@ def extended_digits(fingers: int, rng: Random) -> tuple[bool, ...]:
 def random_pose(fingers: int, rng: Random, side_px: int = SIDE_PX) -> HandPose:
     """A pose that keeps the hand mostly inside the central 128 x 128 px of a picture
     ``side_px`` square (the hand keeps its size whatever the picture's)."""
-    palm = float(rng.uniform(17.0, 26.0))
+    palm = float(rng.uniform(19.0, 27.0))
     centre = (
         side_px / 2 + float(rng.normal(0.0, 7.0)),
         side_px / 2 + 15.0 + float(rng.normal(0.0, 6.0)),
@@ -164,9 +164,27 @@ def _tapered(image: Frame, start: Point, end: Point, width: float, colour: Seque
     cv2.circle(image, _px(end), max(1, round(tip * 16)), _shade(colour, 1.0), -1, cv2.LINE_AA, 4)
 
 
+def _luma(colour: Sequence[float]) -> float:
+    b, g, r = colour
+    return 0.114 * b + 0.587 * g + 0.299 * r
+
+
+def _skin_tone(image: Frame, pose: HandPose, rng: Random) -> tuple[int, int, int]:
+    """A skin tone that stands out from the background around the hand by at least 30
+    grey levels when one does (a hand the camera cannot tell from the wall teaches the
+    network nothing but guessing)."""
+    x, y = round(pose.centre[0]), round(pose.centre[1])
+    reach = round(pose.palm_px * 2)
+    around = image[max(0, y - reach) : y + reach, max(0, x - reach) : x + reach]
+    background = _luma(around.reshape(-1, 3).mean(axis=0)) if around.size else 128.0
+    standing_out = [t for t in SKIN_TONES_BGR if abs(_luma(t) - background) >= 30]
+    tones = standing_out or list(SKIN_TONES_BGR)
+    return tones[int(rng.integers(len(tones)))]
+
+
 def draw_hand(image: Frame, pose: HandPose, rng: Random, *, style: str) -> None:
     """The hand in ``pose`` drawn onto ``image`` (BGR, in place)."""
-    skin = np.array(SKIN_TONES_BGR[int(rng.integers(len(SKIN_TONES_BGR)))], dtype=float)
+    skin = np.array(_skin_tone(image, pose, rng), dtype=float)
     skin = skin * rng.uniform(0.85, 1.15, size=3)
     colour = tuple(int(c) for c in np.clip(skin, 0, 255))
     outline = rng.random() < 0.35
@@ -237,18 +255,20 @@ def _background(height: int, width: int, rng: Random, style: str) -> Frame:
         ramp = (ramp - ramp.min()) / (np.ptp(ramp) or 1.0) * rng.uniform(0.0, 1.0)
         image = base + (other - base) * ramp[..., np.newaxis]
         image = np.clip(image, 0, 255).astype(np.uint8)
-        for _ in range(int(rng.integers(0, 7))):
+        busy = rng.random() < 0.35  # a cluttered room: many small things, many edges
+        reach = max(6, (height + width) // (16 if busy else 6))
+        for _ in range(int(rng.integers(15, 40)) if busy else int(rng.integers(0, 7))):
             colour = tuple(int(c) for c in rng.integers(0, 256, 3))
             centre = (int(rng.integers(0, width)), int(rng.integers(0, height)))
             if rng.random() < 0.5:
-                axes = (int(rng.integers(4, width // 3)), int(rng.integers(4, height // 3)))
+                axes = (int(rng.integers(3, reach)), int(rng.integers(3, reach)))
                 cv2.ellipse(
                     image, centre, axes, float(rng.uniform(0, 180)), 0, 360, colour, -1, cv2.LINE_AA
                 )
             elif rng.random() < 0.5:
                 corner = (
-                    centre[0] + int(rng.integers(5, width // 2)),
-                    centre[1] + int(rng.integers(5, height // 2)),
+                    centre[0] + int(rng.integers(5, reach * 3 // 2)),
+                    centre[1] + int(rng.integers(5, reach * 3 // 2)),
                 )
                 cv2.rectangle(image, centre, corner, colour, -1)
             else:
