@@ -42,6 +42,7 @@ def build_parser() -> argparse.ArgumentParser:
         keys_command,
         nodes_command,
         render_command,
+        replay_command,
         run_command,
         say_command,
         schema_command,
@@ -68,6 +69,7 @@ def build_parser() -> argparse.ArgumentParser:
         dialogs_command,
         cloud_command,
         gesture_command,
+        replay_command,
     ):
         sub = commands.add_parser(
             module.NAME,

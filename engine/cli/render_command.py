@@ -12,22 +12,12 @@ from pathlib import Path
 
 from engine.dialogs.library import DialogLibrary, find_dialogs_folder
 from engine.errors import ConfigError
-from engine.loader.tree_definition import NodeDefinition, TreeDefinition
+from engine.loader.tree_drawing import ascii_tree, dot_source
 from engine.loader.tree_file import TreeLoader
 from engine.nodes.registry import default_registry
-from engine.values.templates import CompiledTemplate
 
 NAME = "render"
 HELP = "draw a tree as ascii, dot, svg or png"
-
-_SHAPES = {"composite": "box", "decorator": "hexagon", "condition": "ellipse", "action": "box"}
-_COLORS = {
-    "composite": "#FFD28C",
-    "decorator": "#E6E6E6",
-    "condition": "#B4DCFF",
-    "action": "#B9F0B9",
-}
-_SYMBOLS = {"Sequence": "->", "Selector": "?", "Parallel": "=>"}
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -45,63 +35,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         default=None,
         help="a profile file, or a name in trees/profiles/ (child, adult)",
     )
-
-
-def label(node: NodeDefinition) -> str:
-    """``Check key=/sensors/force/left_n above=3`` : the type and the arguments given."""
-    parts = [node.name if node.name != node.type.name else node.type.name]
-    if node.name != node.type.name:
-        parts.append(f"[{node.type.name}]")
-    for param in node.type.params:
-        value = node.args.get(param.name)
-        if value is None or value == param.default:
-            continue
-        shown = f'"{value.source}"' if isinstance(value, CompiledTemplate) else f"{value}"
-        parts.append(f"{param.name}={shown}")
-    return " ".join(parts)
-
-
-def ascii_tree(definition: TreeDefinition) -> str:
-    lines = [f"{definition.name} ({definition.rate_hz:g} Hz)"]
-
-    def walk(node: NodeDefinition, prefix: str, last: bool) -> None:
-        branch = "`-- " if last else "|-- "
-        symbol = _SYMBOLS.get(node.type.name)
-        lines.append(prefix + branch + (f"[{symbol}] " if symbol else "") + label(node))
-        for index, child in enumerate(node.children):
-            walk(child, prefix + ("    " if last else "|   "), index == len(node.children) - 1)
-
-    walk(definition.root, "", True)
-    return "\n".join(lines) + "\n"
-
-
-def dot_source(definition: TreeDefinition) -> str:
-    lines = [
-        f'digraph "{definition.name}" {{',
-        "  graph [rankdir=TB, fontname=Helvetica];",
-        "  node [style=filled, fontname=Helvetica, fontsize=11];",
-        f'  title [shape=plaintext, style="", label="{definition.name} '
-        f'({definition.rate_hz:g} Hz)"];',
-    ]
-    counter = iter(range(1_000_000))
-
-    def escape(text: str) -> str:
-        return text.replace("\\", "\\\\").replace('"', '\\"')
-
-    def walk(node: NodeDefinition) -> str:
-        ident = f"n{next(counter)}"
-        kind = node.type.kind
-        lines.append(
-            f'  {ident} [shape={_SHAPES[kind]}, fillcolor="{_COLORS[kind]}", '
-            f'label="{escape(label(node))}"];'
-        )
-        for child in node.children:
-            lines.append(f"  {ident} -> {walk(child)};")
-        return ident
-
-    root = walk(definition.root)
-    lines += [f"  title -> {root} [style=invis];", "}"]
-    return "\n".join(lines) + "\n"
 
 
 def main(args: argparse.Namespace) -> int:

@@ -20,18 +20,22 @@ from __future__ import annotations
 
 import argparse
 import sys
+from collections.abc import Callable
 from pathlib import Path
 
 from engine.cli.output import shown, tell
 from engine.cli.run_inputs import DEFAULT_HARDWARE, load_run_inputs
 from engine.cli.timeline import Timeline
-from engine.clock import Clock, RealClock, VirtualClock
+from engine.clock import Clock, EpochClock, RealClock, VirtualClock
 from engine.errors import ConfigError, UsageError
 from engine.files.problems import LoadError
 from engine.files.yaml_source import read_text
+from engine.recording.recorder import SessionRecorder
 from engine.runtime.reload import TreeReloader
+from engine.runtime.robot import Behaviors
 from engine.runtime.robot_factory import build_robot
 from engine.scenario.player import ScenarioPlayer
+from engine.scenario.scenario_file import ScenarioEvent
 from engine.services.cloud_link import CloudLink
 from engine.services.interfaces import Speech
 from engine.services.simulated import simulated_services
@@ -101,12 +105,35 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="the robot's token for --cloud (finished commands are kept in FILE.done.json)",
     )
     parser.add_argument(
+        "--record",
+        type=Path,
+        default=None,
+        metavar="FILE",
+        help="record the session (trees, statuses, blackboard, actions) for vest replay",
+    )
+    parser.add_argument(
         "--hardware",
         type=Path,
         default=DEFAULT_HARDWARE,
         metavar="CONFIG",
         help="robot config (default: examples/robots/sim.yaml, the simulated vest)",
     )
+
+
+EventListener = Callable[[float, ScenarioEvent], None]
+
+
+def _profile_name(behaviors: Behaviors) -> str:
+    profile = behaviors.loader.profile
+    return "" if profile is None else str(profile.path or profile.name)
+
+
+def _both(first: EventListener, second: EventListener) -> EventListener:
+    def both(at_s: float, event: ScenarioEvent) -> None:
+        first(at_s, event)
+        second(at_s, event)
+
+    return both
 
 
 def _positive_seconds(text: str) -> float:
@@ -181,6 +208,7 @@ def main(args: argparse.Namespace) -> int:
     )
     robot, blackboard = assembled.robot, assembled.blackboard
     reloader: TreeReloader | None = None
+    recorder: SessionRecorder | None = None
     try:
         start_s = clock.now()  # after start-up, which takes simulated time too
         timeline = Timeline(sys.stdout, start_s=start_s, as_json=args.json)
@@ -195,9 +223,24 @@ def main(args: argparse.Namespace) -> int:
             lambda key, value: timeline.blackboard_write(key, value, clock.now())
         )
         timeline.on_closed = robot.scheduler.stop
+        on_event: EventListener = timeline.world
+        if args.record is not None:
+            recorder = SessionRecorder(args.record, clock, blackboard.catalogue)
+            recorder.describe(
+                robot_config=str(args.hardware),
+                profile=_profile_name(behaviors),
+                scenario=str(scenario.path),
+                started=f"{EpochClock().now():.3f}",
+            )
+            recorder.begin(start_s, robot.trees)
+            robot.scheduler.after_tick.append(recorder.tree_ticked)
+            blackboard.watchers.append(recorder.blackboard_write)
+            robot.action_log.listeners.append(recorder.action)
+            robot.action_log.failure_listeners.append(recorder.failed)
+            on_event = _both(timeline.world, recorder.world)
         # the world moves first, then the pollers read it, then the trees tick
         robot.scheduler.hooks.insert(
-            0, ScenarioPlayer(scenario, assembled.world, start_s=start_s, on_event=timeline.world)
+            0, ScenarioPlayer(scenario, assembled.world, start_s=start_s, on_event=on_event)
         )
         if not args.fast:  # reload work runs beside the scheduler, swaps between ticks
             reloader = TreeReloader(behaviors.loader, robot.trees, clock)
@@ -220,4 +263,6 @@ def main(args: argparse.Namespace) -> int:
         if reloader is not None:
             reloader.stop()
         assembled.close()
+        if recorder is not None:
+            recorder.close()
     return 0 if timeline.write_error is None else 1  # the robot ran; its timeline was lost

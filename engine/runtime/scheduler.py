@@ -96,6 +96,9 @@ class Scheduler:
         self.clock = clock
         self.blackboard = blackboard
         self.hooks = hooks if hooks is not None else []
+        self.after_tick: list[Callable[[RunningTree], None]] = []
+        """Called with each tree right after it ticked (a recorder noting what changed);
+        one that raises is logged and the robot goes on."""
         self.trees: list[RunningTree] = []
         self._measure = measure
         self._stop = clock.event()
@@ -193,6 +196,12 @@ class Scheduler:
             tree.stats.errors += 1
             _log.error("%s: tick failed: %s: %s", tree.name, type(error).__name__, error)
         tree.stats.record(self._measure() - started, max(0.0, lateness))
+        for observer in self.after_tick:
+            try:
+                observer(tree)
+            except Exception as error:  # a view or recorder must never stop the robot
+                self.hook_errors += 1
+                _log.exception("after-tick observer %r failed: %s", observer, error)
         tree.period_index += 1
         if tree.next_deadline_s <= now:
             behind = math.floor((now - tree.origin_s) / tree.period_s) + 1

@@ -1,0 +1,1 @@
+"""Session recordings: everything a run did, kept in one SQLite file, replayed later."""

@@ -1,0 +1,171 @@
+"""Reading a session recording back: the trees' statuses and the blackboard at any moment.
+
+:class:`Recording` answers "what was the robot doing at 12.5 s?" from the file alone (the
+tree files may have changed since): each tree as it ran then, each node's last status at
+or before that moment, each key's last value.
+"""
+
+from __future__ import annotations
+
+import json
+import sqlite3
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from engine.recording.session_file import open_for_reading
+
+STATUS_MARKS = {"SUCCESS": "ok", "FAILURE": "no", "RUNNING": "..", "INVALID": "  "}
+"""How a status reads in the terminal: success, failure, running, not ticked."""
+
+
+@dataclass(frozen=True)
+class RecordedNode:
+    index: int
+    path: str
+    type: str
+    label: str
+    depth: int
+
+
+@dataclass(frozen=True)
+class RecordedTree:
+    """One version of a tree as it ran from ``at_s`` on."""
+
+    name: str
+    version: int
+    at_s: float
+    rate_hz: float
+    digest: str
+    nodes: tuple[RecordedNode, ...]
+
+
+@dataclass(frozen=True)
+class NodeState:
+    status: str
+    feedback: str
+    since_s: float
+
+
+@dataclass(frozen=True)
+class KeyState:
+    value: Any
+    since_s: float
+
+
+@dataclass(frozen=True)
+class RecordedAction:
+    at_s: float
+    tree: str
+    action: str
+    args: dict[str, Any]
+    error: str | None
+
+
+class Recording:
+    """A recording opened for reading (:func:`Recording.open`)."""
+
+    def __init__(self, path: Path, connection: sqlite3.Connection) -> None:
+        self.path = path
+        self._db = connection
+        self.meta = dict(connection.execute("SELECT key, value FROM meta").fetchall())
+        self.trees = self._read_trees()
+
+    @classmethod
+    def open(cls, path: Path) -> Recording:
+        """ConfigError naming the file when it is not a recording this vest reads."""
+        return cls(path, open_for_reading(path))
+
+    def close(self) -> None:
+        self._db.close()
+
+    @property
+    def format(self) -> int:
+        return int(self.meta["format"])
+
+    @property
+    def duration_s(self) -> float:
+        """How long the session ran (the last thing recorded, if it was cut off)."""
+        if "duration_s" in self.meta:
+            return float(self.meta["duration_s"])
+        last = [
+            self._db.execute(f"SELECT max(at_s) FROM {table}").fetchone()[0]
+            for table in ("statuses", "blackboard", "actions")
+        ]
+        return max((t for t in last if t is not None), default=0.0)
+
+    def _read_trees(self) -> list[RecordedTree]:
+        nodes: dict[tuple[str, int], list[RecordedNode]] = {}
+        for tree, version, index, path, kind, label, depth in self._db.execute(
+            "SELECT tree, version, node, path, type, label, depth FROM nodes "
+            "ORDER BY tree, version, node"
+        ):
+            nodes.setdefault((tree, version), []).append(
+                RecordedNode(index, path, kind, label, depth)
+            )
+        return [
+            RecordedTree(
+                name, version, at_s, rate_hz, digest, tuple(nodes.get((name, version), []))
+            )
+            for name, version, at_s, rate_hz, digest in self._db.execute(
+                "SELECT tree, version, at_s, rate_hz, digest FROM trees ORDER BY tree, version"
+            )
+        ]
+
+    def trees_at(self, at_s: float) -> list[RecordedTree]:
+        """Each tree as it ran at ``at_s`` (its latest version by then; the first before)."""
+        chosen: dict[str, RecordedTree] = {}
+        for tree in self.trees:
+            if tree.name not in chosen or tree.at_s <= at_s:
+                chosen[tree.name] = tree
+        return [chosen[name] for name in sorted(chosen)]
+
+    def statuses_at(self, at_s: float) -> dict[tuple[str, int, int], NodeState]:
+        """(tree, version, node) -> its last status at or before ``at_s``."""
+        rows = self._db.execute(
+            "SELECT tree, version, node, status, feedback, at_s FROM statuses "
+            "WHERE rowid IN (SELECT max(rowid) FROM statuses WHERE at_s <= ? "
+            "GROUP BY tree, version, node)",
+            (at_s,),
+        )
+        return {(t, v, n): NodeState(s, f, a) for t, v, n, s, f, a in rows}
+
+    def blackboard_at(self, at_s: float) -> dict[str, KeyState]:
+        """Each key's last value (an event key: its last event) at or before ``at_s``."""
+        rows = self._db.execute(
+            "SELECT key, value, at_s FROM blackboard WHERE rowid IN "
+            "(SELECT max(rowid) FROM blackboard WHERE at_s <= ? GROUP BY key)",
+            (at_s,),
+        )
+        return {key: KeyState(json.loads(value), at) for key, value, at in rows}
+
+    def actions(self, until_s: float | None = None) -> list[RecordedAction]:
+        """The service calls, in order (up to ``until_s`` when given)."""
+        rows = self._db.execute(
+            "SELECT at_s, tree, action, args, error FROM actions WHERE at_s <= ? ORDER BY rowid",
+            (float("inf") if until_s is None else until_s,),
+        )
+        return [RecordedAction(t, tree, a, json.loads(args), e) for t, tree, a, args, e in rows]
+
+
+def moment(recording: Recording, at_s: float) -> str:
+    """The trees' statuses and the blackboard at ``at_s``, as ``vest replay --at`` prints."""
+    statuses = recording.statuses_at(at_s)
+    lines = [f"at {at_s:.2f} s of {recording.duration_s:.2f} s ({recording.path.name})"]
+    for tree in recording.trees_at(at_s):
+        reloaded = f", version {tree.version}" if tree.version > 1 else ""
+        lines.append(f"\n{tree.name} ({tree.rate_hz:g} Hz{reloaded})")
+        for node in tree.nodes:
+            state = statuses.get((tree.name, tree.version, node.index))
+            mark = STATUS_MARKS.get(state.status, "?") if state else "  "
+            detail = f"  -- {state.feedback}" if state and state.feedback else ""
+            lines.append(f"  [{mark}] {'  ' * node.depth}{node.label}{detail}")
+    lines.append("\nblackboard")
+    for key, written in sorted(recording.blackboard_at(at_s).items()):
+        lines.append(f"  {key} = {json.dumps(written.value)}  (since {written.since_s:.2f} s)")
+    done = recording.actions(at_s)
+    if done:
+        last = done[-1]
+        lines.append(f"\nlast action: {last.at_s:.2f} s {last.tree} {last.action} {last.args}")
+    lines.append("\n[ok] success  [no] failure  [..] running  [  ] not ticked")
+    return "\n".join(lines)

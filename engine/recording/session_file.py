@@ -1,0 +1,98 @@
+"""The session recording file: one SQLite database (docs/recordings.md describes it).
+
+Times are seconds since the session started (its first tick's clock time). Tables:
+
+- ``meta``: ``format`` (this module's :data:`FORMAT_VERSION`), when it was recorded, the
+  robot config, the profile, how long it lasted, and how many changes were lost;
+- ``trees``: each tree as it was run, one row per version (a hot reload adds one): its
+  file, the SHA-256 of its files, its rate, its YAML source and its Graphviz drawing;
+- ``nodes``: each node of each tree version, numbered in depth-first order as
+  ``vest render`` numbers them (``n0`` is the root), with its path and type;
+- ``statuses``: a node's status (and feedback message) each time it changes after a tick;
+- ``blackboard``: each write that changed a key's value, and every event, as JSON;
+- ``actions``: each service call (say, led, move, ...), and its error when it failed;
+- ``world``: what happened around the robot (a scenario's events).
+
+A later version of vest reads every earlier format; it refuses a newer one by name.
+"""
+
+from __future__ import annotations
+
+import json
+import sqlite3
+from pathlib import Path
+from typing import Any
+
+from engine.errors import ConfigError
+
+FORMAT_VERSION = 1
+SCHEMA = """
+CREATE TABLE meta (key TEXT PRIMARY KEY, value TEXT NOT NULL);
+CREATE TABLE trees (
+    tree TEXT NOT NULL, version INTEGER NOT NULL, at_s REAL NOT NULL, file TEXT NOT NULL,
+    digest TEXT NOT NULL, rate_hz REAL NOT NULL, source TEXT NOT NULL, dot TEXT NOT NULL,
+    PRIMARY KEY (tree, version)
+);
+CREATE TABLE nodes (
+    tree TEXT NOT NULL, version INTEGER NOT NULL, node INTEGER NOT NULL,
+    path TEXT NOT NULL, type TEXT NOT NULL, label TEXT NOT NULL, depth INTEGER NOT NULL,
+    PRIMARY KEY (tree, version, node)
+);
+CREATE TABLE statuses (
+    at_s REAL NOT NULL, tree TEXT NOT NULL, version INTEGER NOT NULL, tick INTEGER NOT NULL,
+    node INTEGER NOT NULL, status TEXT NOT NULL, feedback TEXT NOT NULL
+);
+CREATE INDEX statuses_by_time ON statuses (at_s);
+CREATE TABLE blackboard (
+    at_s REAL NOT NULL, key TEXT NOT NULL, value TEXT NOT NULL, event INTEGER NOT NULL
+);
+CREATE INDEX blackboard_by_time ON blackboard (at_s);
+CREATE TABLE actions (
+    at_s REAL NOT NULL, tree TEXT NOT NULL, action TEXT NOT NULL, args TEXT NOT NULL,
+    error TEXT
+);
+CREATE TABLE world (at_s REAL NOT NULL, kind TEXT NOT NULL, description TEXT NOT NULL);
+"""
+
+
+def as_json(value: Any) -> str:
+    """A blackboard value as JSON; what JSON cannot hold is kept as its text."""
+    try:
+        return json.dumps(value, allow_nan=False, default=str)
+    except ValueError:  # NaN or infinity
+        return json.dumps(str(value))
+
+
+def create(path: Path) -> sqlite3.Connection:
+    """A new, empty recording at ``path`` (replacing one there); ConfigError when the
+    folder is missing or not writable."""
+    try:
+        if path.exists():
+            path.unlink()
+        connection = sqlite3.connect(str(path), check_same_thread=False)
+        connection.executescript(SCHEMA)
+        connection.execute("INSERT INTO meta VALUES ('format', ?)", (str(FORMAT_VERSION),))
+        connection.commit()
+    except (OSError, sqlite3.Error) as error:
+        raise ConfigError(f"--record {path}: cannot write a recording there ({error})") from None
+    return connection
+
+
+def open_for_reading(path: Path) -> sqlite3.Connection:
+    """An existing recording, read-only; ConfigError naming the file when it is not one,
+    or is of a newer format than this vest reads."""
+    if not path.is_file():
+        raise ConfigError(f"{path}: no such recording")
+    try:
+        connection = sqlite3.connect(f"file:{path}?mode=ro", uri=True)
+        row = connection.execute("SELECT value FROM meta WHERE key = 'format'").fetchone()
+    except sqlite3.Error:
+        raise ConfigError(f"{path}: not a vest recording (vest run --record makes them)") from None
+    if row is None or not str(row[0]).isdigit():
+        raise ConfigError(f"{path}: not a vest recording (it has no format number)")
+    if int(row[0]) > FORMAT_VERSION:
+        raise ConfigError(
+            f"{path}: recorded in format {row[0]}, newer than this vest reads "
+            f"({FORMAT_VERSION}); update vest"
+        )
+    return connection
