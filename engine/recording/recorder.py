@@ -63,6 +63,7 @@ class SessionRecorder:
         self._connection: sqlite3.Connection | None = create(path)
         self._queue: queue.Queue[Row | None] = queue.Queue(maxsize=capacity)
         self._trees: dict[str, _RecordedTree] = {}
+        self._values: dict[str, str] = {}
         self._thread = threading.Thread(target=self._write, name="recorder", daemon=True)
         self._thread.start()
 
@@ -136,12 +137,15 @@ class SessionRecorder:
                 )
 
     def blackboard_write(self, key: str, value: Any) -> None:
-        """A blackboard watcher: a committed write (or event)."""
+        """A blackboard watcher: a committed write (or event). A state key's write that
+        does not change its value (a sensor polled 20 times a second) is not noted."""
         spec = self.catalogue.lookup(key)
         event = spec is not None and spec.kind == "event"
-        self._note(
-            "INSERT INTO blackboard VALUES (?, ?, ?, ?)", (self._at(), key, as_json(value), event)
-        )
+        text = as_json(value)
+        if not event and self._values.get(key) == text:
+            return
+        self._values[key] = text
+        self._note("INSERT INTO blackboard VALUES (?, ?, ?, ?)", (self._at(), key, text, event))
 
     def action(self, record: ActionRecord) -> None:
         """An action log listener: a service call."""
