@@ -1,0 +1,97 @@
+"""A session recorded with `vest run --record` and looked at again with `vest replay`."""
+
+from __future__ import annotations
+
+import sqlite3
+from pathlib import Path
+
+import pytest
+
+from engine.cli import main
+from engine.recording.replay import Recording
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+@pytest.fixture
+def demo(tmp_path: Path, capsys, monkeypatch) -> Path:
+    """The demo scenario, run on the virtual clock and recorded."""
+    monkeypatch.chdir(ROOT)
+    path = tmp_path / "demo.db"
+    assert main(["run", "--fast", "--speech", "text", "--record", str(path)]) == 0
+    capsys.readouterr()
+    return path
+
+
+def test_the_recording_holds_every_tree_as_vest_render_draws_it(demo: Path) -> None:
+    recording = Recording.open(demo)
+    names = [tree.name for tree in recording.trees]
+    assert {"hug", "dialog", "touch_thanks", "finger_game"} <= set(names)
+    hug = next(tree for tree in recording.trees if tree.name == "hug")
+    assert hug.rate_hz == 20.0 and len(hug.digest) == 64
+    assert hug.nodes[0].index == 0 and hug.nodes[0].depth == 0
+    source, dot = (
+        sqlite3.connect(demo).execute("SELECT source, dot FROM trees WHERE tree = 'hug'").fetchone()
+    )
+    assert "name: hug" in source
+    assert all(f"n{node.index} [" in dot for node in hug.nodes)
+    assert recording.duration_s == pytest.approx(32.0, abs=0.2)
+
+
+def test_at_a_moment_the_hug_is_running_and_the_squeeze_is_on_the_blackboard(demo: Path) -> None:
+    recording = Recording.open(demo)
+    hug = next(tree for tree in recording.trees_at(3.5) if tree.name == "hug")
+    statuses = recording.statuses_at(3.5)
+    root = statuses[("hug", hug.version, 0)]
+    assert root.status == "RUNNING" and 3.0 <= root.since_s < 3.5
+    board = recording.blackboard_at(3.5)
+    assert board["/sensors/force/left_n"].value > 5.0
+    assert recording.blackboard_at(0.5)["/sensors/force/left_n"].value == 0.0
+    said = [a.args["text"] for a in recording.actions(4.0) if a.action == "say"]
+    assert said == ["Thank you", "I love hugs!"]
+
+
+def test_vest_replay_at_prints_the_trees_and_the_blackboard(demo: Path, capsys) -> None:
+    assert main(["replay", str(demo), "--at", "3.5"]) == 0
+    out = capsys.readouterr().out
+    assert out.startswith("at 3.50 s of 32.")
+    assert "\nhug (20 Hz)\n  [..] " in out
+    assert "/sensors/force/left_n = " in out
+    assert "[ok] success  [no] failure  [..] running  [  ] not ticked" in out
+
+
+def test_vest_replay_without_a_moment_says_what_the_recording_holds(demo: Path, capsys) -> None:
+    assert main(["replay", str(demo)]) == 0
+    out = capsys.readouterr().out
+    assert "a session of 32." in out and "hug: 7 nodes at 20 Hz" in out
+
+
+def test_a_moment_after_the_session_is_refused_in_words(demo: Path, capsys) -> None:
+    assert main(["replay", str(demo), "--at", "99"]) == 2
+    assert "--at 99: the session lasted 32." in capsys.readouterr().err
+
+
+def test_a_file_that_is_not_a_recording_is_named(tmp_path: Path, capsys) -> None:
+    text = tmp_path / "notes.db"
+    text.write_text("hello")
+    assert main(["replay", str(text)]) == 1
+    assert "notes.db: not a vest recording" in capsys.readouterr().err
+    assert main(["replay", str(tmp_path / "gone.db")]) == 1
+    assert "gone.db: no such recording" in capsys.readouterr().err
+
+
+def test_a_recording_from_a_newer_vest_is_refused_by_its_format(demo: Path, capsys) -> None:
+    with sqlite3.connect(demo) as db:
+        db.execute("UPDATE meta SET value = '99' WHERE key = 'format'")
+    assert main(["replay", str(demo)]) == 1
+    assert "recorded in format 99, newer than this vest reads (1)" in capsys.readouterr().err
+
+
+def test_recording_into_a_missing_folder_stops_before_the_robot_starts(
+    tmp_path: Path, capsys, monkeypatch
+) -> None:
+    monkeypatch.chdir(ROOT)
+    where = tmp_path / "no" / "such" / "s.db"
+    assert main(["run", "--fast", "--speech", "text", "--record", str(where)]) == 1
+    err = capsys.readouterr().err
+    assert "--record" in err and "cannot write a recording there" in err
