@@ -15,19 +15,16 @@ import logging
 import queue
 import sqlite3
 import threading
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
-
-import py_trees
 
 from engine.blackboard.catalogue import KeyCatalogue
 from engine.clock import Clock
 from engine.loader.tree_definition import TreeDefinition
-from engine.loader.tree_drawing import dot_source, label, preorder
-from engine.nodes.base import node_path
+from engine.loader.tree_drawing import dot_source
 from engine.recording.session_file import as_json, create
 from engine.runtime.scheduler import RunningTree
+from engine.runtime.tree_watch import TreeWatch, WatchedTree
 from engine.scenario.scenario_file import ScenarioEvent
 from engine.services.actions import ActionRecord
 
@@ -35,18 +32,6 @@ log = logging.getLogger(__name__)
 CAPACITY = 200_000
 """Notes the queue holds before it drops (minutes of a busy session's changes)."""
 Row = tuple[str, tuple[Any, ...]]
-
-
-@dataclass
-class _RecordedTree:
-    """What the recorder knows of one running tree: the version recorded last, its nodes
-    in depth-first order, and each one's last recorded status and feedback."""
-
-    definition: TreeDefinition
-    version: int
-    nodes: list[py_trees.behaviour.Behaviour]
-    last: list[tuple[str, str]]
-    ticks: int = 0
 
 
 class SessionRecorder:
@@ -62,7 +47,7 @@ class SessionRecorder:
         self.dropped = 0
         self._connection: sqlite3.Connection | None = create(path)
         self._queue: queue.Queue[Row | None] = queue.Queue(maxsize=capacity)
-        self._trees: dict[str, _RecordedTree] = {}
+        self._watch = TreeWatch()
         self._values: dict[str, str] = {}
         self._thread = threading.Thread(target=self._write, name="recorder", daemon=True)
         self._thread.start()
@@ -77,21 +62,18 @@ class SessionRecorder:
         """Times count from ``start_s`` (clock seconds); record every tree as it is now."""
         self.start_s = start_s
         for tree in trees:
-            self._record_tree(tree)
+            self._record_tree(self._watch.watch(tree))
 
     def _at(self) -> float:
         return round(self.clock.now() - self.start_s, 6)
 
-    def _record_tree(self, tree: RunningTree) -> _RecordedTree:
-        known = self._trees.get(tree.name)
-        version = 1 if known is None else known.version + 1
-        definition = tree.definition
-        nodes = list(_preorder_nodes(tree.tree.root))
+    def _record_tree(self, watched: WatchedTree) -> None:
+        definition = watched.definition
         self._note(
             "INSERT INTO trees VALUES (?, ?, ?, ?, ?, ?, ?, ?)",
             (
-                tree.name,
-                version,
+                watched.name,
+                watched.version,
                 self._at(),
                 str(definition.path),
                 _digest(definition),
@@ -100,41 +82,32 @@ class SessionRecorder:
                 dot_source(definition),
             ),
         )
-        for index, ((node_definition, depth), node) in enumerate(
-            zip(preorder(definition.root), nodes, strict=True)
-        ):
+        for node in watched.info:
             self._note(
                 "INSERT INTO nodes VALUES (?, ?, ?, ?, ?, ?, ?)",
                 (
-                    tree.name,
-                    version,
-                    index,
-                    node_path(node),
-                    node_definition.type.name,
-                    label(node_definition),
-                    depth,
+                    watched.name,
+                    watched.version,
+                    node.index,
+                    node.path,
+                    node.type,
+                    node.label,
+                    node.depth,
                 ),
             )
-        recorded = _RecordedTree(definition, version, nodes, [("", "")] * len(nodes))
-        self._trees[tree.name] = recorded
-        return recorded
 
     # -- as the robot runs (the scheduler's thread) ---------------------------------------
     def tree_ticked(self, tree: RunningTree) -> None:
         """After ``tree`` ticked: note each node whose status or feedback changed."""
-        recorded = self._trees.get(tree.name)
-        if recorded is None or recorded.definition is not tree.definition:
-            recorded = self._record_tree(tree)  # new, or hot-reloaded
-        recorded.ticks += 1
+        watched, new, changes = self._watch.look(tree)
+        if new:  # hot-reloaded
+            self._record_tree(watched)
         at = self._at()
-        for index, node in enumerate(recorded.nodes):
-            now = (node.status.name, node.feedback_message or "")
-            if now != recorded.last[index]:
-                recorded.last[index] = now
-                self._note(
-                    "INSERT INTO statuses VALUES (?, ?, ?, ?, ?, ?, ?)",
-                    (at, tree.name, recorded.version, recorded.ticks, index, *now),
-                )
+        for index, status, feedback in changes:
+            self._note(
+                "INSERT INTO statuses VALUES (?, ?, ?, ?, ?, ?, ?)",
+                (at, tree.name, watched.version, watched.ticks, index, status, feedback),
+            )
 
     def blackboard_write(self, key: str, value: Any) -> None:
         """A blackboard watcher: a committed write (or event). A state key's write that
@@ -212,13 +185,6 @@ class SessionRecorder:
             log.warning(
                 "recording %s lost %d changes (the disk fell behind)", self.path, self.dropped
             )
-
-
-def _preorder_nodes(root: py_trees.behaviour.Behaviour) -> list[py_trees.behaviour.Behaviour]:
-    nodes = [root]
-    for child in root.children:
-        nodes.extend(_preorder_nodes(child))
-    return nodes
 
 
 def _digest(definition: TreeDefinition) -> str:
