@@ -2,6 +2,8 @@
 
 Without --at: what the recording holds (trees, how long, how many actions). With --at
 SECONDS: every tree's node statuses and the blackboard at that moment of the session.
+With --view: the same page as `vest run --view`, with a time slider, play, steps, and
+jumps to the next action or the next change of a chosen node (until Ctrl-C).
 """
 
 from __future__ import annotations
@@ -10,8 +12,11 @@ import argparse
 import math
 from pathlib import Path
 
+from engine.cli.view_options import add_view_arguments, start_view
+from engine.clock import RealClock
 from engine.errors import UsageError
 from engine.recording.replay import Recording, moment
+from engine.view.replay_source import ReplaySource
 
 NAME = "replay"
 HELP = "show a recorded session at a moment (trees' statuses, the blackboard)"
@@ -32,12 +37,28 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--at", type=_seconds, default=None, metavar="SECONDS", help="the moment to show"
     )
+    add_view_arguments(parser)
+
+
+def _serve(recording: Recording, args: argparse.Namespace) -> int:
+    """The replay page until Ctrl-C."""
+    view = start_view(ReplaySource(recording), args)
+    clock = RealClock()
+    forever = clock.event()
+    try:
+        while not clock.wait(forever, 3600.0):
+            pass
+    finally:
+        view.stop()
+    return 0
 
 
 def main(args: argparse.Namespace) -> int:
     recording = Recording.open(args.recording)
     try:
         duration = recording.duration_s
+        if args.view:
+            return _serve(recording, args)
         if args.at is None:
             trees = recording.trees_at(duration)
             print(f"{args.recording}: a session of {duration:.2f} s (format {recording.format})")

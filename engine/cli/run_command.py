@@ -26,6 +26,7 @@ from pathlib import Path
 from engine.cli.output import shown, tell
 from engine.cli.run_inputs import DEFAULT_HARDWARE, load_run_inputs
 from engine.cli.timeline import Timeline
+from engine.cli.view_options import add_view_arguments, start_view
 from engine.clock import Clock, EpochClock, RealClock, VirtualClock
 from engine.errors import ConfigError, UsageError
 from engine.files.problems import LoadError
@@ -40,6 +41,8 @@ from engine.services.cloud_link import CloudLink
 from engine.services.interfaces import Speech
 from engine.services.simulated import simulated_services
 from engine.speech.robot_speech import RobotSpeech, audio_folder, build_speech, speech_settings
+from engine.view.hub import ViewHub
+from engine.view.server import LiveSource, ViewServer
 
 NAME = "run"
 HELP = "run the behaviors (default: the demo scenario on the simulated vest)"
@@ -104,6 +107,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         metavar="FILE",
         help="the robot's token for --cloud (finished commands are kept in FILE.done.json)",
     )
+    add_view_arguments(parser)
     parser.add_argument(
         "--record",
         type=Path,
@@ -209,6 +213,7 @@ def main(args: argparse.Namespace) -> int:
     robot, blackboard = assembled.robot, assembled.blackboard
     reloader: TreeReloader | None = None
     recorder: SessionRecorder | None = None
+    view: ViewServer | None = None
     try:
         start_s = clock.now()  # after start-up, which takes simulated time too
         timeline = Timeline(sys.stdout, start_s=start_s, as_json=args.json)
@@ -237,7 +242,17 @@ def main(args: argparse.Namespace) -> int:
             blackboard.watchers.append(recorder.blackboard_write)
             robot.action_log.listeners.append(recorder.action)
             robot.action_log.failure_listeners.append(recorder.failed)
-            on_event = _both(timeline.world, recorder.world)
+            on_event = _both(on_event, recorder.world)
+        if args.view:
+            hub = ViewHub(clock, blackboard.catalogue, device_stats=assembled.hardware.stats)
+            hub.begin(start_s, robot.trees)
+            robot.scheduler.after_tick.append(hub.tree_ticked)
+            robot.scheduler.hooks.append(hub.stats_hook)
+            blackboard.watchers.append(hub.blackboard_write)
+            robot.action_log.listeners.append(hub.action)
+            robot.action_log.failure_listeners.append(hub.failed)
+            on_event = _both(on_event, hub.world)
+            view = start_view(LiveSource(hub), args)
         # the world moves first, then the pollers read it, then the trees tick
         robot.scheduler.hooks.insert(
             0, ScenarioPlayer(scenario, assembled.world, start_s=start_s, on_event=on_event)
@@ -265,4 +280,6 @@ def main(args: argparse.Namespace) -> int:
         assembled.close()
         if recorder is not None:
             recorder.close()
+        if view is not None:
+            view.stop()
     return 0 if timeline.write_error is None else 1  # the robot ran; its timeline was lost

@@ -139,6 +139,31 @@ class Recording:
         )
         return {key: KeyState(json.loads(value), at) for key, value, at in rows}
 
+    def dot(self, tree: str, version: int) -> str | None:
+        """The Graphviz source of a tree version, as it was drawn when recorded."""
+        row = self._db.execute(
+            "SELECT dot FROM trees WHERE tree = ? AND version = ?", (tree, version)
+        ).fetchone()
+        return None if row is None else str(row[0])
+
+    def moments(self) -> list[float]:
+        """Every moment something changed (a status, a key, an action), in order: the
+        steps of a replay."""
+        rows = self._db.execute(
+            "SELECT at_s FROM statuses UNION SELECT at_s FROM blackboard "
+            "UNION SELECT at_s FROM actions ORDER BY 1"
+        )
+        return [at for (at,) in rows]
+
+    def node_changes(self, tree: str, version: int, node: int) -> list[tuple[float, str, str]]:
+        """Each (moment, status, feedback) of one node, in order."""
+        rows = self._db.execute(
+            "SELECT at_s, status, feedback FROM statuses WHERE tree = ? AND version = ? "
+            "AND node = ? ORDER BY rowid",
+            (tree, version, node),
+        )
+        return [(at, status, feedback) for at, status, feedback in rows]
+
     def actions(self, until_s: float | None = None) -> list[RecordedAction]:
         """The service calls, in order (up to ``until_s`` when given)."""
         rows = self._db.execute(

@@ -1,0 +1,44 @@
+"""The command-line options of the view, shared by `vest run --view` and `vest replay --view`."""
+
+from __future__ import annotations
+
+import argparse
+import secrets
+
+from engine.cli.output import tell
+from engine.view.server import ViewServer, ViewSource, is_loopback
+
+DEFAULT_PORT = 8765
+
+
+def _port(text: str) -> int:
+    if not text.isdigit() or not 0 <= int(text) <= 65535:
+        raise argparse.ArgumentTypeError(
+            f"must be a port number 0..65535 (0: any free), got {text!r}"
+        )
+    return int(text)
+
+
+def add_view_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--view", action="store_true", help="show the trees live in a browser (prints the address)"
+    )
+    parser.add_argument(
+        "--view-port", type=_port, default=DEFAULT_PORT, metavar="P", help=f"default {DEFAULT_PORT}"
+    )
+    parser.add_argument(
+        "--view-host",
+        default="127.0.0.1",
+        metavar="ADDRESS",
+        help="default loopback; another address (a lab's tablet) gets a token in the address",
+    )
+
+
+def start_view(source: ViewSource, args: argparse.Namespace) -> ViewServer:
+    """Serve ``source`` as the options say and tell the address on stderr; DeviceError
+    when the port is taken."""
+    token = None if is_loopback(args.view_host) else secrets.token_urlsafe(18)
+    server = ViewServer(source, host=args.view_host, port=args.view_port, token=token)
+    server.start()
+    tell(f"view: {server.url}")
+    return server

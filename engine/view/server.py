@@ -1,0 +1,239 @@
+"""The view's web server: one page (engine/view/web/) for the live robot and for replays.
+
+Plain HTTP from the standard library, a thread per connection, beside the robot:
+
+- ``GET /`` the page, ``/view.js``, ``/view.css``;
+- ``GET /api/info`` live or replay (with the recording's length and its moments);
+- ``GET /api/snapshot[?at=S]`` every tree with its nodes' statuses, the blackboard, the
+  recent actions and the statistics (now, or at S seconds into a recording);
+- ``GET /api/svg/TREE/VERSION`` the tree drawn by Graphviz as ``vest render`` draws it,
+  node ``n3`` being the fourth node depth-first;
+- ``GET /api/node?tree=T&version=V&node=N`` a recorded node's status changes;
+- ``GET /api/events`` (live) server-sent events, one JSON change each.
+
+On loopback (the default) no token is asked; on any other address every request must
+carry ``?token=...`` (the address ``vest run --view`` prints has it).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import hmac
+import ipaddress
+import json
+import logging
+import shutil
+import subprocess
+import threading
+from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
+from pathlib import Path
+from typing import Any, Protocol
+from urllib.parse import parse_qs, unquote, urlparse
+
+from engine.errors import ConfigError, DeviceError
+from engine.view.hub import Change, ViewHub
+
+log = logging.getLogger(__name__)
+WEB = Path(__file__).resolve().parent / "web"
+STATIC = {
+    "/": ("index.html", "text/html; charset=utf-8"),
+    "/view.js": ("view.js", "text/javascript; charset=utf-8"),
+    "/view.css": ("view.css", "text/css; charset=utf-8"),
+}
+DOT_TIMEOUT_S = 20.0
+
+
+class ViewSource(Protocol):
+    """What the page asks: the live hub (:class:`LiveSource`) or a recording."""
+
+    def info(self) -> dict[str, Any]: ...
+
+    def snapshot(self, at_s: float) -> Change: ...
+
+    def dot(self, tree: str, version: int) -> str | None: ...
+
+    def node_changes(self, tree: str, version: int, node: int) -> list[tuple[float, str, str]]: ...
+
+
+class LiveSource:
+    """The running robot, through its :class:`ViewHub`."""
+
+    def __init__(self, hub: ViewHub) -> None:
+        self.hub = hub
+
+    def info(self) -> dict[str, Any]:
+        return {"mode": "live"}
+
+    def snapshot(self, at_s: float) -> Change:
+        return self.hub.snapshot()
+
+    def dot(self, tree: str, version: int) -> str | None:
+        return self.hub.dot(tree, version)
+
+    def node_changes(self, tree: str, version: int, node: int) -> list[tuple[float, str, str]]:
+        return []  # the live page keeps each node's changes as they come
+
+
+def is_loopback(host: str) -> bool:
+    if host == "localhost":
+        return True
+    try:
+        return ipaddress.ip_address(host).is_loopback
+    except ValueError:
+        return False
+
+
+class ViewServer:
+    """Serves ``source`` on ``host``:``port`` (0: any free port) in a thread of its own."""
+
+    def __init__(
+        self, source: ViewSource, *, host: str = "127.0.0.1", port: int = 8765, token: str | None
+    ) -> None:
+        if not is_loopback(host) and not token:
+            raise ConfigError(f"the view on {host} needs a token (only loopback goes without)")
+        self.source = source
+        self.token = token
+        self._svg: dict[tuple[str, int], bytes] = {}
+        self._svg_lock = threading.Lock()
+        handler = _handler_for(self)
+        try:
+            self._server = ThreadingHTTPServer((host, port), handler)
+        except OSError as error:
+            raise DeviceError(
+                error.errno, f"the view cannot listen on {host}:{port} ({error.strerror})"
+            ) from None
+        self._server.daemon_threads = True
+        self.host, self.port = host, int(self._server.server_address[1])
+        self._thread = threading.Thread(target=self._server.serve_forever, name="view", daemon=True)
+
+    @property
+    def url(self) -> str:
+        shown = f"[{self.host}]" if ":" in self.host else self.host
+        query = f"?token={self.token}" if self.token else ""
+        return f"http://{shown}:{self.port}/{query}"
+
+    def start(self) -> None:
+        self._thread.start()
+
+    def stop(self) -> None:
+        if isinstance(self.source, LiveSource):
+            self.source.hub.close()
+        self._server.shutdown()
+        self._server.server_close()
+
+    def svg(self, tree: str, version: int) -> bytes | None:
+        """The tree drawn by Graphviz (cached); None when unknown or Graphviz is missing."""
+        key = (tree, version)
+        with self._svg_lock:
+            if key in self._svg:
+                return self._svg[key]
+        source = self.source.dot(tree, version)
+        dot = shutil.which("dot")
+        if source is None or dot is None:
+            return None
+        try:
+            done = subprocess.run(
+                [dot, "-Tsvg"], input=source.encode(), capture_output=True, timeout=DOT_TIMEOUT_S
+            )
+        except (OSError, subprocess.TimeoutExpired) as error:
+            log.error("drawing %s failed: %s", tree, error)
+            return None
+        if done.returncode != 0:
+            return None
+        with self._svg_lock:
+            self._svg[key] = done.stdout
+        return done.stdout
+
+
+def _handler_for(view: ViewServer) -> type[BaseHTTPRequestHandler]:
+    class Handler(BaseHTTPRequestHandler):
+        server_version = "vest-view"
+
+        def log_message(self, format: str, *args: Any) -> None:
+            log.debug("view: " + format, *args)
+
+        def do_GET(self) -> None:
+            url = urlparse(self.path)
+            query = {key: values[-1] for key, values in parse_qs(url.query).items()}
+            if view.token and not hmac.compare_digest(query.get("token", ""), view.token):
+                self._send(403, b"a token is needed: use the address vest printed\n", "text/plain")
+                return
+            with contextlib.suppress(BrokenPipeError, ConnectionResetError):  # the page left
+                self._route(url.path, query)
+
+        def _route(self, path: str, query: dict[str, str]) -> None:
+            if path in STATIC:
+                name, kind = STATIC[path]
+                self._send(200, (WEB / name).read_bytes(), kind)
+            elif path == "/api/info":
+                self._json(view.source.info())
+            elif path == "/api/snapshot":
+                at = _number(query.get("at"))
+                self._json(view.source.snapshot(at if at is not None else 0.0))
+            elif path.startswith("/api/svg/"):
+                self._svg(path.removeprefix("/api/svg/"))
+            elif path == "/api/node":
+                self._node(query)
+            elif path == "/api/events" and isinstance(view.source, LiveSource):
+                self._events(view.source.hub)
+            else:
+                self._send(404, b"not found\n", "text/plain")
+
+        def _svg(self, rest: str) -> None:
+            tree, _, version = rest.rpartition("/")
+            drawn = view.svg(unquote(tree), int(version)) if version.isdigit() else None
+            if drawn is None:
+                self._send(404, b"no drawing (is Graphviz installed?)\n", "text/plain")
+            else:
+                self._send(200, drawn, "image/svg+xml")
+
+        def _node(self, query: dict[str, str]) -> None:
+            version, node = query.get("version", ""), query.get("node", "")
+            if not (version.isdigit() and node.isdigit()):
+                self._send(400, b"version and node are numbers\n", "text/plain")
+                return
+            changes = view.source.node_changes(query.get("tree", ""), int(version), int(node))
+            self._json([{"at": at, "status": s, "feedback": f} for at, s, f in changes])
+
+        def _events(self, hub: ViewHub) -> None:
+            page = hub.subscribe()
+            try:
+                self.send_response(200)
+                self.send_header("Content-Type", "text/event-stream")
+                self.send_header("Cache-Control", "no-store")
+                self.end_headers()
+                self.wfile.write(b": connected\n\n")
+                self.wfile.flush()
+                while True:
+                    change = page.changes.get()
+                    if change is None:
+                        break
+                    if page.overflowed:  # behind: start again from the present state
+                        page.overflowed = False
+                        while not page.changes.empty():
+                            page.changes.get_nowait()
+                        change = {"kind": "resync"}
+                    self.wfile.write(b"data: " + json.dumps(change).encode() + b"\n\n")
+                    self.wfile.flush()
+            finally:
+                hub.unsubscribe(page)
+
+        def _json(self, value: Any) -> None:
+            self._send(200, json.dumps(value).encode(), "application/json")
+
+        def _send(self, status: int, body: bytes, kind: str) -> None:
+            self.send_response(status)
+            self.send_header("Content-Type", kind)
+            self.send_header("Content-Length", str(len(body)))
+            self.send_header("Cache-Control", "no-store")
+            self.end_headers()
+            self.wfile.write(body)
+
+    return Handler
+
+
+def _number(text: str | None) -> float | None:
+    try:
+        return None if text is None else float(text)
+    except ValueError:
+        return None

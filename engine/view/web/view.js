@@ -1,0 +1,324 @@
+// The view of the robot's trees: live (server-sent changes) or a replay (a slider over a
+// recording). One data model for both: the server's snapshot, then changes applied to it.
+
+const token = new URLSearchParams(location.search).get("token");
+const api = (path, params = {}) => {
+  const query = new URLSearchParams(params);
+  if (token) query.set("token", token);
+  const text = query.toString();
+  return text ? `${path}?${text}` : path;
+};
+const $ = (selector) => document.querySelector(selector);
+
+const state = { trees: new Map(), keys: new Map(), actions: [], stats: null, now: 0 };
+const history = new Map(); // "tree/version/node" -> [{at, status, feedback}], live only
+let info = { mode: "live" };
+let chosen = null; // {tree, version, node}
+const MAX_HISTORY = 20;
+
+function nodeKey(tree, version, node) {
+  return `${tree}/${version}/${node}`;
+}
+
+async function getJson(path, params) {
+  const response = await fetch(api(path, params));
+  if (!response.ok) throw new Error(`${path}: ${response.status}`);
+  return response.json();
+}
+
+function load(snapshot) {
+  state.now = snapshot.now;
+  state.trees = new Map(snapshot.trees.map((tree) => [tree.tree, tree]));
+  for (const tree of state.trees.values()) {
+    tree.byNode = new Map(tree.statuses.map((change) => [change.node, change]));
+  }
+  state.keys = new Map(snapshot.keys.map((change) => [change.key, change]));
+  state.actions = snapshot.actions;
+  state.stats = snapshot.stats;
+}
+
+// -- drawing ------------------------------------------------------------------------------
+async function drawTrees() {
+  const container = $("#trees");
+  const wanted = [...state.trees.values()];
+  const present = new Set(wanted.map((tree) => `${tree.tree}/${tree.version}`));
+  for (const card of [...container.children]) {
+    if (!present.has(card.dataset.id)) card.remove();
+  }
+  for (const tree of wanted) {
+    const id = `${tree.tree}/${tree.version}`;
+    if (container.querySelector(`[data-id="${CSS.escape(id)}"]`)) continue;
+    const card = document.createElement("article");
+    card.className = "tree";
+    card.dataset.id = id;
+    card.dataset.tree = tree.tree;
+    card.innerHTML = `<h2></h2><div class="drawing">drawing...</div>`;
+    card.querySelector("h2").textContent = `${tree.tree} (${tree.rate_hz} Hz)`;
+    container.append(card);
+    const drawing = card.querySelector(".drawing");
+    const response = await fetch(api(`/api/svg/${encodeURIComponent(tree.tree)}/${tree.version}`));
+    if (response.ok) {
+      drawing.innerHTML = await response.text();
+      for (const group of drawing.querySelectorAll("g.node")) {
+        const title = group.querySelector("title")?.textContent ?? "";
+        if (!/^n\d+$/.test(title)) continue;
+        group.dataset.node = title.slice(1);
+        group.addEventListener("click", () => choose(tree.tree, tree.version, Number(group.dataset.node)));
+      }
+    } else {
+      // no Graphviz on this machine: the nodes as an indented list
+      const list = document.createElement("ul");
+      for (const node of tree.nodes) {
+        const item = document.createElement("li");
+        item.dataset.node = String(node.index);
+        item.style.marginLeft = `${node.depth * 1.2}em`;
+        item.textContent = node.label;
+        item.addEventListener("click", () => choose(tree.tree, tree.version, node.index));
+        list.append(item);
+      }
+      drawing.replaceChildren(list);
+    }
+    colorTree(tree);
+  }
+}
+
+function colorTree(tree) {
+  const card = document.querySelector(`.tree[data-id="${CSS.escape(`${tree.tree}/${tree.version}`)}"]`);
+  if (!card) return;
+  for (const element of card.querySelectorAll("[data-node]")) {
+    const change = tree.byNode.get(Number(element.dataset.node));
+    const status = change ? change.status : "INVALID";
+    element.classList.remove("st-RUNNING", "st-SUCCESS", "st-FAILURE", "st-INVALID");
+    element.classList.add(`st-${status}`);
+    element.dataset.status = status;
+    const isChosen = chosen && chosen.tree === tree.tree && chosen.version === tree.version
+      && chosen.node === Number(element.dataset.node);
+    element.classList.toggle("chosen", Boolean(isChosen));
+  }
+}
+
+function fill(selector, rows) {
+  const body = $(`${selector} tbody`);
+  body.replaceChildren(...rows.map(([cells, fresh, testId]) => {
+    const row = document.createElement("tr");
+    if (fresh) row.className = "fresh";
+    if (testId) row.dataset.key = testId;
+    for (const [text, className] of cells) {
+      const cell = document.createElement("td");
+      cell.textContent = text;
+      if (className) cell.className = className;
+      row.append(cell);
+    }
+    return row;
+  }));
+}
+
+function drawTables() {
+  $("#clock").textContent = `${state.now.toFixed(2)} s`;
+  const keys = [...state.keys.values()].sort((a, b) => a.key.localeCompare(b.key));
+  fill("#keys", keys.map((change) => [[
+    [change.key], [change.value, "value"], [change.at.toFixed(2)], [change.writer || ""],
+  ], state.now - change.at < 1, change.key]));
+  const online = new Map();
+  for (const change of keys) {
+    const match = /^\/devices\/(.+)\/ok$/.exec(change.key);
+    if (match) online.set(match[1], change.value === "true");
+  }
+  const devices = state.stats ? state.stats.devices : {};
+  const names = [...new Set([...online.keys(), ...Object.keys(devices)])].sort();
+  fill("#devices", names.map((name) => {
+    const stats = devices[name];
+    const isOnline = stats ? stats.online : online.get(name);
+    return [[
+      [name], [isOnline === false ? "offline" : "online"],
+      [stats ? String(stats.transactions) : "-"], [stats ? String(stats.retries) : "-"],
+      [stats ? String(stats.errors) : "-"], [stats ? String(Math.round(stats.latency_p99_us ?? 0)) : "-"],
+    ], isOnline === false, name];
+  }));
+  const ticks = state.stats ? Object.entries(state.stats.trees) : [];
+  fill("#ticks", ticks.map(([name, stats]) => [[
+    [name], [String(stats.ticks)], [stats.duration_p99_ms.toFixed(3)],
+    [stats.lateness_p99_ms.toFixed(2)], [String(stats.skipped)],
+  ], false, name]));
+  const list = $("#actions");
+  list.replaceChildren(...state.actions.slice(-30).reverse().map((action) => {
+    const item = document.createElement("li");
+    item.textContent = `${action.at.toFixed(2)} s ${action.tree}: ${action.action} ${action.args}`
+      + (action.error ? ` (failed: ${action.error})` : "");
+    if (action.error) item.className = "failed";
+    return item;
+  }));
+}
+
+async function draw() {
+  await drawTrees();
+  for (const tree of state.trees.values()) colorTree(tree);
+  drawTables();
+  showChosen();
+}
+
+// -- a chosen node ------------------------------------------------------------------------
+function choose(tree, version, node) {
+  chosen = { tree, version, node };
+  $("#next-change").disabled = info.mode !== "replay";
+  for (const each of state.trees.values()) colorTree(each);
+  showChosen();
+}
+
+async function showChosen() {
+  const panel = $("#node");
+  if (!chosen) return;
+  const tree = state.trees.get(chosen.tree);
+  if (!tree || tree.version !== chosen.version) { panel.hidden = true; return; }
+  panel.hidden = false;
+  const node = tree.nodes[chosen.node];
+  const change = tree.byNode.get(chosen.node);
+  const facts = [
+    ["tree", `${tree.tree} (version ${tree.version})`], ["node", `n${node.index}`],
+    ["path", node.path], ["type", node.type], ["parameters", node.label],
+    ["status", change ? change.status : "not ticked"],
+    ["since", change ? `${change.at.toFixed(2)} s` : "-"],
+    ["feedback", change && change.feedback ? change.feedback : "-"],
+  ];
+  $("#node-facts").replaceChildren(...facts.flatMap(([name, value]) => {
+    const term = document.createElement("dt");
+    term.textContent = name;
+    const detail = document.createElement("dd");
+    detail.textContent = value;
+    return [term, detail];
+  }));
+  let changes = history.get(nodeKey(tree.tree, tree.version, node.index)) ?? [];
+  if (info.mode === "replay") {
+    const all = await getJson("/api/node", { tree: tree.tree, version: tree.version, node: node.index });
+    changes = all.filter((each) => each.at <= state.now).slice(-MAX_HISTORY);
+  }
+  $("#node-changes").replaceChildren(...changes.slice().reverse().map((each) => {
+    const item = document.createElement("li");
+    item.textContent = `${each.at.toFixed(2)} s ${each.status}${each.feedback ? `: ${each.feedback}` : ""}`;
+    return item;
+  }));
+}
+
+// -- live ---------------------------------------------------------------------------------
+function apply(change) {
+  if (change.at !== undefined) state.now = Math.max(state.now, change.at);
+  if (change.kind === "status") {
+    const tree = state.trees.get(change.tree);
+    if (!tree || tree.version !== change.version) return;
+    tree.byNode.set(change.node, change);
+    const key = nodeKey(change.tree, change.version, change.node);
+    const list = history.get(key) ?? [];
+    list.push(change);
+    if (list.length > MAX_HISTORY) list.shift();
+    history.set(key, list);
+    dirtyTrees.add(tree);
+  } else if (change.kind === "key") {
+    state.keys.set(change.key, change);
+  } else if (change.kind === "action") {
+    state.actions.push(change);
+    if (state.actions.length > 100) state.actions.shift();
+  } else if (change.kind === "action_failed") {
+    const match = [...state.actions].reverse().find((a) => a.at === change.at && a.tree === change.tree);
+    if (match) match.error = change.error;
+  } else if (change.kind === "stats") {
+    state.stats = change;
+  }
+}
+
+const dirtyTrees = new Set();
+let scheduled = false;
+function redrawSoon() {
+  if (scheduled) return;
+  scheduled = true;
+  requestAnimationFrame(() => {
+    scheduled = false;
+    for (const tree of dirtyTrees) colorTree(tree);
+    dirtyTrees.clear();
+    drawTables();
+    showChosen();
+  });
+}
+
+async function live() {
+  $("#mode").textContent = "live";
+  load(await getJson("/api/snapshot"));
+  await draw();
+  const events = new EventSource(api("/api/events"));
+  events.onmessage = async (message) => {
+    const change = JSON.parse(message.data);
+    if (change.kind === "resync" || change.kind === "tree") {
+      load(await getJson("/api/snapshot"));
+      await draw();
+      return;
+    }
+    apply(change);
+    redrawSoon();
+  };
+  events.onerror = () => { $("#mode").textContent = "live (connection lost: retrying)"; };
+  events.onopen = () => { $("#mode").textContent = "live"; };
+}
+
+// -- replay -------------------------------------------------------------------------------
+let playing = null;
+async function showMoment(at) {
+  const moment = Math.max(0, Math.min(info.duration, at));
+  load(await getJson("/api/snapshot", { at: moment.toFixed(3) }));
+  state.now = moment;
+  $("#slider").value = String(moment);
+  await draw();
+}
+
+function nextMoment(after) {
+  return info.moments.find((at) => at > after + 1e-9);
+}
+
+function previousMoment(before) {
+  return [...info.moments].reverse().find((at) => at < before - 1e-9);
+}
+
+async function replay() {
+  $("#mode").textContent = `replay of ${info.file} (${info.duration.toFixed(2)} s)`;
+  $("#replay").hidden = false;
+  const slider = $("#slider");
+  slider.max = String(info.duration);
+  slider.addEventListener("input", () => showMoment(Number(slider.value)));
+  $("#forward").addEventListener("click", () => {
+    const at = nextMoment(state.now);
+    if (at !== undefined) showMoment(at);
+  });
+  $("#back").addEventListener("click", () => showMoment(previousMoment(state.now) ?? 0));
+  $("#next-action").addEventListener("click", () => {
+    const at = info.actions.find((time) => time > state.now + 1e-9);
+    if (at !== undefined) showMoment(at);
+  });
+  $("#next-change").addEventListener("click", async () => {
+    if (!chosen) return;
+    const all = await getJson("/api/node", chosen);
+    const next = all.find((each) => each.at > state.now + 1e-9);
+    if (next) showMoment(next.at);
+  });
+  $("#play").addEventListener("click", () => {
+    if (playing) {
+      clearInterval(playing);
+      playing = null;
+      $("#play").innerHTML = "&#9654;";
+      return;
+    }
+    $("#play").innerHTML = "&#10074;&#10074;";
+    playing = setInterval(() => {
+      if (state.now >= info.duration) { $("#play").click(); return; }
+      showMoment(state.now + 0.1);
+    }, 100);
+  });
+  await showMoment(0);
+}
+
+async function start() {
+  info = await getJson("/api/info");
+  document.body.dataset.mode = info.mode;
+  if (info.mode === "replay") await replay();
+  else await live();
+  document.body.dataset.ready = "true";
+}
+
+start().catch((error) => { $("#mode").textContent = `cannot load the view: ${error.message}`; });
