@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 import sqlite3
+import threading
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -67,9 +68,14 @@ class Recording:
 
     def __init__(self, path: Path, connection: sqlite3.Connection) -> None:
         self.path = path
-        self._db = connection
-        self.meta = dict(connection.execute("SELECT key, value FROM meta").fetchall())
+        self._connection = connection
+        self._lock = threading.Lock()  # the replay view asks from several threads
+        self.meta = dict(self._rows("SELECT key, value FROM meta"))
         self.trees = self._read_trees()
+
+    def _rows(self, sql: str, parameters: tuple[Any, ...] = ()) -> list[Any]:
+        with self._lock:
+            return self._connection.execute(sql, parameters).fetchall()
 
     @classmethod
     def open(cls, path: Path) -> Recording:
@@ -77,7 +83,8 @@ class Recording:
         return cls(path, open_for_reading(path))
 
     def close(self) -> None:
-        self._db.close()
+        with self._lock:
+            self._connection.close()
 
     @property
     def format(self) -> int:
@@ -89,14 +96,14 @@ class Recording:
         if "duration_s" in self.meta:
             return float(self.meta["duration_s"])
         last = [
-            self._db.execute(f"SELECT max(at_s) FROM {table}").fetchone()[0]
+            self._rows(f"SELECT max(at_s) FROM {table}")[0][0]
             for table in ("statuses", "blackboard", "actions")
         ]
         return max((t for t in last if t is not None), default=0.0)
 
     def _read_trees(self) -> list[RecordedTree]:
         nodes: dict[tuple[str, int], list[RecordedNode]] = {}
-        for tree, version, index, path, kind, label, depth in self._db.execute(
+        for tree, version, index, path, kind, label, depth in self._rows(
             "SELECT tree, version, node, path, type, label, depth FROM nodes "
             "ORDER BY tree, version, node"
         ):
@@ -107,7 +114,7 @@ class Recording:
             RecordedTree(
                 name, version, at_s, rate_hz, digest, tuple(nodes.get((name, version), []))
             )
-            for name, version, at_s, rate_hz, digest in self._db.execute(
+            for name, version, at_s, rate_hz, digest in self._rows(
                 "SELECT tree, version, at_s, rate_hz, digest FROM trees ORDER BY tree, version"
             )
         ]
@@ -122,7 +129,7 @@ class Recording:
 
     def statuses_at(self, at_s: float) -> dict[tuple[str, int, int], NodeState]:
         """(tree, version, node) -> its last status at or before ``at_s``."""
-        rows = self._db.execute(
+        rows = self._rows(
             "SELECT tree, version, node, status, feedback, at_s FROM statuses "
             "WHERE rowid IN (SELECT max(rowid) FROM statuses WHERE at_s <= ? "
             "GROUP BY tree, version, node)",
@@ -132,7 +139,7 @@ class Recording:
 
     def blackboard_at(self, at_s: float) -> dict[str, KeyState]:
         """Each key's last value (an event key: its last event) at or before ``at_s``."""
-        rows = self._db.execute(
+        rows = self._rows(
             "SELECT key, value, at_s FROM blackboard WHERE rowid IN "
             "(SELECT max(rowid) FROM blackboard WHERE at_s <= ? GROUP BY key)",
             (at_s,),
@@ -141,15 +148,13 @@ class Recording:
 
     def dot(self, tree: str, version: int) -> str | None:
         """The Graphviz source of a tree version, as it was drawn when recorded."""
-        row = self._db.execute(
-            "SELECT dot FROM trees WHERE tree = ? AND version = ?", (tree, version)
-        ).fetchone()
-        return None if row is None else str(row[0])
+        rows = self._rows("SELECT dot FROM trees WHERE tree = ? AND version = ?", (tree, version))
+        return str(rows[0][0]) if rows else None
 
     def moments(self) -> list[float]:
         """Every moment something changed (a status, a key, an action), in order: the
         steps of a replay."""
-        rows = self._db.execute(
+        rows = self._rows(
             "SELECT at_s FROM statuses UNION SELECT at_s FROM blackboard "
             "UNION SELECT at_s FROM actions ORDER BY 1"
         )
@@ -157,7 +162,7 @@ class Recording:
 
     def node_changes(self, tree: str, version: int, node: int) -> list[tuple[float, str, str]]:
         """Each (moment, status, feedback) of one node, in order."""
-        rows = self._db.execute(
+        rows = self._rows(
             "SELECT at_s, status, feedback FROM statuses WHERE tree = ? AND version = ? "
             "AND node = ? ORDER BY rowid",
             (tree, version, node),
@@ -166,7 +171,7 @@ class Recording:
 
     def actions(self, until_s: float | None = None) -> list[RecordedAction]:
         """The service calls, in order (up to ``until_s`` when given)."""
-        rows = self._db.execute(
+        rows = self._rows(
             "SELECT at_s, tree, action, args, error FROM actions WHERE at_s <= ? ORDER BY rowid",
             (float("inf") if until_s is None else until_s,),
         )

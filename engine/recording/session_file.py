@@ -84,7 +84,8 @@ def open_for_reading(path: Path) -> sqlite3.Connection:
     if not path.is_file():
         raise ConfigError(f"{path}: no such recording")
     try:
-        connection = sqlite3.connect(f"file:{path}?mode=ro", uri=True)
+        # one connection, used from the view's threads one query at a time (Recording locks)
+        connection = sqlite3.connect(f"file:{path}?mode=ro", uri=True, check_same_thread=False)
         row = connection.execute("SELECT value FROM meta WHERE key = 'format'").fetchone()
     except sqlite3.Error:
         raise ConfigError(f"{path}: not a vest recording (vest run --record makes them)") from None
