@@ -38,6 +38,7 @@ IOT_INBOX = "/iot/inbox"
 HAND_FINGERS = "/vision/hand/fingers"
 HAND_CONFIDENCE = "/vision/hand/confidence"
 HAND_SHOWN = "/vision/hand/shown"
+HAND_HELD = "/vision/hand/held"
 
 
 def force_key(pad: str) -> str:
@@ -275,6 +276,15 @@ def default_catalogue() -> KeyCatalogue:
                 "a hand showing this many fingers, 0..5: once when the count changes and "
                 "holds for the camera's steady_frames",
                 kind="event",
+            ),
+            KeySpec(
+                HAND_HELD,
+                int,
+                "",
+                "vision worker (camera + finger-count CNN)",
+                "the count a hand holds up steadily now, 0..5 (the last /vision/hand/shown); "
+                "absent once no hand (or no sure count) has held as long",
+                alias="hand_held",
             ),
             KeySpec(
                 "/devices/*/ok",

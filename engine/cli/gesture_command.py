@@ -27,6 +27,20 @@ HELP = "count fingers in pictures; record, generate, train and check a hand mode
 ACTIONS = ("classify", "record", "generate", "train", "eval")
 
 
+def writable_folder(folder: Path) -> None:
+    """``folder`` exists (made if need be) and a file can be written in it; ConfigError
+    naming it when not."""
+    from engine.errors import ConfigError
+
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        probe = folder / ".vest-write-check"
+        probe.write_bytes(b"")
+        probe.unlink()
+    except OSError as error:
+        raise ConfigError(f"{folder}: cannot write there ({error.strerror or error})") from None
+
+
 def with_action(argv: Sequence[str]) -> list[str]:
     """``vest gesture IMAGE...`` is ``vest gesture classify IMAGE...``."""
     words = list(argv)
@@ -57,6 +71,16 @@ def _positive(text: str) -> int:
         raise argparse.ArgumentTypeError(f"must be a whole number, got {text!r}") from None
     if value < 1:
         raise argparse.ArgumentTypeError(f"must be 1 or more, got {value}")
+    return value
+
+
+def _seed(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be a whole number, got {text!r}") from None
+    if not 0 <= value < 2**32:
+        raise argparse.ArgumentTypeError(f"must be 0 .. 4294967295, got {value}")
     return value
 
 
@@ -116,7 +140,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     generate = actions.add_parser("generate", help="draw labelled hands (the project's data)")
     generate.add_argument("data", type=Path, metavar="DATA")
     generate.add_argument("--count", type=_positive, required=True)
-    generate.add_argument("--seed", type=int, default=1)
+    generate.add_argument("--seed", type=_seed, default=1)
     generate.add_argument("--style", choices=("studio", "variant"), default="studio")
 
     train = actions.add_parser("train", help="train the table-2 network (needs .[train])")
@@ -124,7 +148,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     train.add_argument("-o", "--output", type=Path, required=True, metavar="MODEL.onnx")
     train.add_argument("--epochs", type=_positive, default=16)
     train.add_argument("--batch", type=_positive, default=64)
-    train.add_argument("--seed", type=int, default=1)
+    train.add_argument("--seed", type=_seed, default=1)
     train.add_argument("--held-out", type=_share, default=0.15, help="share held out (0..1)")
     train.add_argument("--split", choices=("session", "file"), default="session")
     train.add_argument("--threads", type=_positive, default=2, help="CPU threads")
@@ -189,6 +213,7 @@ def _classify(args: argparse.Namespace) -> int:
 def _generate(args: argparse.Namespace) -> int:
     from engine.vision.synthetic_hands import write_dataset
 
+    writable_folder(args.data)
     written = write_dataset(args.data, args.count, args.seed, style=args.style)
     print(f"{written} pictures ({args.style}, seed {args.seed}) in {args.data}")
     return 0
@@ -207,6 +232,9 @@ def _train(args: argparse.Namespace) -> int:
 
     if args.output.suffix != ".onnx":
         raise ConfigError(f"{args.output}: the model's file name must end in .onnx")
+    writable_folder(args.output.parent)  # before the training, not after it
+    if args.matrix is not None:
+        writable_folder(args.matrix.parent)
     settings = TrainingSettings(
         epochs=args.epochs,
         batch=args.batch,
@@ -239,6 +267,7 @@ def _evaluate(args: argparse.Namespace) -> int:
         print(evaluation.table())
         print(evaluation.summary())
     if args.matrix is not None:
+        writable_folder(args.matrix.parent)
         evaluation.write_png(args.matrix, f"{args.model.name} on {args.data.name}")
     sys.stdout.flush()
     return 0

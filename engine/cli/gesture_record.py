@@ -4,7 +4,8 @@ own hands.
 From the camera, either ``--label N --frames K`` (K frames in a row, a few frames apart
 so they are not all the same) or, without ``--label``, one frame each time a label is
 typed (``0``..``5``, ``n`` for no hand, then Enter; ``q`` or end of input stops). From a
-folder with ``--from``: every picture in it, checked and stored as PNG. Files are named
+folder with ``--from``: every picture in it (of the ``--label`` count, or in its own
+``0/`` .. ``5/`` and ``none/`` folders), checked and stored as PNG. Files are named
 ``<session>-<n>.png``: training holds whole sessions out, so record each child or each
 sitting as its own session (``--session``, by default the date and time).
 """
@@ -19,10 +20,11 @@ from pathlib import Path
 
 import cv2
 
+from engine.cli.gesture_command import writable_folder
 from engine.clock import EpochClock
 from engine.drivers.camera import CameraError, OpenCvCamera
-from engine.errors import ConfigError, DeviceError
-from engine.vision.dataset import IMAGE_SUFFIXES
+from engine.errors import ConfigError
+from engine.vision.dataset import FOLDERS, IMAGE_SUFFIXES
 from engine.vision.preprocess import SIDE_PX, Frame, read_image
 from engine.vision.synthetic_hands import NO_HAND
 
@@ -40,19 +42,15 @@ def record(args: argparse.Namespace) -> int:
             f"--session {session!r}: use letters, digits, '_' and '.' (no '-': it ends a session)"
         )
     if args.source is not None:
-        if args.label is None:
-            raise ConfigError("--from needs --label: the pictures in a folder show one count")
         return _from_folder(args.data, args.source, args.label, session)
+    if args.frames is not None and args.label is None:
+        raise ConfigError("--frames needs --label (without it, type a label per frame)")
+    writable_folder(args.data)
     camera = OpenCvCamera(int(args.camera) if args.camera.isdigit() else args.camera)
-    try:
-        camera.open()
-    except CameraError as error:
-        raise DeviceError(None, str(error)) from None
+    camera.open()
     try:
         if args.label is not None:
             return _burst(camera, args.data, args.label, session, args.frames or 50)
-        if args.frames is not None:
-            raise ConfigError("--frames needs --label (without it, type a label per frame)")
         return _by_key(camera, args.data, session)
     finally:
         camera.close()
@@ -72,14 +70,14 @@ class Recorder:
                 f"{SIDE_PX}x{SIDE_PX} window"
             )
         folder = self.data / label
-        folder.mkdir(parents=True, exist_ok=True)
+        writable_folder(folder)
         number = len(list(folder.glob(f"{self.session}-*.png")))
         path = folder / f"{self.session}-{number:05d}.png"
         while path.exists():
             number += 1
             path = folder / f"{self.session}-{number:05d}.png"
         if not cv2.imwrite(str(path), frame):
-            raise OSError(f"{path}: cannot be written")
+            raise ConfigError(f"{path}: cannot be written")
         self.saved += 1
         return path
 
@@ -92,7 +90,7 @@ def _burst(camera: OpenCvCamera, data: Path, label: str, session: str, frames: i
             frame = camera.read()
         except CameraError as error:
             if recorder.saved == 0:
-                raise DeviceError(None, str(error)) from None
+                raise
             print(f"{camera.name} stopped after {recorder.saved} frames: {error}")
             break
         if read % FRAMES_APART == 0:
@@ -113,7 +111,7 @@ def _by_key(camera: OpenCvCamera, data: Path, session: str) -> int:
             print(f"{key!r}: not a label (0..5, n, or q)")
             continue
         try:
-            frame = camera.read()
+            frame = camera.newest()
         except CameraError as error:
             print(f"{error}; kept {recorder.saved} pictures")
             return 1
@@ -122,23 +120,36 @@ def _by_key(camera: OpenCvCamera, data: Path, session: str) -> int:
     return 0
 
 
-def _from_folder(data: Path, source: Path, label: str, session: str) -> int:
+def _from_folder(data: Path, source: Path, label: str | None, session: str) -> int:
+    """Pictures of one count from a folder (``--label``), or a folder laid out as a data
+    folder is (``0/`` .. ``5/``, ``none/``) without it."""
     if not source.is_dir():
         raise ConfigError(f"{source}: no such folder")
+    if label is None:
+        labelled = [(source / name, name) for name in FOLDERS if (source / name).is_dir()]
+        if not labelled:
+            raise ConfigError(
+                f"{source}: holds no 0/ .. 5/ or none/ folders; name the count of its "
+                "pictures with --label"
+            )
+    else:
+        labelled = [(source, label)]
     recorder = Recorder(data, session)
     skipped = 0
-    for path in sorted(source.iterdir()):
-        if path.suffix.lower() not in IMAGE_SUFFIXES:
-            continue
-        try:
-            recorder.save(read_image(path), label)
-        except (ValueError, ConfigError) as error:
-            print(f"skipped {path}: {error}")
-            skipped += 1
+    for folder, name in labelled:
+        for path in sorted(folder.iterdir()):
+            if path.suffix.lower() not in IMAGE_SUFFIXES:
+                continue
+            try:
+                recorder.save(read_image(path), name)
+            except ValueError as error:  # ConfigError is one too
+                print(f"skipped {path}: {error}")
+                skipped += 1
     if recorder.saved == 0:
         raise ConfigError(f"{source}: no picture that could be used")
+    counts = ", ".join(name for _, name in labelled)
     print(
-        f"{recorder.saved} pictures of {label} in {data / label}"
+        f"{recorder.saved} pictures ({counts}) in {data}"
         + (f"; {skipped} skipped" if skipped else "")
     )
     return 0

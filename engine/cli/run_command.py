@@ -219,6 +219,8 @@ def main(args: argparse.Namespace) -> int:
         timeline = Timeline(sys.stdout, start_s=start_s, as_json=args.json)
         for name, why in assembled.hardware.startup_problems.items():
             tell(f"warning: {shown(name)} did not start ({shown(why)}); it will be tried again")
+        if assembled.vision is not None and assembled.vision.summary:
+            tell(f"vision: {assembled.vision.summary}")
         if assembled.speech is not None:
             for part, why in assembled.speech.problems.items():
                 tell(f"warning: speech {part}: {shown(why)}")

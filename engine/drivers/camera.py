@@ -13,13 +13,17 @@ from typing import Protocol
 import cv2
 import numpy as np
 
+from engine.errors import DeviceError
 from engine.vision.preprocess import Frame
 
 log = logging.getLogger(__name__)
 
 
-class CameraError(Exception):
+class CameraError(DeviceError):
     """The camera cannot be opened or stopped giving frames; the message says which."""
+
+    def __init__(self, message: str) -> None:
+        super().__init__(None, message)
 
 
 class Camera(Protocol):
@@ -80,6 +84,13 @@ class OpenCvCamera:
         if not ok or frame is None:
             raise CameraError(f"{self.name}: gave no frame (unplugged?)")
         return np.asarray(frame, dtype=np.uint8)
+
+    def newest(self) -> Frame:
+        """The frame of this moment, not the one the camera kept since the last read (for a
+        picture taken when a person asks, long after the previous one)."""
+        if self._capture is not None:
+            self._capture.grab()  # drops the frame held in the buffer
+        return self.read()
 
     def close(self) -> None:
         if self._capture is not None:

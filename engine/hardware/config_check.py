@@ -22,6 +22,7 @@ from engine.files.yaml_source import YMap, YScalar, YValue, describe, plain
 from engine.hardware.chips import ChipRegistry, default_chips
 from engine.hardware.chips.fields import ChipFields, number_text
 from engine.hardware.config import (
+    CAMERA_NAME,
     COMMON_FIELDS,
     BusConfig,
     ChipSpec,
@@ -143,6 +144,12 @@ class ConfigChecker:
         camera = check_camera(self, document, simulated, self.path.parent)
         buses = check_buses(self, document)
         devices = self._devices(document, buses)
+        if camera is not None and CAMERA_NAME in devices:
+            self.problems.add(
+                devices[CAMERA_NAME].mark,
+                f"a device may not be called {CAMERA_NAME!r}: the camera section has the name",
+                "rename the device, or say camera: none",
+            )
         self.problems.raise_if_any()
         return RobotConfig(
             name=robot_name,

@@ -45,6 +45,17 @@ def _set(attribute: str, value: Any, what: str) -> Change:
     return change
 
 
+def _take_away(hand: ShownHand) -> Change:
+    """The hand is lowered, unless another was held up meanwhile (it stays)."""
+
+    def change(world: World) -> None:
+        if world.hand is hand:
+            world.hand = None
+            world.changed("hand")
+
+    return change
+
+
 def _happen(kind: str, value: Any) -> Change:
     def change(world: World) -> None:
         world.happened(kind, value)
@@ -85,7 +96,7 @@ def changes_of(event: ScenarioEvent) -> list[tuple[float, Change]]:
         seed = round(at * 1000) * 8 + (value["fingers"] if value["fingers"] is not None else 7)
         hand = ShownHand(value["fingers"], value["image"], value["video"], seed)
         gone = at + value["seconds"]
-        return [(at, _set("hand", hand, "hand")), (gone, _set("hand", None, "hand"))]
+        return [(at, _set("hand", hand, "hand")), (gone, _take_away(hand))]
     if event.kind == "cloud":
         command = {"id": value["id"], "type": value["type"], "args": value["args"] or {}}
         return [(at, _happen("cloud", command))]

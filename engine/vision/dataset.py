@@ -37,6 +37,9 @@ from engine.vision.synthetic_hands import NO_HAND
 
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp")
 FOLDERS = (*(str(label) for label in LABELS), NO_HAND)
+MARGIN_PX = 24
+"""Kept around the window of each training picture: shifts of 8 px and turns of 10
+degrees look no further."""
 NONE_INDEX = len(LABELS)
 """The label index of a picture with no hand (one past the finger counts)."""
 
@@ -104,17 +107,24 @@ def split(
 
 
 def load_pictures(pictures: Sequence[Picture], settings: Preprocessing) -> list[Frame]:
-    """The pictures' images; ConfigError naming the first that cannot be read or is
-    smaller than the window."""
+    """The pictures' images, each cut to its centred window and a margin of up to
+    :data:`MARGIN_PX` around it (all that training's shifts and turns look at: a lab's
+    thousands of 640 x 360 frames then fit in memory); ConfigError naming the first that
+    cannot be read or is smaller than the window."""
     images = []
+    side = settings.side_px
     for picture in pictures:
         try:
             image = read_image(picture.path)
-            settings.window(image.shape[0], image.shape[1])
+            x, y = settings.window(image.shape[0], image.shape[1])
         except ValueError as error:
             raise ConfigError(
                 str(error) if str(picture.path) in str(error) else f"{picture.path}: {error}"
             ) from None
+        if settings.crop_x is None and settings.crop_y is None:
+            height, width = image.shape[:2]
+            margin = min(MARGIN_PX, x, y, width - x - side, height - y - side)
+            image = image[y - margin : y + side + margin, x - margin : x + side + margin].copy()
         images.append(image)
     return images
 

@@ -15,6 +15,7 @@ import cv2
 import numpy as np
 import numpy.typing as npt
 
+from engine.errors import ConfigError
 from engine.vision.preprocess import LABELS
 
 ROWS = (*(str(label) for label in LABELS), "none")
@@ -117,6 +118,5 @@ class Evaluation:
                 cv2.rectangle(image, (x, y), (x + cell - 2, y + cell - 2), colour, -1)
                 text = str(int(self.matrix[row, column]))
                 cv2.putText(image, text, (x + 8, y + cell // 2 + 5), font, 0.5, (0, 0, 0), 1)
-        path.parent.mkdir(parents=True, exist_ok=True)
         if not cv2.imwrite(str(path), image):
-            raise OSError(f"{path}: cannot write the picture")
+            raise ConfigError(f"{path}: cannot write the picture there")

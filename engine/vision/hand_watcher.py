@@ -2,7 +2,8 @@
 
 Every frame it stages ``/vision/hand/fingers`` (0..5, or None when no hand is seen or the
 network is not sure) and ``/vision/hand/confidence``; when a count changes and holds for
-``steady_frames`` frames it stages one ``/vision/hand/shown`` event. Trees only read
+``steady_frames`` frames it stages one ``/vision/hand/shown`` event, and
+``/vision/hand/held`` keeps that count until another (or no hand) holds as long. Trees only read
 the blackboard: the camera, the preprocessing and the network never run in a tick.
 
 On a real clock it is a thread (:meth:`start`): it reads a frame when one is due at the
@@ -21,7 +22,7 @@ import logging
 import threading
 
 from engine.blackboard.board import Blackboard
-from engine.blackboard.catalogue import HAND_CONFIDENCE, HAND_FINGERS, HAND_SHOWN
+from engine.blackboard.catalogue import HAND_CONFIDENCE, HAND_FINGERS, HAND_HELD, HAND_SHOWN
 from engine.clock import Clock, ClockEvent
 from engine.drivers.camera import Camera, CameraError
 from engine.hardware.device_health import DeviceHealth
@@ -30,6 +31,8 @@ from engine.vision.preprocess import Frame
 
 log = logging.getLogger(__name__)
 REOPEN_S = 2.0
+STOP_WAIT_S = 5.0
+"""How long stopping waits for a frame being read (a webcam gives one within a second)."""
 
 
 class SteadyCount:
@@ -96,9 +99,12 @@ class HandWatcher:
         self.frames += 1
         self.blackboard.stage(HAND_FINGERS, reading.fingers)
         self.blackboard.stage(HAND_CONFIDENCE, round(reading.confidence, 4))
+        held = self.steady.shown
         shown = self.steady.add(reading.fingers)
         if shown is not None:
             self.blackboard.stage_event(HAND_SHOWN, shown)
+        if self.steady.shown != held:
+            self.blackboard.stage(HAND_HELD, self.steady.shown)
         return reading
 
     def take_frame(self) -> HandReading | None:
@@ -117,17 +123,24 @@ class HandWatcher:
             self.health.driver_status(True)
         try:
             frame = self.camera.read()
+            return self.process(frame)
         except CameraError as error:
             self.camera.close()
             self._open = False
             self._failed(str(error), now)
-            return None
-        return self.process(frame)
+        except ValueError as error:  # frames the window does not fit (a camera's own size)
+            self.camera.close()
+            self._open = False
+            self._failed(f"{self.camera.name}: {error}", now)
+        return None
 
     def _failed(self, why: str, now_s: float) -> None:
         if self.health.driver_ok:
             log.warning("%s; trying again every %g s", why, self.reopen_s)
             self.blackboard.stage(HAND_FINGERS, None)
+            self.blackboard.stage(HAND_CONFIDENCE, None)
+            if self.steady.shown is not None:
+                self.blackboard.stage(HAND_HELD, None)
             self.steady.reset()
         self.health.driver_status(False, why)
         self._retry_s = now_s + self.reopen_s
@@ -152,9 +165,16 @@ class HandWatcher:
 
     def _run(self) -> None:
         assert self._stop is not None
+        try:
+            self._frames_until_stopped(self._stop)
+        finally:
+            self.camera.close()  # by the thread that reads it, never under its feet
+            self._open = False
+
+    def _frames_until_stopped(self, stop: ClockEvent) -> None:
         next_s = self.clock.now()
-        while not self._stop.is_set():
-            if self.clock.sleep_until(next_s, self._stop):
+        while not stop.is_set():
+            if self.clock.sleep_until(next_s, stop):
                 break
             try:
                 self.take_frame()
@@ -168,11 +188,15 @@ class HandWatcher:
                 next_s += missed * self.period_s
 
     def stop(self) -> None:
-        """Stop the worker (if running) and close the camera."""
+        """Stop the worker (if running: it closes the camera when its read returns) or
+        close the camera."""
         if self._stop is not None:
             self._stop.set()
         if self._thread is not None:
-            self._thread.join(timeout=5.0)
+            self._thread.join(timeout=STOP_WAIT_S)
+            if self._thread.is_alive():  # a read stuck on a dying camera: it closes it after
+                log.warning("%s: still reading; it closes when its read returns", self.camera.name)
             self._thread = None
+            return
         self.camera.close()
         self._open = False

@@ -155,9 +155,12 @@ def network_input(frame: Frame, settings: Preprocessing) -> npt.NDArray[np.float
 
 def read_image(path: Path) -> Frame:
     """An image file as a BGR frame; ValueError naming the file when it cannot be read."""
-    data = np.fromfile(str(path), dtype=np.uint8) if path.is_file() else None
-    if data is None:
+    if not path.is_file():
         raise ValueError(f"{path}: no such file")
+    try:
+        data = np.fromfile(str(path), dtype=np.uint8)
+    except OSError as error:
+        raise ValueError(f"{path}: cannot be read ({error.strerror or error})") from None
     image = cv2.imdecode(data, cv2.IMREAD_COLOR) if data.size else None
     if image is None:
         raise ValueError(f"{path}: not an image OpenCV can read")

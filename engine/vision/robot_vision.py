@@ -35,6 +35,8 @@ class RobotVision:
     health: DeviceHealth
     watcher: HandWatcher | None
     problem: str | None = None
+    summary: str = ""
+    """The model and where it runs, e.g. ``hand_fingers.onnx on CPUExecutionProvider``."""
 
     def start(self) -> None:
         """On a real clock: start the worker thread."""
@@ -49,24 +51,31 @@ class RobotVision:
 
 
 def load_hand_model(config: CameraConfig) -> HandModel:
-    """The config's model (the project's by default); ConfigError naming the file."""
-    return HandModel.load(
+    """The config's model (the project's by default), reading the config's window when it
+    names one (else the model's own); ConfigError naming the file."""
+    model = HandModel.load(
         config.model or DEFAULT_MODEL,
         threads=config.threads,
         providers=config.providers,
         min_confidence=config.min_confidence,
     )
+    if config.crop is not None:
+        model.settings = model.settings.with_crop(*config.crop)
+    return model
 
 
-def open_camera(config: CameraConfig, world: World, clock: Clock) -> Camera:
-    """The config's camera, not yet opened; the simulated one listens to ``world``."""
+def open_camera(
+    config: CameraConfig, world: World, clock: Clock, *, window: tuple[int, int] | None
+) -> Camera:
+    """The config's camera, not yet opened; the simulated one listens to ``world`` and
+    draws a hand in the ``window`` (its top-left corner, px; None: centred)."""
     if config.simulated:
         camera = SimulatedCamera(
             world,
             clock,
             width=config.width,
             height=config.height,
-            window=config.crop,
+            window=window,
             name=CAMERA_NAME,
         )
         world.listeners.append(camera)
@@ -78,7 +87,6 @@ def build_vision(
     config: CameraConfig, world: World, clock: Clock, blackboard: Blackboard
 ) -> RobotVision:
     """The robot's sight; never raises for a bad model (see the module's doc)."""
-    camera = open_camera(config, world, clock)
     health = DeviceHealth(CAMERA_NAME, blackboard)
     try:
         model = load_hand_model(config)
@@ -86,9 +94,13 @@ def build_vision(
         problem = f"{error}; the robot runs without counting fingers"
         log.error("camera: %s", problem)
         health.driver_status(False, problem)
+        camera = open_camera(config, world, clock, window=config.crop)
         return RobotVision(camera, health, None, problem)
-    if config.crop is not None:
-        model.settings = model.settings.with_crop(*config.crop)
+    try:  # the simulated camera holds a hand where the model looks
+        window: tuple[int, int] | None = model.settings.window(config.height, config.width)
+    except ValueError:
+        window = None  # the worker says so when the frames come
+    camera = open_camera(config, world, clock, window=window)
     watcher = HandWatcher(
         camera,
         model,
@@ -98,4 +110,4 @@ def build_vision(
         fps=config.fps,
         steady_frames=config.steady_frames,
     )
-    return RobotVision(camera, health, watcher)
+    return RobotVision(camera, health, watcher, summary=model.describe())

@@ -27,6 +27,7 @@ import cv2
 import numpy as np
 import numpy.typing as npt
 
+from engine.errors import ConfigError
 from engine.vision.preprocess import SIDE_PX, Frame
 
 STYLES = ("studio", "variant")
@@ -370,7 +371,9 @@ def write_dataset(
         folder = out / (NO_HAND if fingers is None else str(fingers))
         folder.mkdir(parents=True, exist_ok=True)
         image = render_window(fingers, rng, style=style, side_px=side)
-        cv2.imwrite(str(folder / f"{style}-{seed}-{index:06d}.png"), image)
+        path = folder / f"{style}-{seed}-{index:06d}.png"
+        if not cv2.imwrite(str(path), image):
+            raise ConfigError(f"{path}: cannot be written")
     return count
 
 

@@ -16,7 +16,7 @@ from engine.vision.robot_vision import load_hand_model, open_camera
 def describe_vision(config: CameraConfig, clock: Clock) -> list[DeviceRow]:
     """One row for the camera, one for the model (run once on the camera's frame)."""
     where = "simulated vest" if config.simulated else str(config.device)
-    camera = open_camera(config, World(), clock)
+    camera = open_camera(config, World(), clock, window=config.crop)
     frame: Frame | None = None
     try:
         camera.open()
@@ -53,11 +53,12 @@ def _model_row(config: CameraConfig, frame: Frame | None) -> DeviceRow:
     identity = f"input {shape}, on {providers}"
     if frame is None:
         return DeviceRow(name, "CNN (ONNX)", model.path.name, True, identity, "no frame to read")
-    if config.crop is not None:
-        model.settings = model.settings.with_crop(*config.crop)
     stopwatch = RealClock()  # how long it took on this machine, whatever the robot's clock
     started = stopwatch.now()
-    reading = model.read(frame)
+    try:
+        reading = model.read(frame)
+    except ValueError as error:  # the camera's frames do not hold the window
+        return DeviceRow(name, "CNN (ONNX)", model.path.name, False, f"no: {error}", "-")
     took_ms = (stopwatch.now() - started) * 1000
     said = "not sure" if reading.fingers is None else f"{reading.fingers} fingers"
     return DeviceRow(

@@ -72,3 +72,9 @@ def test_every_mistake_in_the_camera_section_is_named_with_its_place(tmp_path: P
 def test_a_robot_camera_needs_its_device(tmp_path: Path) -> None:
     [problem] = problems(tmp_path, ROBOT + "camera: {fps: 10}\n")
     assert "camera needs 'device' on a robot" in problem
+
+
+def test_a_device_called_camera_beside_the_camera_is_named(tmp_path: Path) -> None:
+    text = SIMULATED.replace("devices: {}", "devices:\n  camera: {chip: mpr121}")
+    found = problems(tmp_path, text)
+    assert any("a device may not be called 'camera'" in problem for problem in found)

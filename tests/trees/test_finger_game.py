@@ -22,7 +22,7 @@ def robot(tree_harness: Callable[..., TreeHarness]) -> TreeHarness:
 def show(robot: TreeHarness, fingers: int, *, then_wait_s: float = 6.0) -> None:
     """The vision worker saw a steady count; the robot gets time to answer."""
     robot.set(SHOWN, fingers)
-    robot.set("/vision/hand/fingers", fingers)
+    robot.set("/vision/hand/held", fingers)
     robot.advance(then_wait_s)
 
 

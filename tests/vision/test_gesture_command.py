@@ -79,6 +79,7 @@ def test_bad_pictures_are_named_and_the_others_still_counted(tmp_path: Path, cap
     [
         (["--crop", "1,2"], "must be X,Y,W in px"),
         (["--crop", "-5,0,128"], "X and Y must be 0 or more"),
+        (["--crop", "600,300,128"], "does not fit a 640x360 image"),
         (["--model", "nowhere/kids.onnx"], "kids.onnx: no such model file"),
     ],
 )
@@ -149,11 +150,38 @@ def test_record_adds_pictures_from_a_folder_and_skips_what_it_cannot_use(
     assert "skipped" in capsys.readouterr().out
 
 
+def test_record_takes_a_folder_laid_out_by_count_at_once(tmp_path: Path, capsys) -> None:
+    source = tmp_path / "old_session"
+    for label, fingers in (("2", 2), ("none", None)):
+        (source / label).mkdir(parents=True)
+        picture(source / label, "a.png", fingers, seed=7)
+    data = tmp_path / "data"
+    assert main(["gesture", "record", str(data), "--from", str(source), "--session", "s1"]) == 0
+    assert [p.name for p in (data / "2").iterdir()] == ["s1-00000.png"]
+    assert [p.name for p in (data / "none").iterdir()] == ["s1-00000.png"]
+    assert "2 pictures (2, none)" in capsys.readouterr().out
+
+
+def test_generating_or_training_into_a_place_that_cannot_be_written_is_said_first(
+    tmp_path: Path, capsys
+) -> None:
+    blocked = tmp_path / "file"
+    blocked.write_text("not a folder")
+    assert main(["gesture", "generate", str(blocked / "data"), "--count", "2"]) == 1
+    assert "cannot write there" in capsys.readouterr().err
+    data = tmp_path / "data"
+    assert main(["gesture", "generate", str(data), "--count", "6"]) == 0
+    assert main(["gesture", "train", str(data), "-o", str(blocked / "m.onnx")]) == 1
+    err = capsys.readouterr().err
+    assert "cannot write there" in err and "epoch" not in err
+
+
 @pytest.mark.parametrize(
     ("args", "message"),
     [
         (["--label", "7"], "must be one of 0, 1, 2, 3, 4, 5, none"),
-        (["--from", "x"], "--from needs --label"),
+        (["--from", "nowhere"], "nowhere: no such folder"),
+        (["--frames", "3"], "--frames needs --label"),
         (["--label", "2", "--session", "a-b"], "no '-': it ends a session"),
         (["--label", "2", "--camera", "/dev/video63"], "camera /dev/video63: cannot be opened"),
     ],

@@ -143,3 +143,21 @@ def test_a_camera_pulled_out_goes_offline_and_is_reopened_when_back() -> None:
     assert board.get(CAMERA_OK) is True
     assert board.get(FINGERS) == 2
     assert shown(board) == [2, 2]  # the hand seen again after the outage is news
+
+
+class NeedsTheWindow(ReadsTheNumber):
+    """A fake network that, as the real one, needs frames the window fits in."""
+
+    def read(self, frame: Frame) -> HandReading:
+        if frame.shape[0] < 2:
+            raise ValueError("a 1x1 image is smaller than the 2x2 window")
+        return super().read(frame)
+
+
+def test_frames_smaller_than_the_window_put_the_camera_offline_with_the_reason() -> None:
+    watcher, _, board, clock = watching([3])
+    watcher.model = NeedsTheWindow()
+    run(watcher, board, clock, 0.5)
+    assert board.get(CAMERA_OK) is False
+    assert "smaller than the 2x2 window" in (watcher.health.last_error or "")
+    assert watcher.frames == 0

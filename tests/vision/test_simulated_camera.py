@@ -125,3 +125,16 @@ def test_a_missing_picture_and_a_file_that_is_no_video_are_named_before_the_run(
     assert len(found) == 2
     assert "scene.yaml:3:" in found[0] and "gone.png: no such file" in found[0]
     assert "scene.yaml:4:" in found[1] and "notes.avi: not a video OpenCV can play" in found[1]
+
+
+def test_a_hand_held_up_while_another_is_lowered_stays(tmp_path: Path) -> None:
+    camera, player, clock = camera_on(
+        tmp_path,
+        "  - {at: 1.0, show_hand: {fingers: 2, seconds: 5}}\n"
+        "  - {at: 3.0, show_hand: {fingers: 4, seconds: 5}}\n",
+    )
+    room = camera.read()
+    at(player, clock, 6.5)  # the first is lowered at 6 s; the second is still up
+    assert not np.array_equal(camera.read()[WINDOW], room[WINDOW])
+    at(player, clock, 8.5)
+    assert np.array_equal(camera.read(), room)

@@ -43,6 +43,7 @@ class SimulatedCamera:
         self._unplugged_until_s = float("-inf")
         self._open = False
         self._shown: ShownHand | None = None
+        self._shown_before: ShownHand | None = None
         self._shown_at_s = 0.0
         self._still: Frame | None = None
         self._video: cv2.VideoCapture | None = None
@@ -85,9 +86,12 @@ class SimulatedCamera:
     def close(self) -> None:
         self._open = False
         self._release_video()
+        self._shown = None  # opened again, it looks afresh (a video resumes where it is)
 
     def _show(self, hand: ShownHand | None) -> None:
-        self._shown, self._shown_at_s = hand, self.clock.now()
+        if hand is not self._shown_before:  # held up now, not the same one looked at again
+            self._shown_at_s = self.clock.now()
+        self._shown = self._shown_before = hand
         self._still = None
         self._release_video()
         if hand is None:
