@@ -43,6 +43,7 @@ def build_parser() -> argparse.ArgumentParser:
         nodes_command,
         render_command,
         replay_command,
+        report_command,
         run_command,
         say_command,
         schema_command,
@@ -70,6 +71,7 @@ def build_parser() -> argparse.ArgumentParser:
         cloud_command,
         gesture_command,
         replay_command,
+        report_command,
     ):
         sub = commands.add_parser(
             module.NAME,

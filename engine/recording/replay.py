@@ -169,6 +169,32 @@ class Recording:
         )
         return [(at, status, feedback) for at, status, feedback in rows]
 
+    def world(self) -> list[tuple[float, str, str]]:
+        """(moment, kind, description) of what happened around a simulated robot (its
+        scenario's events); none for a robot in a real room."""
+        rows = self._rows("SELECT at_s, kind, description FROM world ORDER BY rowid")
+        return [(at, kind, description) for at, kind, description in rows]
+
+    def key_history(self, key: str) -> list[tuple[float, Any]]:
+        """Each (moment, value) ``key`` took (each event, for an event key), in order."""
+        rows = self._rows("SELECT at_s, value FROM blackboard WHERE key = ? ORDER BY rowid", (key,))
+        return [(at, json.loads(value)) for at, value in rows]
+
+    def keys_like(self, pattern: str) -> list[str]:
+        """The keys written that match an SQL LIKE ``pattern`` (``/devices/%/ok``)."""
+        rows = self._rows(
+            "SELECT DISTINCT key FROM blackboard WHERE key LIKE ? ORDER BY key", (pattern,)
+        )
+        return [key for (key,) in rows]
+
+    def feedback_containing(self, text: str) -> list[tuple[float, str]]:
+        """(moment, feedback) of each node status change whose feedback holds ``text``."""
+        rows = self._rows(
+            "SELECT at_s, feedback FROM statuses WHERE instr(feedback, ?) > 0 ORDER BY rowid",
+            (text,),
+        )
+        return [(at, feedback) for at, feedback in rows]
+
     def actions(self, until_s: float | None = None) -> list[RecordedAction]:
         """The service calls, in order (up to ``until_s`` when given)."""
         rows = self._rows(

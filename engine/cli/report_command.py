@@ -1,0 +1,46 @@
+"""Write a recorded session (`vest run --record FILE`) as a report a therapist reads: what
+the person did and how the robot answered, how fast; how often each behaviour acted; what
+it did not understand; devices that dropped out; the sensors over the session. One HTML
+file with its pictures inside, printable on A4.
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from engine.errors import ConfigError
+from engine.recording.replay import Recording
+from engine.recording.report import report_html
+
+NAME = "report"
+HELP = "write a recorded session as a report for the therapist (HTML)"
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("recording", type=Path, metavar="FILE", help="made by vest run --record")
+    parser.add_argument(
+        "-o",
+        "--output",
+        type=Path,
+        default=None,
+        metavar="REPORT.html",
+        help="default: FILE with .html",
+    )
+
+
+def main(args: argparse.Namespace) -> int:
+    recording = Recording.open(args.recording)
+    try:
+        page = report_html(recording)
+    finally:
+        recording.close()
+    output = args.output or args.recording.with_suffix(".html")
+    try:
+        output.write_text(page, encoding="utf-8")
+    except OSError as error:
+        raise ConfigError(
+            f"{output}: cannot write the report ({error.strerror or error})"
+        ) from None
+    print(f"report: {output}")
+    return 0

@@ -1,0 +1,71 @@
+"""`vest report`: a recorded session as the therapist reads it."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from engine.cli import main
+from engine.recording.replay import Recording
+from engine.recording.report import outages, person_moments
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def record(tmp_path: Path, scenario: str, capsys, monkeypatch) -> Path:
+    monkeypatch.chdir(ROOT)
+    path = tmp_path / "session.db"
+    args = ["run", "--fast", "--speech", "text", "--scenario", scenario, "--record", str(path)]
+    assert main(args) == 0
+    capsys.readouterr()
+    return path
+
+
+def test_each_thing_the_person_did_is_paired_with_the_robot_s_answer(
+    tmp_path: Path, capsys, monkeypatch
+) -> None:
+    recording = Recording.open(
+        record(tmp_path, "examples/scenarios/demo.yaml", capsys, monkeypatch)
+    )
+    moments = person_moments(recording)
+    did = [(round(m.at_s, 1), m.answer.tree if m.answer else None) for m in moments]
+    assert did[:3] == [(1.0, "touch_thanks"), (3.0, "hug"), (6.0, "wave_greeting")]
+    before_the_game = [m for m in moments if m.at_s < 21.0]
+    assert all(m.response_s is not None and m.response_s >= 0 for m in before_the_game)
+
+
+def test_a_device_that_dropped_out_is_listed_with_how_long(
+    tmp_path: Path, capsys, monkeypatch
+) -> None:
+    path = record(tmp_path, "examples/scenarios/unplug_touch.yaml", capsys, monkeypatch)
+    [(device, since, back)] = outages(Recording.open(path))
+    assert device == "touch" and 2.0 <= since < 2.5 and back is not None and 6.0 <= back < 8.5
+
+
+def test_vest_report_writes_one_printable_page_with_its_pictures_inside(
+    tmp_path: Path, capsys, monkeypatch
+) -> None:
+    path = record(tmp_path, "examples/scenarios/unplug_touch.yaml", capsys, monkeypatch)
+    assert main(["report", str(path)]) == 0
+    page = path.with_suffix(".html").read_text()
+    assert f"report: {path.with_suffix('.html')}" in capsys.readouterr().out
+    assert "What the person did, and how the robot answered" in page
+    assert "hug: said \u201cI love hugs!\u201d" in page or "hug: lit its face pink" in page
+    assert "<td>touch</td>" in page  # it dropped out
+    assert page.count("<svg") == 3 and "@page { size: A4" in page
+    assert "src=" not in page and "href=" not in page  # nothing outside the file
+
+
+def test_a_report_that_cannot_be_written_is_said_in_one_line(
+    tmp_path: Path, capsys, monkeypatch
+) -> None:
+    path = record(tmp_path, "examples/scenarios/unplug_touch.yaml", capsys, monkeypatch)
+    assert main(["report", str(path), "-o", str(tmp_path / "no" / "r.html")]) == 1
+    assert "r.html: cannot write the report" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("name", ["gone.db"])
+def test_a_missing_recording_is_named(tmp_path: Path, capsys, name: str) -> None:
+    assert main(["report", str(tmp_path / name)]) == 1
+    assert f"{name}: no such recording" in capsys.readouterr().err
