@@ -1,0 +1,107 @@
+"""What watching and recording cost the robot: tick lateness and tick time with the live
+view (a page connected and reading every change) and with a recording, against the same
+run with neither, in one run.
+
+Run: ``.venv/bin/python bench/bench_view.py`` (``--seconds S``, ``--rounds N``); about
+2 minutes with the defaults (3 ways x 2 rounds x 20 s).
+
+Each run is ``vest run --speech text`` on the demo scenario in real time (every tree of
+trees/, the simulated vest with its poller threads), ``--duration S``; the ways are
+interleaved round by round so a busy machine hurts them alike. From each run's summary
+table: the worst tree's tick p99 and lateness p99 (ms). The view's page is a client that
+reads the server-sent changes as a browser does (every one of them, parsed as JSON).
+
+Target (issue 11): the view and the recording cost the tick nothing a person notices:
+lateness p99 with them within 1 ms of the run without.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import re
+import statistics
+import subprocess
+import sys
+import tempfile
+import threading
+from pathlib import Path
+
+import requests
+
+ROOT = Path(__file__).resolve().parents[1]
+VEST = [sys.executable, "-c", "import sys; from engine.cli import main; sys.exit(main())"]
+ROW = re.compile(r"^(\w+)\s+\d+/s\s+(\d+)\s+([\d.]+)ms\s+([\d.]+)ms\s+([\d.]+)ms\s+(\d+)$", re.M)
+
+
+def read_changes(address: str, counted: list[int], stop: threading.Event) -> None:
+    """A page: reads every change the view sends."""
+    with requests.get(address + "api/events", stream=True, timeout=60) as response:
+        for line in response.iter_lines():
+            if stop.is_set():
+                return
+            if line.startswith(b"data: "):
+                json.loads(line[6:])
+                counted[0] += 1
+
+
+def run(way: str, seconds: float, folder: Path) -> dict[str, float]:
+    args = [*VEST, "run", "--speech", "text", "--duration", str(seconds)]
+    if way == "record":
+        args += ["--record", str(folder / "bench.db")]
+    if way == "view":
+        args += ["--view", "--view-port", "0"]
+    process = subprocess.Popen(
+        args, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
+    )
+    counted, stop = [0], threading.Event()
+    reader: threading.Thread | None = None
+    if way == "view":
+        assert process.stderr is not None
+        for line in process.stderr:
+            if line.startswith("view: "):
+                address = line.removeprefix("view: ").strip()
+                reader = threading.Thread(
+                    target=read_changes, args=(address, counted, stop), daemon=True
+                )
+                reader.start()
+                break
+    out, _ = process.communicate(timeout=seconds + 120)
+    stop.set()
+    rows = ROW.findall(out)
+    if not rows:
+        raise SystemExit(f"no statistics from vest run ({way}):\n{out[-2000:]}")
+    return {
+        "tick_p99_ms": max(float(r[3]) for r in rows),
+        "late_p99_ms": max(float(r[4]) for r in rows),
+        "changes": float(counted[0]),
+    }
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--seconds", type=float, default=20.0, help="each run's length")
+    parser.add_argument("--rounds", type=int, default=2)
+    args = parser.parse_args()
+    ways = ("plain", "record", "view")
+    results: dict[str, list[dict[str, float]]] = {way: [] for way in ways}
+    with tempfile.TemporaryDirectory() as folder:
+        for round_number in range(args.rounds):
+            for way in ways:
+                results[way].append(run(way, args.seconds, Path(folder)))
+                print(f"round {round_number + 1} {way:7} {results[way][-1]}", flush=True)
+    base = {key: statistics.median(r[key] for r in results["plain"]) for key in results["plain"][0]}
+    print(f"\nworst tree over {args.rounds} rounds of {args.seconds:g} s (median of rounds)")
+    print(f"{'':8} {'tick p99 ms':>12} {'late p99 ms':>12} {'changes read':>13}")
+    for way in ways:
+        tick = statistics.median(r["tick_p99_ms"] for r in results[way])
+        late = statistics.median(r["late_p99_ms"] for r in results[way])
+        changes = statistics.median(r["changes"] for r in results[way])
+        print(
+            f"{way:8} {tick:12.3f} {late:12.3f} {changes:13.0f}"
+            f"   lateness {late - base['late_p99_ms']:+.3f} ms vs plain"
+        )
+
+
+if __name__ == "__main__":
+    main()
