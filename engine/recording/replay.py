@@ -180,6 +180,10 @@ class Recording:
         rows = self._rows("SELECT at_s, value FROM blackboard WHERE key = ? ORDER BY rowid", (key,))
         return [(at, json.loads(value)) for at, value in rows]
 
+    def is_event(self, key: str) -> bool:
+        """Whether ``key`` was recorded as an event key."""
+        return bool(self._rows("SELECT max(event) FROM blackboard WHERE key = ?", (key,))[0][0])
+
     def keys_like(self, pattern: str) -> list[str]:
         """The keys written that match an SQL LIKE ``pattern`` (``/devices/%/ok``)."""
         rows = self._rows(
