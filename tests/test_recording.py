@@ -95,3 +95,12 @@ def test_recording_into_a_missing_folder_stops_before_the_robot_starts(
     assert main(["run", "--fast", "--speech", "text", "--record", str(where)]) == 1
     err = capsys.readouterr().err
     assert "--record" in err and "cannot write a recording there" in err
+
+
+def test_a_recording_of_format_1_kept_in_the_repository_still_replays(capsys) -> None:
+    """Made by vest run --record when format 1 was new: later versions must read it."""
+    kept = Path(__file__).parent / "recordings" / "unplug_touch.format1.db"
+    assert main(["replay", str(kept), "--at", "4.5"]) == 0
+    out = capsys.readouterr().out
+    assert "\nhug (20 Hz)\n  [..] " in out  # hugged at 4 s
+    assert "/devices/touch/ok = false" in out  # unplugged from 2 s to 6 s
