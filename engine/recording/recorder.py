@@ -45,6 +45,7 @@ class SessionRecorder:
         self.catalogue = catalogue
         self.start_s = clock.now()
         self.dropped = 0
+        self._broken = False
         self._connection: sqlite3.Connection | None = create(path)
         self._queue: queue.Queue[Row | None] = queue.Queue(maxsize=capacity)
         self._watch = TreeWatch()
@@ -144,6 +145,8 @@ class SessionRecorder:
         )
 
     def _note(self, sql: str, row: tuple[Any, ...]) -> None:
+        if self._broken:
+            return
         try:
             self._queue.put_nowait((sql, row))
         except queue.Full:
@@ -170,6 +173,7 @@ class SessionRecorder:
                 connection.commit()
             except sqlite3.Error as error:  # a full disk: the robot goes on, the record stops
                 log.error("recording %s stopped: %s", self.path, error)
+                self._broken = True
                 return
 
     def close(self) -> None:
@@ -177,8 +181,9 @@ class SessionRecorder:
         if self._connection is None:
             return
         self.describe(duration_s=f"{self._at():.3f}", dropped=str(self.dropped))
-        self._queue.put(None)
-        self._thread.join()
+        if not self._broken:  # a writer that stopped reads no more: nothing to wait for
+            self._queue.put(None)
+            self._thread.join()
         self._connection.close()
         self._connection = None
         if self.dropped:
