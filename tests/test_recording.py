@@ -104,3 +104,21 @@ def test_a_recording_of_format_1_kept_in_the_repository_still_replays(capsys) ->
     out = capsys.readouterr().out
     assert "\nhug (20 Hz)\n  [..] " in out  # hugged at 4 s
     assert "/devices/touch/ok = false" in out  # unplugged from 2 s to 6 s
+
+
+def test_recording_over_a_file_that_is_not_a_recording_is_refused(
+    tmp_path: Path, capsys, monkeypatch
+) -> None:
+    monkeypatch.chdir(ROOT)
+    precious = tmp_path / "hug.yaml"
+    precious.write_text("name: hug\n")
+    assert main(["run", "--fast", "--speech", "text", "--record", str(precious)]) == 1
+    assert "holds something else; only an old recording is replaced" in capsys.readouterr().err
+    assert precious.read_text() == "name: hug\n"
+
+
+def test_at_the_moment_of_an_action_the_tree_that_took_it_shows_running(demo: Path) -> None:
+    recording = Recording.open(demo)
+    squeeze = next(a for a in recording.actions() if a.tree == "hug")
+    hug = next(tree for tree in recording.trees_at(squeeze.at_s) if tree.name == "hug")
+    assert recording.statuses_at(squeeze.at_s)[("hug", hug.version, 0)].status == "RUNNING"

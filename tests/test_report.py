@@ -39,8 +39,8 @@ def test_a_device_that_dropped_out_is_listed_with_how_long(
     tmp_path: Path, capsys, monkeypatch
 ) -> None:
     path = record(tmp_path, "examples/scenarios/unplug_touch.yaml", capsys, monkeypatch)
-    [(device, since, back)] = outages(Recording.open(path))
-    assert device == "touch" and 2.0 <= since < 2.5 and back is not None and 6.0 <= back < 8.5
+    [(since, back)] = [(s, b) for d, s, b in outages(Recording.open(path)) if d == "touch"]
+    assert 2.0 <= since < 2.5 and back is not None and 6.0 <= back < 8.5
 
 
 def test_vest_report_writes_one_printable_page_with_its_pictures_inside(
@@ -53,8 +53,19 @@ def test_vest_report_writes_one_printable_page_with_its_pictures_inside(
     assert "What the person did, and how the robot answered" in page
     assert "hug: said \u201cI love hugs!\u201d" in page or "hug: lit its face pink" in page
     assert "<td>touch</td>" in page  # it dropped out
-    assert page.count("<svg") == 3 and "@page { size: A4" in page
+    assert page.count("<svg") == 2  # squeeze and touch; nobody came in front of it
+    assert "@page { size: A4" in page
     assert "src=" not in page and "href=" not in page  # nothing outside the file
+
+
+def test_the_answer_to_a_touch_the_robot_could_not_feel_is_not_the_hug_after_it(
+    tmp_path: Path, capsys, monkeypatch
+) -> None:
+    path = record(tmp_path, "examples/scenarios/unplug_touch.yaml", capsys, monkeypatch)
+    moments = {round(m.at_s): m for m in person_moments(Recording.open(path))}
+    assert moments[3].answer is None  # pad 5 touched while the touch sensor was unplugged
+    assert moments[4].answer is not None and moments[4].answer.tree == "hug"
+    assert [a.action for a in moments[4].answers] == ["led", "say"]
 
 
 def test_a_report_that_cannot_be_written_is_said_in_one_line(

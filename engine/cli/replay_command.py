@@ -65,7 +65,8 @@ def main(args: argparse.Namespace) -> int:
             for tree in trees:
                 versions = [t for t in recording.trees if t.name == tree.name]
                 reloads = f", reloaded {len(versions) - 1}x" if len(versions) > 1 else ""
-                print(f"  {tree.name}: {len(tree.nodes)} nodes at {tree.rate_hz:g} Hz{reloads}")
+                nodes = f"{len(tree.nodes)} node{'' if len(tree.nodes) == 1 else 's'}"
+                print(f"  {tree.name}: {nodes} at {tree.rate_hz:g} Hz{reloads}")
             print(f"  {len(recording.actions())} actions; vest replay {args.recording} --at S")
             return 0
         if args.at > duration:

@@ -282,6 +282,7 @@ def main(args: argparse.Namespace) -> int:
         assembled.close()
         if recorder is not None:
             recorder.close()
+            tell(f"recording: {args.record} (vest replay {args.record} --view)")
         if view is not None:
             view.stop()
     return 0 if timeline.write_error is None else 1  # the robot ran; its timeline was lost

@@ -103,7 +103,7 @@ class SessionRecorder:
         watched, new, changes = self._watch.look(tree)
         if new:  # hot-reloaded
             self._record_tree(watched)
-        at = self._at()
+        at = tick_moment(tree, self.start_s)
         for index, status, feedback in changes:
             self._note(
                 "INSERT INTO statuses VALUES (?, ?, ?, ?, ?, ?, ?)",
@@ -190,6 +190,12 @@ class SessionRecorder:
             log.warning(
                 "recording %s lost %d changes (the disk fell behind)", self.path, self.dropped
             )
+
+
+def tick_moment(tree: RunningTree, start_s: float) -> float:
+    """When the tick that just ended was due (s since ``start_s``): its statuses hold from
+    then, so a moment shows a tree's actions and the statuses that led to them together."""
+    return round(tree.next_deadline_s - start_s, 6)
 
 
 def _digest(definition: TreeDefinition) -> str:

@@ -227,5 +227,9 @@ def moment(recording: Recording, at_s: float) -> str:
     if done:
         last = done[-1]
         lines.append(f"\nlast action: {last.at_s:.2f} s {last.tree} {last.action} {last.args}")
+    around = [(at, what) for at, _, what in recording.world() if at <= at_s]
+    if around:
+        at, what = around[-1]
+        lines.append(f"last around the robot: {at:.2f} s {what}")
     lines.append("\n[ok] success  [no] failure  [..] running  [  ] not ticked")
     return "\n".join(lines)

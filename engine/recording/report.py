@@ -36,11 +36,16 @@ PRESSED_N = 1.0
 
 @dataclass(frozen=True)
 class Moment:
-    """Something the person did, and the robot's first answer (None: no answer)."""
+    """Something the person did, and the robot's answer: the actions of the first tree
+    that acted after it and before the person's next act (none: no answer)."""
 
     at_s: float
     did: str
-    answer: RecordedAction | None
+    answers: tuple[RecordedAction, ...]
+
+    @property
+    def answer(self) -> RecordedAction | None:
+        return self.answers[0] if self.answers else None
 
     @property
     def response_s(self) -> float | None:
@@ -63,10 +68,15 @@ def person_moments(recording: Recording) -> list[Moment]:
         (at, description) for at, kind, description in recording.world() if kind in PERSON_EVENTS
     ] or sensed(recording)
     actions = recording.actions()
+    ordered = sorted(done)
     moments = []
-    for at, did in sorted(done):
-        answer = next((a for a in actions if at <= a.at_s <= at + ANSWER_WITHIN_S), None)
-        moments.append(Moment(at, did, answer))
+    for index, (at, did) in enumerate(ordered):
+        later = [t for t, _ in ordered[index + 1 :] if t > at]
+        until = min([at + ANSWER_WITHIN_S, *later[:1]])
+        window = [a for a in actions if at <= a.at_s < until]
+        tree = window[0].tree if window else None
+        answers = tuple(a for a in window if a.tree == tree)[:3]
+        moments.append(Moment(at, did, answers))
     return moments
 
 
@@ -123,9 +133,15 @@ def outages(recording: Recording) -> list[tuple[str, float, float | None]]:
             elif ok is True and since is not None:
                 found.append((device, since, at))
                 since = None
-        if since is not None and since > 0.1:  # offline from the start: never plugged in
+        if since is not None:  # to the end (from the start: never there, or no model)
             found.append((device, since, None))
     return sorted(found, key=lambda item: item[1])
+
+
+def _lasted(since: float, back: float | None) -> str:
+    if back is None:
+        return "the whole session" if since < 0.5 else "until the end"
+    return f"{back - since:.1f} s"
 
 
 def _answer_text(action: RecordedAction) -> str:
@@ -144,17 +160,20 @@ def _answer_text(action: RecordedAction) -> str:
 
 
 def _plot(
-    title: str, unit: str, series: list[tuple[str, str, list[tuple[float, float]]]], end_s: float
+    title: str,
+    unit: str,
+    series: list[tuple[str, str, list[tuple[float, float | None]]]],
+    end_s: float,
 ) -> str:
     """A small line plot (SVG) of step-wise series over the session."""
     width, height, left, bottom = 680, 150, 48, 22
-    values = [v for _, _, points in series for _, v in points]
+    values = [v for _, _, points in series for _, v in points if v is not None]
     if not values:
         return ""
     top = max(max(values), 1e-9)
 
     def x(t: float) -> float:
-        return left + (width - left - 8) * (t / end_s if end_s else 0.0)
+        return left + (width - left - 24) * (t / end_s if end_s else 0.0)
 
     def y(v: float) -> float:
         return 8 + (height - bottom - 8) * (1 - v / (top * 1.1))
@@ -180,20 +199,37 @@ def _plot(
         parts.append(text(x(t), height - 6, f"{t:g} s", "middle"))
         t += step
     for index, (name, colour, points) in enumerate(series):
-        path, last = [], 0.0
-        for at, value in points:
-            path.append(f"{x(at):.1f},{y(last):.1f} {x(at):.1f},{y(value):.1f}")
-            last = value
-        path.append(f"{x(end_s):.1f},{y(last):.1f}")
-        joined = " ".join(path)
-        parts.append(f'<polyline fill="none" stroke="{colour}" points="{joined}"/>')
+        dash = ' stroke-dasharray="5 3"' if index else ""
+        for run in _runs(points, end_s):  # no reading (nothing in range): no line
+            joined = " ".join(f"{x(at):.1f},{y(value):.1f}" for at, value in run)
+            parts.append(f'<polyline fill="none" stroke="{colour}"{dash} points="{joined}"/>')
         parts.append(text(width - 10, 20 + 12 * index, name, "end", colour))
     parts.append("</svg>")
     return "".join(parts)
 
 
-def _numbers(rows: list[tuple[float, Any]], scale: float = 1.0) -> list[tuple[float, float]]:
-    return [(at, float(v) * scale if isinstance(v, int | float) else 0.0) for at, v in rows]
+def _runs(
+    points: list[tuple[float, float | None]], end_s: float
+) -> list[list[tuple[float, float]]]:
+    """Step-wise line pieces between the moments a value was absent."""
+    runs: list[list[tuple[float, float]]] = []
+    current: list[tuple[float, float]] = []
+    for index, (at, value) in enumerate(points):
+        until = points[index + 1][0] if index + 1 < len(points) else end_s
+        if value is None:
+            if current:
+                runs.append(current)
+            current = []
+            continue
+        current += [(at, value), (until, value)]
+    if current:
+        runs.append(current)
+    return runs
+
+
+def _numbers(rows: list[tuple[float, Any]], scale: float = 1.0) -> list[tuple[float, float | None]]:
+    """Readings as numbers (True is 1); None where the sensor saw nothing."""
+    return [(at, float(v) * scale if isinstance(v, int | float) else None) for at, v in rows]
 
 
 STYLE = (Path(__file__).resolve().parent / "report.css").read_text
@@ -210,14 +246,16 @@ def report_html(recording: Recording) -> str:
         if moment.answer is None:
             answer, took = '<span class="none">no answer</span>', "-"
         else:
-            answer = html.escape(f"{moment.answer.tree}: {_answer_text(moment.answer)}")
+            done = ", ".join(_answer_text(action) for action in moment.answers)
+            answer = html.escape(f"{moment.answer.tree}: {done}")
             took = f"{moment.response_s:.2f} s"
         rows.append(
             f"<tr><td class='num'>{moment.at_s:.1f} s</td><td>{html.escape(moment.did)}</td>"
             f"<td>{answer}</td><td class='num'>{took}</td></tr>"
         )
     rows_html = "".join(rows)
-    fired = Counter(action.tree for action in recording.actions())
+    fired = Counter({tree.name: 0 for tree in recording.trees})
+    fired.update(action.tree for action in recording.actions())
     behaviours = "".join(
         f"<tr><td>{html.escape(tree)}</td><td class='num'>{count}</td></tr>"
         for tree, count in fired.most_common()
@@ -229,7 +267,7 @@ def report_html(recording: Recording) -> str:
     dropped = "".join(
         f"<tr><td>{html.escape(device)}</td><td class='num'>{since:.1f} s</td>"
         f"<td class='num'>{'-' if back is None else f'{back:.1f} s'}</td>"
-        f"<td class='num'>{'until the end' if back is None else f'{back - since:.1f} s'}</td></tr>"
+        f"<td class='num'>{_lasted(since, back)}</td></tr>"
         for device, since, back in outages(recording)
     )
     median = sorted(answered)[len(answered) // 2] if answered else None

@@ -66,6 +66,12 @@ def as_json(value: Any) -> str:
 def create(path: Path) -> sqlite3.Connection:
     """A new, empty recording at ``path`` (replacing one there); ConfigError when the
     folder is missing or not writable."""
+    if path.is_dir():
+        raise ConfigError(f"--record {path}: is a folder; name a file")
+    if path.exists() and not _is_recording(path):
+        raise ConfigError(
+            f"--record {path}: holds something else; only an old recording is replaced"
+        )
     try:
         if path.exists():
             path.unlink()
@@ -76,6 +82,21 @@ def create(path: Path) -> sqlite3.Connection:
     except (OSError, sqlite3.Error) as error:
         raise ConfigError(f"--record {path}: cannot write a recording there ({error})") from None
     return connection
+
+
+def _is_recording(path: Path) -> bool:
+    try:
+        with open(path, "rb") as file:
+            if file.read(16) != b"SQLite format 3\x00":
+                return False
+        connection = sqlite3.connect(f"file:{path}?mode=ro", uri=True)
+        try:
+            row = connection.execute("SELECT value FROM meta WHERE key = 'format'").fetchone()
+        finally:
+            connection.close()
+    except (OSError, sqlite3.Error):
+        return False
+    return row is not None
 
 
 def open_for_reading(path: Path) -> sqlite3.Connection:

@@ -84,7 +84,10 @@ class TreeWatch:
         watched.ticks += 1
         changes: list[StatusChange] = []
         for index, node in enumerate(watched.nodes):
-            now = (node.status.name, node.feedback_message or "")
+            status = node.status.name
+            # a node not ticked keeps py_trees' last message: it no longer says anything
+            feedback = "" if status == "INVALID" else node.feedback_message or ""
+            now = (status, feedback)
             if now != watched.last[index]:
                 watched.last[index] = now
                 changes.append((index, *now))

@@ -23,6 +23,7 @@ from engine.blackboard.catalogue import VARIABLES_PREFIX, KeyCatalogue
 from engine.clock import Clock
 from engine.drivers.device_stats import DeviceStats
 from engine.loader.tree_drawing import dot_source
+from engine.recording.recorder import tick_moment
 from engine.recording.session_file import as_json
 from engine.runtime.scheduler import RunningTree
 from engine.runtime.tree_watch import TreeWatch, WatchedTree
@@ -50,8 +51,7 @@ class Subscription:
             self.overflowed = True
 
     def close(self) -> None:
-        """Wake the page's sender so it ends."""
-        self.overflowed = True
+        """Wake the page's sender so it ends (after what is queued)."""
         with contextlib.suppress(queue.Full):  # a full queue wakes its sender anyway
             self.changes.put_nowait(None)
 
@@ -82,6 +82,7 @@ class ViewHub:
         self._keys: dict[str, Change] = {}
         self._values: dict[str, str] = {}
         self._actions: deque[Change] = deque(maxlen=RECENT_ACTIONS)
+        self._world: deque[Change] = deque(maxlen=RECENT_ACTIONS)
         self._stats: Change = {"kind": "stats", "at": 0.0, "trees": {}, "devices": {}}
         self._running: list[RunningTree] = []
         self._next_stats_s = 0.0
@@ -118,7 +119,7 @@ class ViewHub:
             self._tree(watched)
         if not changes:
             return
-        at = self._at()
+        at = round(tick_moment(tree, self.start_s), 3)
         for index, status, feedback in changes:
             change = {
                 "kind": "status",
@@ -177,9 +178,10 @@ class ViewHub:
         self._publish(change)
 
     def world(self, at_s: float, event: ScenarioEvent) -> None:
-        self._publish(
-            {"kind": "world", "at": round(at_s - self.start_s, 3), "what": event.describe()}
-        )
+        change = {"kind": "world", "at": round(at_s - self.start_s, 3), "what": event.describe()}
+        with self._lock:
+            self._world.append(change)
+        self._publish(change)
 
     def stats_hook(self, now_s: float) -> None:
         """A scheduler hook: every second, the trees' tick statistics and the buses'."""
@@ -215,6 +217,7 @@ class ViewHub:
 
     def close(self) -> None:
         """Tell every page the session ended."""
+        self._publish({"kind": "end", "at": self._at()})
         with self._lock:
             pages, self._pages = list(self._pages), []
         for page in pages:
@@ -232,6 +235,7 @@ class ViewHub:
                 ],
                 "keys": sorted(self._keys.values(), key=lambda change: change["key"]),
                 "actions": list(self._actions),
+                "world": list(self._world),
                 "stats": self._stats,
             }
 

@@ -10,6 +10,20 @@ from engine.recording.replay import Recording
 from engine.recording.session_file import as_json
 from engine.view.hub import RECENT_ACTIONS, Change
 
+STEP_S = 0.01
+"""Moments closer than this are one step of the replay (one tick's changes)."""
+
+
+def _steps(moments: list[float]) -> list[float]:
+    """The moments a replay steps through: the last of each cluster (its changes all in)."""
+    steps: list[float] = []
+    for at in moments:
+        if steps and at - steps[-1] < STEP_S:
+            steps[-1] = at
+        else:
+            steps.append(at)
+    return steps
+
 
 class ReplaySource:
     """Answers the page's questions from a recording (:class:`Recording`)."""
@@ -23,7 +37,7 @@ class ReplaySource:
             "mode": "replay",
             "file": self.recording.path.name,
             "duration": self.recording.duration_s,
-            "moments": self.recording.moments(),
+            "moments": _steps(self.recording.moments()),
             "actions": [action.at_s for action in self.recording.actions()],
         }
 
@@ -82,8 +96,14 @@ class ReplaySource:
             }
             for action in recording.actions(at_s)[-RECENT_ACTIONS:]
         ]
+        world = [
+            {"kind": "world", "at": at, "what": what}
+            for at, _, what in self.recording.world()
+            if at <= at_s
+        ]
         return {
             "now": at_s,
+            "world": world[-RECENT_ACTIONS:],
             "trees": trees,
             "keys": keys,
             "actions": actions,

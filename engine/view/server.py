@@ -23,6 +23,7 @@ import ipaddress
 import json
 import logging
 import shutil
+import socket
 import subprocess
 import threading
 from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
@@ -100,7 +101,9 @@ class ViewServer:
             self._server = ThreadingHTTPServer((host, port), handler)
         except OSError as error:
             raise DeviceError(
-                error.errno, f"the view cannot listen on {host}:{port} ({error.strerror})"
+                error.errno,
+                f"the view cannot listen on {host}:{port} ({error.strerror}); "
+                "choose another with --view-port (0: any free one)",
             ) from None
         self._server.daemon_threads = True
         self.host, self.port = host, int(self._server.server_address[1])
@@ -108,7 +111,9 @@ class ViewServer:
 
     @property
     def url(self) -> str:
-        shown = f"[{self.host}]" if ":" in self.host else self.host
+        """The page's address; on every address (0.0.0.0, ::), this machine's name."""
+        host = socket.gethostname() if self.host in ("0.0.0.0", "::") else self.host
+        shown = f"[{host}]" if ":" in host else host
         query = f"?token={self.token}" if self.token else ""
         return f"http://{shown}:{self.port}/{query}"
 
@@ -208,7 +213,7 @@ def _handler_for(view: ViewServer) -> type[BaseHTTPRequestHandler]:
                     change = page.changes.get()
                     if change is None:
                         break
-                    if page.overflowed:  # behind: start again from the present state
+                    if page.overflowed and change.get("kind") != "end":  # behind: start over
                         page.overflowed = False
                         while not page.changes.empty():
                             page.changes.get_nowait()

@@ -10,7 +10,7 @@ const api = (path, params = {}) => {
 };
 const $ = (selector) => document.querySelector(selector);
 
-const state = { trees: new Map(), keys: new Map(), actions: [], stats: null, now: 0 };
+const state = { trees: new Map(), keys: new Map(), actions: [], world: [], stats: null, now: 0 };
 const history = new Map(); // "tree/version/node" -> [{at, status, feedback}], live only
 let info = { mode: "live" };
 let chosen = null; // {tree, version, node}
@@ -34,6 +34,7 @@ function load(snapshot) {
   }
   state.keys = new Map(snapshot.keys.map((change) => [change.key, change]));
   state.actions = snapshot.actions;
+  state.world = snapshot.world ?? [];
   state.stats = snapshot.stats;
 }
 
@@ -59,6 +60,14 @@ async function drawTrees() {
     const response = await fetch(api(`/api/svg/${encodeURIComponent(tree.tree)}/${tree.version}`));
     if (response.ok) {
       drawing.innerHTML = await response.text();
+      const svg = drawing.querySelector("svg");
+      if (svg) {
+        // every tree at one scale (a big tree scrolls in its card, its words stay readable)
+        const width = svg.width.baseVal.valueInSpecifiedUnits;
+        const height = svg.height.baseVal.valueInSpecifiedUnits;
+        svg.style.width = `${Math.round(width * 0.9)}px`;
+        svg.style.height = `${Math.round(height * 0.9)}px`;
+      }
       for (const group of drawing.querySelectorAll("g.node")) {
         const title = group.querySelector("title")?.textContent ?? "";
         if (!/^n\d+$/.test(title)) continue;
@@ -141,11 +150,17 @@ function drawTables() {
     [stats.lateness_p99_ms.toFixed(2)], [String(stats.skipped)],
   ], false, name]));
   const list = $("#actions");
-  list.replaceChildren(...state.actions.slice(-30).reverse().map((action) => {
+  const happened = [...state.actions, ...state.world].sort((a, b) => a.at - b.at).slice(-40);
+  list.replaceChildren(...happened.reverse().map((entry) => {
     const item = document.createElement("li");
-    item.textContent = `${action.at.toFixed(2)} s ${action.tree}: ${action.action} ${action.args}`
-      + (action.error ? ` (failed: ${action.error})` : "");
-    if (action.error) item.className = "failed";
+    if (entry.kind === "world") {
+      item.textContent = `${entry.at.toFixed(2)} s around the robot: ${entry.what}`;
+      item.className = "world";
+      return item;
+    }
+    item.textContent = `${entry.at.toFixed(2)} s ${entry.tree}: ${entry.action} ${entry.args}`
+      + (entry.error ? ` (failed: ${entry.error})` : "");
+    if (entry.error) item.className = "failed";
     return item;
   }));
 }
@@ -220,6 +235,9 @@ function apply(change) {
   } else if (change.kind === "action_failed") {
     const match = [...state.actions].reverse().find((a) => a.at === change.at && a.tree === change.tree);
     if (match) match.error = change.error;
+  } else if (change.kind === "world") {
+    state.world.push(change);
+    if (state.world.length > 100) state.world.shift();
   } else if (change.kind === "stats") {
     state.stats = change;
   }
@@ -246,6 +264,14 @@ async function live() {
   const events = new EventSource(api("/api/events"));
   events.onmessage = async (message) => {
     const change = JSON.parse(message.data);
+    if (change.kind === "end") {
+      events.close();
+      state.now = change.at;
+      drawTables();
+      $("#mode").textContent = `session ended at ${change.at.toFixed(2)} s`;
+      document.body.dataset.ended = "true";
+      return;
+    }
     if (change.kind === "resync" || change.kind === "tree") {
       load(await getJson("/api/snapshot"));
       await draw();
@@ -254,7 +280,9 @@ async function live() {
     apply(change);
     redrawSoon();
   };
-  events.onerror = () => { $("#mode").textContent = "live (connection lost: retrying)"; };
+  events.onerror = () => {
+    if (document.body.dataset.ended !== "true") $("#mode").textContent = "live (connection lost: retrying)";
+  };
   events.onopen = () => { $("#mode").textContent = "live"; };
 }
 
@@ -262,7 +290,7 @@ async function live() {
 let playing = null;
 async function showMoment(at) {
   const moment = Math.max(0, Math.min(info.duration, at));
-  load(await getJson("/api/snapshot", { at: moment.toFixed(3) }));
+  load(await getJson("/api/snapshot", { at: String(moment) }));
   state.now = moment;
   $("#slider").value = String(moment);
   await draw();
@@ -290,12 +318,14 @@ async function replay() {
   $("#next-action").addEventListener("click", () => {
     const at = info.actions.find((time) => time > state.now + 1e-9);
     if (at !== undefined) showMoment(at);
+    else $("#mode").textContent = `replay of ${info.file}: no action after ${state.now.toFixed(2)} s`;
   });
   $("#next-change").addEventListener("click", async () => {
     if (!chosen) return;
     const all = await getJson("/api/node", chosen);
     const next = all.find((each) => each.at > state.now + 1e-9);
     if (next) showMoment(next.at);
+    else $("#mode").textContent = `replay of ${info.file}: the chosen node does not change after ${state.now.toFixed(2)} s`;
   });
   $("#play").addEventListener("click", () => {
     if (playing) {
