@@ -152,6 +152,16 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     train.add_argument("--held-out", type=_share, default=0.15, help="share held out (0..1)")
     train.add_argument("--split", choices=("session", "file"), default="session")
     train.add_argument("--threads", type=_positive, default=2, help="CPU threads")
+    train.add_argument(
+        "--learning-rate", type=_share, default=5e-4, metavar="RATE", help="Adam's (default 5e-4)"
+    )
+    train.add_argument(
+        "--init",
+        type=Path,
+        default=None,
+        metavar="MODEL.onnx",
+        help="start from this model's weights (train further, or fit it to your pictures)",
+    )
     train.add_argument("--matrix", type=Path, default=None, help="confusion matrix PNG")
 
     evaluate = actions.add_parser("eval", help="measure a model on labelled pictures")
@@ -242,6 +252,8 @@ def _train(args: argparse.Namespace) -> int:
         held_out=args.held_out,
         split_by=args.split,
         threads=args.threads,
+        learning_rate=args.learning_rate,
+        start_from=args.init,
     )
     result = train(args.data, args.output, settings, lambda line: print(line, flush=True))
     print(result.evaluation.table())

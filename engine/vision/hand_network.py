@@ -77,6 +77,28 @@ def parameter_count(network: nn.Module) -> int:
     return sum(int(p.numel()) for p in network.parameters())
 
 
+def load_onnx_weights(network: HandNetwork, path: Path) -> None:
+    """Start ``network`` from the weights of a model exported by :func:`export_onnx` (the
+    shipped one, or a lab's): to train further, or to fit it to a lab's own pictures.
+    ValueError naming the file when it is not this network."""
+    import onnx
+    from onnx import numpy_helper
+
+    try:
+        graph = onnx.load(str(path)).graph
+    except Exception as error:  # onnx raises its own decode errors
+        raise ValueError(f"{path}: not an ONNX model ({error})") from None
+    weights = {item.name: numpy_helper.to_array(item) for item in graph.initializer}
+    state = WithSoftmax(network).state_dict()
+    missing = [name for name in state if name not in weights]
+    wrong = [n for n in state if n in weights and tuple(weights[n].shape) != tuple(state[n].shape)]
+    if missing or wrong:
+        raise ValueError(f"{path}: not the table-2 network this trains ({(missing + wrong)[0]})")
+    WithSoftmax(network).load_state_dict(
+        {name: torch.from_numpy(weights[name].copy()) for name in state}
+    )
+
+
 def export_onnx(network: HandNetwork, path: Path) -> None:
     """The network with its softmax as one ONNX file (weights inside, any batch size):
     input ``image`` (N, 1, 128, 128) float32, output ``probabilities`` (N, 6)."""

@@ -24,6 +24,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from engine.errors import ConfigError
 from engine.vision.classifier import MODEL_FORMAT, HandModel
 from engine.vision.dataset import (
     NONE_INDEX,
@@ -58,6 +59,8 @@ class TrainingSettings:
     threads: int = 2
     min_confidence: float = 0.6
     preprocessing: Preprocessing = field(default_factory=Preprocessing)
+    start_from: Path | None = None
+    """A model whose weights training starts from (else He initialisation)."""
 
 
 @dataclass(frozen=True)
@@ -101,7 +104,7 @@ def train(
     when the data is not a labelled folder."""
     import torch
 
-    from engine.vision.hand_network import HandNetwork, export_onnx
+    from engine.vision.hand_network import HandNetwork, export_onnx, load_onnx_weights
 
     pictures = find_pictures(data)
     train_set, test_set, how = split(
@@ -119,6 +122,12 @@ def train(
     torch.set_num_threads(max(1, settings.threads))
     rng = np.random.default_rng(settings.seed)
     network = HandNetwork()
+    if settings.start_from is not None:
+        try:
+            load_onnx_weights(network, settings.start_from)
+        except ValueError as error:
+            raise ConfigError(str(error)) from None
+        progress(f"starting from the weights of {settings.start_from}")
     optimiser = torch.optim.Adam(network.parameters(), lr=settings.learning_rate)
     steps_per_epoch = math.ceil(len(train_images) / settings.batch)
     schedule = torch.optim.lr_scheduler.LambdaLR(
@@ -180,6 +189,7 @@ def write_sidecar(
             "learning_rate": settings.learning_rate,
             "warmup_steps": settings.warmup_steps,
             "seed": settings.seed,
+            "started_from": None if settings.start_from is None else settings.start_from.name,
             "torch": torch.__version__,
         },
     }
