@@ -122,3 +122,37 @@ def test_at_the_moment_of_an_action_the_tree_that_took_it_shows_running(demo: Pa
     squeeze = next(a for a in recording.actions() if a.tree == "hug")
     hug = next(tree for tree in recording.trees_at(squeeze.at_s) if tree.name == "hug")
     assert recording.statuses_at(squeeze.at_s)[("hug", hug.version, 0)].status == "RUNNING"
+
+
+def test_a_damaged_recording_is_named_not_a_traceback(demo: Path, tmp_path: Path, capsys) -> None:
+    no_nodes = tmp_path / "no_nodes.db"
+    no_nodes.write_bytes(demo.read_bytes())
+    with sqlite3.connect(no_nodes) as db:
+        db.execute("DROP TABLE nodes")
+    bad_length = tmp_path / "bad_length.db"
+    bad_length.write_bytes(demo.read_bytes())
+    with sqlite3.connect(bad_length) as db:
+        db.execute("UPDATE meta SET value = 'nan' WHERE key = 'duration_s'")
+    for broken, why in [(no_nodes, "no table 'nodes'"), (bad_length, "duration nan")]:
+        for command in (["replay", str(broken)], ["report", str(broken)]):
+            assert main(command) == 1
+            err = capsys.readouterr().err
+            assert f"{broken.name}: a damaged recording ({why})" in err, err
+
+
+def test_a_recording_cut_off_mid_write_is_recovered_on_opening(demo: Path, tmp_path: Path) -> None:
+    """A robot that lost power while writing leaves SQLite's journal beside the file."""
+    cut = tmp_path / "cut.db"
+    cut.write_bytes(demo.read_bytes())
+    writer = sqlite3.connect(cut)
+    writer.execute("PRAGMA journal_mode=DELETE")
+    writer.execute("BEGIN")
+    writer.execute("DELETE FROM actions")  # half a batch, never committed
+    journal = cut.with_name("cut.db-journal")
+    writer.execute("PRAGMA cache_size=1")  # spill to disk: the journal is hot
+    assert journal.exists()
+    kept = journal.read_bytes()
+    writer.close()  # (closing rolls back; put the hot journal back as a power cut leaves it)
+    journal.write_bytes(kept)
+    recording = Recording.open(cut)
+    assert len(recording.actions()) > 10

@@ -25,6 +25,8 @@ from pathlib import Path
 NAME = "gesture"
 HELP = "count fingers in pictures; record, generate, train and check a hand model"
 ACTIONS = ("classify", "record", "generate", "train", "eval")
+STYLE_NAMES = ("studio", "wallpaper", "variant")
+"""The hand generator's styles (engine/vision/synthetic_hands.py; not imported here)."""
 
 
 def writable_folder(folder: Path) -> None:
@@ -141,7 +143,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     generate.add_argument("data", type=Path, metavar="DATA")
     generate.add_argument("--count", type=_positive, required=True)
     generate.add_argument("--seed", type=_seed, default=1)
-    generate.add_argument("--style", choices=("studio", "variant"), default="studio")
+    generate.add_argument("--style", choices=STYLE_NAMES, default="studio")
 
     train = actions.add_parser("train", help="train the table-2 network (needs .[train])")
     train.add_argument("data", type=Path, metavar="DATA")

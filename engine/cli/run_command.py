@@ -231,6 +231,16 @@ def main(args: argparse.Namespace) -> int:
         )
         timeline.on_closed = robot.scheduler.stop
         on_event: EventListener = timeline.world
+        if args.view:
+            hub = ViewHub(clock, blackboard.catalogue, device_stats=assembled.hardware.stats)
+            hub.begin(start_s, robot.trees)
+            robot.scheduler.after_tick.append(hub.tree_ticked)
+            robot.scheduler.hooks.append(hub.stats_hook)
+            blackboard.watchers.append(hub.blackboard_write)
+            robot.action_log.listeners.append(hub.action)
+            robot.action_log.failure_listeners.append(hub.failed)
+            on_event = _both(on_event, hub.world)
+            view = start_view(LiveSource(hub), args)
         if args.record is not None:
             recorder = SessionRecorder(args.record, clock, blackboard.catalogue)
             recorder.describe(
@@ -245,16 +255,6 @@ def main(args: argparse.Namespace) -> int:
             robot.action_log.listeners.append(recorder.action)
             robot.action_log.failure_listeners.append(recorder.failed)
             on_event = _both(on_event, recorder.world)
-        if args.view:
-            hub = ViewHub(clock, blackboard.catalogue, device_stats=assembled.hardware.stats)
-            hub.begin(start_s, robot.trees)
-            robot.scheduler.after_tick.append(hub.tree_ticked)
-            robot.scheduler.hooks.append(hub.stats_hook)
-            blackboard.watchers.append(hub.blackboard_write)
-            robot.action_log.listeners.append(hub.action)
-            robot.action_log.failure_listeners.append(hub.failed)
-            on_event = _both(on_event, hub.world)
-            view = start_view(LiveSource(hub), args)
         # the world moves first, then the pollers read it, then the trees tick
         robot.scheduler.hooks.insert(
             0, ScenarioPlayer(scenario, assembled.world, start_s=start_s, on_event=on_event)

@@ -57,18 +57,20 @@ def ascii_tree(definition: TreeDefinition) -> str:
     return "\n".join(lines) + "\n"
 
 
+def escape(text: str) -> str:
+    """``text`` inside a dot string: it cannot end the string or the line it is on."""
+    return text.replace("\\", "\\\\").replace('"', '\\"').replace("\n", "\\n").replace("\r", "")
+
+
 def dot_source(definition: TreeDefinition) -> str:
+    name = escape(definition.name)
     lines = [
-        f'digraph "{definition.name}" {{',
+        f'digraph "{name}" {{',
         "  graph [rankdir=TB, fontname=Helvetica];",
         "  node [style=filled, fontname=Helvetica, fontsize=11];",
-        f'  title [shape=plaintext, style="", label="{definition.name} '
-        f'({definition.rate_hz:g} Hz)"];',
+        f'  title [shape=plaintext, style="", label="{name} ({definition.rate_hz:g} Hz)"];',
     ]
     counter = iter(range(1_000_000))
-
-    def escape(text: str) -> str:
-        return text.replace("\\", "\\\\").replace('"', '\\"')
 
     def walk(node: NodeDefinition) -> str:
         ident = f"n{next(counter)}"

@@ -8,12 +8,14 @@ or before that moment, each key's last value.
 from __future__ import annotations
 
 import json
+import math
 import sqlite3
 import threading
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from engine.errors import ConfigError
 from engine.recording.session_file import open_for_reading
 
 STATUS_MARKS = {"SUCCESS": "ok", "FAILURE": "no", "RUNNING": "..", "INVALID": "  "}
@@ -74,8 +76,12 @@ class Recording:
         self.trees = self._read_trees()
 
     def _rows(self, sql: str, parameters: tuple[Any, ...] = ()) -> list[Any]:
+        """ConfigError naming the file when it turns out damaged."""
         with self._lock:
-            return self._connection.execute(sql, parameters).fetchall()
+            try:
+                return self._connection.execute(sql, parameters).fetchall()
+            except (sqlite3.Error, OverflowError) as error:
+                raise ConfigError(f"{self.path}: a damaged recording ({error})") from None
 
     @classmethod
     def open(cls, path: Path) -> Recording:
@@ -94,7 +100,13 @@ class Recording:
     def duration_s(self) -> float:
         """How long the session ran (the last thing recorded, if it was cut off)."""
         if "duration_s" in self.meta:
-            return float(self.meta["duration_s"])
+            try:
+                duration = float(self.meta["duration_s"])
+            except ValueError:
+                duration = math.nan
+            if not math.isfinite(duration) or duration < 0:
+                raise ConfigError(f"{self.path}: a damaged recording (duration {duration!r})")
+            return duration
         last = [
             self._rows(f"SELECT max(at_s) FROM {table}")[0][0]
             for table in ("statuses", "blackboard", "actions")

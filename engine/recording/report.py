@@ -170,7 +170,7 @@ def _plot(
     values = [v for _, _, points in series for _, v in points if v is not None]
     if not values:
         return ""
-    top = max(max(values), 1e-9)
+    top = max(values) if max(values) > 0 else 1.0
 
     def x(t: float) -> float:
         return left + (width - left - 24) * (t / end_s if end_s else 0.0)

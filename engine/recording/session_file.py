@@ -26,6 +26,7 @@ from typing import Any
 from engine.errors import ConfigError
 
 FORMAT_VERSION = 1
+TABLES = ("meta", "trees", "nodes", "statuses", "blackboard", "actions", "world")
 SCHEMA = """
 CREATE TABLE meta (key TEXT PRIMARY KEY, value TEXT NOT NULL);
 CREATE TABLE trees (
@@ -104,6 +105,15 @@ def open_for_reading(path: Path) -> sqlite3.Connection:
     or is of a newer format than this vest reads."""
     if not path.is_file():
         raise ConfigError(f"{path}: no such recording")
+    journal = path.with_name(path.name + "-journal")
+    if journal.exists():  # cut off mid-write: SQLite rolls the last batch back on opening
+        try:
+            with sqlite3.connect(str(path)) as recovering:
+                recovering.execute("SELECT count(*) FROM sqlite_master").fetchone()
+        except sqlite3.Error as error:
+            raise ConfigError(
+                f"{path}: an interrupted recording that cannot be recovered ({error})"
+            ) from None
     try:
         # one connection, used from the view's threads one query at a time (Recording locks)
         connection = sqlite3.connect(f"file:{path}?mode=ro", uri=True, check_same_thread=False)
@@ -117,4 +127,11 @@ def open_for_reading(path: Path) -> sqlite3.Connection:
             f"{path}: recorded in format {row[0]}, newer than this vest reads "
             f"({FORMAT_VERSION}); update vest"
         )
+    try:
+        tables = {name for (name,) in connection.execute("SELECT name FROM sqlite_master")}
+    except sqlite3.Error as error:
+        raise ConfigError(f"{path}: a damaged recording ({error})") from None
+    missing = sorted(set(TABLES) - tables)
+    if missing:
+        raise ConfigError(f"{path}: a damaged recording (no table {missing[0]!r})")
     return connection

@@ -22,6 +22,8 @@ import hmac
 import ipaddress
 import json
 import logging
+import math
+import re
 import shutil
 import socket
 import subprocess
@@ -42,6 +44,9 @@ STATIC = {
     "/view.css": ("view.css", "text/css; charset=utf-8"),
 }
 DOT_TIMEOUT_S = 20.0
+CSP = "default-src 'self'; img-src 'self' data:; style-src 'self' 'unsafe-inline'"
+"""Only the page's own files run: a drawing cannot carry a script or a javascript: link."""
+LOOPBACK_NAMES = ("127.0.0.1", "localhost", "[::1]")
 
 
 class ViewSource(Protocol):
@@ -126,6 +131,14 @@ class ViewServer:
         self._server.shutdown()
         self._server.server_close()
 
+    def host_allowed(self, host_header: str) -> bool:
+        """On loopback, only a page opened as 127.0.0.1 or localhost may ask (a web page
+        elsewhere cannot make the browser read the robot through a name of its own)."""
+        if not is_loopback(self.host):
+            return True  # the token guards it
+        name = host_header.rsplit(":", 1)[0] if not host_header.endswith("]") else host_header
+        return name in LOOPBACK_NAMES
+
     def svg(self, tree: str, version: int) -> bytes | None:
         """The tree drawn by Graphviz (cached); None when unknown or Graphviz is missing."""
         key = (tree, version)
@@ -160,7 +173,15 @@ def _handler_for(view: ViewServer) -> type[BaseHTTPRequestHandler]:
         def do_GET(self) -> None:
             url = urlparse(self.path)
             query = {key: values[-1] for key, values in parse_qs(url.query).items()}
-            if view.token and not hmac.compare_digest(query.get("token", ""), view.token):
+            if not view.host_allowed(self.headers.get("Host", "")):
+                self._send(403, b"not this host: open the address vest printed\n", "text/plain")
+                return
+            given = query.get("token", "").encode("utf-8", "replace")
+            if (
+                view.token
+                and url.path not in STATIC  # the page itself holds no data; it asks with the token
+                and not hmac.compare_digest(given, view.token.encode())
+            ):
                 self._send(403, b"a token is needed: use the address vest printed\n", "text/plain")
                 return
             with contextlib.suppress(BrokenPipeError, ConnectionResetError):  # the page left
@@ -173,8 +194,11 @@ def _handler_for(view: ViewServer) -> type[BaseHTTPRequestHandler]:
             elif path == "/api/info":
                 self._json(view.source.info())
             elif path == "/api/snapshot":
-                at = _number(query.get("at"))
-                self._json(view.source.snapshot(at if at is not None else 0.0))
+                at = _number(query.get("at", "0"))
+                if at is None:
+                    self._send(400, b"at is a number of seconds\n", "text/plain")
+                    return
+                self._json(view.source.snapshot(at))
             elif path.startswith("/api/svg/"):
                 self._svg(path.removeprefix("/api/svg/"))
             elif path == "/api/node":
@@ -186,18 +210,19 @@ def _handler_for(view: ViewServer) -> type[BaseHTTPRequestHandler]:
 
         def _svg(self, rest: str) -> None:
             tree, _, version = rest.rpartition("/")
-            drawn = view.svg(unquote(tree), int(version)) if version.isdigit() else None
+            number = _count(version)
+            drawn = view.svg(unquote(tree), number) if number is not None else None
             if drawn is None:
-                self._send(404, b"no drawing (is Graphviz installed?)\n", "text/plain")
+                self._send(404, b"no drawing of that tree (or no Graphviz)\n", "text/plain")
             else:
                 self._send(200, drawn, "image/svg+xml")
 
         def _node(self, query: dict[str, str]) -> None:
-            version, node = query.get("version", ""), query.get("node", "")
-            if not (version.isdigit() and node.isdigit()):
+            version, node = _count(query.get("version", "")), _count(query.get("node", ""))
+            if version is None or node is None:
                 self._send(400, b"version and node are numbers\n", "text/plain")
                 return
-            changes = view.source.node_changes(query.get("tree", ""), int(version), int(node))
+            changes = view.source.node_changes(query.get("tree", ""), version, node)
             self._json([{"at": at, "status": s, "feedback": f} for at, s, f in changes])
 
         def _events(self, hub: ViewHub) -> None:
@@ -231,14 +256,23 @@ def _handler_for(view: ViewServer) -> type[BaseHTTPRequestHandler]:
             self.send_header("Content-Type", kind)
             self.send_header("Content-Length", str(len(body)))
             self.send_header("Cache-Control", "no-store")
+            self.send_header("Content-Security-Policy", CSP)
+            self.send_header("X-Content-Type-Options", "nosniff")
             self.end_headers()
             self.wfile.write(body)
 
     return Handler
 
 
-def _number(text: str | None) -> float | None:
+def _number(text: str) -> float | None:
+    """A finite number of seconds, or None."""
     try:
-        return None if text is None else float(text)
+        value = float(text)
     except ValueError:
         return None
+    return value if math.isfinite(value) else None
+
+
+def _count(text: str) -> int | None:
+    """A whole number as the page sends it (ASCII digits, at most 9), or None."""
+    return int(text) if re.fullmatch(r"[0-9]{1,9}", text) else None

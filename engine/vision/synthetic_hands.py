@@ -7,10 +7,11 @@ the window at the bottom, and five digits each extended or folded, in any combin
 that shows the asked count; pose, scale, rotation, mirroring, skin tone, lighting,
 clutter, blur, noise and JPEG vary with the seed.
 
-Two styles are drawn by different code, so a model trained on one can be checked on the
-other: ``studio`` (the training style: round-ended fingers, an elliptic palm, plain,
-graded or cluttered backgrounds) and ``variant`` (never trained on: tapered fingers, a
-polygonal palm, a sleeve, striped, checked or textured backgrounds). Everything is drawn
+The shipped model learns from two styles, ``studio`` (round-ended fingers, an elliptic
+palm, plain, graded or cluttered rooms) and ``wallpaper`` (the same hands before busy
+patterned walls: plaids, dots, bricks, grain). A third, ``variant``, is drawn by other
+code and never trained on, so it checks what the model learnt: tapered fingers, a
+polygonal palm, a sleeve, striped, checked or smoothly textured backgrounds. Everything is drawn
 in the 128 x 128 px window the paper crops; :func:`render_frame` places it in a full
 640 x 360 frame for the simulated camera.
 """
@@ -30,7 +31,10 @@ import numpy.typing as npt
 from engine.errors import ConfigError
 from engine.vision.preprocess import SIDE_PX, Frame
 
-STYLES = ("studio", "variant")
+STYLES = ("studio", "wallpaper", "variant")
+TRAINING_STYLES = ("studio", "wallpaper")
+"""The styles the shipped model learns from: their hands are drawn alike (round-ended
+fingers, an elliptic palm); only their backgrounds differ."""
 NO_HAND = "none"
 """The folder name of frames with no hand in them (trained towards "not sure")."""
 Random = np.random.Generator
@@ -190,7 +194,8 @@ def draw_hand(image: Frame, pose: HandPose, rng: Random, *, style: str) -> None:
     colour = tuple(int(c) for c in np.clip(skin, 0, 255))
     outline = rng.random() < 0.35
     dark = _shade(colour, float(rng.uniform(0.55, 0.8)))
-    finger = _capsule if style == "studio" else _tapered
+    drawn_as_studio = style in TRAINING_STYLES
+    finger = _capsule if drawn_as_studio else _tapered
 
     # The forearm (or, in the variant style, a sleeve) leaves the window at the bottom.
     forearm = [
@@ -201,7 +206,7 @@ def draw_hand(image: Frame, pose: HandPose, rng: Random, *, style: str) -> None:
     ]
     arm_colour = (
         colour
-        if style == "studio" or rng.random() < 0.4
+        if drawn_as_studio or rng.random() < 0.4
         else tuple(int(c) for c in rng.integers(0, 256, 3))
     )
     cv2.fillPoly(
@@ -214,7 +219,7 @@ def draw_hand(image: Frame, pose: HandPose, rng: Random, *, style: str) -> None:
             scale = 0.35 if digit == 0 else float(rng.uniform(0.15, 0.3))
             base, tip, width = _digit_line(pose, digit, scale, rng)
             finger(image, base, tip, width * 1.05, _shade(colour, 0.93))
-    if style == "studio":
+    if drawn_as_studio:
         axes = (pose.palm_px * 0.95, pose.palm_px * 1.05)
         cv2.ellipse(
             image,
@@ -250,6 +255,8 @@ def _background(height: int, width: int, rng: Random, style: str) -> Frame:
     base = rng.integers(0, 256, size=3).astype(float)
     other = rng.integers(0, 256, size=3).astype(float)
     ys, xs = np.mgrid[0:height, 0:width].astype(np.float32)
+    if style == "wallpaper":
+        return _wallpaper(xs, ys, base, other, rng)
     if style == "studio":
         angle = rng.uniform(0, 2 * np.pi)
         ramp = (np.cos(angle) * xs + np.sin(angle) * ys) / max(height, width)
@@ -293,6 +300,44 @@ def _background(height: int, width: int, rng: Random, style: str) -> Frame:
         coarse = rng.random((int(rng.integers(3, 12)), int(rng.integers(3, 12)))).astype(np.float32)
         mix = cv2.resize(coarse, (width, height), interpolation=cv2.INTER_CUBIC)
         mix = np.clip(mix, 0.0, 1.0) + rng.normal(0.0, 0.08, (height, width)).astype(np.float32)
+    image = base + (other - base) * np.clip(mix, 0.0, 1.0)[..., np.newaxis]
+    return np.asarray(np.clip(image, 0, 255), dtype=np.uint8)
+
+
+def _wallpaper(
+    xs: npt.NDArray[np.float32],
+    ys: npt.NDArray[np.float32],
+    base: npt.NDArray[np.float64],
+    other: npt.NDArray[np.float64],
+    rng: Random,
+) -> Frame:
+    """A busy patterned wall (the wallpaper style): a plaid of crossing waves, a grid of
+    dots, bricks, or grain; many edges the network must learn to look past."""
+    kind = rng.integers(4)
+    if kind == 0:  # plaid: two or three waves at any angles and periods
+        mix = np.zeros_like(xs)
+        for _ in range(int(rng.integers(2, 4))):
+            angle, period = rng.uniform(0, np.pi), rng.uniform(5.0, 28.0)
+            mix += np.sin(2 * np.pi * (np.cos(angle) * xs + np.sin(angle) * ys) / period)
+        if rng.random() < 0.5:
+            mix = (mix > rng.uniform(-0.5, 0.5)).astype(np.float32)
+        mix = ((mix - mix.min()) / (np.ptp(mix) or 1.0)).astype(np.float32)
+    elif kind == 1:  # dots on a grid
+        spacing = rng.uniform(7.0, 22.0)
+        radius = spacing * rng.uniform(0.15, 0.4)
+        gx = (xs + rng.uniform(0, spacing)) % spacing - spacing / 2
+        gy = (ys + rng.uniform(0, spacing)) % spacing - spacing / 2
+        mix = (np.hypot(gx, gy) < radius).astype(np.float32)
+    elif kind == 2:  # bricks
+        high, wide = rng.uniform(6.0, 18.0), rng.uniform(14.0, 40.0)
+        row = np.floor(ys / high)
+        offset = (row % 2) * wide / 2
+        mortar = (ys % high < 1.5) | ((xs + offset) % wide < 1.5)
+        mix = mortar.astype(np.float32)
+    else:  # grain: noise blurred to any scale
+        noise = rng.random(xs.shape).astype(np.float32)
+        grain = np.asarray(cv2.GaussianBlur(noise, (0, 0), float(rng.uniform(0.6, 3.0))))
+        mix = np.clip((grain - grain.mean()) * rng.uniform(3.0, 8.0) + 0.5, 0.0, 1.0)
     image = base + (other - base) * np.clip(mix, 0.0, 1.0)[..., np.newaxis]
     return np.asarray(np.clip(image, 0, 255), dtype=np.uint8)
 

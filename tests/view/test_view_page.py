@@ -135,13 +135,33 @@ def test_a_view_on_another_address_needs_its_token(page: Page) -> None:
         ViewServer(EmptySource(), host="0.0.0.0", port=0, token=None)
     guarded = ViewServer(EmptySource(), port=0, token="s3cret")
     guarded.start()
+    base = guarded.url.removesuffix("?token=s3cret")
     try:
-        refused = page.goto(guarded.url.replace("?token=s3cret", ""))
-        assert refused is not None and refused.status == 403
-        allowed = page.goto(guarded.url)
-        assert allowed is not None and allowed.status == 200
+        for path in ("api/snapshot", "api/info", "api/events", "api/svg/hug/1"):
+            refused = page.goto(base + path)
+            assert refused is not None and refused.status == 403, path
+            wrong = page.goto(base + path + "?token=%C3%A9")  # not ASCII: refused, not a crash
+            assert wrong is not None and wrong.status == 403, path
+        page.goto(guarded.url)  # the page itself loads, and asks with the token
+        expect(page.locator("body")).to_have_attribute("data-ready", "true")
+        expect(page.locator("#mode")).to_contain_text("replay of -")
     finally:
         guarded.stop()
+
+
+def test_odd_requests_are_answered_not_crashed_on(page: Page, replay: str) -> None:
+    base = replay.rstrip("/")
+    for path, status in [
+        ("/api/snapshot?at=nan", 400),
+        ("/api/snapshot?at=1e999", 400),
+        ("/api/node?tree=hug&version=%C2%B2&node=1", 400),
+        ("/api/node?tree=hug&version=1&node=99999999999999999999", 400),
+        ("/api/svg/../../etc/passwd", 404),
+        ("/api/svg/hug/abc", 404),
+        ("/nothing", 404),
+    ]:
+        answered = page.goto(base + path)
+        assert answered is not None and answered.status == status, path
 
 
 class EmptySource:
@@ -158,3 +178,19 @@ class EmptySource:
 
     def node_changes(self, tree: str, version: int, node: int) -> list:
         return []
+
+
+def test_a_tree_name_cannot_smuggle_a_link_into_its_drawing() -> None:
+    from engine.loader.tree_drawing import escape
+
+    assert escape('hello" { /*') == 'hello\\" { /*'
+    assert escape("two\nlines") == "two\\nlines"
+
+
+def test_on_loopback_only_a_page_opened_as_loopback_may_ask(replay: str) -> None:
+    import requests
+
+    snapshot = replay.rstrip("/") + "/api/snapshot"
+    assert requests.get(snapshot, timeout=10).status_code == 200
+    rebound = requests.get(snapshot, headers={"Host": "attacker.example:80"}, timeout=10)
+    assert rebound.status_code == 403

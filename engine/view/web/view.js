@@ -39,6 +39,21 @@ function load(snapshot) {
 }
 
 // -- drawing ------------------------------------------------------------------------------
+// A drawing is data, never code: links, scripts and event attributes are dropped.
+function cleanSvg(text) {
+  const parsed = new DOMParser().parseFromString(text, "image/svg+xml");
+  const svg = parsed.documentElement;
+  for (const element of svg.querySelectorAll("script, foreignObject")) element.remove();
+  for (const link of svg.querySelectorAll("a")) link.replaceWith(...link.childNodes);
+  for (const element of [svg, ...svg.querySelectorAll("*")]) {
+    for (const attribute of [...element.attributes]) {
+      const name = attribute.name.toLowerCase();
+      if (name.startsWith("on") || name.endsWith("href")) element.removeAttribute(attribute.name);
+    }
+  }
+  return document.importNode(svg, true);
+}
+
 async function drawTrees() {
   const container = $("#trees");
   const wanted = [...state.trees.values()];
@@ -59,7 +74,7 @@ async function drawTrees() {
     const drawing = card.querySelector(".drawing");
     const response = await fetch(api(`/api/svg/${encodeURIComponent(tree.tree)}/${tree.version}`));
     if (response.ok) {
-      drawing.innerHTML = await response.text();
+      drawing.replaceChildren(cleanSvg(await response.text()));
       const svg = drawing.querySelector("svg");
       if (svg) {
         // every tree at one scale (a big tree scrolls in its card, its words stay readable)
