@@ -14,7 +14,6 @@ be any size at least the window's; training shifts, turns, flips and relights th
 
 from __future__ import annotations
 
-import math
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -167,7 +166,3 @@ def batches(count: int, size: int, rng: np.random.Generator) -> Iterator[npt.NDA
     order = rng.permutation(count)
     for start in range(0, count, size):
         yield order[start : start + size]
-
-
-def batch_count(count: int, size: int) -> int:
-    return math.ceil(count / size)

@@ -160,10 +160,10 @@ function drawTables() {
     ], isOnline === false, name];
   }));
   const ticks = state.stats ? Object.entries(state.stats.trees) : [];
-  fill("#ticks", ticks.map(([name, stats]) => [[
+  fill("#ticks", ticks.length || info.mode !== "replay" ? ticks.map(([name, stats]) => [[
     [name], [String(stats.ticks)], [stats.duration_p99_ms.toFixed(3)],
     [stats.lateness_p99_ms.toFixed(2)], [String(stats.skipped)],
-  ], false, name]));
+  ], false, name]) : [[[["(tick statistics are not in recordings)"]], false, ""]]);
   const list = $("#actions");
   const happened = [...state.actions, ...state.world].sort((a, b) => a.at - b.at).slice(-40);
   list.replaceChildren(...happened.reverse().map((entry) => {
