@@ -25,7 +25,7 @@ from pathlib import Path
 NAME = "gesture"
 HELP = "count fingers in pictures; record, generate, train and check a hand model"
 ACTIONS = ("classify", "record", "generate", "train", "eval")
-STYLE_NAMES = ("studio", "wallpaper", "variant")
+STYLE_NAMES = ("studio", "wallpaper", "varied", "variant")
 """The hand generator's styles (engine/vision/synthetic_hands.py; not imported here)."""
 
 

@@ -31,8 +31,10 @@ import numpy.typing as npt
 from engine.errors import ConfigError
 from engine.vision.preprocess import SIDE_PX, Frame
 
-STYLES = ("studio", "wallpaper", "variant")
+STYLES = ("studio", "wallpaper", "varied", "variant")
 TRAINING_STYLES = ("studio", "wallpaper")
+"""Styles whose hands :func:`draw_hand` draws alike (round-ended fingers, an elliptic
+palm); ``varied`` hands come from :func:`draw_varied_hand`; all three are trained on."""
 """The styles the shipped model learns from: their hands are drawn alike (round-ended
 fingers, an elliptic palm); only their backgrounds differ."""
 NO_HAND = "none"
@@ -249,12 +251,82 @@ def draw_hand(image: Frame, pose: HandPose, rng: Random, *, style: str) -> None:
             finger(image, base, tip, width, colour)
 
 
+def draw_varied_hand(image: Frame, pose: HandPose, rng: Random) -> None:
+    """A hand of the varied style onto ``image``: a lumpy palm, jointed fingers narrowing
+    by a random amount, a cuff or a sleeve now and then (shapes the studio hands lack)."""
+    colour = tuple(
+        int(c)
+        for c in np.clip(
+            np.array(_skin_tone(image, pose, rng)) * rng.uniform(0.85, 1.15, 3), 0, 255
+        )
+    )
+    cloth = tuple(int(c) for c in rng.integers(0, 256, 3))
+    clothed = rng.random()  # < 0.3: a sleeve up to the palm; < 0.55: a cuff at the wrist
+    arm_top = 0.6 if clothed >= 0.3 else 0.75
+    forearm = [(-0.8, arm_top), (0.8, arm_top), (1.05, 4.5), (-1.05, 4.5)]
+    arm = np.array([_place(pose, x, y) for x, y in forearm])
+    cv2.fillPoly(
+        image,
+        [np.round(arm * 16).astype(np.int32)],
+        cloth if clothed < 0.3 else colour,
+        cv2.LINE_AA,
+        4,
+    )
+    if 0.3 <= clothed < 0.55:
+        cuff = np.array(
+            [_place(pose, x, y) for x, y in [(-0.9, 1.6), (0.9, 1.6), (0.95, 2.2), (-0.95, 2.2)]]
+        )
+        cv2.fillPoly(image, [np.round(cuff * 16).astype(np.int32)], cloth, cv2.LINE_AA, 4)
+
+    taper = float(rng.uniform(0.5, 1.0))  # tip width / base width
+    aspect = float(rng.uniform(0.85, 1.15))
+
+    def jointed(digit: int, length_scale: float, shade: float) -> None:
+        base, tip, width = _digit_line(pose, digit, length_scale, rng)
+        bend = float(rng.normal(0.0, 0.06))
+        points = [base]
+        for step in (1, 2, 3):
+            share = step / 3
+            x = base[0] + (tip[0] - base[0]) * share + bend * pose.palm_px * step * (step - 1) / 6
+            y = base[1] + (tip[1] - base[1]) * share
+            points.append((x, y))
+        for index in range(3):
+            thick = width * (1.0 - (1.0 - taper) * (index + 0.5) / 3)
+            _capsule(image, points[index], points[index + 1], thick, _shade(colour, shade))
+
+    for digit in range(5):
+        if not pose.extended[digit]:
+            jointed(digit, 0.35 if digit == 0 else float(rng.uniform(0.15, 0.3)), 0.93)
+    angles = np.linspace(0, 2 * np.pi, 18, endpoint=False)
+    bumps = 1.0 + rng.normal(0.0, 0.06, 18)
+    palm = np.array(
+        [
+            _place(pose, 0.95 * aspect * r * np.cos(a), 1.05 / aspect * r * np.sin(a))
+            for a, r in zip(angles, bumps, strict=True)
+        ]
+    )
+    cv2.fillPoly(image, [np.round(palm * 16).astype(np.int32)], colour, cv2.LINE_AA, 4)
+    if not pose.extended[0]:
+        _capsule(
+            image,
+            _place(pose, -0.9, 0.3),
+            _place(pose, 0.1, -0.1),
+            pose.palm_px * 0.38,
+            _shade(colour, 0.9),
+        )
+    for digit in range(5):
+        if pose.extended[digit]:
+            jointed(digit, 1.0, 1.0)
+
+
 def _background(height: int, width: int, rng: Random, style: str) -> Frame:
     """A background: plain, graded or cluttered (studio); striped, checked or textured
     (variant)."""
     base = rng.integers(0, 256, size=3).astype(float)
     other = rng.integers(0, 256, size=3).astype(float)
     ys, xs = np.mgrid[0:height, 0:width].astype(np.float32)
+    if style == "varied":
+        style = "studio" if rng.random() < 0.5 else "wallpaper"
     if style == "wallpaper":
         return _wallpaper(xs, ys, base, other, rng)
     if style == "studio":
@@ -365,6 +437,13 @@ def _camera_effects(image: Frame, rng: Random) -> Frame:
     return np.asarray(out, dtype=np.uint8)
 
 
+def _draw(image: Frame, pose: HandPose, rng: Random, style: str) -> None:
+    if style == "varied":
+        draw_varied_hand(image, pose, rng)
+    else:
+        draw_hand(image, pose, rng, style=style)
+
+
 def _check_style(style: str) -> None:
     if style not in STYLES:
         raise ValueError(f"style must be one of {', '.join(STYLES)}, not {style!r}")
@@ -378,7 +457,7 @@ def render_window(
     _check_style(style)
     image = _background(side_px, side_px, rng, style)
     if fingers is not None:
-        draw_hand(image, random_pose(fingers, rng, side_px), rng, style=style)
+        _draw(image, random_pose(fingers, rng, side_px), rng, style)
     return _camera_effects(image, rng)
 
 
@@ -398,7 +477,7 @@ def render_frame(
     frame = _background(height_px, width_px, rng, style)
     if fingers is not None:
         window_view = frame[y : y + SIDE_PX, x : x + SIDE_PX]
-        draw_hand(window_view, random_pose(fingers, rng), rng, style=style)
+        _draw(window_view, random_pose(fingers, rng), rng, style)
     return _camera_effects(frame, rng)
 
 
