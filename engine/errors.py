@@ -28,7 +28,7 @@ class DeviceError(VestError, OSError):
     """
 
     def __str__(self) -> str:
-        if self.errno is not None and self.strerror:
+        if self.strerror:
             return str(self.strerror)
         return super().__str__()
 

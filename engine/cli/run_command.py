@@ -219,7 +219,9 @@ def main(args: argparse.Namespace) -> int:
         timeline = Timeline(sys.stdout, start_s=start_s, as_json=args.json)
         for name, why in assembled.hardware.startup_problems.items():
             tell(f"warning: {shown(name)} did not start ({shown(why)}); it will be tried again")
-        if assembled.vision is not None and assembled.vision.summary:
+        if assembled.vision is not None and assembled.vision.problem:
+            tell(f"warning: camera: {shown(assembled.vision.problem)}")
+        elif assembled.vision is not None:
             tell(f"vision: {assembled.vision.summary}")
         if assembled.speech is not None:
             for part, why in assembled.speech.problems.items():

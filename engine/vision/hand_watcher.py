@@ -136,7 +136,7 @@ class HandWatcher:
 
     def _failed(self, why: str, now_s: float) -> None:
         if self.health.driver_ok:
-            log.warning("%s; trying again every %g s", why, self.reopen_s)
+            log.info("%s; trying again every %g s", why, self.reopen_s)  # the timeline says so
             self.blackboard.stage(HAND_FINGERS, None)
             self.blackboard.stage(HAND_CONFIDENCE, None)
             if self.steady.shown is not None:

@@ -9,7 +9,6 @@ False); the rest of the robot is not held up by its eyes.
 
 from __future__ import annotations
 
-import logging
 from dataclasses import dataclass
 
 from engine.blackboard.board import Blackboard
@@ -22,8 +21,6 @@ from engine.hardware.device_health import DeviceHealth
 from engine.scenario.world import World
 from engine.vision.classifier import DEFAULT_MODEL, HandModel
 from engine.vision.hand_watcher import HandWatcher
-
-log = logging.getLogger(__name__)
 
 
 @dataclass
@@ -92,8 +89,7 @@ def build_vision(
         model = load_hand_model(config)
     except ConfigError as error:
         problem = f"{error}; the robot runs without counting fingers"
-        log.error("camera: %s", problem)
-        health.driver_status(False, problem)
+        health.driver_status(False, problem)  # the caller says it (vest run: at start-up)
         camera = open_camera(config, world, clock, window=config.crop)
         return RobotVision(camera, health, None, problem)
     try:  # the simulated camera holds a hand where the model looks

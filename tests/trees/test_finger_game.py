@@ -56,6 +56,12 @@ def test_two_wrong_tries_end_the_round_kindly_and_the_game_goes_on(robot: TreeHa
         "Good try! We'll count three together another time.",
         "Show me two fingers!",
     ]
+    robot.advance(20.0)  # nothing more shown: the round for two ends too, and the next begins
+    assert robot.said.count("Show me three fingers!") == 1
+    assert robot.said[-2:] == [
+        "Good try! We'll count two together another time.",
+        "Show me five fingers!",
+    ]
 
 
 def test_a_child_already_showing_the_count_is_praised_at_once(robot: TreeHarness) -> None:

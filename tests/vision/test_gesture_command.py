@@ -78,7 +78,7 @@ def test_bad_pictures_are_named_and_the_others_still_counted(tmp_path: Path, cap
     ("args", "message"),
     [
         (["--crop", "1,2"], "must be X,Y,W in px"),
-        (["--crop", "-5,0,128"], "X and Y must be 0 or more"),
+        (["--crop=-5,0,128"], "X and Y must be 0 or more"),
         (["--crop", "600,300,128"], "does not fit a 640x360 image"),
         (["--model", "nowhere/kids.onnx"], "kids.onnx: no such model file"),
     ],

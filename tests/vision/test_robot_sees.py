@@ -90,6 +90,7 @@ def test_a_missing_model_is_said_at_start_up_and_the_rest_of_the_robot_runs(
     config.write_text(text + "\ncamera: {model: kids.onnx}\n")
     assert main(["run", "--fast", "--speech", "text", "--hardware", str(config)]) == 0
     captured = capsys.readouterr()
+    assert "warning: camera: " in captured.err
     assert "kids.onnx: no such model file; the robot runs without counting fingers" in captured.err
     assert 'hug            says "I love hugs!"' in captured.out
     assert not re.search(r"finger_game +says", captured.out)  # no eyes, no game

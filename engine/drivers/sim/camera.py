@@ -19,7 +19,7 @@ from engine.clock import Clock
 from engine.drivers.camera import CameraError
 from engine.scenario.world import ShownHand, World
 from engine.vision.preprocess import Frame, read_image
-from engine.vision.synthetic_hands import render_frame
+from engine.vision.synthetic_hands import render_frame, render_shown_hand
 
 
 class SimulatedCamera:
@@ -102,9 +102,9 @@ class SimulatedCamera:
             self._video_frame_last: Frame = self._room
         elif hand.image is not None:
             self._still = self._fit(read_image(Path(hand.image)))
-        else:
+        elif hand.fingers is not None:  # (no fingers, no picture: the empty room)
             rng = np.random.default_rng(hand.seed)
-            self._still = render_frame(
+            self._still = render_shown_hand(
                 hand.fingers, rng, width_px=self.width, height_px=self.height, window=self.window
             )
 
