@@ -22,25 +22,13 @@ import sys
 from collections.abc import Sequence
 from pathlib import Path
 
+from engine.cli.output import writable_folder
+
 NAME = "gesture"
 HELP = "count fingers in pictures; record, generate, train and check a hand model"
 ACTIONS = ("classify", "record", "generate", "train", "eval")
 STYLE_NAMES = ("studio", "wallpaper", "varied", "variant")
 """The hand generator's styles (engine/vision/synthetic_hands.py; not imported here)."""
-
-
-def writable_folder(folder: Path) -> None:
-    """``folder`` exists (made if need be) and a file can be written in it; ConfigError
-    naming it when not."""
-    from engine.errors import ConfigError
-
-    try:
-        folder.mkdir(parents=True, exist_ok=True)
-        probe = folder / ".vest-write-check"
-        probe.write_bytes(b"")
-        probe.unlink()
-    except OSError as error:
-        raise ConfigError(f"{folder}: cannot write there ({error.strerror or error})") from None
 
 
 def with_action(argv: Sequence[str]) -> list[str]:

@@ -20,7 +20,7 @@ from pathlib import Path
 
 import cv2
 
-from engine.cli.gesture_command import writable_folder
+from engine.cli.output import writable_folder
 from engine.clock import EpochClock
 from engine.drivers.camera import CameraError, OpenCvCamera
 from engine.errors import ConfigError

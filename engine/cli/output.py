@@ -14,7 +14,10 @@ import math
 import os
 import sys
 import unicodedata
+from pathlib import Path
 from typing import Any, TextIO
+
+from engine.errors import ConfigError
 
 # categories whose characters move the cursor, end a line or drive the terminal
 _UNSAFE_CATEGORIES = frozenset({"Cc", "Zl", "Zp"})
@@ -112,3 +115,15 @@ def discard(stream: TextIO) -> None:
 def reason(error: OSError) -> str:
     """An OSError in words, without Python's ``[Errno 28]``."""
     return error.strerror or str(error) or type(error).__name__
+
+
+def writable_folder(folder: Path) -> None:
+    """``folder`` exists (made if need be) and a file can be written in it; ConfigError
+    naming it when not."""
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        probe = folder / ".vest-write-check"
+        probe.write_bytes(b"")
+        probe.unlink()
+    except OSError as error:
+        raise ConfigError(f"{folder}: cannot write there ({error.strerror or error})") from None

@@ -19,7 +19,8 @@ from engine.clock import Clock
 from engine.drivers.camera import CameraError
 from engine.scenario.world import ShownHand, World
 from engine.vision.preprocess import Frame, read_image
-from engine.vision.synthetic_hands import render_frame, render_shown_hand
+from engine.vision.shown_hand import render_shown_hand
+from engine.vision.synthetic_hands import render_frame
 
 
 class SimulatedCamera:
