@@ -33,10 +33,15 @@ def test_every_demo_event_is_answered_by_the_right_behavior_once(capsys, monkeyp
         ("dialog", "The temperature is 72 degrees"),
         ("dialog", "My name is H B S 2"),
         ("iot_command", "hello from the cloud"),
+        ("finger_game", "Let's play a counting game!"),  # a hand held up to the camera
+        ("finger_game", "Show me three fingers!"),
+        ("finger_game", "Yes! That's three. Well done!"),
+        ("finger_game", "Show me two fingers!"),
     ]
     assert [(t, a["color"]) for t, action, a in actions if action == "led"] == [
         ("hug", "pink"),
         ("wave_greeting", "green"),
+        ("finger_game", "green"),
     ]
     assert [(t, a["joint"], a["angle_deg"]) for t, action, a in actions if action == "servo"] == [
         ("tracking", "neck", 30.0)

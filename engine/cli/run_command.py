@@ -221,8 +221,6 @@ def main(args: argparse.Namespace) -> int:
             tell(f"warning: {shown(name)} did not start ({shown(why)}); it will be tried again")
         if assembled.vision is not None and assembled.vision.problem:
             tell(f"warning: camera: {shown(assembled.vision.problem)}")
-        elif assembled.vision is not None:
-            tell(f"vision: {assembled.vision.summary}")
         if assembled.speech is not None:
             for part, why in assembled.speech.problems.items():
                 tell(f"warning: speech {part}: {shown(why)}")

@@ -132,10 +132,6 @@ class HandModel:
         log.info("hand model %s runs on %s", path.name, ", ".join(session.get_providers()))
         return model
 
-    def describe(self) -> str:
-        """``hand_fingers.onnx on CPUExecutionProvider``: the file and where it runs."""
-        return f"{self.path.name} on {', '.join(self.providers)}"
-
     @property
     def providers(self) -> list[str]:
         """The execution providers the session runs on, first preferred."""

@@ -32,8 +32,6 @@ class RobotVision:
     health: DeviceHealth
     watcher: HandWatcher | None
     problem: str | None = None
-    summary: str = ""
-    """The model and where it runs, e.g. ``hand_fingers.onnx on CPUExecutionProvider``."""
 
     def start(self) -> None:
         """On a real clock: start the worker thread."""
@@ -106,4 +104,4 @@ def build_vision(
         fps=config.fps,
         steady_frames=config.steady_frames,
     )
-    return RobotVision(camera, health, watcher, summary=model.describe())
+    return RobotVision(camera, health, watcher)
