@@ -19,7 +19,9 @@ from engine.vision.synthetic_hands import render_frame
 ROOT = Path(__file__).resolve().parents[2]
 
 
-@pytest.mark.parametrize(("style", "at_least"), [("studio", 0.85), ("wallpaper", 0.85)])
+@pytest.mark.parametrize(
+    ("style", "at_least"), [("studio", 0.88), ("wallpaper", 0.86), ("varied", 0.8)]
+)
 def test_the_shipped_model_counts_fingers_it_never_saw(style: str, at_least: float) -> None:
     """Frames drawn with a seed no training stage used (docs/vision-model-card.md)."""
     model = HandModel.load()
