@@ -156,3 +156,13 @@ def test_a_recording_cut_off_mid_write_is_recovered_on_opening(demo: Path, tmp_p
     journal.write_bytes(kept)
     recording = Recording.open(cut)
     assert len(recording.actions()) > 10
+
+
+def test_an_event_s_message_is_not_kept_once_the_node_waits_again(demo: Path) -> None:
+    recording = Recording.open(demo)
+    wave = next(tree for tree in recording.trees if tree.name == "wave_greeting")
+    on_event = next(node for node in wave.nodes if node.type == "OnEvent")
+    changes = recording.node_changes("wave_greeting", wave.version, on_event.index)
+    took = [i for i, (_, status, _) in enumerate(changes) if status == "SUCCESS"]
+    assert took and "swipe_right" in changes[took[0]][2]
+    assert changes[took[0] + 1][1:] == ("FAILURE", "")  # waiting again, with nothing to say

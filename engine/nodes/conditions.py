@@ -212,7 +212,9 @@ class OnEvent(Condition):
 
     def check(self) -> bool:
         found, value = self.events.take()
-        if found and self.save_as is not None:
+        if not found:
+            self.feedback_message = ""  # the last event's message would be stale
+        elif self.save_as is not None:
             self.write(self.save_as, value)
         return found
 
