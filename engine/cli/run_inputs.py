@@ -20,7 +20,7 @@ from engine.files.problems import LoadError, Problem, Problems
 from engine.hardware.chips import default_chips
 from engine.hardware.config import CAMERA_NAME, RobotConfig
 from engine.hardware.config_file import load_robot_config
-from engine.hardware.sim_vest import check_fault_events
+from engine.hardware.fault_events import check_fault_events
 from engine.loader.tree_definition import NodeDefinition, TreeDefinition
 from engine.nodes.registry import NodeRegistry, default_registry
 from engine.nodes.remote import COMMAND_TYPES

@@ -31,7 +31,7 @@ take their time on the chips without holding up the robot.
 from __future__ import annotations
 
 import logging
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Callable, Sequence
 from typing import Any
 
 from engine.blackboard.board import Blackboard
@@ -44,12 +44,10 @@ from engine.drivers.sim.maestro_emulator import MaestroEmulator
 from engine.drivers.sim.mcp3008 import SimMCP3008
 from engine.drivers.sim.spi_bus import Bit, SimSpiDev, SimSpiDevice
 from engine.drivers.sim.tca9548a import SimTCA9548A
-from engine.files.problems import Problem
 from engine.hardware.branching_clock import BranchingClock
 from engine.hardware.chips import ChipRegistry, default_chips
-from engine.hardware.config import CAMERA_NAME, BusConfig, DeviceConfig, RobotConfig
+from engine.hardware.config import BusConfig, DeviceConfig, RobotConfig
 from engine.scenario.world import EVENT_KEYS, World
-from engine.values.params import did_you_mean
 
 _log = logging.getLogger("vest.sim_vest")
 
@@ -360,50 +358,3 @@ class UnwiredSenses:
                 self.blackboard.stage_event(EVENT_KEYS[kind], text)
         elif kind in self.kinds:
             self.blackboard.stage_event(EVENT_KEYS[kind], value)
-
-
-def check_fault_events(events: Iterable[Any], config: RobotConfig) -> list[Problem]:
-    """Problems with the ``unplug`` and ``fault`` events of a scenario against ``config``.
-
-    ``events`` are :class:`~engine.scenario.scenario_file.ScenarioEvent` (``kind``,
-    ``value`` with ``device``, ``kind`` and ``seconds``, ``mark``); each problem names the
-    event's place: an unknown device (with the nearest name), a device the simulation
-    cannot fail (the Maestro), a fault an SPI device cannot have.
-    """
-    problems: list[Problem] = []
-    for event in events:
-        if event.kind not in ("unplug", "fault"):
-            continue
-        name = event.value["device"]
-        device = config.devices.get(name)
-        if device is None and config.camera is not None and name == CAMERA_NAME:
-            if event.value.get("kind", "unplugged") != "unplugged":
-                problems.append(
-                    Problem(event.mark, f"the {name} can be unplugged, not {event.value['kind']!r}")
-                )
-            continue
-        if device is None:
-            hint = did_you_mean(name, list(config.devices))
-            known = "devices: " + ", ".join(config.devices)
-            problems.append(
-                Problem(event.mark, f"no device {name!r} in {config.path}", hint or known)
-            )
-            continue
-        kind = event.value.get("kind", "unplugged")
-        bus = config.bus_of(device)
-        if bus.kind == "serial":
-            problems.append(
-                Problem(
-                    event.mark,
-                    f"{name!r} ({device.chip}) cannot be failed in the simulation",
-                    "the simulated vest fails I2C and SPI devices",
-                )
-            )
-        elif bus.kind == "spi" and kind not in SPI_FAULTS:
-            problems.append(
-                Problem(
-                    event.mark,
-                    f"{name!r} is on SPI: it can be {' or '.join(SPI_FAULTS)}, not {kind!r}",
-                )
-            )
-    return problems

@@ -15,7 +15,7 @@ from engine.blackboard.catalogue import RANGE_CENTER_MM, RANGE_LEFT_MM, RANGE_RI
 from engine.colors import NAMED_COLORS, parse_color
 from engine.errors import ServiceError
 from engine.nodes.base import Leaf, ServiceAction
-from engine.nodes.event_reader import EventReader
+from engine.nodes.event_reader import EQUALS, ONE_OF, EventReader, check_choice, wanted
 from engine.services.interfaces import ON_REQUEST_SENSORS
 from engine.services.jobs import ImmediateJob, Job
 from engine.values.params import (
@@ -26,13 +26,11 @@ from engine.values.params import (
     CheckContext,
     Choice,
     Key,
-    ListOf,
     Number,
     Param,
     ParamIssue,
     ParamProblem,
     ParamType,
-    Scalar,
     Text,
     did_you_mean,
 )
@@ -211,10 +209,8 @@ class WaitForEvent(Leaf):
     """
 
     key = Param("key", Key(kinds=("event",)), doc="the event key, e.g. /vision/hand/shown")
-    equals = Param("equals", Scalar(), None, "only events with this value count")
-    one_of = Param(
-        "one_of", ListOf(Scalar(), 1), None, "only events with one of these values count"
-    )
+    equals = EQUALS
+    one_of = ONE_OF
     save_as = Param(
         "save_as", Key(access="write"), None, "a /vars/ key to keep the event's value in"
     )
@@ -222,14 +218,11 @@ class WaitForEvent(Leaf):
 
     @classmethod
     def check_params(cls, args: Mapping[str, Any], ctx: CheckContext) -> list[ParamIssue]:
-        if args.get("equals") is not None and args.get("one_of") is not None:
-            return [ParamIssue("one_of", "give equals or one_of, not both")]
-        return []
+        return check_choice(args, ctx)
 
     def __init__(self, *a: Any) -> None:
         super().__init__(*a)
-        wanted = self.one_of or ([self.equals] if self.equals is not None else None)
-        self.events = EventReader(self, self.key, wanted)
+        self.events = EventReader(self, self.key, wanted(self.equals, self.one_of))
         self.until_s: float | None = None
 
     def initialise(self) -> None:

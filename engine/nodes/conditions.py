@@ -8,7 +8,7 @@ from typing import Any
 
 from engine.blackboard.catalogue import VARIABLES_PREFIX, KeySpec
 from engine.nodes.base import Condition
-from engine.nodes.event_reader import EventReader
+from engine.nodes.event_reader import EQUALS, ONE_OF, EventReader, check_choice, wanted
 from engine.values.params import (
     SECONDS,
     CheckContext,
@@ -191,24 +191,19 @@ class OnEvent(Condition):
     """
 
     key = Param("key", Key(kinds=("event",)), doc="the event key, e.g. /sensors/gesture/last")
-    equals = Param("equals", Scalar(), None, "only events with this value count")
-    one_of = Param(
-        "one_of", ListOf(Scalar(), 1), None, "only events with one of these values count"
-    )
+    equals = EQUALS
+    one_of = ONE_OF
     save_as = Param(
         "save_as", Key(access="write"), None, "a /vars/ key to keep the event's value in"
     )
 
     @classmethod
     def check_params(cls, args: Mapping[str, Any], ctx: CheckContext) -> list[ParamIssue]:
-        if args.get("equals") is not None and args.get("one_of") is not None:
-            return [ParamIssue("one_of", "give equals or one_of, not both")]
-        return []
+        return check_choice(args, ctx)
 
     def __init__(self, *a: Any) -> None:
         super().__init__(*a)
-        wanted = self.one_of or ([self.equals] if self.equals is not None else None)
-        self.events = EventReader(self, self.key, wanted)
+        self.events = EventReader(self, self.key, wanted(self.equals, self.one_of))
 
     def check(self) -> bool:
         found, value = self.events.take()

@@ -2,11 +2,30 @@
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 from engine.blackboard.events import EVENT_LOG_LENGTH, EventLog
 from engine.nodes.base import Leaf, node_path
+from engine.values.params import CheckContext, ListOf, Param, ParamIssue, Scalar
+
+EQUALS = Param("equals", Scalar(), None, "only events with this value count")
+ONE_OF = Param("one_of", ListOf(Scalar(), 1), None, "only events with one of these values count")
+"""The parameters that choose which events count (OnEvent, WaitForEvent)."""
+
+
+def check_choice(args: Mapping[str, Any], ctx: CheckContext) -> list[ParamIssue]:
+    """``equals`` and ``one_of`` are one or the other."""
+    if args.get("equals") is not None and args.get("one_of") is not None:
+        return [ParamIssue("one_of", "give equals or one_of, not both")]
+    return []
+
+
+def wanted(equals: Any, one_of: Sequence[Any] | None) -> list[Any] | None:
+    """The event values that count (None: every one)."""
+    if one_of:
+        return list(one_of)
+    return None if equals is None else [equals]
 
 
 class EventReader:

@@ -22,7 +22,7 @@ from engine.blackboard.catalogue import KeyCatalogue
 from engine.clock import Clock
 from engine.loader.tree_definition import TreeDefinition
 from engine.loader.tree_drawing import dot_source
-from engine.recording.session_file import as_json, create
+from engine.recording.session_file import ChangedKeys, create
 from engine.runtime.scheduler import RunningTree
 from engine.runtime.tree_watch import TreeWatch, WatchedTree
 from engine.scenario.scenario_file import ScenarioEvent
@@ -42,14 +42,13 @@ class SessionRecorder:
     ) -> None:
         self.path = path
         self.clock = clock
-        self.catalogue = catalogue
         self.start_s = clock.now()
         self.dropped = 0
         self._broken = False
         self._connection: sqlite3.Connection | None = create(path)
         self._queue: queue.Queue[Row | None] = queue.Queue(maxsize=capacity)
         self._watch = TreeWatch()
-        self._values: dict[str, str] = {}
+        self._changed = ChangedKeys(catalogue)
         self._thread = threading.Thread(target=self._write, name="recorder", daemon=True)
         self._thread.start()
 
@@ -113,12 +112,10 @@ class SessionRecorder:
     def blackboard_write(self, key: str, value: Any) -> None:
         """A blackboard watcher: a committed write (or event). A state key's write that
         does not change its value (a sensor polled 20 times a second) is not noted."""
-        spec = self.catalogue.lookup(key)
-        event = spec is not None and spec.kind == "event"
-        text = as_json(value)
-        if not event and self._values.get(key) == text:
+        news = self._changed.news(key, value)
+        if news is None:
             return
-        self._values[key] = text
+        text, event = news
         self._note("INSERT INTO blackboard VALUES (?, ?, ?, ?)", (self._at(), key, text, event))
 
     def action(self, record: ActionRecord) -> None:

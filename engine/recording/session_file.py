@@ -23,6 +23,7 @@ import sqlite3
 from pathlib import Path
 from typing import Any
 
+from engine.blackboard.catalogue import KeyCatalogue
 from engine.errors import ConfigError
 
 FORMAT_VERSION = 1
@@ -62,6 +63,25 @@ def as_json(value: Any) -> str:
         return json.dumps(value, allow_nan=False, default=str)
     except ValueError:  # NaN or infinity
         return json.dumps(str(value))
+
+
+class ChangedKeys:
+    """Which blackboard writes say something new: every event, and a state key's write
+    only when its value changed (a sensor polled 20 times a second mostly repeats)."""
+
+    def __init__(self, catalogue: KeyCatalogue) -> None:
+        self.catalogue = catalogue
+        self._values: dict[str, str] = {}
+
+    def news(self, key: str, value: Any) -> tuple[str, bool] | None:
+        """(the value as JSON, whether ``key`` is an event key), or None: nothing new."""
+        spec = self.catalogue.lookup(key)
+        event = spec is not None and spec.kind == "event"
+        text = as_json(value)
+        if not event and self._values.get(key) == text:
+            return None
+        self._values[key] = text
+        return text, event
 
 
 def create(path: Path) -> sqlite3.Connection:

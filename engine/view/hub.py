@@ -24,7 +24,7 @@ from engine.clock import Clock
 from engine.drivers.device_stats import DeviceStats
 from engine.loader.tree_drawing import dot_source
 from engine.recording.recorder import tick_moment
-from engine.recording.session_file import as_json
+from engine.recording.session_file import ChangedKeys, as_json
 from engine.runtime.scheduler import RunningTree
 from engine.runtime.tree_watch import TreeWatch, WatchedTree
 from engine.scenario.scenario_file import ScenarioEvent
@@ -80,7 +80,7 @@ class ViewHub:
         self._dots: dict[tuple[str, int], str] = {}
         self._statuses: dict[str, dict[int, Change]] = {}
         self._keys: dict[str, Change] = {}
-        self._values: dict[str, str] = {}
+        self._changed = ChangedKeys(catalogue)
         self._actions: deque[Change] = deque(maxlen=RECENT_ACTIONS)
         self._world: deque[Change] = deque(maxlen=RECENT_ACTIONS)
         self._stats: Change = {"kind": "stats", "at": 0.0, "trees": {}, "devices": {}}
@@ -135,12 +135,11 @@ class ViewHub:
             self._publish(change)
 
     def blackboard_write(self, key: str, value: Any) -> None:
-        spec = self.catalogue.lookup(key)
-        event = spec is not None and spec.kind == "event"
-        text = as_json(value)
-        if not event and self._values.get(key) == text:
+        news = self._changed.news(key, value)
+        if news is None:
             return
-        self._values[key] = text
+        text, event = news
+        spec = self.catalogue.lookup(key)
         writer = "trees" if key.startswith(VARIABLES_PREFIX) else (spec.writer if spec else "")
         change = {
             "kind": "key",

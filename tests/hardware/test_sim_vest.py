@@ -19,7 +19,8 @@ from engine.files.problems import Mark
 from engine.hardware.assembly import build_hardware
 from engine.hardware.config import RobotConfig
 from engine.hardware.config_file import load_robot_config
-from engine.hardware.sim_vest import build_sim_vest, check_fault_events
+from engine.hardware.fault_events import check_fault_events
+from engine.hardware.sim_vest import build_sim_vest
 from engine.scenario.scenario_file import ScenarioEvent
 from engine.scenario.world import World
 
