@@ -45,13 +45,24 @@ class Cooldown(py_trees.decorators.Decorator):
     (the LEDs failed but the robot spoke): the robot rests either way, rather than
     trying again on the next tick and stuttering. A child that failed before any action
     ran (a check inside it said no) starts no rest.
+
+    ``counting_from`` is ``"end"`` (the rest starts when the child finished) or
+    ``"start"`` (it starts when the child started: with a 5 s rest and 1.5 s of moves, a
+    pat 5 s after the first one is answered).
     """
 
-    def __init__(self, name: str, child: Any, seconds: float, clock: Clock) -> None:
+    def __init__(
+        self, name: str, child: Any, seconds: float, clock: Clock, counting_from: str = "end"
+    ) -> None:
         super().__init__(name=name, child=child)
         self.seconds = seconds
         self.clock = clock
+        self.counting_from = counting_from
         self.ready_at_s = float("-inf")
+        self.started_s = float("-inf")
+
+    def initialise(self) -> None:
+        self.started_s = self.clock.now()
 
     def tick(self) -> Any:
         remaining = self.ready_at_s - self.clock.now()
@@ -67,7 +78,8 @@ class Cooldown(py_trees.decorators.Decorator):
         if status == Status.SUCCESS or (
             status == Status.FAILURE and _an_action_ran(self.decorated)
         ):
-            self.ready_at_s = self.clock.now() + self.seconds
+            since = self.started_s if self.counting_from == "start" else self.clock.now()
+            self.ready_at_s = since + self.seconds
         self.feedback_message = ""
         return status
 
@@ -106,7 +118,7 @@ def _timeout(name: str, args: SimpleNamespace, children: list[Any], ctx: TreeCon
 
 
 def _cooldown(name: str, args: SimpleNamespace, children: list[Any], ctx: TreeContext) -> Any:
-    return Cooldown(name, _child(children), args.seconds, ctx.clock)
+    return Cooldown(name, _child(children), args.seconds, ctx.clock, args.counting_from)
 
 
 def _one_shot(name: str, args: SimpleNamespace, children: list[Any], ctx: TreeContext) -> Any:
@@ -170,10 +182,22 @@ DECORATORS = (
     NodeType(
         "Cooldown",
         "decorator",
-        """After the child succeeds, rest for ``seconds`` so a behavior does not repeat itself.
+        """After the child acted, rest for ``seconds`` so a behavior does not repeat itself.
+
+        The rest counts from the end of the child's action (``counting_from: end``, the
+        default) or from its start (``counting_from: start``: a 5 s rest around a 1.5 s arm
+        move answers again 5 s after the last answer began).
 
         The child's status; FAILURE without ticking the child while cooling down.""",
-        (Param("seconds", SECONDS, REQUIRED, "rest time after a success, in seconds"),),
+        (
+            Param("seconds", SECONDS, REQUIRED, "rest time, in seconds"),
+            Param(
+                "counting_from",
+                Choice(("end", "start")),
+                "end",
+                "end: the rest starts when the child finished; start: when it started",
+            ),
+        ),
         _cooldown,
     ),
     NodeType(
