@@ -24,6 +24,9 @@ DEVICES_PREFIX = "/devices/"
 # -- every sensor key's name, defined once (the catalogue below describes each) ----------------
 TOUCH_PADS = "/sensors/touch/pads"
 TOUCH_ANY = "/sensors/touch/any"
+TOUCH_TOUCHED = "/sensors/touch/touched"
+TOUCH_PAT = "/sensors/touch/pat"
+FORCE_SQUEEZE = "/sensors/force/squeeze"
 FORCE_LEFT_N = "/sensors/force/left_n"
 FORCE_RIGHT_N = "/sensors/force/right_n"
 RANGE_LEFT_MM = "/sensors/range/left_mm"
@@ -162,6 +165,30 @@ def default_catalogue() -> KeyCatalogue:
                 "",
                 "touch poller (MPR121)",
                 "True while any pad is touched",
+            ),
+            KeySpec(
+                TOUCH_TOUCHED,
+                list,
+                "",
+                "touch poller (MPR121)",
+                "the names of the pads touched now (the robot config's pad_names)",
+            ),
+            KeySpec(
+                TOUCH_PAT,
+                str,
+                "",
+                "touch poller (MPR121)",
+                "a pad's name, once each time a hand comes onto it (a resting hand is one pat)",
+                kind="event",
+            ),
+            KeySpec(
+                FORCE_SQUEEZE,
+                str,
+                "",
+                "force poller (ADS1115 / MCP3008 + FSR 406)",
+                "a force pad's name (left, right), once each time it is squeezed past the "
+                "config's squeeze_n",
+                kind="event",
             ),
             KeySpec(
                 FORCE_LEFT_N,

@@ -26,6 +26,7 @@ from pathlib import Path
 from engine.cli.output import shown, tell
 from engine.cli.run_inputs import DEFAULT_HARDWARE, load_run_inputs
 from engine.cli.timeline import Timeline
+from engine.cli.validate_command import turn_warnings
 from engine.cli.view_options import add_view_arguments, start_view
 from engine.clock import Clock, EpochClock, RealClock, VirtualClock
 from engine.errors import ConfigError, UsageError
@@ -217,6 +218,8 @@ def main(args: argparse.Namespace) -> int:
     try:
         start_s = clock.now()  # after start-up, which takes simulated time too
         timeline = Timeline(sys.stdout, start_s=start_s, as_json=args.json)
+        for warning in turn_warnings(behaviors.trees):
+            tell(warning)
         for name, why in assembled.hardware.startup_problems.items():
             tell(f"warning: {shown(name)} did not start ({shown(why)}); it will be tried again")
         if assembled.vision is not None and assembled.vision.problem:
@@ -226,6 +229,7 @@ def main(args: argparse.Namespace) -> int:
                 tell(f"warning: speech {part}: {shown(why)}")
         robot.action_log.listeners.append(timeline.action)
         robot.action_log.failure_listeners.append(timeline.failed)
+        robot.turns.listeners.append(timeline.turn)
         blackboard.watchers.append(
             lambda key, value: timeline.blackboard_write(key, value, clock.now())
         )

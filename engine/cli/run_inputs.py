@@ -21,6 +21,7 @@ from engine.hardware.chips import default_chips
 from engine.hardware.config import CAMERA_NAME, RobotConfig
 from engine.hardware.config_file import load_robot_config
 from engine.hardware.fault_events import check_fault_events
+from engine.hardware.touch_pads import name_scenario_pads, robot_pad_names, unknown_pad
 from engine.loader.tree_definition import NodeDefinition, TreeDefinition
 from engine.nodes.registry import NodeRegistry, default_registry
 from engine.nodes.remote import COMMAND_TYPES
@@ -131,6 +132,31 @@ def check_items(definition: TreeDefinition, lengths: dict[str, int]) -> list[Pro
     return problems
 
 
+def check_on_robot(
+    definition: TreeDefinition, config: RobotConfig | None, lengths: dict[str, int]
+) -> list[Problem]:
+    """What a tree names that the robot does not have: list items, touch pads."""
+    problems = check_items(definition, lengths)
+    if config is not None:
+        problems += check_tree_pads(definition, config)
+    return problems
+
+
+def check_tree_pads(definition: TreeDefinition, config: RobotConfig) -> list[Problem]:
+    """``OnTouch`` nodes naming pads the robot does not have would never fire: each name,
+    at its node's place."""
+    names = robot_pad_names(config)
+    problems: list[Problem] = []
+    for node in _nodes(definition.root):
+        if node.type.name != "OnTouch":
+            continue
+        for param in ("pads", "except_pads"):
+            for name in node.args.get(param) or ():
+                if name not in names:
+                    problems.append(Problem(node.mark, *unknown_pad(str(name), names, config)))
+    return problems
+
+
 def _nodes(node: NodeDefinition) -> Iterator[NodeDefinition]:
     yield node
     for child in node.children:
@@ -140,7 +166,7 @@ def _nodes(node: NodeDefinition) -> Iterator[NodeDefinition]:
 def check_scenario_events(events: Iterable[ScenarioEvent], config: RobotConfig) -> list[Problem]:
     """The scenario's faults name devices of ``config``; its remote commands are of a type
     the robot carries out; a hand is shown only to a simulated camera."""
-    problems = check_fault_events(events, config)
+    problems = check_fault_events(events, config) + name_scenario_pads(events, config)
     for event in events:
         if event.kind == "show_hand" and (config.camera is None or not config.camera.simulated):
             problems.append(
@@ -195,7 +221,7 @@ def load_checked_behaviors(
         return None
     lengths = list_lengths(config)
     for definition in behaviors.trees:
-        problems.extend(check_items(definition, lengths))
+        problems.extend(check_on_robot(definition, config, lengths))
     return behaviors
 
 

@@ -23,12 +23,15 @@ from engine.services.actions import ActionRecord
 def describe_action(action: str, args: dict[str, Any]) -> str:
     if action == "say":
         return f'says "{args["text"]}"'
+    if action == "led" and args["color"] == "off":
+        return "turns the face LEDs off" + (" (halted: back to rest)" if args.get("rest") else "")
     if action == "led":
         seconds = f" for {args['seconds']:g} s" if args.get("seconds") else ""
         return f"lights the face {args['color']}{seconds}"
     if action == "servo":
         speed = f" at {args['speed_dps']:g} deg/s" if args.get("speed_dps") else ""
-        return f"turns {args['joint']} to {args['angle_deg']:g} deg{speed}"
+        rest = " (halted: back to rest)" if args.get("rest") else ""
+        return f"turns {args['joint']} to {args['angle_deg']:g} deg{speed}{rest}"
     if action == "read":
         return f"reads the {args['sensor']} sensor"
     if action == "report":
@@ -126,6 +129,11 @@ class Timeline:
         else:
             what = describe_action(record.action, record.args)
             self._line(record.t, record.tree, f"could not: {what} ({record.error})")
+
+    def turn(self, at_s: float, tree: str, what: str) -> None:
+        """A tree interrupting, waiting for or yielding to another (one voice at a time)."""
+        if not self.as_json:
+            self._line(at_s, tree, what)
 
     def _line(self, at_s: float, who: str, what: str) -> None:
         self._write(f"{at_s - self.start_s:8.2f}  {shown(who):14} {shown(what)}\n")

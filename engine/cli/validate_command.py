@@ -12,10 +12,11 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from engine.cli.output import tell
 from engine.cli.run_inputs import (
     DEFAULT_DIALOGS,
     DEFAULT_HARDWARE,
-    check_items,
+    check_on_robot,
     check_scenario_events,
     dialogs_folder,
     list_lengths,
@@ -29,7 +30,9 @@ from engine.files.problems import LoadError, Mark, Problem, Problems
 from engine.files.yaml_source import YMap, YScalar
 from engine.hardware.config import RobotConfig
 from engine.loader.substitution import Profile, load_profile, undeclared_params
+from engine.loader.tree_definition import TreeDefinition
 from engine.loader.tree_file import TreeLoader, shown_path
+from engine.loader.tree_resources import collisions
 from engine.nodes.registry import NodeRegistry, default_registry
 from engine.runtime.robot import declared_beside, tree_files
 from engine.scenario.scenario_file import load_scenario
@@ -118,6 +121,8 @@ class Validator:
         """Parameters the trees checked so far declare."""
         self.files = ParsedFiles()
         """Each file is parsed once, however many checks look at it."""
+        self.trees: list[TreeDefinition] = []
+        """The trees checked, to find those that would take turns by chance."""
 
     def dialogs_for(self, path: Path) -> DialogLibrary | None:
         """The dialogs a tree at ``path`` uses (none when there is no dialogs folder, as in
@@ -161,8 +166,9 @@ class Validator:
         try:
             if kind == "tree":
                 definition = self.loader_for(path).load(path)
+                self.trees.append(definition)
                 self.declared |= definition.declared_params
-                self.problems.extend(check_items(definition, self.lengths))
+                self.problems.extend(check_on_robot(definition, self.config, self.lengths))
             elif kind == "profile":
                 self.check_profile(path)
             elif kind == "dialog" and self.is_dialogs_folder(path.parent):
@@ -254,5 +260,24 @@ def main(args: argparse.Namespace) -> int:
         raise LoadError(list(dict.fromkeys(validator.problems.items)))
     if not files:
         raise LoadError([Problem(Mark(str(args.paths[0]), 1, 1), "no YAML files found")])
+    for warning in turn_warnings(validator.trees, by_folder=True):
+        tell(warning)
     print(f"ok: {len(files)} file{'s' if len(files) != 1 else ''}")
     return 0
+
+
+def turn_warnings(trees: list[TreeDefinition], *, by_folder: bool = False) -> list[str]:
+    """Trees run together that can want the same speaker, LEDs or joint at the same
+    priority, each pair as a warning line. ``by_folder``: the trees of one folder are run
+    together (``vest validate``; subtrees in parts/ aside)."""
+    folders: dict[Path, list[TreeDefinition]] = {}
+    for tree in trees:
+        if not by_folder:
+            folders.setdefault(Path(), []).append(tree)
+        elif tree.path.parent.name != "parts":
+            folders.setdefault(tree.path.parent.resolve(), []).append(tree)
+    return [
+        f"warning: {shown_path(c.second.path)}: {c.describe()}"
+        for folder in folders.values()
+        for c in collisions(folder)
+    ]

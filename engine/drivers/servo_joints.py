@@ -62,6 +62,13 @@ class Joint:
     min_us: float = 1000.0
     max_us: float = 2000.0
     home_deg: float = 0.0
+    rest_speed_dps: float | None = None
+    """How fast the joint goes home when a behavior is halted (None: a third of its limit)."""
+
+    @property
+    def safe_speed_dps(self) -> float:
+        """The speed of a move home after a halt, in deg/s."""
+        return self.rest_speed_dps or self.max_speed_dps / 3
 
     def __post_init__(self) -> None:
         where = f"joint {self.name!r}"

@@ -161,6 +161,13 @@ class HardwareServos:
         self.angles_deg[joint] = angle_deg
         return TimedFutureJob(future, self.clock, abs(angle_deg - start) / speed)
 
+    def rest_pose(self, joint: str) -> tuple[float, float | None]:
+        """The joint's ``home_deg`` and its safe speed (``rest_speed_dps``)."""
+        limits = self.joints.get(joint)
+        if limits is None:
+            return 0.0, None
+        return limits.home_deg, limits.safe_speed_dps
+
     def position_deg(self, joint: str) -> float:
         """The angle the Maestro drives ``joint`` to now (a query; waits for the reply)."""
         return self._on.call(lambda joints: joints.position_deg(joint))

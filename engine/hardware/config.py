@@ -172,6 +172,10 @@ class DeviceConfig:
     mux: str | None = None
     mux_channel: int | None = None
     gesture_names: dict[str, str] = field(default_factory=dict)
+    pad_names: tuple[str, ...] = ()
+    """Touch pads' names, electrode 0 first (the config's ``pad_names``)."""
+    squeeze_n: float | None = None
+    """Force pads: a squeeze event when a pad's force rises past this (N)."""
     description: str = ""
 
     @property

@@ -371,7 +371,8 @@ class ConfigChecker:
                     )
                     ok = False
                     continue
-                kinds = ("event",) if spec.role == "gesture" else ("state",)
+                default = self.ctx.catalogue.lookup(spec.outputs[output])
+                kinds = (default.kind,) if default is not None else ("state",)
                 key = self.convert(Key(kinds=kinds), value, output)
                 if key is None or not self._same_type(keys.get(output), key, value, output):
                     ok = False

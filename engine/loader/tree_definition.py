@@ -42,6 +42,10 @@ class TreeDefinition:
     files: list[Path] = field(default_factory=list)
     declared_params: frozenset[str] = frozenset()
     """Parameter names this tree and its subtrees declare (what a profile may set)."""
+    priority: int = 0
+    """0..100: higher interrupts lower for the speaker, the face LEDs and the joints."""
+    wait_for_turn_s: float = 0.0
+    """How long an action waits for a resource another tree has (0: let it go at once)."""
 
     def build(self, ctx: TreeContext) -> py_trees.trees.BehaviourTree:
         """A fresh py_trees tree whose nodes use ``ctx``."""

@@ -46,13 +46,13 @@ from engine.loader.substitution import (
     unresolved,
 )
 from engine.loader.tree_definition import NodeDefinition, TreeDefinition
+from engine.loader.tree_settings import SETTINGS, read_settings
 from engine.nodes.registry import NodeRegistry
 from engine.nodes.spec import NodeType
-from engine.values.params import RATE_HZ, CheckContext, ParamProblem, did_you_mean
+from engine.values.params import CheckContext, ParamProblem, did_you_mean
 
-TOP_KEYS = ("name", "description", "rate_hz", "params", "root")
+TOP_KEYS = ("name", "description", *(setting.name for setting in SETTINGS), "params", "root")
 SUBTREE = "Subtree"
-DEFAULT_RATE_HZ = 10.0
 
 
 @dataclass
@@ -130,14 +130,22 @@ class TreeLoader:
             else:
                 problems.add(raw_name.mark, f"'name' must be text, got {describe(raw_name)}")
         params = self._params(document, problems, overrides=None, where="")
-        rate_hz = self._rate(document, params, problems)
+        settings = read_settings(document, params, problems, self.check_context)
         description = document.get("description")
         root = self._root(document, path, params, problems, [resolved(path)], seen)
         problems.raise_if_any()
         assert root is not None
         text = plain(description) if description is not None else ""
         return TreeDefinition(
-            name, rate_hz, str(text or ""), root, path, seen.files, frozenset(seen.declared)
+            name,
+            settings.rate_hz,
+            str(text or ""),
+            root,
+            path,
+            seen.files,
+            frozenset(seen.declared),
+            priority=settings.priority,
+            wait_for_turn_s=settings.wait_for_turn_s,
         )
 
     # -- file level -----------------------------------------------------------------------
@@ -189,23 +197,6 @@ class TreeLoader:
             elif check_override(name, params[name], given, problems, where):
                 params[name] = given
         return params
-
-    def _rate(self, document: YMap, params: dict[str, ParamValue], problems: Problems) -> float:
-        raw = document.get("rate_hz")
-        if raw is None:
-            return DEFAULT_RATE_HZ
-        raw = substitute(raw, params, problems)
-        if unresolved(raw):
-            return DEFAULT_RATE_HZ
-        try:
-            return RATE_HZ.convert(plain(raw), self.check_context)
-        except ParamProblem as problem:
-            problems.add(
-                raw.mark,
-                f"'rate_hz' {problem.message}",
-                f"ticks per second, from {RATE_HZ.minimum:g} to {RATE_HZ.maximum:g}, e.g. 10",
-            )
-            return DEFAULT_RATE_HZ
 
     def _root(
         self,

@@ -6,7 +6,7 @@ import math
 from collections.abc import Callable, Mapping
 from typing import Any
 
-from engine.blackboard.catalogue import VARIABLES_PREFIX, KeySpec
+from engine.blackboard.catalogue import TOUCH_PAT, VARIABLES_PREFIX, KeySpec
 from engine.nodes.base import Condition
 from engine.nodes.event_reader import EQUALS, ONE_OF, EventReader, check_choice, wanted
 from engine.values.params import (
@@ -19,6 +19,7 @@ from engine.values.params import (
     Param,
     ParamIssue,
     Scalar,
+    Text,
 )
 
 _COMPARISONS = ("equals", "not_equals", "above", "below", "between")
@@ -214,4 +215,44 @@ class OnEvent(Condition):
         return found
 
 
-CONDITIONS = (Check, Fresh, OnEvent)
+class OnTouch(Condition):
+    """React once to each new touch of a pad, by the pad's name (a pat).
+
+    A hand coming onto a pad is one pat, however long it rests there. SUCCESS once per
+    new pat on one of ``pads`` (any pad when not given) and on none of ``except_pads``,
+    writing the pad's name to ``save_as``; FAILURE when no such pat came. Pad names come
+    from the robot config's ``pad_names`` (``vest keys --pads`` shows them on the vest).
+    """
+
+    pads = Param("pads", ListOf(Text(), 1), None, "only pats on these pads count")
+    except_pads = Param("except_pads", ListOf(Text(), 1), None, "pats on these pads do not count")
+    save_as = Param("save_as", Key(access="write"), None, "a /vars/ key to keep the pad's name in")
+    reads = (TOUCH_PAT,)
+
+    @classmethod
+    def check_params(cls, args: Mapping[str, Any], ctx: CheckContext) -> list[ParamIssue]:
+        both = set(args.get("pads") or ()) & set(args.get("except_pads") or ())
+        if both:
+            return [ParamIssue("except_pads", f"{sorted(both)} are in pads and except_pads")]
+        return []
+
+    def __init__(self, *a: Any) -> None:
+        super().__init__(*a)
+        self.events = EventReader(self, TOUCH_PAT, self.pads)
+        self._ignored = set(self.except_pads or ())
+
+    def check(self) -> bool:
+        while True:
+            found, pad = self.events.take()
+            if not found:
+                self.feedback_message = ""
+                return False
+            if pad not in self._ignored:
+                break
+        self.feedback_message = f"a pat on {pad}"
+        if self.save_as is not None:
+            self.write(self.save_as, pad)
+        return True
+
+
+CONDITIONS = (Check, Fresh, OnEvent, OnTouch)

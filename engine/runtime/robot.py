@@ -17,9 +17,10 @@ from engine.loader.tree_file import TreeLoader
 from engine.nodes.context import NodeErrorHandler, NodeErrorLog, TreeContext
 from engine.nodes.registry import NodeRegistry, default_registry
 from engine.runtime.scheduler import RunningTree, Scheduler
-from engine.services.actions import ActionLog, TreeActions
+from engine.services.actions import ActionLog, TreeActions, TurnTaking
 from engine.services.interfaces import Services
 from engine.services.staged_readings import with_staged_readings
+from engine.services.turns import Turns
 
 
 def tree_files(paths: list[Path]) -> list[Path]:
@@ -138,6 +139,10 @@ class Robot:
         self.blackboard = blackboard
         self.action_log = action_log or ActionLog()
         self.scheduler = Scheduler(clock, blackboard)
+        self.turns = Turns(clock)
+        """Who has the speaker, the face LEDs and each joint; ``turns.listeners`` hear who
+        interrupted, waited for or yielded to whom."""
+        self.turns.interrupt = self.interrupt
         staged = with_staged_readings(services, blackboard)  # readings reach every tree
         node_errors = on_node_error or NodeErrorLog()  # one count per node and error kind
         for definition in behaviors.trees:
@@ -145,7 +150,13 @@ class Robot:
                 tree=definition.name,
                 clock=clock,
                 blackboard=blackboard,
-                actions=TreeActions(staged, clock, definition.name, self.action_log),
+                actions=TreeActions(
+                    staged,
+                    clock,
+                    definition.name,
+                    self.action_log,
+                    taking=TurnTaking(self.turns, definition.priority, definition.wait_for_turn_s),
+                ),
                 dialogs=behaviors.dialogs,
                 on_node_error=node_errors,
             )
@@ -154,3 +165,8 @@ class Robot:
     @property
     def trees(self) -> list[RunningTree]:
         return self.scheduler.trees
+
+    def interrupt(self, name: str) -> None:
+        """Halt tree ``name`` cleanly (pre-empted): its actions stop, its joints go back
+        to rest and its LEDs off; it starts afresh at its next tick."""
+        self.scheduler.tree(name).halt()

@@ -11,7 +11,7 @@ from __future__ import annotations
 import logging
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import py_trees
 
@@ -74,12 +74,21 @@ class RunningTree:
         self.period_index = 0
         self.definition = definition
         self.tree = new_tree
+        actions = self.context.actions
+        if actions.taking is not None:  # the new version's priority and patience
+            actions.taking = replace(
+                actions.taking,
+                priority=definition.priority,
+                wait_for_turn_s=definition.wait_for_turn_s,
+            )
 
     def halt(self) -> None:
-        """Stop whatever is running (cancels service jobs: speech, moves, lights)."""
+        """Stop whatever is running (cancels service jobs: speech, moves, lights), then
+        send the joints it moved back to rest and turn off the LEDs it lit."""
         root = self.tree.root
         if root.status == py_trees.common.Status.RUNNING:
             root.stop(py_trees.common.Status.INVALID)
+            self.context.actions.settle()
 
 
 class Scheduler:

@@ -4,7 +4,7 @@
 
     duration_s: 20
     events:
-      - {at: 1.0,  touch: {pad: 3, seconds: 0.3}}
+      - {at: 1.0,  touch: {pad: middle_back, seconds: 0.3}}   # or a number: pad: 3
       - {at: 3.0,  squeeze: {left_n: 6.0, right_n: 6.0, seconds: 2.0}}
       - {at: 6.0,  gesture: wave}
       - {at: 8.0,  obstacle: {left_mm: 250, center_mm: 600, right_mm: 900, seconds: 2.0}}
@@ -54,11 +54,32 @@ GESTURES = (
     "hover_up",
 )
 _SECONDS = Number(0.01, 3600.0, "s")
+
+
+@dataclass(frozen=True)
+class PadRef(ParamType[int | str]):
+    """A touch pad by number (0..11) or by the name the robot config gives it; names are
+    checked against the robot the scenario runs on."""
+
+    name = "pad"
+
+    def convert(self, value: Any, ctx: CheckContext) -> int | str:
+        if isinstance(value, str) and value:
+            return value
+        return Integer(0, 11).convert(value, ctx)
+
+    def describe(self) -> str:
+        return "pad name or number 0..11"
+
+    def json_schema(self) -> dict[str, Any]:
+        return {"type": ["string", "integer"]}
+
+
 _DISTANCE_MM = Number(0.0, 8190.0, "mm")
 
 EVENT_FIELDS: dict[str, tuple[Param[Any], ...] | ParamType[Any]] = {
     "touch": (
-        Param("pad", Integer(0, 11), doc="pad number 0..11"),
+        Param("pad", PadRef(), doc="pad name (the robot config's pad_names) or number 0..11"),
         Param("seconds", _SECONDS, 0.3, "how long the hand stays"),
     ),
     "squeeze": (
@@ -122,7 +143,8 @@ class ScenarioEvent:
         """A short human description for the timeline."""
         value = self.value
         if self.kind == "touch":
-            return f"pad {value['pad']} touched for {value['seconds']:g} s"
+            pad = value.get("pad_name") or f"pad {value['pad']}"
+            return f"{pad} touched for {value['seconds']:g} s"
         if self.kind == "squeeze":
             return (
                 f"squeezed left {value['left_n']:g} N, right {value['right_n']:g} N "

@@ -17,6 +17,14 @@ from typing import Any
 from engine.clock import Clock
 from engine.services.interfaces import Services
 from engine.services.jobs import ImmediateJob, Job
+from engine.services.turns import (
+    FACE_LEDS,
+    SPEAKER,
+    Turns,
+    WaitingJob,
+    joint_resource,
+    let_go,
+)
 
 _log = logging.getLogger("vest.actions")
 
@@ -123,49 +131,142 @@ class _WatchedJob:
         self._job.cancel()
 
 
+@dataclass(frozen=True)
+class TurnTaking:
+    """How one tree takes turns with the others (see :mod:`engine.services.turns`):
+    its ``priority`` (higher interrupts lower) and how long an action of it waits for a
+    busy resource before it is let go (``wait_for_turn_s``; 0: let go at once)."""
+
+    turns: Turns
+    priority: int = 0
+    wait_for_turn_s: float = 0.0
+
+
 class TreeActions:
     """The services as one tree sees them: every call recorded under the tree's name.
 
     A service that raises while accepting work gives a failed job instead, so a node
     reports FAILURE rather than stopping the tick. The jobs returned mark their record in
-    the log when they are seen failed.
+    the log when they are seen failed. With ``taking`` the speaker, the face LEDs and the
+    joints are shared with the other trees by priority; an action waiting for its turn
+    is recorded when it starts.
     """
 
-    def __init__(self, services: Services, clock: Clock, tree: str, log: ActionLog) -> None:
+    def __init__(
+        self,
+        services: Services,
+        clock: Clock,
+        tree: str,
+        log: ActionLog,
+        *,
+        taking: TurnTaking | None = None,
+    ) -> None:
         self.services = services
         self.clock = clock
         self.tree = tree
         self.log = log
+        self.taking = taking
+        self._moved: set[str] = set()
+        self._lit = False
 
-    def _call(self, action: str, args: dict[str, Any], start: Callable[[], Job]) -> Job:
-        record = ActionRecord(self.clock.now(), self.tree, action, args)
-        self.log.add(record)
-        try:
-            job = start()
-        except Exception as error:  # a service refusing work is a failed action, not a crash
-            job = ImmediateJob(error=error)
-        watched = _WatchedJob(job, record, self.log)
-        watched.done()  # a call refused at once is marked failed at once
-        return watched
+    def _call(
+        self,
+        action: str,
+        args: dict[str, Any],
+        start: Callable[[], Job],
+        uses: tuple[str, ...] = (),
+        what: str = "",
+    ) -> Job:
+        def begin() -> Job:
+            record = ActionRecord(self.clock.now(), self.tree, action, args)
+            self.log.add(record)
+            try:
+                job = start()
+            except Exception as error:  # a service refusing work is a failed action
+                job = ImmediateJob(error=error)
+            watched = _WatchedJob(job, record, self.log)
+            watched.done()  # a call refused at once is marked failed at once
+            return watched
+
+        taking = self.taking
+        if taking is None or not uses:
+            return begin()
+        turns, priority = taking.turns, taking.priority
+        blocked = turns.blocking(uses, self.tree, priority)
+        if blocked is None:
+            turns.take(uses, self.tree, priority)
+            job = begin()
+            turns.hold(uses, self.tree, priority, job)
+            return job
+        resource, turn = blocked
+        if taking.wait_for_turn_s <= 0:
+            return ImmediateJob(error=let_go(turns, self.tree, what, resource, turn))
+        turns.tell(self.tree, f"waits for the {resource}: {turn.tree} has it")
+        deadline_s = self.clock.now() + taking.wait_for_turn_s
+        return WaitingJob(turns, begin, uses, self.tree, priority, deadline_s, what)
 
     def say(self, text: str, *, volume: float | None = None) -> Job:
         args: dict[str, Any] = {"text": text}
         if volume is not None:
             args["volume"] = volume
-        return self._call("say", args, lambda: self.services.speech.say(text, volume=volume))
+        return self._call(
+            "say",
+            args,
+            lambda: self.services.speech.say(text, volume=volume),
+            (SPEAKER,),
+            f"saying {text!r}",
+        )
+
+    def settle(self) -> list[Job]:
+        """After the tree was halted in the middle: each joint it moved goes back to its
+        rest pose at its safe speed, and the face LEDs it lit go off, unless another tree
+        used them since. Not subject to turns: a halted tree always comes to rest."""
+        jobs: list[Job] = []
+        for joint in sorted(self._moved):
+            if self._last_user(joint_resource(joint)):
+                angle_deg, speed_dps = self.services.servos.rest_pose(joint)
+                args = {"joint": joint, "angle_deg": angle_deg, "rest": True}
+                if speed_dps is not None:
+                    args["speed_dps"] = speed_dps
+                jobs.append(self._call("servo", args, self._mover(joint, angle_deg, speed_dps)))
+        if self._lit and self._last_user(FACE_LEDS):
+            off = lambda: self.services.leds.set_color("off")  # noqa: E731
+            jobs.append(self._call("led", {"color": "off", "rest": True}, off))
+        self._moved.clear()
+        self._lit = False
+        return jobs
+
+    def _mover(self, joint: str, angle_deg: float, speed_dps: float | None) -> Callable[[], Job]:
+        return lambda: self.services.servos.move(joint, angle_deg, speed_dps=speed_dps)
+
+    def _last_user(self, resource: str) -> bool:
+        """Whether this tree used ``resource`` last (always, without turn-taking)."""
+        return self.taking is None or self.taking.turns.last_user(resource) in (None, self.tree)
 
     def set_led(self, color: str, *, seconds: float | None = None) -> Job:
+        self._lit = color != "off"
         args: dict[str, Any] = {"color": color}
         if seconds is not None:
             args["seconds"] = seconds
-        return self._call("led", args, lambda: self.services.leds.set_color(color, seconds=seconds))
+        return self._call(
+            "led",
+            args,
+            lambda: self.services.leds.set_color(color, seconds=seconds),
+            (FACE_LEDS,),
+            f"lighting the face {color}",
+        )
 
     def move_servo(self, joint: str, angle_deg: float, *, speed_dps: float | None = None) -> Job:
+        self._moved.add(joint)
         args: dict[str, Any] = {"joint": joint, "angle_deg": angle_deg}
         if speed_dps is not None:
             args["speed_dps"] = speed_dps
         return self._call(
-            "servo", args, lambda: self.services.servos.move(joint, angle_deg, speed_dps=speed_dps)
+            "servo",
+            args,
+            lambda: self.services.servos.move(joint, angle_deg, speed_dps=speed_dps),
+            (joint_resource(joint),),
+            f"turning {joint} to {angle_deg:g} deg",
         )
 
     def read_sensor(self, sensor: str) -> Job:

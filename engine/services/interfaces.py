@@ -28,6 +28,10 @@ class Servos(Protocol):
         """Move ``joint`` to ``angle_deg`` at ``speed_dps`` degrees/second (None: joint's max)."""
         ...
 
+    def rest_pose(self, joint: str) -> tuple[float, float | None]:
+        """Where ``joint`` rests and how fast it goes there after a halt: (deg, deg/s)."""
+        ...
+
 
 ON_REQUEST_SENSORS = ("temperature", "ultrasound")
 """The sensors a tree reads on request (the others are polled onto the blackboard)."""

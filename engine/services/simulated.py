@@ -87,6 +87,10 @@ class SimulatedServos(_Recording):
         seconds = abs(angle_deg - start) / speed if speed > 0 else 0.0
         return _ServoMove(self, joint, start, angle_deg, seconds)
 
+    def rest_pose(self, joint: str) -> tuple[float, float | None]:
+        """Every simulated joint rests at 0 deg, going there at a third of the default speed."""
+        return 0.0, (self.default_speed_dps / 3) or None
+
 
 class _ServoMove(TimedJob):
     """A move that, cancelled half-way, leaves the joint where it had got to."""

@@ -48,7 +48,12 @@ def test_defaults_come_from_the_chip(tmp_path):
 
     touch = config.device("touch")
     assert (touch.bus, touch.address, touch.rate_hz) == ("i2c", 0x5A, 20.0)
-    assert touch.keys == {"pads": "/sensors/touch/pads", "any": "/sensors/touch/any"}
+    assert touch.keys == {
+        "pads": "/sensors/touch/pads",
+        "any": "/sensors/touch/any",
+        "touched": "/sensors/touch/touched",
+        "pat": "/sensors/touch/pat",
+    }
     assert touch.options == {"touch_threshold": 12, "release_threshold": 6}
     assert config.device("range").keys == {"range": "/sensors/range/left_mm"}
 

@@ -1,4 +1,7 @@
-"""touch_thanks: a pat on the back or shoulders -> "Thank you" (paper, section 4.5.1)."""
+"""touch_thanks: a pat on the back or shoulders -> "Thank you" (paper, section 4.5.1).
+
+A pat is a hand coming onto a pad: the touch poller sends one ``/sensors/touch/pat``
+event naming the pad, however long the hand rests there."""
 
 from __future__ import annotations
 
@@ -19,12 +22,10 @@ def robot(tree_harness: Callable[..., TreeHarness]) -> TreeHarness:
     return tree_harness(TREE)
 
 
-def pat(robot: TreeHarness, seconds: float = 0.3) -> None:
-    """A hand on a pad for ``seconds``, then lifted."""
-    robot.set("/sensors/touch/any", True)
+def pat(robot: TreeHarness, pad: str = "middle_back", seconds: float = 0.3) -> None:
+    """A hand comes onto ``pad`` (one pat event) and rests there for ``seconds``."""
+    robot.set("/sensors/touch/pat", pad)
     robot.advance(seconds)
-    robot.set("/sensors/touch/any", False)
-    robot.tick()
 
 
 def test_a_pat_on_the_back_is_thanked_once(robot: TreeHarness) -> None:
@@ -38,9 +39,15 @@ def test_nobody_touching_means_nothing_is_said(robot: TreeHarness) -> None:
     assert robot.said == []
 
 
-def test_a_hand_resting_on_the_back_is_not_thanked_every_tick(robot: TreeHarness) -> None:
-    robot.set("/sensors/touch/any", True)
-    robot.advance(2.0)  # the rest is 3 s
+def test_a_hand_resting_on_the_back_is_thanked_once_however_long_it_stays(
+    robot: TreeHarness,
+) -> None:
+    pat(robot, seconds=10.0)  # the rest is 3 s: a resting hand is still one pat
+    assert robot.said == ["Thank you"]
+
+
+def test_a_pat_on_a_shoulder_is_thanked_as_one_on_the_back(robot: TreeHarness) -> None:
+    pat(robot, "left_shoulder")
     assert robot.said == ["Thank you"]
 
 
@@ -88,11 +95,13 @@ def test_an_unplugged_speaker_fails_the_tree_which_rests_then_thanks_once_it_is_
     robot: TreeHarness,
 ) -> None:
     robot.services.speech.fail_next = "speaker unplugged"
-    robot.set("/sensors/touch/any", True)
+    robot.set("/sensors/touch/pat", "middle_back")
     assert robot.tick() == Status.FAILURE
     assert robot.tree.root.tip().feedback_message == "could not act: speaker unplugged"
     # no second try on the next tick (that is a stutter): the tree rests as after a thanks
+    robot.set("/sensors/touch/pat", "upper_back")
     assert robot.tick() == Status.FAILURE
     assert [r.action for r in robot.actions] == ["say"]
-    robot.advance(3.0)  # the rest is over, the hand still rests, the speaker is back
+    robot.advance(3.0)  # the rest is over and the speaker is back: the next pat is thanked
+    pat(robot)
     assert robot.said == ["Thank you"]

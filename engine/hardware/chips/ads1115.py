@@ -5,10 +5,11 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
+from engine.blackboard.catalogue import FORCE_SQUEEZE
 from engine.drivers.ads1115 import ADS1115
 from engine.drivers.sim.ads1115 import SimADS1115
 from engine.hardware.chips.fields import ChipFields
-from engine.hardware.chips.force_pads import force_pads, force_poll, show_forces
+from engine.hardware.chips.force_pads import force_fields, force_poll, show_forces
 from engine.hardware.chips.kind import ChipKind, SimPlacement
 from engine.hardware.config import ChipSpec, DeviceConfig
 from engine.hardware.managed_buses import ManagedI2C
@@ -17,8 +18,7 @@ from engine.values.params import Choice, Param
 
 
 def _pads(fields: ChipFields) -> dict[str, Any] | None:
-    pads = force_pads(fields, channels=4)
-    return None if pads is None else {"pads": pads}
+    return force_fields(fields, channels=4)
 
 
 def _simulate(vest: SimPlacement, device: DeviceConfig) -> None:
@@ -60,7 +60,8 @@ KIND = ChipKind(
                 "conversions per second (a reading takes about its inverse)",
             ),
         ),
-        fields=("pads",),
+        outputs={"squeeze": FORCE_SQUEEZE},
+        fields=("pads", "squeeze_n"),
     ),
     _pads,
     simulate=_simulate,

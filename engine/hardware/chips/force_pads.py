@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
-from typing import Protocol
+from typing import Any, Protocol
 
 from engine.blackboard.catalogue import force_key
 from engine.drivers.force_calibration import ForceCalibration
@@ -13,13 +13,31 @@ from engine.files.yaml_source import YList, YValue, describe, plain
 from engine.hardware.chips.fields import ChipFields
 from engine.hardware.config import DeviceConfig, ForcePad
 from engine.hardware.readings import PollParts, Staged
-from engine.values.params import REQUIRED, Integer, Key, Param
+from engine.values.params import REQUIRED, Integer, Key, Number, Param
 
 
 class ForceReader(Protocol):
     """An ADC driver that reads one input in volts (ADS1115, MCP3008)."""
 
     def read_volts(self, channel: int) -> float: ...
+
+
+DEFAULT_SQUEEZE_N = 3.0
+SQUEEZE = Param(
+    "squeeze_n",
+    Number(0.1, 100.0, "N"),
+    DEFAULT_SQUEEZE_N,
+    "a squeeze event when a pad's force rises past this; again once it fell below half",
+)
+
+
+def force_fields(fields: ChipFields, channels: int) -> dict[str, Any] | None:
+    """The pads and the squeeze threshold of a force chip's config entry."""
+    pads = force_pads(fields, channels)
+    values = fields.checker.fields(fields.raw, (SQUEEZE,), f"device {fields.name!r}")
+    if pads is None or values is None:
+        return None
+    return {"pads": pads, "squeeze_n": values["squeeze_n"]}
 
 
 def force_pads(fields: ChipFields, channels: int) -> tuple[ForcePad, ...] | None:
@@ -159,19 +177,36 @@ def _calibration(fields: ChipFields, raw: YValue) -> tuple[tuple[float, float], 
 
 
 def force_poll(device: DeviceConfig, connect: Callable[[], ForceReader]) -> PollParts:
-    """The poller parts of an ADC's force pads: each pad's volts through its calibration."""
+    """The poller parts of an ADC's force pads: each pad's volts through its calibration,
+    and a ``squeeze`` event naming a pad whose force rose past ``squeeze_n`` (armed again
+    once it fell below half of that, so a held squeeze is one event)."""
     calibrations = [(pad, ForceCalibration(pad.calibration)) for pad in device.pads]
+    squeeze_n = device.squeeze_n if device.squeeze_n is not None else DEFAULT_SQUEEZE_N
+    squeeze_key = device.keys.get("squeeze")
+    squeezed = {pad.name: False for pad in device.pads}
+
+    def reconnect() -> ForceReader:
+        squeezed.update(dict.fromkeys(squeezed, False))
+        return connect()
 
     def read(driver: ForceReader) -> list[Staged]:
-        return [
-            Staged(pad.key, calibration.newtons(driver.read_volts(pad.channel)))
-            for pad, calibration in calibrations
-        ]
+        writes: list[Staged] = []
+        events: list[Staged] = []
+        for pad, calibration in calibrations:
+            newtons = calibration.newtons(driver.read_volts(pad.channel))
+            writes.append(Staged(pad.key, newtons))
+            if newtons >= squeeze_n and not squeezed[pad.name]:
+                squeezed[pad.name] = True
+                if squeeze_key:
+                    events.append(Staged(squeeze_key, pad.name, event=True))
+            elif newtons < squeeze_n / 2:
+                squeezed[pad.name] = False
+        return writes + events
 
-    return connect, read, [Staged(pad.key, 0.0) for pad in device.pads]
+    return reconnect, read, [Staged(pad.key, 0.0) for pad in device.pads]
 
 
 def show_forces(device: DeviceConfig, writes: Sequence[Staged]) -> str:
     """``left 6.0 N, right 0.0 N``: one reading of the pads, as ``vest devices`` prints it."""
     names = {pad.key: pad.name for pad in device.pads}
-    return ", ".join(f"{names.get(w.key, w.key)} {w.value:.1f} N" for w in writes)
+    return ", ".join(f"{names.get(w.key, w.key)} {w.value:.1f} N" for w in writes if not w.event)

@@ -19,6 +19,12 @@ JOINT_FIELDS = (
     Param("min_us", Number(unit="us"), 1000.0, "pulse width at min_deg, 64..4000 us"),
     Param("max_us", Number(unit="us"), 2000.0, "pulse width at max_deg, 64..4000 us"),
     Param("home_deg", Number(-360.0, 360.0, "deg"), 0.0, "resting angle"),
+    Param(
+        "rest_speed_dps",
+        Number(0.0, 10_000.0, "deg/s"),
+        None,
+        "speed back to home_deg when a behavior is halted (default: a third of max_speed_dps)",
+    ),
 )
 CHANNEL_COUNTS = ("6", "12", "18", "24")
 
@@ -112,6 +118,13 @@ def _joint(fields: ChipFields, joint_name: str, body: YValue, channels: int) -> 
         problems.add(
             place("max_speed_dps", raw).mark,
             f"joint {joint_name!r}: max_speed_dps must be above 0",
+        )
+    rest = values["rest_speed_dps"]
+    if rest is not None and not 0 < rest <= values["max_speed_dps"]:
+        problems.add(
+            place("rest_speed_dps", raw).mark,
+            f"joint {joint_name!r}: rest_speed_dps {rest:g} must be above 0 and at most "
+            f"max_speed_dps {values['max_speed_dps']:g}",
         )
     if len(problems) > before:
         return None

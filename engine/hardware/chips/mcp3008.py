@@ -4,9 +4,10 @@ from __future__ import annotations
 
 from typing import Any
 
+from engine.blackboard.catalogue import FORCE_SQUEEZE
 from engine.drivers.mcp3008 import MCP3008
 from engine.hardware.chips.fields import ChipFields
-from engine.hardware.chips.force_pads import force_pads, force_poll, show_forces
+from engine.hardware.chips.force_pads import force_fields, force_poll, show_forces
 from engine.hardware.chips.kind import ChipKind, SimPlacement
 from engine.hardware.config import ChipSpec, DeviceConfig
 from engine.hardware.managed_buses import ManagedSpi
@@ -15,8 +16,7 @@ from engine.values.params import Integer, Number, Param
 
 
 def _pads(fields: ChipFields) -> dict[str, Any] | None:
-    pads = force_pads(fields, channels=8)
-    return None if pads is None else {"pads": pads}
+    return force_fields(fields, channels=8)
 
 
 def _simulate(vest: SimPlacement, device: DeviceConfig) -> None:
@@ -40,7 +40,8 @@ KIND = ChipKind(
             Param("vref_v", Number(0.25, 5.5, "V"), 3.3, "reference voltage"),
             Param("max_speed_hz", Integer(10_000, 3_600_000), 1_000_000, "SPI clock"),
         ),
-        fields=("pads",),
+        outputs={"squeeze": FORCE_SQUEEZE},
+        fields=("pads", "squeeze_n"),
     ),
     _pads,
     simulate=_simulate,

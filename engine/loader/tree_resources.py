@@ -1,0 +1,81 @@
+"""What a tree can use of the robot, read from its nodes: the speaker, the face LEDs, the
+joints. Two trees that can want one resource at the same priority take turns by who asks
+first, which a therapist rarely means: :func:`collisions` names them at load time."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from dataclasses import dataclass
+
+from engine.loader.tree_definition import NodeDefinition, TreeDefinition
+from engine.services.turns import FACE_LEDS, SPEAKER, joint_resource
+
+ANY_JOINT = joint_resource("any")
+_SPEAKS = ("Say", "Reply")
+_LIGHTS = ("SetLed",)
+_MOVES = ("MoveServo", "LookToward")
+_REMOTE = ("CarryOut",)  # a remote command may speak, light or move
+
+
+def tree_resources(definition: TreeDefinition) -> set[str]:
+    """The resources the built-in action nodes of ``definition`` use (plugins' own nodes
+    are not known here)."""
+    used: set[str] = set()
+    for node in _nodes(definition.root):
+        kind = node.type.name
+        if kind in _SPEAKS or kind in _REMOTE:
+            used.add(SPEAKER)
+        if kind in _LIGHTS or kind in _REMOTE:
+            used.add(FACE_LEDS)
+        if kind in _MOVES:
+            used.add(joint_resource(str(node.args.get("joint", "neck"))))
+        if kind in _REMOTE:
+            used.add(ANY_JOINT)
+    return used
+
+
+@dataclass(frozen=True)
+class Collision:
+    """Two trees of one priority that can want the same resources."""
+
+    first: TreeDefinition
+    second: TreeDefinition
+    resources: tuple[str, ...]
+
+    def describe(self) -> str:
+        shared = " and the ".join(self.resources)
+        return (
+            f"trees {self.first.name!r} and {self.second.name!r} both use the {shared} at "
+            f"priority {self.first.priority}: when both want it, the first to ask has it "
+            f"(give one of them a higher 'priority:')"
+        )
+
+
+def collisions(definitions: list[TreeDefinition]) -> list[Collision]:
+    """Each pair of trees of equal priority that share a resource, in file order."""
+    used = [(definition, tree_resources(definition)) for definition in definitions]
+    found: list[Collision] = []
+    for index, (first, first_uses) in enumerate(used):
+        for second, second_uses in used[index + 1 :]:
+            if first.priority != second.priority:
+                continue
+            shared = _shared(first_uses, second_uses)
+            if shared:
+                found.append(Collision(first, second, tuple(sorted(shared))))
+    return found
+
+
+def _shared(first: set[str], second: set[str]) -> set[str]:
+    shared = first & second
+    joints = {r for r in first | second if r.endswith(" joint") and r != ANY_JOINT}
+    if ANY_JOINT in first:
+        shared |= joints & second
+    if ANY_JOINT in second:
+        shared |= joints & first
+    return shared
+
+
+def _nodes(node: NodeDefinition) -> Iterator[NodeDefinition]:
+    yield node
+    for child in node.children:
+        yield from _nodes(child)

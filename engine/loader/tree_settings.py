@@ -1,0 +1,73 @@
+"""A tree file's settings beside its root: how often it ticks and how it takes turns.
+
+::
+
+    rate_hz: 20            # ticks per second
+    priority: 40           # higher interrupts lower for the speaker, face LEDs, joints
+    wait_for_turn_s: 2     # how long an action waits for a busy resource (0: let it go)
+
+Each may be a ``${parameter}``, so a profile can set it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+from engine.files.problems import Problems
+from engine.files.yaml_source import YMap, plain
+from engine.loader.substitution import ParamValue, substitute, unresolved
+from engine.values.params import RATE_HZ, CheckContext, Integer, Number, Param, ParamProblem
+
+DEFAULT_RATE_HZ = 10.0
+PRIORITY = Integer(0, 100)
+WAIT_FOR_TURN_S = Number(0.0, 60.0, "s")
+SETTINGS = (
+    Param(
+        "rate_hz",
+        RATE_HZ,
+        DEFAULT_RATE_HZ,
+        f"ticks per second, from {RATE_HZ.minimum:g} to {RATE_HZ.maximum:g}, e.g. 10",
+    ),
+    Param(
+        "priority",
+        PRIORITY,
+        0,
+        "0..100: a tree of higher priority interrupts a lower one for the speaker, the "
+        "face LEDs or a joint, e.g. priority: 40",
+    ),
+    Param(
+        "wait_for_turn_s",
+        WAIT_FOR_TURN_S,
+        0.0,
+        "seconds an action waits while another tree has the speaker, LEDs or joint "
+        "(0: let the action go at once), e.g. wait_for_turn_s: 2",
+    ),
+)
+
+
+@dataclass(frozen=True)
+class TreeSettings:
+    rate_hz: float = DEFAULT_RATE_HZ
+    priority: int = 0
+    wait_for_turn_s: float = 0.0
+
+
+def read_settings(
+    document: YMap, params: dict[str, ParamValue], problems: Problems, ctx: CheckContext
+) -> TreeSettings:
+    """The settings of a tree file (defaults where absent or wrong; problems added)."""
+    values: dict[str, Any] = {}
+    for param in SETTINGS:
+        values[param.name] = param.default
+        raw = document.get(param.name)
+        if raw is None:
+            continue
+        raw = substitute(raw, params, problems)
+        if unresolved(raw):
+            continue
+        try:
+            values[param.name] = param.type.convert(plain(raw), ctx)
+        except ParamProblem as problem:
+            problems.add(raw.mark, f"{param.name!r} {problem.message}", param.doc)
+    return TreeSettings(**values)

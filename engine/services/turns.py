@@ -1,0 +1,165 @@
+"""One voice at a time: the speaker, the face LEDs and each joint are resources.
+
+A tree's service call holds the resources it uses while its job runs. When another tree
+asks for a resource that is held:
+
+- a tree of higher priority interrupts the holder: the holder's tree is halted cleanly
+  (its jobs cancelled, its joints sent to rest) and the call goes through;
+- a tree of the same or lower priority waits for its turn up to its ``wait_for_turn_s``
+  and then lets the action go (the node fails with the reason), or lets it go at once.
+
+Every interruption, wait and yield is told to the ``listeners`` as
+``(t_s, tree, text)``: the timeline prints who yielded to whom.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+from engine.clock import Clock
+from engine.errors import ServiceError
+from engine.services.jobs import Job
+
+SPEAKER = "speaker"
+FACE_LEDS = "face LEDs"
+
+
+def joint_resource(joint: str) -> str:
+    """The resource of one joint: ``left_arm joint``."""
+    return f"{joint} joint"
+
+
+TurnListener = Callable[[float, str, str], None]
+
+
+class TurnYieldedError(ServiceError):
+    """An action was let go because another tree had the resource it needs."""
+
+
+@dataclass
+class Turn:
+    """A tree holding a resource while ``job`` runs."""
+
+    tree: str
+    priority: int
+    job: Job
+
+
+class Turns:
+    """Who holds each resource now, and the rules for taking turns.
+
+    ``interrupt`` halts a tree by name (the robot sets it: halt cleanly, joints to rest).
+    """
+
+    def __init__(self, clock: Clock) -> None:
+        self.clock = clock
+        self._held: dict[str, Turn] = {}
+        self.interrupt: Callable[[str], None] = lambda tree: None
+        self.listeners: list[TurnListener] = []
+
+    def holder(self, resource: str, tree: str) -> Turn | None:
+        """Another tree's turn on ``resource`` that is still running, or None."""
+        turn = self._held.get(resource)
+        if turn is None or turn.tree == tree or turn.job.done():
+            return None
+        return turn
+
+    def blocking(
+        self, resources: Sequence[str], tree: str, priority: int
+    ) -> tuple[str, Turn] | None:
+        """The first of ``resources`` held by another tree of the same or a higher
+        priority, with that tree's turn; None when ``tree`` may go ahead."""
+        for resource in resources:
+            turn = self.holder(resource, tree)
+            if turn is not None and turn.priority >= priority:
+                return resource, turn
+        return None
+
+    def take(self, resources: Sequence[str], tree: str, priority: int) -> None:
+        """Interrupt every lower-priority tree holding one of ``resources``."""
+        for resource in resources:
+            turn = self.holder(resource, tree)
+            if turn is not None and turn.priority < priority:
+                self.tell(tree, f"interrupts {turn.tree} to use the {resource}")
+                self.interrupt(turn.tree)
+                self._held.pop(resource, None)
+
+    def hold(self, resources: Sequence[str], tree: str, priority: int, job: Job) -> None:
+        for resource in resources:
+            self._held[resource] = Turn(tree, priority, job)
+
+    def last_user(self, resource: str) -> str | None:
+        """The tree whose action on ``resource`` started last (its job may be over)."""
+        turn = self._held.get(resource)
+        return turn.tree if turn is not None else None
+
+    def tell(self, tree: str, text: str) -> None:
+        now = self.clock.now()
+        for listener in self.listeners:
+            listener(now, tree, text)
+
+
+class WaitingJob:
+    """An action waiting for its turn: started once nothing of the same or a higher
+    priority holds its resources, or let go (failed with :class:`TurnYieldedError`) when
+    ``deadline_s`` passes first."""
+
+    def __init__(
+        self,
+        turns: Turns,
+        start: Callable[[], Job],
+        resources: Sequence[str],
+        tree: str,
+        priority: int,
+        deadline_s: float,
+        what: str,
+    ) -> None:
+        self._turns = turns
+        self._start = start
+        self._resources = resources
+        self._tree = tree
+        self._priority = priority
+        self._deadline_s = deadline_s
+        self._what = what
+        self._job: Job | None = None
+        self._error: BaseException | None = None
+
+    def done(self) -> bool:
+        if self._job is not None:
+            return self._job.done()
+        if self._error is not None:
+            return True
+        blocked = self._turns.blocking(self._resources, self._tree, self._priority)
+        if blocked is None:
+            self._turns.take(self._resources, self._tree, self._priority)
+            self._job = self._start()
+            self._turns.hold(self._resources, self._tree, self._priority, self._job)
+            return self._job.done()
+        if self._turns.clock.now() >= self._deadline_s:
+            resource, turn = blocked
+            self._error = let_go(self._turns, self._tree, self._what, resource, turn)
+            return True
+        return False
+
+    def error(self) -> BaseException | None:
+        if self._job is not None:
+            return self._job.error()
+        return self._error
+
+    def result(self) -> Any:
+        return self._job.result() if self._job is not None else None
+
+    def cancel(self) -> None:
+        if self._job is not None:
+            self._job.cancel()
+        elif self._error is None:
+            self._error = TurnYieldedError("stopped while waiting for its turn")
+
+
+def let_go(turns: Turns, tree: str, what: str, resource: str, turn: Turn) -> TurnYieldedError:
+    """Tell that ``tree`` lets ``what`` go because ``turn`` has ``resource``; the error
+    its node fails with."""
+    turns.tell(tree, f"yields the {resource} to {turn.tree}: not {what}")
+    return TurnYieldedError(f"{turn.tree} has the {resource} (priority {turn.priority})")
