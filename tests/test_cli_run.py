@@ -42,6 +42,7 @@ def test_every_demo_event_is_answered_by_the_right_behavior_once(capsys, monkeyp
         ("hug", "pink"),
         ("wave_greeting", "green"),
         ("finger_game", "green"),
+        ("finger_game", "off"),  # the run ends mid-game: halted, its lights go out
     ]
     assert [(t, a["joint"], a["angle_deg"]) for t, action, a in actions if action == "servo"] == [
         ("tracking", "neck", 30.0)
@@ -78,7 +79,7 @@ def test_the_timeline_reads_like_a_story(capsys, monkeypatch):
     monkeypatch.chdir(ROOT)
     assert main(["run", "--fast", "--duration", "4"]) == 0
     out = capsys.readouterr().out
-    assert "    1.00  world          pad 3 touched for 0.3 s" in out
+    assert "    1.00  world          middle_back touched for 0.3 s" in out
     assert '    1.00  touch_thanks   says "Thank you"' in out
     assert "    3.00  hug            lights the face pink for 2 s" in out
     assert "tick p99" in out  # the per-tree statistics close the run

@@ -29,12 +29,12 @@ def test_an_older_harness_refuses_to_be_set_after_a_newer_one_was_created() -> N
     TreeHarness.from_file(TOUCH_THANKS)
 
     with pytest.raises(HarnessReplacedError, match="used after another TreeHarness was created"):
-        adult.set("/sensors/touch/any", True)
+        adult.set("/sensors/touch/pat", "middle_back")
 
 
 def test_two_robots_are_compared_one_after_the_other() -> None:
     adult = TreeHarness.from_file(TOUCH_THANKS, TREES / "profiles" / "adult.yaml")
-    adult.set("/sensors/touch/any", True)
+    adult.set("/sensors/touch/pat", "middle_back")
     adult.advance(1.0)
     adult_said = adult.said  # what it did stays readable after it is replaced
 

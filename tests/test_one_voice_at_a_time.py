@@ -46,7 +46,16 @@ A_PAT = "{at: 1.0, touch: {pad: left_shoulder, seconds: 0.3}}"
 def run(tmp_path: Path, capsys, trees: list[Path], *events: str, as_json: bool = False) -> str:
     scenario = tmp_path / "scenario.yaml"
     scenario.write_text("duration_s: 8\nevents:\n" + "".join(f"  - {e}\n" for e in events))
-    args = ["run", "--fast", "--speech", "text", "--scenario", str(scenario), "--dialogs", "dialogs"]
+    args = [
+        "run",
+        "--fast",
+        "--speech",
+        "text",
+        "--scenario",
+        str(scenario),
+        "--dialogs",
+        "dialogs",
+    ]
     assert main([*args, *(["--json"] if as_json else []), "--trees", *map(str, trees)]) == 0
     return capsys.readouterr()
 
@@ -68,7 +77,7 @@ def test_when_two_trees_answer_one_pat_the_higher_priority_speaks_and_the_lower_
     monkeypatch.chdir(ROOT)
     trees = [THANKS, tickles(tmp_path, priority=20)]
     out = run(tmp_path, capsys, trees, A_PAT).out
-    assert "touch_thanks   says \"Thank you\"" in out
+    assert 'touch_thanks   says "Thank you"' in out
     assert "tickles        yields the speaker to touch_thanks: not saying" in out
     assert 'says "Oh, that tickles!"' not in out
 

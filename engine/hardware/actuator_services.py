@@ -161,6 +161,17 @@ class HardwareServos:
         self.angles_deg[joint] = angle_deg
         return TimedFutureJob(future, self.clock, abs(angle_deg - start) / speed)
 
+    def stop(self, joint: str) -> None:
+        """Hold ``joint`` where the Maestro has it now (its target set to its position)."""
+        if joint not in self.joints:
+            return
+
+        def hold(joints: ServoJoints) -> None:
+            joints.move(joint, joints.position_deg(joint), self.joints[joint].max_speed_dps)
+
+        self._on.submit(hold)
+        self.angles_deg.pop(joint, None)  # where it stopped is known to the Maestro
+
     def rest_pose(self, joint: str) -> tuple[float, float | None]:
         """The joint's ``home_deg`` and its safe speed (``rest_speed_dps``)."""
         limits = self.joints.get(joint)

@@ -247,6 +247,26 @@ class CameraConfig:
 
 
 @dataclass(frozen=True)
+class SafetyConfig:
+    """The safety envelope (``safety:``): limits no tree, remote command or button can
+    lift. Distances in mm (to the chest's range sensors), forces in N (the side pads),
+    speeds in deg/s, volume and brightness as fractions 0..1. None: that rule is off.
+
+    ``arms`` are the joints the distance and force rules cover; ``joint_limits`` narrow a
+    joint's angles (deg) below what its servo allows.
+    """
+
+    arms: tuple[str, ...] = ()
+    still_within_mm: float | None = None
+    slow_within_mm: float | None = None
+    slow_speed_dps: float = 20.0
+    stop_above_n: float | None = None
+    max_volume: float = 1.0
+    max_brightness: float = 1.0
+    joint_limits: dict[str, tuple[float, float]] = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
 class RobotConfig:
     """A checked robot config."""
 
@@ -259,6 +279,7 @@ class RobotConfig:
     description: str = ""
     audio: AudioConfig = field(default_factory=AudioConfig)
     camera: CameraConfig | None = None
+    safety: SafetyConfig = field(default_factory=SafetyConfig)
 
     def device(self, name: str) -> DeviceConfig:
         """The device called ``name``; ConfigError naming the nearest and the known ones."""

@@ -34,6 +34,7 @@ from engine.hardware.config_audio import check_audio
 from engine.hardware.config_buses import check_buses
 from engine.hardware.config_camera import check_camera
 from engine.hardware.config_cross_checks import CrossChecks
+from engine.hardware.config_safety import check_safety
 from engine.values.params import (
     RATE_HZ,
     Boolean,
@@ -47,16 +48,8 @@ from engine.values.params import (
     did_you_mean,
 )
 
-TOP_FIELDS = (
-    "name",
-    "description",
-    "simulated",
-    "buses",
-    "gpio",
-    "audio",
-    "camera",
-    "devices",
-)
+TOP_FIELDS: tuple[str, ...] = ("name", "description", "simulated", "buses", "gpio", "audio")
+TOP_FIELDS += ("camera", "devices", "safety")
 DEVICE_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 """A device name: it names ``/devices/<name>/ok`` and is written in trees, so an identifier."""
 # Options whose YAML value is a number but which the drivers take from a fixed set.
@@ -150,7 +143,9 @@ class ConfigChecker:
                 f"a device may not be called {CAMERA_NAME!r}: the camera section has the name",
                 "rename the device, or say camera: none",
             )
+        safety = check_safety(self, document, devices)
         self.problems.raise_if_any()
+        assert safety is not None
         return RobotConfig(
             name=robot_name,
             path=self.path,
@@ -161,6 +156,7 @@ class ConfigChecker:
             description=description,
             audio=audio,
             camera=camera,
+            safety=safety,
         )
 
     def _text(self, document: YMap, key: str, default: str) -> str:

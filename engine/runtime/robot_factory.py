@@ -4,7 +4,9 @@
 blackboard (with the catalogue the trees were checked against), the world a simulated vest
 answers to, the bus managers, drivers, pollers and hardware services, and the trees on a
 scheduler whose hooks poll the devices, and the camera's vision worker when the config
-has a camera. The caller hands in the speech (the assembled
+has a camera. Every speech, LED and servo call passes through the config's safety envelope,
+whose watcher stops the arms between ticks when a person is too close or presses too hard.
+The caller hands in the speech (the assembled
 :class:`~engine.speech.robot_speech.RobotSpeech`, or any Speech service, e.g. a recording
 fake, with heard text then staged as text) and the cloud's service. The caller adds its
 own hooks (a scenario player goes first: the world moves, then the pollers read it, then
@@ -20,6 +22,12 @@ from engine.clock import Clock
 from engine.hardware.assembly import build_hardware
 from engine.hardware.config import RobotConfig
 from engine.hardware.robot_hardware import Hardware
+from engine.hardware.safety_envelope import (
+    EnvelopedServos,
+    EnvelopeWatcher,
+    SafetyEnvelope,
+    with_envelope,
+)
 from engine.hardware.sim_vest import SimVest, UnwiredSenses, build_sim_vest
 from engine.runtime.robot import Behaviors, Robot
 from engine.scenario.world import World
@@ -92,6 +100,8 @@ def build_robot(
     try:
         service = robot_speech.speaker if robot_speech is not None else speech
         services = hardware.services(speech=service, iot=iot, fallback=fallback)  # type: ignore[arg-type]
+        envelope = SafetyEnvelope.of(config, blackboard)
+        services = with_envelope(services, envelope)  # no tree reaches around it
         robot = Robot(
             behaviors, clock=clock, services=services, blackboard=blackboard, action_log=action_log
         )
@@ -101,6 +111,8 @@ def build_robot(
             vest.close()
         raise
     robot.scheduler.hooks.extend(hardware.hooks)
+    assert isinstance(services.servos, EnvelopedServos)
+    robot.scheduler.hooks.append(EnvelopeWatcher(services.servos, envelope, robot.turns.tell))
     if robot_speech is not None:  # the microphone hears the room the world just changed
         robot.scheduler.hooks.append(robot_speech)
     vision = None

@@ -149,8 +149,16 @@ class Scheduler:
     def next_deadline_s(self) -> float:
         return min(tree.next_deadline_s for tree in self.trees)
 
-    def run(self, *, until_s: float | None = None, start_s: float | None = None) -> None:
-        """Tick until :meth:`stop` or, when given, until clock time ``until_s``.
+    def run(
+        self,
+        *,
+        until_s: float | None = None,
+        start_s: float | None = None,
+        halt_at_end: bool = True,
+    ) -> None:
+        """Tick until :meth:`stop` or, when given, until clock time ``until_s``; then halt
+        every tree (the robot stops: joints to rest, LEDs off), unless ``halt_at_end`` is
+        False (a test running the robot a while at a time).
 
         On the first run every tree's first deadline is ``start_s`` (default: now), so
         trees of one rate tick together (one wake-up, one snapshot) and none starts late;
@@ -172,7 +180,7 @@ class Scheduler:
                     break
                 self.step()
         finally:
-            for tree in self.trees:  # nothing keeps speaking or moving after the run
+            for tree in self.trees if halt_at_end else ():  # nothing goes on after the run
                 try:
                     tree.halt()
                 except Exception as error:  # a terminate() failing must not hide the others

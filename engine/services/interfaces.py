@@ -32,6 +32,10 @@ class Servos(Protocol):
         """Where ``joint`` rests and how fast it goes there after a halt: (deg, deg/s)."""
         ...
 
+    def stop(self, joint: str) -> None:
+        """Stop ``joint`` where it is now (a move under way ends there)."""
+        ...
+
 
 ON_REQUEST_SENSORS = ("temperature", "ultrasound")
 """The sensors a tree reads on request (the others are polled onto the blackboard)."""

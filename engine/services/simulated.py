@@ -75,6 +75,7 @@ class SimulatedServos(_Recording):
         self.clock = clock
         self.default_speed_dps = default_speed_dps
         self.angles_deg: dict[str, float] = {}
+        self._moves: dict[str, _ServoMove] = {}
 
     def move(self, joint: str, angle_deg: float, *, speed_dps: float | None = None) -> Job:
         self.calls.append((joint, angle_deg, speed_dps))
@@ -85,7 +86,15 @@ class SimulatedServos(_Recording):
         self.angles_deg[joint] = angle_deg
         speed = speed_dps or self.default_speed_dps
         seconds = abs(angle_deg - start) / speed if speed > 0 else 0.0
-        return _ServoMove(self, joint, start, angle_deg, seconds)
+        move = self._moves[joint] = _ServoMove(self, joint, start, angle_deg, seconds)
+        return move
+
+    def stop(self, joint: str) -> None:
+        """The joint stays where its move under way has got to."""
+        self.calls.append((joint, "stop"))
+        move = self._moves.pop(joint, None)
+        if move is not None:
+            move.cancel()
 
     def rest_pose(self, joint: str) -> tuple[float, float | None]:
         """Every simulated joint rests at 0 deg, going there at a third of the default speed."""

@@ -47,7 +47,7 @@ def tick_for(robot: Robot, clock: VirtualClock, seconds: float) -> None:
 
 
 def test_hot_reload_in_the_middle_of_a_wave_puts_the_arm_down_and_the_lights_out(tmp_path):
-    robot, clock, tree = robot_waving(tmp_path)
+    robot, _, tree = robot_waving(tmp_path)
     servos = robot.services.servos
     assert isinstance(servos, SimulatedServos)
     assert servos.angles_deg["left_arm"] == 80  # up, waiting
@@ -61,7 +61,7 @@ def test_hot_reload_in_the_middle_of_a_wave_puts_the_arm_down_and_the_lights_out
 
 
 def test_stopping_the_robot_mid_wave_puts_the_arm_down(tmp_path):
-    robot, clock, tree = robot_waving(tmp_path)
+    robot, _, _ = robot_waving(tmp_path)
     robot.scheduler.stop()
     robot.scheduler.run()  # ends at once, halting what runs
     servos = robot.services.servos
@@ -75,7 +75,7 @@ def test_stopping_the_robot_mid_wave_puts_the_arm_down(tmp_path):
 
 
 def test_a_behavior_that_finished_is_not_moved_when_the_robot_stops(tmp_path):
-    robot, clock, tree = robot_waving(tmp_path)
+    robot, clock, _ = robot_waving(tmp_path)
     tick_for(robot, clock, 4.0)  # the wave ended: arm down, LEDs off, by the tree
     count = len(robot.action_log.records)
     robot.scheduler.stop()

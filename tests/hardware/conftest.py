@@ -48,8 +48,8 @@ class SimRobot:
         return [text for text, _volume in self.speech.calls]
 
     def run_for(self, seconds: float) -> None:
-        """Tick the robot for ``seconds`` of virtual time."""
-        self.robot.scheduler.run(until_s=self.clock.now() + seconds)
+        """Tick the robot for ``seconds`` of virtual time (what runs goes on after)."""
+        self.robot.scheduler.run(until_s=self.clock.now() + seconds, halt_at_end=False)
 
     def key(self, key: str) -> object:
         return self.blackboard.get(key)

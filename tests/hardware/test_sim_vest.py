@@ -26,7 +26,7 @@ from engine.scenario.world import World
 
 from .conftest import MUXED, ROOT, SimRobot
 
-PINK = (1.0, 0.125, 0.375)
+PINK = (0.8, 0.1, 0.3)  # pink dimmed to sim.yaml's safety max_brightness 0.8
 
 
 def face_duty(robot: SimRobot, led: str = "left_eye") -> tuple[float, float, float]:

@@ -1,0 +1,139 @@
+"""The ``safety:`` section of a robot config: the envelope no tree can switch off.
+
+::
+
+    safety:
+      arms: [left_arm, right_arm]   # joints the distance and force rules cover
+                                    # (default: every joint but the neck)
+      still_within_mm: 100          # no arm moves while anything is closer to the chest
+      slow_within_mm: 300           # closer than this, arms move at most slow_speed_dps
+      slow_speed_dps: 30
+      stop_above_n: 12              # a side force above this stops the arms where they are
+      max_volume: 0.9               # speech at most this loud (0..1)
+      max_brightness: 0.8           # face LEDs at most this bright (0..1)
+      joint_limits:                 # narrower than the servos allow, in degrees
+        left_arm: [-10, 70]
+
+Each rule is checked on every service call (trees, remote commands, buttons) and by a
+watcher between ticks (:mod:`engine.hardware.safety_envelope`).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from engine.files.yaml_source import YList, YMap, describe, plain
+from engine.hardware.chips.fields import ConfigChecks
+from engine.hardware.config import DeviceConfig, SafetyConfig
+from engine.values.params import Number, Param, did_you_mean
+
+OWN_CHECKS = ("arms", "joint_limits")
+FIELDS: tuple[Param[Any], ...] = (
+    Param("still_within_mm", Number(0.0, 5000.0, "mm"), None, "no arm moves this close"),
+    Param("slow_within_mm", Number(0.0, 5000.0, "mm"), None, "slow arm moves this close"),
+    Param("slow_speed_dps", Number(0.1, 1000.0, "deg/s"), 20.0, "arm speed near a person"),
+    Param("stop_above_n", Number(0.1, 1000.0, "N"), None, "side force that stops the arms"),
+    Param("max_volume", Number(0.0, 1.0), 1.0, "loudest speech, 0..1"),
+    Param("max_brightness", Number(0.0, 1.0), 1.0, "brightest face LEDs, 0..1"),
+)
+EXAMPLE = "e.g. safety: {still_within_mm: 100, stop_above_n: 12, max_volume: 0.9}"
+
+
+def check_safety(
+    checker: ConfigChecks, document: YMap, devices: dict[str, DeviceConfig]
+) -> SafetyConfig | None:
+    """The envelope of a config (no rules when the section is absent); None on problems."""
+    joints = {joint.name: joint for d in devices.values() for joint in d.joints}
+    raw = document.get("safety")
+    default_arms = tuple(name for name in joints if name != "neck")
+    if raw is None:
+        return SafetyConfig(arms=default_arms)
+    section = checker.mapping(raw, "'safety'", EXAMPLE)
+    if section is None:
+        return None
+    checker.unknown_fields(section, [*OWN_CHECKS, *(p.name for p in FIELDS)], "safety")
+    entries = {key: value for key, value in section.items() if key not in OWN_CHECKS}
+    values = checker.fields(YMap(entries, section.mark, section.key_marks), FIELDS, "safety")
+    arms = _arms(checker, section, joints, default_arms)
+    limits = _joint_limits(checker, section, joints)
+    if values is None or arms is None or limits is None:
+        return None
+    still, slow = values["still_within_mm"], values["slow_within_mm"]
+    if still is not None and slow is not None and slow < still:
+        checker.problems.add(
+            (section.get("slow_within_mm") or section).mark,
+            f"slow_within_mm {slow:g} is closer than still_within_mm {still:g}",
+            "arms slow down farther out than they stop: slow_within_mm >= still_within_mm",
+        )
+        return None
+    return SafetyConfig(arms=arms, joint_limits=limits, **values)
+
+
+def _unknown_joint(checker: ConfigChecks, item: Any, name: str, joints: dict[str, Any]) -> None:
+    checker.problems.add(
+        item.mark,
+        f"safety names joint {name!r}, which the robot does not have",
+        did_you_mean(name, list(joints)) or "joints: " + (", ".join(joints) or "none"),
+    )
+
+
+def _arms(
+    checker: ConfigChecks, section: YMap, joints: dict[str, Any], default: tuple[str, ...]
+) -> tuple[str, ...] | None:
+    raw = section.get("arms")
+    if raw is None:
+        return default
+    if not isinstance(raw, YList):
+        checker.problems.add(raw.mark, f"'arms' must be a list, got {describe(raw)}", EXAMPLE)
+        return None
+    names: list[str] = []
+    for item in raw:
+        name = str(plain(item))
+        if name not in joints:
+            _unknown_joint(checker, item, name, joints)
+            return None
+        names.append(name)
+    return tuple(names)
+
+
+def _joint_limits(
+    checker: ConfigChecks, section: YMap, joints: dict[str, Any]
+) -> dict[str, tuple[float, float]] | None:
+    raw = section.get("joint_limits")
+    if raw is None:
+        return {}
+    limits_section = checker.mapping(raw, "'joint_limits'", "e.g. {left_arm: [-10, 70]}")
+    if limits_section is None:
+        return None
+    limits: dict[str, tuple[float, float]] = {}
+    for name, value in limits_section.items():
+        where = limits_section.key_marks[name]
+        joint = joints.get(name)
+        if joint is None:
+            _unknown_joint(checker, value, name, joints)
+            return None
+        pair = plain(value)
+        if (
+            not isinstance(pair, list)
+            or len(pair) != 2
+            or any(isinstance(v, bool) or not isinstance(v, int | float) for v in pair)
+            or not pair[0] < pair[1]
+        ):
+            checker.problems.add(
+                value.mark,
+                f"joint_limits of {name!r} must be [lowest, highest] in degrees, "
+                f"got {describe(value)}",
+                "e.g. [-10, 70]",
+            )
+            return None
+        low, high = float(pair[0]), float(pair[1])
+        if low < joint.min_deg or high > joint.max_deg:
+            checker.problems.add(
+                where,
+                f"joint_limits of {name!r} [{low:g}, {high:g}] reach beyond the servo's "
+                f"{joint.min_deg:g}..{joint.max_deg:g} deg",
+                "safety limits narrow a joint's range; they cannot widen it",
+            )
+            return None
+        limits[name] = (low, high)
+    return limits
