@@ -30,6 +30,7 @@ def test_every_demo_event_is_answered_by_the_right_behavior_once(capsys, monkeyp
         ("touch_thanks", "Thank you"),
         ("hug", "I love hugs!"),
         ("wave_greeting", "Hello"),
+        ("buttons", "Well done! That was great."),  # the therapist's button at 7 s
         ("dialog", "The temperature is 72 degrees"),
         ("dialog", "My name is H B S 2"),
         ("iot_command", "hello from the cloud"),
@@ -41,6 +42,8 @@ def test_every_demo_event_is_answered_by_the_right_behavior_once(capsys, monkeyp
     assert [(t, a["color"]) for t, action, a in actions if action == "led"] == [
         ("hug", "pink"),
         ("wave_greeting", "green"),
+        ("wave_greeting", "off"),  # interrupted by the button: its lights go out
+        ("buttons", "green"),
         ("finger_game", "green"),
         ("finger_game", "off"),  # the run ends mid-game: halted, its lights go out
     ]
@@ -49,8 +52,8 @@ def test_every_demo_event_is_answered_by_the_right_behavior_once(capsys, monkeyp
     ]
     reports = [a for t, action, a in actions if action == "report"]
     assert [(r["id"], r["status"]) for r in reports] == [
-        ("cmd-8", "succeeded"),
         ("cmd-9", "succeeded"),
+        ("cmd-10", "succeeded"),
     ]
     # read through the simulated MCP9808, which resolves 1/16 degC
     assert reports[1]["result"]["/sensors/temperature/c"] == pytest.approx(22.2, abs=0.0625)

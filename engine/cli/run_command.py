@@ -23,8 +23,9 @@ import sys
 from collections.abc import Callable
 from pathlib import Path
 
+from engine.buttons.wizard import Wizard
 from engine.cli.output import shown, tell
-from engine.cli.run_inputs import DEFAULT_HARDWARE, load_run_inputs
+from engine.cli.run_inputs import DEFAULT_BUTTONS, DEFAULT_HARDWARE, load_run_inputs
 from engine.cli.timeline import Timeline
 from engine.cli.validate_command import turn_warnings
 from engine.cli.view_options import add_view_arguments, start_view
@@ -110,6 +111,15 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     add_view_arguments(parser)
     parser.add_argument(
+        "--buttons",
+        type=Path,
+        default=None,
+        metavar="FILE",
+        help="the therapist's buttons (a YAML file; default trees/buttons/session.yaml, whose "
+        "buttons a scenario may press): given, a page at /buttons on the view's address "
+        "(--view-port, --view-host) whose presses take over from the behaviors",
+    )
+    parser.add_argument(
         "--record",
         type=Path,
         default=None,
@@ -180,6 +190,7 @@ def main(args: argparse.Namespace) -> int:
         profile=args.profile,
         hardware=args.hardware,
         scenario=args.scenario,
+        buttons=args.buttons or (DEFAULT_BUTTONS if DEFAULT_BUTTONS.is_file() else None),
     )
     behaviors, config, scenario = inputs.behaviors, inputs.config, inputs.scenario
     if args.fast and not config.simulated:
@@ -212,6 +223,11 @@ def main(args: argparse.Namespace) -> int:
         fallback=simulated,
     )
     robot, blackboard = assembled.robot, assembled.blackboard
+    wizard = None
+    if inputs.buttons is not None:  # ticks after the behaviors built from the trees
+        wizard = Wizard(inputs.buttons, robot)
+        robot.scheduler.hooks.append(wizard)
+        assembled.world.listeners.append(wizard)
     reloader: TreeReloader | None = None
     recorder: SessionRecorder | None = None
     view: ViewServer | None = None
@@ -235,7 +251,7 @@ def main(args: argparse.Namespace) -> int:
         )
         timeline.on_closed = robot.scheduler.stop
         on_event: EventListener = timeline.world
-        if args.view:
+        if args.view or args.buttons is not None:  # the page only when asked for
             hub = ViewHub(clock, blackboard.catalogue, device_stats=assembled.hardware.stats)
             hub.begin(start_s, robot.trees)
             robot.scheduler.after_tick.append(hub.tree_ticked)
@@ -244,7 +260,7 @@ def main(args: argparse.Namespace) -> int:
             robot.action_log.listeners.append(hub.action)
             robot.action_log.failure_listeners.append(hub.failed)
             on_event = _both(on_event, hub.world)
-            view = start_view(LiveSource(hub), args)
+            view = start_view(LiveSource(hub), args, wizard=wizard)
         if args.record is not None:
             recorder = SessionRecorder(args.record, clock, blackboard.catalogue)
             recorder.describe(
@@ -259,6 +275,8 @@ def main(args: argparse.Namespace) -> int:
             robot.action_log.listeners.append(recorder.action)
             robot.action_log.failure_listeners.append(recorder.failed)
             on_event = _both(on_event, recorder.world)
+        if wizard is not None:
+            wizard.on_press = on_event  # the timeline and the recording hear each press
         # the world moves first, then the pollers read it, then the trees tick
         robot.scheduler.hooks.insert(
             0, ScenarioPlayer(scenario, assembled.world, start_s=start_s, on_event=on_event)

@@ -15,6 +15,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from engine.blackboard.catalogue import KeyCatalogue, KeySpec, default_catalogue
+from engine.buttons.button_file import ButtonBoard, load_buttons
 from engine.errors import ConfigError
 from engine.files.problems import LoadError, Problem, Problems
 from engine.hardware.chips import default_chips
@@ -23,6 +24,7 @@ from engine.hardware.config_file import load_robot_config
 from engine.hardware.fault_events import check_fault_events
 from engine.hardware.touch_pads import name_scenario_pads, robot_pad_names, unknown_pad
 from engine.loader.tree_definition import NodeDefinition, TreeDefinition
+from engine.loader.tree_file import TreeLoader
 from engine.nodes.registry import NodeRegistry, default_registry
 from engine.nodes.remote import COMMAND_TYPES
 from engine.runtime.robot import Behaviors, load_behaviors
@@ -32,6 +34,7 @@ from engine.values.params import did_you_mean
 DEFAULT_DIALOGS = Path("dialogs")
 DEFAULT_HARDWARE = Path("examples/robots/sim.yaml")
 DEFAULT_SCENARIO = Path("examples/scenarios/demo.yaml")
+DEFAULT_BUTTONS = Path("trees/buttons/session.yaml")
 _DEVICE_OK = "/devices/*/ok"
 
 
@@ -232,6 +235,48 @@ class RunInputs:
     behaviors: Behaviors
     config: RobotConfig
     scenario: Scenario
+    buttons: ButtonBoard | None = None
+
+
+def load_checked_buttons(
+    path: Path, loader: TreeLoader, config: RobotConfig | None, problems: Problems
+) -> ButtonBoard | None:
+    """The therapist's buttons, their actions checked as trees are (against the robot's
+    nodes, keys, pads and dialogs); None with problems added."""
+    try:
+        board = load_buttons(path, loader)
+    except LoadError as error:
+        problems.extend(error.problems)
+        return None
+    lengths = list_lengths(config)
+    for button in board.buttons:
+        if button.tree is not None:
+            problems.extend(check_on_robot(button.tree, config, lengths))
+    return board
+
+
+def check_presses(
+    events: Iterable[ScenarioEvent], board: ButtonBoard | None, buttons: Path | None
+) -> list[Problem]:
+    """A scenario presses only buttons the run has (by label)."""
+    problems: list[Problem] = []
+    labels = [button.label for button in board.buttons] if board is not None else []
+    for event in events:
+        if event.kind != "press":
+            continue
+        if buttons is None:
+            problems.append(
+                Problem(event.mark, "the scenario presses a button", "run with --buttons FILE")
+            )
+        elif board is not None and event.value not in labels:
+            problems.append(
+                Problem(
+                    event.mark,
+                    f"no button labelled {event.value!r} in {buttons}",
+                    did_you_mean(str(event.value), labels) or "buttons: " + ", ".join(labels),
+                )
+            )
+    return problems
 
 
 def load_run_inputs(
@@ -241,6 +286,7 @@ def load_run_inputs(
     profile: str | None,
     hardware: Path,
     scenario: Path | None,
+    buttons: Path | None = None,
 ) -> RunInputs:
     """What ``vest run`` checks at start-up; LoadError listing every problem of every file,
     ConfigError for a file or folder that is not there."""
@@ -256,6 +302,9 @@ def load_run_inputs(
     behaviors = load_checked_behaviors(
         trees, dialogs=folder, profile=profile_path, config=config, problems=problems
     )
+    board = None
+    if buttons is not None and behaviors is not None:
+        board = load_checked_buttons(buttons, behaviors.loader, config, problems)
     loaded: Scenario | None = None
     if config is not None:
         try:
@@ -264,9 +313,10 @@ def load_run_inputs(
             problems.extend(error.problems)
         if loaded is not None:
             problems.extend(check_scenario_events(loaded.events, config))
+            problems.extend(check_presses(loaded.events, board, buttons))
     problems.raise_if_any()
     assert behaviors is not None and config is not None and loaded is not None
-    return RunInputs(behaviors, config, loaded)
+    return RunInputs(behaviors, config, loaded, board)
 
 
 def default_scenario(path: Path | None, *, simulated: bool) -> Scenario:

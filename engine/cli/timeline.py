@@ -95,8 +95,10 @@ class Timeline:
         self._write(line + "\n")
 
     def world(self, at_s: float, event: ScenarioEvent) -> None:
+        """What happened around the robot; a button press is the therapist's."""
         if not self.as_json:
-            self._line(at_s, "world", event.describe())
+            who = "therapist" if event.kind in ("press", "button") else "world"
+            self._line(at_s, who, event.describe())
 
     def blackboard_write(self, key: str, value: Any, at_s: float) -> None:
         """Show what the robot heard, the fingers it saw held up, and a device going

@@ -20,6 +20,7 @@ from engine.cli.run_inputs import (
     check_scenario_events,
     dialogs_folder,
     list_lengths,
+    load_checked_buttons,
     load_config,
     resolve_profile,
     robot_catalogue,
@@ -95,6 +96,8 @@ def kind_of(document: object) -> str | None:
         return "scenario"
     if "devices" in document or "buses" in document:
         return "robot config"
+    if "buttons" in document:
+        return "buttons"
     return None
 
 
@@ -181,6 +184,8 @@ class Validator:
                     self.problems.extend(check_scenario_events(scenario.events, self.config))
             elif kind == "robot config":
                 load_config(path, self.problems)
+            elif kind == "buttons":
+                load_checked_buttons(path, self.loader_for(path), self.config, self.problems)
             else:
                 where = document.mark if document is not None else Mark(str(path), 1, 1)
                 self.problems.add(

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import secrets
 
+from engine.buttons.wizard import Wizard
 from engine.cli.output import tell
 from engine.view.server import ViewServer, ViewSource, is_loopback
 
@@ -34,11 +35,17 @@ def add_view_arguments(parser: argparse.ArgumentParser) -> None:
     )
 
 
-def start_view(source: ViewSource, args: argparse.Namespace) -> ViewServer:
-    """Serve ``source`` as the options say and tell the address on stderr; DeviceError
-    when the port is taken."""
+def start_view(
+    source: ViewSource, args: argparse.Namespace, *, wizard: Wizard | None = None
+) -> ViewServer:
+    """Serve ``source`` (and the buttons of ``wizard``) as the options say and tell the
+    addresses on stderr; DeviceError when the port is taken."""
     token = None if is_loopback(args.view_host) else secrets.token_urlsafe(18)
-    server = ViewServer(source, host=args.view_host, port=args.view_port, token=token)
+    server = ViewServer(
+        source, host=args.view_host, port=args.view_port, token=token, wizard=wizard
+    )
     server.start()
     tell(f"view: {server.url}")
+    if wizard is not None:
+        tell(f"buttons: {server.page_url('/buttons')}")
     return server

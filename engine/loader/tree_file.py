@@ -22,7 +22,6 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
 
 from engine.blackboard.catalogue import KeyCatalogue
 from engine.dialogs.library import DialogLibrary
@@ -37,19 +36,19 @@ from engine.files.yaml_source import (
     plain,
     resolved,
 )
+from engine.loader.node_arguments import node_arguments
 from engine.loader.substitution import (
     ParamValue,
     Profile,
     check_override,
     read_params,
     substitute,
-    unresolved,
 )
 from engine.loader.tree_definition import NodeDefinition, TreeDefinition
 from engine.loader.tree_settings import SETTINGS, read_settings
 from engine.nodes.registry import NodeRegistry
 from engine.nodes.spec import NodeType
-from engine.values.params import CheckContext, ParamProblem, did_you_mean
+from engine.values.params import CheckContext, did_you_mean
 
 TOP_KEYS = ("name", "description", *(setting.name for setting in SETTINGS), "params", "root")
 SUBTREE = "Subtree"
@@ -255,83 +254,26 @@ class TreeLoader:
                 body.mark, f"{type_name} takes {expected[node_type.children]}, got {describe(body)}"
             )
             return None
-        args, name, children_raw = self._arguments(
-            node_type, params_raw, children_raw, mark, problems
+        args, name, children_raw = node_arguments(
+            node_type, params_raw, children_raw, mark, problems, self.check_context
         )
         children = self._children(node_type, children_raw, mark, path, problems, stack, seen)
         if args is None or children is None:
             return None
         return NodeDefinition(node_type, name, args, children, mark)
 
-    def _arguments(
-        self,
-        node_type: NodeType,
-        body: YMap | None,
-        children_raw: YValue | None,
-        mark: Mark,
-        problems: Problems,
-    ) -> tuple[dict[str, Any] | None, str, YValue | None]:
-        structural = {"many": "children", "one": "child"}.get(node_type.children)
-        args: dict[str, Any] = {}
-        name = node_type.name
-        ok = True
-        given = dict(body.items()) if body is not None else {}
-        key_marks = body.key_marks if body is not None else {}
-        if structural and structural in given:
-            children_raw = given.pop(structural)
-        raw_name = given.pop("name", None)
-        if raw_name is not None:
-            if isinstance(raw_name, YScalar) and isinstance(raw_name.value, str | int):
-                name = str(raw_name.value)
-            else:
-                problems.add(raw_name.mark, f"'name' must be text, got {describe(raw_name)}")
-        known = [p.name for p in node_type.params]
-        for key, value in given.items():
-            param = node_type.param(key)
-            if param is not None and unresolved(value):
-                ok = False  # the unknown ${name} is the problem, already reported
-                continue
-            if param is None:
-                options = [*known, "name", *([structural] if structural else [])]
-                hint = did_you_mean(key, options) or (
-                    f"{node_type.name} takes " + (", ".join(options))
-                )
-                problems.add(
-                    key_marks[key], f"unknown parameter {key!r} for {node_type.name}", hint
-                )
-                ok = False
-                continue
-            try:
-                args[key] = param.type.convert(plain(value), self.check_context)
-            except ParamProblem as problem:
-                message = problem.message
-                if message.startswith(("must", "needs", "takes", "item")):
-                    message = f"{key!r} {message}"
-                if isinstance(value, YScalar) and value.via is not None:
-                    # the fix is where the value was written, not where it is used
-                    parameter, written = value.via
-                    message = (
-                        f"parameter {parameter!r} is used as {node_type.name}.{key} "
-                        f"({value.mark}): {message}"
-                    )
-                    problems.add(written, message, problem.hint)
-                else:
-                    problems.add(value.mark, message, problem.hint)
-                ok = False
-        for param in node_type.params:
-            if param.name in args or param.name in given:
-                continue
-            if param.required:
-                problems.add(mark, f"{node_type.name} needs {param.name!r}", param.doc or None)
-                ok = False
-            else:
-                args[param.name] = param.default
-        if ok and node_type.check is not None:
-            for issue in node_type.check(args, self.check_context):
-                where = given[issue.param].mark if issue.param in given else mark
-                problems.add(where, issue.message, issue.hint)
-                ok = False
-        return (args if ok else None), name, children_raw
+    def load_node(
+        self, raw: YMap, path: Path, *, name: str, rate_hz: float, priority: int
+    ) -> TreeDefinition:
+        """A one-node tree from a node written in another file (a button's action), its
+        subtrees relative to ``path``; LoadError listing every problem."""
+        problems, seen = Problems(), _Seen()
+        root = self._node(raw, path, problems, [resolved(path)], seen)
+        problems.raise_if_any()
+        assert root is not None
+        return TreeDefinition(
+            name, rate_hz, "", root, path, seen.files, frozenset(), priority=priority
+        )
 
     def _children(
         self,

@@ -143,24 +143,32 @@ class Robot:
         """Who has the speaker, the face LEDs and each joint; ``turns.listeners`` hear who
         interrupted, waited for or yielded to whom."""
         self.turns.interrupt = self.interrupt
-        staged = with_staged_readings(services, blackboard)  # readings reach every tree
-        node_errors = on_node_error or NodeErrorLog()  # one count per node and error kind
+        self._staged = with_staged_readings(services, blackboard)  # readings reach every tree
+        self._node_errors = on_node_error or NodeErrorLog()  # one count per node and error
         for definition in behaviors.trees:
-            context = TreeContext(
-                tree=definition.name,
-                clock=clock,
-                blackboard=blackboard,
-                actions=TreeActions(
-                    staged,
-                    clock,
-                    definition.name,
-                    self.action_log,
-                    taking=TurnTaking(self.turns, definition.priority, definition.wait_for_turn_s),
-                ),
-                dialogs=behaviors.dialogs,
-                on_node_error=node_errors,
-            )
-            self.scheduler.add(RunningTree(definition, context, definition.build(context)))
+            self.add_tree(definition)
+
+    def add_tree(self, definition: TreeDefinition, *, first: bool = False) -> RunningTree:
+        """Build ``definition`` on this robot (its clock, blackboard, services and turns)
+        and schedule it; ``first``: it ticks before the others due at the same moment."""
+        context = TreeContext(
+            tree=definition.name,
+            clock=self.clock,
+            blackboard=self.blackboard,
+            actions=TreeActions(
+                self._staged,
+                self.clock,
+                definition.name,
+                self.action_log,
+                taking=TurnTaking(self.turns, definition.priority, definition.wait_for_turn_s),
+            ),
+            dialogs=self.behaviors.dialogs,
+            on_node_error=self._node_errors,
+        )
+        tree = self.scheduler.add(RunningTree(definition, context, definition.build(context)))
+        if first:
+            self.scheduler.trees.insert(0, self.scheduler.trees.pop())
+        return tree
 
     @property
     def trees(self) -> list[RunningTree]:

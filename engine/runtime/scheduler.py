@@ -38,6 +38,8 @@ class RunningTree:
     origin_s: float = 0.0
     period_index: int = 0
     stats: TickStats = field(default_factory=TickStats)
+    paused: bool = False
+    """A paused tree keeps its deadlines but is not ticked (the therapist paused it)."""
 
     @property
     def name(self) -> str:
@@ -200,8 +202,13 @@ class Scheduler:
         self.blackboard.commit()
         due = [tree for tree in self.trees if tree.next_deadline_s <= now + 1e-9]
         for tree in due:
-            self._tick(tree)
-        return due
+            if tree.paused:  # its deadlines go by untouched
+                tree.period_index = math.floor((now - tree.origin_s) / tree.period_s)
+                while tree.next_deadline_s <= now + 1e-9:
+                    tree.period_index += 1
+            else:
+                self._tick(tree)
+        return [tree for tree in due if not tree.paused]
 
     def _tick(self, tree: RunningTree) -> None:
         now = self.clock.now()  # hooks and earlier trees of this step count as lateness

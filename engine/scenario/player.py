@@ -97,6 +97,8 @@ def changes_of(event: ScenarioEvent) -> list[tuple[float, Change]]:
         hand = ShownHand(value["fingers"], value["image"], value["video"], seed)
         gone = at + value["seconds"]
         return [(at, _set("hand", hand, "hand")), (gone, _take_away(hand))]
+    if event.kind == "press":
+        return [(at, _happen("press", {"button": value}))]
     if event.kind == "cloud":
         command = {"id": value["id"], "type": value["type"], "args": value["args"] or {}}
         return [(at, _happen("cloud", command))]

@@ -13,6 +13,7 @@
       - {at: 12.5, hear: {text: "what is your name", snr_db: 10}}   # in a noisy room
       - {at: 13.5, hear: {wav: recordings/question.wav}}             # beside the scenario
       - {at: 14.0, cloud: {type: say, args: {text: "hello from the cloud"}}}
+      - {at: 14.5, press: Well done}     # a button of the file given with --buttons
       - {at: 15.0, show_hand: {fingers: 3, seconds: 2}}   # to the simulated camera
       - {at: 18.0, show_hand: {image: pictures/two.png}}  # beside the scenario
       - {at: 21.0, show_hand: {video: clips/counting.avi}}
@@ -124,6 +125,7 @@ EVENT_FIELDS: dict[str, tuple[Param[Any], ...] | ParamType[Any]] = {
         Param("video", Text(), None, "a video, played from this moment"),
         Param("seconds", _SECONDS, 2.0, "how long it is held in front of the camera"),
     ),
+    "press": Text(),
     "cloud": (
         Param("type", Text(), REQUIRED, "command type: say, led, move, read"),
         Param("args", AnyValue(), None, "the command's arguments"),
@@ -178,6 +180,10 @@ class ScenarioEvent:
             return f"{shown} in front of the camera for {value['seconds']:g} s"
         if self.kind == "cloud":
             return f"operator sends {value['type']} {value['args'] or {}}"
+        if self.kind == "press":
+            return f"presses the button {value!r}"
+        if self.kind == "button":
+            return f"presses the button {value['label']!r}"
         return f"{self.kind} {value}"
 
 

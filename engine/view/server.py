@@ -9,7 +9,11 @@ Plain HTTP from the standard library, a thread per connection, beside the robot:
 - ``GET /api/svg/TREE/VERSION`` the tree drawn by Graphviz as ``vest render`` draws it,
   node ``n3`` being the fourth node depth-first;
 - ``GET /api/node?tree=T&version=V&node=N`` a recorded node's status changes;
-- ``GET /api/events`` (live) server-sent events, one JSON change each.
+- ``GET /api/events`` (live) server-sent events, one JSON change each;
+- with buttons (``vest run --buttons``): ``GET /buttons`` the therapist's page,
+  ``GET /api/buttons`` the buttons and what shows, ``GET /api/buttons/events`` the shown
+  set as it changes, ``POST /api/press`` ``{"button": N}`` presses one (JSON only, from the
+  page's own origin: another site cannot press for the therapist).
 
 On loopback (the default) no token is asked; on any other address every request must
 carry ``?token=...`` (the address ``vest run --view`` prints has it).
@@ -33,6 +37,7 @@ from pathlib import Path
 from typing import Any, Protocol
 from urllib.parse import parse_qs, unquote, urlparse
 
+from engine.buttons.wizard import Wizard
 from engine.errors import ConfigError, DeviceError
 from engine.view.hub import Change, ViewHub
 
@@ -42,7 +47,11 @@ STATIC = {
     "/": ("index.html", "text/html; charset=utf-8"),
     "/view.js": ("view.js", "text/javascript; charset=utf-8"),
     "/view.css": ("view.css", "text/css; charset=utf-8"),
+    "/buttons": ("buttons.html", "text/html; charset=utf-8"),
+    "/buttons.js": ("buttons.js", "text/javascript; charset=utf-8"),
+    "/buttons.css": ("buttons.css", "text/css; charset=utf-8"),
 }
+MAX_PRESS_BYTES = 1024
 DOT_TIMEOUT_S = 20.0
 CSP = "default-src 'self'; img-src 'self' data:; style-src 'self' 'unsafe-inline'"
 """Only the page's own files run: a drawing cannot carry a script or a javascript: link."""
@@ -90,15 +99,23 @@ def is_loopback(host: str) -> bool:
 
 
 class ViewServer:
-    """Serves ``source`` on ``host``:``port`` (0: any free port) in a thread of its own."""
+    """Serves ``source`` (and the therapist's buttons, when given a ``wizard``) on
+    ``host``:``port`` (0: any free port) in a thread of its own."""
 
     def __init__(
-        self, source: ViewSource, *, host: str = "127.0.0.1", port: int = 8765, token: str | None
+        self,
+        source: ViewSource,
+        *,
+        host: str = "127.0.0.1",
+        port: int = 8765,
+        token: str | None,
+        wizard: Wizard | None = None,
     ) -> None:
         if not is_loopback(host) and not token:
             raise ConfigError(f"the view on {host} needs a token (only loopback goes without)")
         self.source = source
         self.token = token
+        self.wizard = wizard
         self._svg: dict[tuple[str, int], bytes] = {}
         self._svg_lock = threading.Lock()
         handler = _handler_for(self)
@@ -117,10 +134,14 @@ class ViewServer:
     @property
     def url(self) -> str:
         """The page's address; on every address (0.0.0.0, ::), this machine's name."""
+        return self.page_url("/")
+
+    def page_url(self, page: str) -> str:
+        """The address of ``page`` (``/``, ``/buttons``), with the token when one is needed."""
         host = socket.gethostname() if self.host in ("0.0.0.0", "::") else self.host
         shown = f"[{host}]" if ":" in host else host
         query = f"?token={self.token}" if self.token else ""
-        return f"http://{shown}:{self.port}/{query}"
+        return f"http://{shown}:{self.port}{page}{query}"
 
     def start(self) -> None:
         self._thread.start()
@@ -128,6 +149,8 @@ class ViewServer:
     def stop(self) -> None:
         if isinstance(self.source, LiveSource):
             self.source.hub.close()
+        if self.wizard is not None:
+            self.wizard.close()
         self._server.shutdown()
         self._server.server_close()
 
@@ -170,22 +193,58 @@ def _handler_for(view: ViewServer) -> type[BaseHTTPRequestHandler]:
         def log_message(self, format: str, *args: Any) -> None:
             log.debug("view: " + format, *args)
 
-        def do_GET(self) -> None:
-            url = urlparse(self.path)
-            query = {key: values[-1] for key, values in parse_qs(url.query).items()}
+        def _allowed(self, path: str, query: dict[str, str]) -> bool:
+            """The Host header names this server, and the token is given when needed."""
             if not view.host_allowed(self.headers.get("Host", "")):
                 self._send(403, b"not this host: open the address vest printed\n", "text/plain")
-                return
+                return False
             given = query.get("token", "").encode("utf-8", "replace")
             if (
                 view.token
-                and url.path not in STATIC  # the page itself holds no data; it asks with the token
+                and path not in STATIC  # the page itself holds no data; it asks with the token
                 and not hmac.compare_digest(given, view.token.encode())
             ):
                 self._send(403, b"a token is needed: use the address vest printed\n", "text/plain")
+                return False
+            return True
+
+        def do_GET(self) -> None:
+            url = urlparse(self.path)
+            query = {key: values[-1] for key, values in parse_qs(url.query).items()}
+            if not self._allowed(url.path, query):
                 return
             with contextlib.suppress(BrokenPipeError, ConnectionResetError):  # the page left
                 self._route(url.path, query)
+
+        def do_POST(self) -> None:
+            url = urlparse(self.path)
+            query = {key: values[-1] for key, values in parse_qs(url.query).items()}
+            if not self._allowed(url.path, query):
+                return
+            if url.path != "/api/press" or view.wizard is None:
+                self._send(404, b"not found\n", "text/plain")
+                return
+            origin = self.headers.get("Origin")
+            if origin is not None and urlparse(origin).netloc != self.headers.get("Host"):
+                self._send(403, b"presses come from the buttons page only\n", "text/plain")
+                return
+            kind = self.headers.get("Content-Type", "").split(";")[0].strip()
+            length = _count(self.headers.get("Content-Length", ""))
+            if kind != "application/json" or length is None or length > MAX_PRESS_BYTES:
+                self._send(400, b'send JSON: {"button": N}\n', "text/plain")
+                return
+            try:
+                number = json.loads(self.rfile.read(length)).get("button")
+            except (ValueError, AttributeError):
+                number = None
+            if isinstance(number, bool) or not isinstance(number, int):
+                self._send(400, b'send JSON: {"button": N}\n', "text/plain")
+                return
+            button = view.wizard.press(number)
+            if button is None:
+                self._send(404, b"no such button\n", "text/plain")
+                return
+            self._send(202, json.dumps({"pressed": button.label}).encode(), "application/json")
 
         def _route(self, path: str, query: dict[str, str]) -> None:
             if path in STATIC:
@@ -205,6 +264,12 @@ def _handler_for(view: ViewServer) -> type[BaseHTTPRequestHandler]:
                 self._node(query)
             elif path == "/api/events" and isinstance(view.source, LiveSource):
                 self._events(view.source.hub)
+            elif path == "/api/buttons" and view.wizard is not None:
+                board = view.wizard.board
+                buttons = [button.to_json() for button in board.buttons]
+                self._json({"buttons": buttons, "state": view.wizard.state()})
+            elif path == "/api/buttons/events" and view.wizard is not None:
+                self._button_events(view.wizard)
             else:
                 self._send(404, b"not found\n", "text/plain")
 
@@ -228,12 +293,7 @@ def _handler_for(view: ViewServer) -> type[BaseHTTPRequestHandler]:
         def _events(self, hub: ViewHub) -> None:
             page = hub.subscribe()
             try:
-                self.send_response(200)
-                self.send_header("Content-Type", "text/event-stream")
-                self.send_header("Cache-Control", "no-store")
-                self.end_headers()
-                self.wfile.write(b": connected\n\n")
-                self.wfile.flush()
+                self._stream_start()
                 while True:
                     change = page.changes.get()
                     if change is None:
@@ -247,6 +307,27 @@ def _handler_for(view: ViewServer) -> type[BaseHTTPRequestHandler]:
                     self.wfile.flush()
             finally:
                 hub.unsubscribe(page)
+
+        def _button_events(self, wizard: Wizard) -> None:
+            page = wizard.subscribe()
+            try:
+                self._stream_start()
+                while True:
+                    state = page.get()
+                    self.wfile.write(b"data: " + json.dumps(state).encode() + b"\n\n")
+                    self.wfile.flush()
+                    if state.get("ended"):
+                        break
+            finally:
+                wizard.unsubscribe(page)
+
+        def _stream_start(self) -> None:
+            self.send_response(200)
+            self.send_header("Content-Type", "text/event-stream")
+            self.send_header("Cache-Control", "no-store")
+            self.end_headers()
+            self.wfile.write(b": connected\n\n")
+            self.wfile.flush()
 
         def _json(self, value: Any) -> None:
             self._send(200, json.dumps(value).encode(), "application/json")

@@ -1,0 +1,1 @@
+"""Wizard-of-oz buttons: a therapist's page of buttons that take over the robot."""

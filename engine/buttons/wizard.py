@@ -1,0 +1,219 @@
+"""The therapist's buttons at run time (wizard of oz).
+
+A press comes from the buttons page (any thread), a key on the page, or a scenario; it is
+carried out between ticks by the scheduler hook :meth:`Wizard.__call__`:
+
+- a button that acts (say, led, move, play) halts the autonomous trees that are running
+  and use what it needs (the speaker, the face LEDs, a joint), cleanly (joints to rest,
+  LEDs off), then runs on the buttons' own tree, which outranks every tree; it is
+  answered within one tick of that tree (20 ms);
+- ``pause`` halts every autonomous tree and keeps them from ticking until ``resume``;
+  ``stop`` also halts what a button started.
+
+Every press is told to ``on_press`` (the timeline, the recording) as a ``button`` event.
+Which buttons show depends on what the robot is doing; the page hears the set whenever it
+changes (:meth:`subscribe`).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import dataclasses
+import logging
+import queue
+import threading
+from collections.abc import Callable
+from typing import Any
+
+from engine.buttons.button_file import Button, ButtonBoard, When
+from engine.loader.tree_definition import TreeDefinition
+from engine.loader.tree_resources import tree_resources
+from engine.runtime.robot import Robot
+from engine.runtime.scheduler import RunningTree
+from engine.scenario.scenario_file import ScenarioEvent
+
+_log = logging.getLogger("vest.buttons")
+PressListener = Callable[[float, ScenarioEvent], None]
+PAGE_QUEUE = 16
+"""State updates a page may fall behind by before it is sent only the newest."""
+
+
+class Wizard:
+    """The buttons of ``board`` on ``robot``, on a tree of their own named ``buttons``."""
+
+    def __init__(
+        self, board: ButtonBoard, robot: Robot, *, on_press: PressListener | None = None
+    ) -> None:
+        self.board = board
+        self.robot = robot
+        self.idle = board.idle
+        self.on_press = on_press
+        self.autonomous = list(robot.trees)
+        # first in each step: a press takes what it needs before the behaviors it halted
+        # tick again (and yield)
+        self.tree: RunningTree = robot.add_tree(board.idle, first=True)
+        self.paused = False
+        self.doing: Button | None = None
+        self.presses = 0
+        self._pressed: queue.SimpleQueue[tuple[int, str]] = queue.SimpleQueue()
+        self._lock = threading.Lock()
+        self._pages: list[queue.Queue[dict[str, Any]]] = []
+        self._state: dict[str, Any] = self._current_state()
+
+    # -- from any thread ----------------------------------------------------------------------
+    def press(self, number: int, *, by: str = "page") -> Button | None:
+        """Queue a press of button ``number`` for the next step; None when there is none."""
+        button = self.board.button(number)
+        if button is not None:
+            self._pressed.put((number, by))
+        return button
+
+    def press_label(self, label: str, *, by: str = "scenario") -> Button | None:
+        for button in self.board.buttons:
+            if button.label == label:
+                return self.press(button.number, by=by)
+        return None
+
+    def state(self) -> dict[str, Any]:
+        """What the page shows: the buttons shown, whether paused, what a button does now."""
+        with self._lock:
+            return dict(self._state)
+
+    def subscribe(self) -> queue.Queue[dict[str, Any]]:
+        page: queue.Queue[dict[str, Any]] = queue.Queue(PAGE_QUEUE)
+        with self._lock:
+            self._pages.append(page)
+            page.put(dict(self._state))
+        return page
+
+    def unsubscribe(self, page: queue.Queue[dict[str, Any]]) -> None:
+        with self._lock:
+            if page in self._pages:
+                self._pages.remove(page)
+
+    def close(self) -> None:
+        """Tell every page the session ended."""
+        with self._lock:
+            for page in self._pages:
+                _offer(page, {"ended": True})
+
+    # -- a scenario's presses ---------------------------------------------------------------
+    def world_changed(self, world: Any, what: str) -> None:
+        """Nothing in the world presses a button."""
+
+    def world_event(self, kind: str, value: Any) -> None:
+        if kind == "press":
+            self.press_label(value["button"])
+
+    # -- the scheduler hook -------------------------------------------------------------------
+    def __call__(self, now_s: float) -> None:
+        while True:
+            try:
+                number, by = self._pressed.get_nowait()
+            except queue.Empty:
+                break
+            self._carry_out(self.board.buttons[number], now_s, by)
+        if self.doing is not None and self.tree.status.name in ("SUCCESS", "FAILURE"):
+            self._swap(self.idle)  # done: the buttons' tree idles again
+            self.doing = None
+        self._publish()
+
+    def _carry_out(self, button: Button, now_s: float, by: str) -> None:
+        self.presses += 1
+        if self.on_press is not None and by != "scenario":  # the scenario tells its own
+            event = ScenarioEvent(now_s, "button", {"label": button.label, "by": by}, button.mark)
+            self.on_press(now_s, event)
+        if button.control == "pause":
+            self._pause(True)
+        elif button.control == "resume":
+            self._pause(False)
+        elif button.control == "stop":
+            self._pause(True)
+            self.tree.halt()
+            self._swap(self.idle)
+            self.doing = None
+        elif button.tree is not None:
+            needs = tree_resources(button.tree)
+            for tree in self.autonomous:
+                if tree.status.name == "RUNNING" and needs & tree_resources(tree.definition):
+                    self.robot.turns.tell("buttons", f"interrupts {tree.name} for {button.label!r}")
+                    tree.halt()
+            self._swap(button.tree)
+            self.doing = button
+
+    def _pause(self, paused: bool) -> None:
+        if paused == self.paused:
+            return
+        self.paused = paused
+        for tree in self.autonomous:
+            if paused:
+                tree.halt()
+            else:  # afresh: what happened while paused (a pat, a word) is not answered late
+                tree.replace(dataclasses.replace(tree.definition))
+            tree.paused = paused
+        self.robot.turns.tell(
+            "buttons", "pauses the behaviors" if paused else "resumes the behaviors"
+        )
+
+    def _swap(self, definition: TreeDefinition) -> None:
+        self.tree.swap(definition, definition.build(self.tree.context))
+
+    # -- what the page shows ----------------------------------------------------------------
+    def _shown(self, button: Button) -> bool:
+        when = button.when
+        if when is None:
+            if button.control == "pause":
+                return not self.paused
+            if button.control == "resume":
+                return self.paused
+            return True
+        return self._holds(when)
+
+    def _holds(self, when: When) -> bool:
+        if when.running is not None:
+            return any(
+                t.name == when.running and t.status.name == "RUNNING" for t in self.autonomous
+            )
+        if when.paused is not None:
+            return self.paused == when.paused
+        value = self.robot.blackboard.get(when.key or "")
+        if value is None:
+            return False
+        try:
+            return bool(
+                {
+                    "equals": lambda: value == when.value,
+                    "not_equals": lambda: value != when.value,
+                    "above": lambda: value > when.value,
+                    "below": lambda: value < when.value,
+                }[when.comparison or "equals"]()
+            )
+        except TypeError:  # a value of another kind than the comparison's
+            return False
+
+    def _current_state(self) -> dict[str, Any]:
+        return {
+            "shown": [b.number for b in self.board.buttons if self._shown(b)],
+            "paused": self.paused,
+            "doing": self.doing.label if self.doing is not None else None,
+        }
+
+    def _publish(self) -> None:
+        state = self._current_state()
+        with self._lock:
+            if state == self._state:
+                return
+            self._state = state
+            for page in self._pages:
+                _offer(page, dict(state))
+
+
+def _offer(page: queue.Queue[dict[str, Any]], state: dict[str, Any]) -> None:
+    """Give a page the newest state; a page that fell behind loses the older ones."""
+    while True:
+        try:
+            page.put_nowait(state)
+            return
+        except queue.Full:
+            with contextlib.suppress(queue.Empty):
+                page.get_nowait()

@@ -1,0 +1,93 @@
+// The therapist's buttons: each press goes to the robot, which carries it out within a
+// tick; which buttons show follows what the robot is doing (server-sent events).
+
+const token = new URLSearchParams(location.search).get("token");
+const api = (path) => (token ? `${path}?token=${encodeURIComponent(token)}` : path);
+const $ = (selector) => document.querySelector(selector);
+const byKey = new Map(); // keyboard key -> button id
+const elements = new Map(); // button id -> <button>
+let ended = false;
+
+function keyName(event) {
+  if (event.key === " ") return "Space";
+  return event.key.length === 1 ? event.key.toLowerCase() : event.key;
+}
+
+async function press(id) {
+  const element = elements.get(id);
+  if (ended || !element || element.hidden) return;
+  const response = await fetch(api("/api/press"), {
+    method: "POST",
+    headers: { "Content-Type": "application/json" },
+    body: JSON.stringify({ button: id }),
+  });
+  if (response.ok) {
+    element.classList.add("pressed");
+    setTimeout(() => element.classList.remove("pressed"), 400);
+  } else {
+    $("#state").textContent = `the robot refused: ${await response.text()}`;
+  }
+}
+
+function show(state) {
+  if (state.ended) {
+    ended = true;
+    $("#state").textContent = "the session ended";
+    $("#state").className = "ended";
+    for (const element of elements.values()) element.disabled = true;
+    return;
+  }
+  const shown = new Set(state.shown);
+  for (const [id, element] of elements) {
+    element.hidden = !shown.has(id);
+    element.classList.toggle("doing", element.dataset.label === state.doing);
+  }
+  const what = state.doing ? `doing "${state.doing}"` : "ready";
+  $("#state").textContent = state.paused ? `behaviors paused; ${what}` : what;
+  $("#state").className = state.paused ? "paused" : "";
+}
+
+async function start() {
+  const response = await fetch(api("/api/buttons"));
+  if (!response.ok) {
+    $("#state").textContent = `no buttons here (${response.status})`;
+    return;
+  }
+  const board = await response.json();
+  const container = $("#buttons");
+  for (const button of board.buttons) {
+    const element = document.createElement("button");
+    element.type = "button";
+    element.dataset.label = button.label;
+    element.textContent = button.label; // text, never markup
+    if (button.key) {
+      const key = document.createElement("span");
+      key.className = "key";
+      key.textContent = button.key;
+      element.append(key);
+      byKey.set(button.key, button.id);
+    }
+    if (button.control) element.classList.add(`control-${button.control}`);
+    element.addEventListener("click", () => press(button.id));
+    elements.set(button.id, element);
+    container.append(element);
+  }
+  $("#trees-link").href = api("/");
+  show(board.state);
+  const events = new EventSource(api("/api/buttons/events"));
+  events.onmessage = (message) => show(JSON.parse(message.data));
+  events.onerror = () => {
+    if (!ended) $("#state").textContent = "connection lost: retrying...";
+  };
+}
+
+document.addEventListener("keydown", (event) => {
+  if (event.ctrlKey || event.metaKey || event.altKey || event.repeat) return;
+  const id = byKey.get(keyName(event));
+  if (id !== undefined) {
+    event.preventDefault();
+    press(id);
+  }
+});
+
+start();

@@ -1,0 +1,163 @@
+"""Buttons that take over: the therapist's story.
+
+A button file (trees/buttons/session.yaml) names what each button does. A press pre-empts
+the behaviors that want the same speaker, LEDs or joint (cleanly: lights off, joints to
+rest), is carried out within a tick, shows in the timeline, and is kept in a recording.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from engine.cli import main
+from engine.recording.replay import Recording
+
+ROOT = Path(__file__).resolve().parents[1]
+BUTTONS = ROOT / "trees" / "buttons" / "session.yaml"
+
+
+def run(tmp_path: Path, capsys, *events: str, extra: tuple[str, ...] = ()) -> tuple[str, str]:
+    scenario = tmp_path / "scenario.yaml"
+    scenario.write_text("duration_s: 8\nevents:\n" + "".join(f"  - {e}\n" for e in events))
+    code = main(["run", "--fast", "--speech", "text", "--scenario", str(scenario), *extra])
+    out, err = capsys.readouterr()
+    assert code == 0, err
+    return out, err
+
+
+def lines_after(out: str, text: str) -> list[str]:
+    lines = out.splitlines()
+    start = next(i for i, line in enumerate(lines) if text in line)
+    return [" ".join(line.split()[1:]) for line in lines[start:]]
+
+
+def test_a_button_pressed_mid_hug_speaks_at_once_and_the_hug_gives_way(
+    tmp_path, capsys, monkeypatch
+):
+    monkeypatch.chdir(ROOT)
+    out, _ = run(
+        tmp_path,
+        capsys,
+        "{at: 1.0, squeeze: {left_n: 6.0, right_n: 6.0, seconds: 2.0}}",
+        "{at: 1.2, press: Well done}",
+    )
+    assert lines_after(out, "presses the button")[:6] == [
+        "therapist presses the button 'Well done'",
+        "buttons interrupts hug for 'Well done'",
+        "hug turns the face LEDs off (halted: back to rest)",
+        "buttons lights the face green for 1 s",
+        'buttons says "Well done! That was great."',
+        "hug yields the face LEDs to buttons: not lighting the face pink",
+    ]
+    pressed_at = next(line for line in out.splitlines() if 'says "Well done!' in line)
+    assert pressed_at.split()[0] == "1.20"  # within the tick the press came in
+
+
+def test_while_paused_a_pat_is_not_answered_not_even_after_resuming(tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(ROOT)
+    out, _ = run(
+        tmp_path,
+        capsys,
+        "{at: 1.0, press: Pause}",
+        "{at: 2.0, touch: {pad: middle_back}}",
+        "{at: 3.0, press: Resume}",
+        "{at: 4.0, touch: {pad: upper_back}}",
+    )
+    said = [line for line in out.splitlines() if "touch_thanks   says" in line]
+    assert [line.split()[0] for line in said] == ["4.00"]
+
+
+def test_stop_everything_ends_a_buttons_action_and_pauses_the_behaviors(
+    tmp_path, capsys, monkeypatch
+):
+    monkeypatch.chdir(ROOT)
+    out, _ = run(
+        tmp_path,
+        capsys,
+        "{at: 1.0, press: Look ahead}",
+        "{at: 1.0, gesture: wave}",
+        "{at: 1.5, press: Stop everything}",
+        "{at: 2.0, gesture: wave}",
+    )
+    assert "buttons        pauses the behaviors" in out
+    # the wave at 1.0 is greeted; the one at 2.0, after the stop, is not
+    assert [line.split()[0] for line in out.splitlines() if "wave_greeting  says" in line] == [
+        "1.00"
+    ]
+
+
+def test_the_envelope_refuses_a_button_s_arm_move_while_someone_leans_on_the_chest(
+    tmp_path, capsys, monkeypatch
+):
+    monkeypatch.chdir(ROOT)
+    buttons = tmp_path / "buttons.yaml"
+    buttons.write_text("buttons:\n  - {label: Arm up, move: {joint: left_arm, angle_deg: 45}}\n")
+    out, _ = run(
+        tmp_path,
+        capsys,
+        "{at: 1.0, obstacle: {center_mm: 80, seconds: 2.0}}",
+        "{at: 1.5, press: Arm up}",
+        extra=("--buttons", str(buttons), "--view-port", "0"),
+    )
+    refused = next(line for line in out.splitlines() if "could not" in line)
+    assert refused.split()[1] == "buttons"
+    assert "safety: something is" in refused and "the arms stay still" in refused
+
+
+def test_a_press_is_kept_in_the_session_recording(tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(ROOT)
+    recorded = tmp_path / "session.db"
+    run(tmp_path, capsys, "{at: 1.0, press: Hello}", extra=("--record", str(recorded)))
+    recording = Recording.open(recorded)
+    try:
+        assert (1.0, "press", "presses the button 'Hello'") in recording.world()
+        said = [a for a in recording.actions() if a.action == "say"]
+        assert [(a.tree, a.args["text"]) for a in said] == [
+            ("buttons", "Hello! I am happy to see you.")
+        ]
+    finally:
+        recording.close()
+
+
+def test_a_scenario_pressing_a_button_the_file_lacks_is_refused_with_its_place(
+    tmp_path, capsys, monkeypatch
+):
+    monkeypatch.chdir(ROOT)
+    scenario = tmp_path / "scenario.yaml"
+    scenario.write_text("duration_s: 2\nevents:\n  - {at: 1.0, press: Wel done}\n")
+    assert main(["run", "--fast", "--scenario", str(scenario)]) == 1
+    err = capsys.readouterr().err
+    assert f"{scenario}:3:5: no button labelled 'Wel done'" in err
+    assert "did you mean 'Well done'" in err
+
+
+def check(tmp_path: Path, capsys, text: str) -> str:
+    path = tmp_path / "buttons.yaml"
+    path.write_text(text)
+    assert main(["validate", str(path)]) == 1
+    return capsys.readouterr().err
+
+
+def test_mistakes_in_a_button_file_are_named_at_their_place(tmp_path, capsys):
+    err = check(
+        tmp_path,
+        capsys,
+        "buttons:\n"
+        "  - {label: Hi, say: Hi!, led: green}\n"  # two things at once
+        "  - {label: Ho, key: ctrl, say: Ho}\n"  # not a key
+        "  - {label: Go, do: pasue}\n"  # a typo
+        "  - {label: Up, move: {joint: left_arm, angle: 45}}\n"  # a node's parameter
+        "  - {label: Yo, say: Yo}\n"
+        "  - {label: Yo, say: again}\n",  # two labels alike
+    )
+    assert "buttons.yaml:2:5: button 'Hi' must do one thing: it gives say, led" in err
+    assert "buttons.yaml:3:22: key 'ctrl' is not a key of the keyboard" in err
+    assert "buttons.yaml:4:21: do: must be one of pause, resume, stop, got 'pasue'" in err
+    assert "did you mean 'pause'" in err
+    assert "buttons.yaml:5:41: unknown parameter 'angle' for MoveServo" in err
+    assert "buttons.yaml:7:5: two buttons are labelled 'Yo'" in err
+
+
+def test_the_shipped_button_file_is_valid(capsys, monkeypatch):
+    monkeypatch.chdir(ROOT)
+    assert main(["validate", str(BUTTONS)]) == 0
