@@ -43,11 +43,11 @@ def test_a_button_pressed_mid_hug_speaks_at_once_and_the_hug_gives_way(
     )
     assert lines_after(out, "presses the button")[:6] == [
         "therapist presses the button 'Well done'",
-        "buttons interrupts hug for 'Well done'",
-        "hug turns the face LEDs off (halted: back to rest)",
+        "buttons interrupts hug to use the face LEDs",  # the button's green replaces pink
         "buttons lights the face green for 1 s",
         'buttons says "Well done! That was great."',
         "hug yields the face LEDs to buttons: not lighting the face pink",
+        "hug yields the speaker to buttons: not saying 'I love hugs!'",
     ]
     pressed_at = next(line for line in out.splitlines() if 'says "Well done!' in line)
     assert pressed_at.split()[0] == "1.20"  # within the tick the press came in
@@ -117,6 +117,30 @@ def test_a_press_is_kept_in_the_session_recording(tmp_path, capsys, monkeypatch)
         ]
     finally:
         recording.close()
+
+
+def test_a_button_pressed_while_a_game_waits_for_a_hand_leaves_the_game_going(
+    tmp_path, capsys, monkeypatch
+):
+    monkeypatch.chdir(ROOT)
+    out, _ = run(
+        tmp_path,
+        capsys,
+        "{at: 0.5, show_hand: {fingers: 5, seconds: 1.0}}",  # the game begins
+        "{at: 4.0, press: Show me your hand}",  # shown only while the game runs
+        "{at: 6.0, show_hand: {fingers: 3, seconds: 1.5}}",
+        extra=("--duration", "9"),
+    )
+    assert 'buttons        says "Can you show me your hand?"' in out
+    assert "interrupts finger_game" not in out
+    assert 'finger_game    says "Yes! That\'s three. Well done!"' in out
+
+
+def test_a_button_not_shown_now_does_nothing_and_says_so(tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(ROOT)
+    out, _ = run(tmp_path, capsys, "{at: 1.0, press: Show me your hand}")  # no game runs
+    assert "buttons        'Show me your hand' is not shown now: nothing done" in out
+    assert "Can you show me your hand?" not in out
 
 
 def test_a_scenario_pressing_a_button_the_file_lacks_is_refused_with_its_place(

@@ -42,7 +42,6 @@ def test_every_demo_event_is_answered_by_the_right_behavior_once(capsys, monkeyp
     assert [(t, a["color"]) for t, action, a in actions if action == "led"] == [
         ("hug", "pink"),
         ("wave_greeting", "green"),
-        ("wave_greeting", "off"),  # interrupted by the button: its lights go out
         ("buttons", "green"),
         ("finger_game", "green"),
         ("finger_game", "off"),  # the run ends mid-game: halted, its lights go out

@@ -142,7 +142,9 @@ def test_a_broken_dialog_is_told_once_as_written_and_blames_no_tree(tmp_path, ca
         """\
         name: talk
         root:
-          Reply: {heard: /vars/heard}
+          Sequence:
+            - OnEvent: {key: /speech/heard, save_as: /vars/heard}
+            - Reply: {heard: /vars/heard}
         """,
     )
     told = problems_told(capsys, "validate", "trees/", "dialogs/")
@@ -157,7 +159,7 @@ def test_a_broken_dialog_is_told_once_as_written_and_blames_no_tree(tmp_path, ca
         "--hardware",
         str(ROOT / "examples/robots/sim.yaml"),
         "--scenario",
-        str(ROOT / "examples/scenarios/demo.yaml"),
+        str(ROOT / "examples/scenarios/unplug_touch.yaml"),
     )
     assert ran == told  # and no "no dialog named 'default'" for the tree using it
 
@@ -203,10 +205,12 @@ def test_a_tree_answering_from_dialogs_that_are_not_there_is_refused_by_both(
         """\
         name: talk
         root:
-          Reply: {heard: /vars/heard}
+          Sequence:
+            - OnEvent: {key: /speech/heard, save_as: /vars/heard}
+            - Reply: {heard: /vars/heard}
         """,
     )
     robot = ("--hardware", str(ROOT / "examples/robots/sim.yaml"))
-    scenario = ("--scenario", str(ROOT / "examples/scenarios/demo.yaml"))
+    scenario = ("--scenario", str(ROOT / "examples/scenarios/unplug_touch.yaml"))
     [line] = both_refuse(capsys, trees, *robot, *scenario)
-    assert line == "trees/talk.yaml:3:3: no dialog named 'default' (add dialogs/NAME.yaml)"
+    assert line == "trees/talk.yaml:5:7: no dialog named 'default' (add dialogs/NAME.yaml)"

@@ -102,7 +102,7 @@ def test_a_higher_priority_tree_interrupts_the_lower_one_whose_arm_goes_back_to_
     interrupt = next(i for i, line in enumerate(lines) if "interrupts tickles" in line)
     assert "back_thanks    interrupts tickles to use the speaker" in lines[interrupt]
     assert "tickles        turns left_arm to 0 deg" in lines[interrupt + 1]
-    assert "(halted: back to rest)" in lines[interrupt + 1]
+    assert "(back to rest)" in lines[interrupt + 1]
     assert 'back_thanks    says "Thank you"' in lines[interrupt + 2]
 
 

@@ -44,10 +44,12 @@ FIELDS = ("label", "key", "when", "params", *ACTIONS)
 NAMED_KEYS = ("Escape", "Enter", "Space", *(f"F{n}" for n in range(1, 13)))
 _NODE_OF = {"say": ("Say", "text"), "led": ("SetLed", "color"), "move": ("MoveServo", None)}
 COMPARISONS = ("equals", "not_equals", "above", "below")
+BUTTONS_TREE = "buttons"
+"""The name of the tree a button's action runs on (the timeline's ``buttons`` lines)."""
 BUTTON_PRIORITY = 100
 """A button's action outranks every tree: it interrupts whatever holds what it needs."""
-BUTTON_RATE_HZ = 50.0
-"""How often the buttons' tree ticks: a press is answered within 20 ms."""
+BUTTON_RATE_HZ = 20.0
+"""How often the buttons' tree ticks: a press is answered within 50 ms."""
 
 
 @dataclass(frozen=True)
@@ -131,7 +133,7 @@ def load_buttons(path: Path, loader: TreeLoader) -> ButtonBoard:
     idle = loader.load_node(
         YMap({"Wait": nothing}, here, {"Wait": here}),
         path,
-        name="buttons",
+        name=BUTTONS_TREE,
         rate_hz=BUTTON_RATE_HZ,
         priority=BUTTON_PRIORITY,
     )
@@ -184,7 +186,7 @@ def _button(
         return None
     try:
         tree = loader.load_node(
-            node, path, name="buttons", rate_hz=BUTTON_RATE_HZ, priority=BUTTON_PRIORITY
+            node, path, name=BUTTONS_TREE, rate_hz=BUTTON_RATE_HZ, priority=BUTTON_PRIORITY
         )
     except LoadError as error:
         problems.extend(error.problems)
@@ -239,10 +241,26 @@ def _when(raw: YValue | None, problems: Problems, loader: TreeLoader) -> When | 
         problems.add(raw.mark, f"when: must be a mapping, got {describe(raw)}", example)
         return None
     problems.unknown_fields(raw.key_marks, ("running", "paused", "key", *COMPARISONS), "when")
+    given = [name for name in ("running", "paused", "key") if name in raw]
+    if len(given) > 1:
+        problems.add(raw.mark, f"when: takes one condition, got {', '.join(given)}", example)
+        return None
     if "running" in raw:
-        return When(running=_text(raw.get("running")))
+        running = plain(raw.entries["running"])
+        if not isinstance(running, str) or not running.strip():
+            problems.add(raw.entries["running"].mark, "running: takes a tree's name", example)
+            return None
+        return When(running=running.strip())
     if "paused" in raw:
-        return When(paused=bool(plain(raw.entries["paused"])))
+        paused = plain(raw.entries["paused"])
+        if not isinstance(paused, bool):
+            problems.add(
+                raw.entries["paused"].mark,
+                f"paused: must be true or false, got {paused!r}",
+                "write true or false without quotes",
+            )
+            return None
+        return When(paused=paused)
     key = _text(raw.get("key"))
     compared = [name for name in COMPARISONS if name in raw]
     if key is None or len(compared) != 1:

@@ -3,10 +3,14 @@
 A press comes from the buttons page (any thread), a key on the page, or a scenario; it is
 carried out between ticks by the scheduler hook :meth:`Wizard.__call__`:
 
-- a button that acts (say, led, move, play) halts the autonomous trees that are running
-  and use what it needs (the speaker, the face LEDs, a joint), cleanly (joints to rest,
-  LEDs off), then runs on the buttons' own tree, which outranks every tree; it is
-  answered within one tick of that tree (20 ms);
+- a button that acts (say, led, move, play) runs on the buttons' own tree, which ticks
+  first and outranks every tree: a behavior holding what the press needs (the speaker,
+  the face LEDs, a joint) is halted cleanly (joints to rest, LEDs off) when the press
+  asks for it; behaviors that only wait (a game waiting for a hand) go on. It is answered
+  within one tick of that tree (50 ms). A new press replaces what an earlier press was
+  still doing;
+- a button that is not shown now (its ``when`` does not hold) is not carried out: the
+  page cannot press it, and a scenario's or another client's press of it is told so;
 - ``pause`` halts every autonomous tree and keeps them from ticking until ``resume``;
   ``stop`` also halts what a button started.
 
@@ -25,9 +29,8 @@ import threading
 from collections.abc import Callable
 from typing import Any
 
-from engine.buttons.button_file import Button, ButtonBoard, When
+from engine.buttons.button_file import BUTTONS_TREE, Button, ButtonBoard, When
 from engine.loader.tree_definition import TreeDefinition
-from engine.loader.tree_resources import tree_resources
 from engine.runtime.robot import Robot
 from engine.runtime.scheduler import RunningTree
 from engine.scenario.scenario_file import ScenarioEvent
@@ -123,6 +126,9 @@ class Wizard:
         if self.on_press is not None and by != "scenario":  # the scenario tells its own
             event = ScenarioEvent(now_s, "button", {"label": button.label, "by": by}, button.mark)
             self.on_press(now_s, event)
+        if not self._shown(button):
+            self.robot.turns.tell(BUTTONS_TREE, f"{button.label!r} is not shown now: nothing done")
+            return
         if button.control == "pause":
             self._pause(True)
         elif button.control == "resume":
@@ -133,12 +139,7 @@ class Wizard:
             self._swap(self.idle)
             self.doing = None
         elif button.tree is not None:
-            needs = tree_resources(button.tree)
-            for tree in self.autonomous:
-                if tree.status.name == "RUNNING" and needs & tree_resources(tree.definition):
-                    self.robot.turns.tell("buttons", f"interrupts {tree.name} for {button.label!r}")
-                    tree.halt()
-            self._swap(button.tree)
+            self._swap(button.tree)  # what it needs it takes from whoever holds it
             self.doing = button
 
     def _pause(self, paused: bool) -> None:
@@ -152,7 +153,7 @@ class Wizard:
                 tree.replace(dataclasses.replace(tree.definition))
             tree.paused = paused
         self.robot.turns.tell(
-            "buttons", "pauses the behaviors" if paused else "resumes the behaviors"
+            BUTTONS_TREE, "pauses the behaviors" if paused else "resumes the behaviors"
         )
 
     def _swap(self, definition: TreeDefinition) -> None:

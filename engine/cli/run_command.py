@@ -25,7 +25,12 @@ from pathlib import Path
 
 from engine.buttons.wizard import Wizard
 from engine.cli.output import shown, tell
-from engine.cli.run_inputs import DEFAULT_BUTTONS, DEFAULT_HARDWARE, load_run_inputs
+from engine.cli.run_inputs import (
+    DEFAULT_BUTTONS,
+    DEFAULT_HARDWARE,
+    button_warnings,
+    load_run_inputs,
+)
 from engine.cli.timeline import Timeline
 from engine.cli.validate_command import turn_warnings
 from engine.cli.view_options import add_view_arguments, start_view
@@ -33,6 +38,7 @@ from engine.clock import Clock, EpochClock, RealClock, VirtualClock
 from engine.errors import ConfigError, UsageError
 from engine.files.problems import LoadError
 from engine.files.yaml_source import read_text
+from engine.loader.tree_checks import spoken_quote_warnings
 from engine.recording.recorder import SessionRecorder
 from engine.runtime.reload import TreeReloader
 from engine.runtime.robot import Behaviors
@@ -234,7 +240,10 @@ def main(args: argparse.Namespace) -> int:
     try:
         start_s = clock.now()  # after start-up, which takes simulated time too
         timeline = Timeline(sys.stdout, start_s=start_s, as_json=args.json)
-        for warning in turn_warnings(behaviors.trees):
+        warnings = turn_warnings(behaviors.trees) + spoken_quote_warnings(behaviors.trees)
+        if inputs.buttons is not None:
+            warnings += button_warnings(inputs.buttons, [t.name for t in behaviors.trees])
+        for warning in warnings:
             tell(warning)
         for name, why in assembled.hardware.startup_problems.items():
             tell(f"warning: {shown(name)} did not start ({shown(why)}); it will be tried again")
@@ -251,7 +260,7 @@ def main(args: argparse.Namespace) -> int:
         )
         timeline.on_closed = robot.scheduler.stop
         on_event: EventListener = timeline.world
-        if args.view or args.buttons is not None:  # the page only when asked for
+        if args.view or (args.buttons is not None and not args.fast):  # a page when asked
             hub = ViewHub(clock, blackboard.catalogue, device_stats=assembled.hardware.stats)
             hub.begin(start_s, robot.trees)
             robot.scheduler.after_tick.append(hub.tree_ticked)
@@ -282,7 +291,8 @@ def main(args: argparse.Namespace) -> int:
             0, ScenarioPlayer(scenario, assembled.world, start_s=start_s, on_event=on_event)
         )
         if not args.fast:  # reload work runs beside the scheduler, swaps between ticks
-            reloader = TreeReloader(behaviors.loader, robot.trees, clock)
+            behaving = [tree for tree in robot.trees if wizard is None or tree is not wizard.tree]
+            reloader = TreeReloader(behaviors.loader, behaving, clock)
             robot.scheduler.hooks.append(reloader)
             reloader.start()
         duration = args.duration if args.duration is not None else scenario.duration_s

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from engine.blackboard.catalogue import KeyCatalogue, KeySpec, default_catalogue
-from engine.buttons.button_file import ButtonBoard, load_buttons
+from engine.buttons.button_file import BUTTONS_TREE, ButtonBoard, load_buttons
 from engine.errors import ConfigError
 from engine.files.problems import LoadError, Problem, Problems
 from engine.hardware.chips import default_chips
@@ -23,6 +23,7 @@ from engine.hardware.config import CAMERA_NAME, RobotConfig
 from engine.hardware.config_file import load_robot_config
 from engine.hardware.fault_events import check_fault_events
 from engine.hardware.touch_pads import name_scenario_pads, robot_pad_names, unknown_pad
+from engine.loader.tree_checks import variable_problems
 from engine.loader.tree_definition import NodeDefinition, TreeDefinition
 from engine.loader.tree_file import TreeLoader
 from engine.nodes.registry import NodeRegistry, default_registry
@@ -141,7 +142,39 @@ def check_on_robot(
     """What a tree names that the robot does not have: list items, touch pads."""
     problems = check_items(definition, lengths)
     if config is not None:
-        problems += check_tree_pads(definition, config)
+        problems += check_tree_pads(definition, config) + check_joints(definition, config)
+    return problems
+
+
+def check_joints(definition: TreeDefinition, config: RobotConfig) -> list[Problem]:
+    """Moves of joints the robot does not have, or to angles its servos or its safety
+    envelope will always refuse: each at its node's place."""
+    joints = {joint.name: joint for device in config for joint in device.joints}
+    problems: list[Problem] = []
+    for node in _nodes(definition.root):
+        if node.type.name not in ("MoveServo", "LookToward") or not joints:
+            continue
+        name = str(node.args.get("joint"))
+        joint = joints.get(name)
+        if joint is None:
+            hint = did_you_mean(name, list(joints)) or "joints: " + ", ".join(joints)
+            problems.append(Problem(node.mark, f"the robot has no joint {name!r}", hint))
+            continue
+        angle = node.args.get("angle_deg")
+        if not isinstance(angle, int | float):
+            continue
+        low, high = config.safety.joint_limits.get(name, (joint.min_deg, joint.max_deg))
+        low, high = max(low, joint.min_deg), min(high, joint.max_deg)
+        if not low <= angle <= high:
+            why = "its safety limits" if name in config.safety.joint_limits else "its servo"
+            problems.append(
+                Problem(
+                    node.mark,
+                    f"{name} to {angle:g} deg would always be refused: {why} allow "
+                    f"{low:g}..{high:g} deg",
+                    f"choose an angle from {low:g} to {high:g}",
+                )
+            )
     return problems
 
 
@@ -225,6 +258,7 @@ def load_checked_behaviors(
     lengths = list_lengths(config)
     for definition in behaviors.trees:
         problems.extend(check_on_robot(definition, config, lengths))
+    problems.extend(variable_problems(behaviors.trees, behaviors.loader.catalogue))
     return behaviors
 
 
@@ -253,6 +287,20 @@ def load_checked_buttons(
         if button.tree is not None:
             problems.extend(check_on_robot(button.tree, config, lengths))
     return board
+
+
+def button_warnings(board: ButtonBoard, tree_names: list[str]) -> list[str]:
+    """Buttons shown only while a tree runs that is not run: they never show."""
+    warnings = []
+    for button in board.buttons:
+        running = button.when.running if button.when is not None else None
+        if running is not None and running not in tree_names:
+            hint = did_you_mean(running, tree_names) or "trees run: " + ", ".join(tree_names)
+            warnings.append(
+                f"warning: {button.mark}: button {button.label!r} shows only while "
+                f"{running!r} runs, and no such tree runs ({hint})"
+            )
+    return warnings
 
 
 def check_presses(
@@ -305,6 +353,13 @@ def load_run_inputs(
     board = None
     if buttons is not None and behaviors is not None:
         board = load_checked_buttons(buttons, behaviors.loader, config, problems)
+        for tree in behaviors.trees:
+            if tree.name == BUTTONS_TREE:
+                problems.add(
+                    tree.root.mark,
+                    f"a tree may not be named {BUTTONS_TREE!r}: the therapist's buttons have it",
+                    "rename the tree",
+                )
     loaded: Scenario | None = None
     if config is not None:
         try:

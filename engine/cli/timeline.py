@@ -24,13 +24,13 @@ def describe_action(action: str, args: dict[str, Any]) -> str:
     if action == "say":
         return f'says "{args["text"]}"'
     if action == "led" and args["color"] == "off":
-        return "turns the face LEDs off" + (" (halted: back to rest)" if args.get("rest") else "")
+        return "turns the face LEDs off" + (" (back to rest)" if args.get("rest") else "")
     if action == "led":
         seconds = f" for {args['seconds']:g} s" if args.get("seconds") else ""
         return f"lights the face {args['color']}{seconds}"
     if action == "servo":
         speed = f" at {args['speed_dps']:g} deg/s" if args.get("speed_dps") else ""
-        rest = " (halted: back to rest)" if args.get("rest") else ""
+        rest = " (back to rest)" if args.get("rest") else ""
         return f"turns {args['joint']} to {args['angle_deg']:g} deg{speed}{rest}"
     if action == "read":
         return f"reads the {args['sensor']} sensor"

@@ -12,11 +12,14 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from engine.buttons.button_file import ButtonBoard, load_buttons
 from engine.cli.output import tell
 from engine.cli.run_inputs import (
+    DEFAULT_BUTTONS,
     DEFAULT_DIALOGS,
     DEFAULT_HARDWARE,
     check_on_robot,
+    check_presses,
     check_scenario_events,
     dialogs_folder,
     list_lengths,
@@ -31,6 +34,7 @@ from engine.files.problems import LoadError, Mark, Problem, Problems
 from engine.files.yaml_source import YMap, YScalar
 from engine.hardware.config import RobotConfig
 from engine.loader.substitution import Profile, load_profile, undeclared_params
+from engine.loader.tree_checks import spoken_quote_warnings, variable_problems
 from engine.loader.tree_definition import TreeDefinition
 from engine.loader.tree_file import TreeLoader, shown_path
 from engine.loader.tree_resources import collisions
@@ -182,6 +186,9 @@ class Validator:
                 scenario = load_scenario(path)
                 if self.config is not None:
                     self.problems.extend(check_scenario_events(scenario.events, self.config))
+                buttons = DEFAULT_BUTTONS if DEFAULT_BUTTONS.is_file() else None
+                board = self.buttons(buttons) if buttons is not None else None
+                self.problems.extend(check_presses(scenario.events, board, buttons))
             elif kind == "robot config":
                 load_config(path, self.problems)
             elif kind == "buttons":
@@ -208,6 +215,14 @@ class Validator:
                 self.problems.extend([p for p in error.problems if p.mark.file == str(path)])
         declared = declared_beside(path)
         self.problems.extend(undeclared_params(profile, declared, f"{trees_folder}/"))
+
+    def buttons(self, path: Path) -> ButtonBoard | None:
+        """The button file a scenario's presses are checked against (its own problems are
+        told when it is validated itself)."""
+        try:
+            return load_buttons(path, self.loader_for(path))
+        except LoadError:
+            return None
 
     def check_tree_names(self, files: list[Path]) -> None:
         """Two trees of one folder run together, so their names must differ."""
@@ -260,29 +275,20 @@ def main(args: argparse.Namespace) -> int:
         declared = validator.declared | declared_beside(profile)
         if not problems:
             problems.extend(undeclared_params(validator.profile, declared, where))
+    run_together = [t for t in validator.trees if t.path.parent.name != "parts"]
+    problems.extend(variable_problems(run_together, validator.catalogue))
     if validator.problems:
         # a file met twice (a dialog beside its tree, the robot config named) is told once
         raise LoadError(list(dict.fromkeys(validator.problems.items)))
     if not files:
         raise LoadError([Problem(Mark(str(args.paths[0]), 1, 1), "no YAML files found")])
-    for warning in turn_warnings(validator.trees, by_folder=True):
+    for warning in turn_warnings(run_together) + spoken_quote_warnings(run_together):
         tell(warning)
     print(f"ok: {len(files)} file{'s' if len(files) != 1 else ''}")
     return 0
 
 
-def turn_warnings(trees: list[TreeDefinition], *, by_folder: bool = False) -> list[str]:
+def turn_warnings(trees: list[TreeDefinition]) -> list[str]:
     """Trees run together that can want the same speaker, LEDs or joint at the same
-    priority, each pair as a warning line. ``by_folder``: the trees of one folder are run
-    together (``vest validate``; subtrees in parts/ aside)."""
-    folders: dict[Path, list[TreeDefinition]] = {}
-    for tree in trees:
-        if not by_folder:
-            folders.setdefault(Path(), []).append(tree)
-        elif tree.path.parent.name != "parts":
-            folders.setdefault(tree.path.parent.resolve(), []).append(tree)
-    return [
-        f"warning: {shown_path(c.second.path)}: {c.describe()}"
-        for folder in folders.values()
-        for c in collisions(folder)
-    ]
+    priority, each pair as a warning line."""
+    return [f"warning: {shown_path(c.second.path)}: {c.describe()}" for c in collisions(trees)]

@@ -33,8 +33,10 @@ FIELDS: tuple[Param[Any], ...] = (
     Param("slow_within_mm", Number(0.0, 5000.0, "mm"), None, "slow arm moves this close"),
     Param("slow_speed_dps", Number(0.1, 1000.0, "deg/s"), 20.0, "arm speed near a person"),
     Param("stop_above_n", Number(0.1, 1000.0, "N"), None, "side force that stops the arms"),
-    Param("max_volume", Number(0.0, 1.0), 1.0, "loudest speech, 0..1"),
-    Param("max_brightness", Number(0.0, 1.0), 1.0, "brightest face LEDs, 0..1"),
+    Param("max_volume", Number(0.0, 1.0), 1.0, "loudest speech, a fraction 0..1 (0.9: 90 %)"),
+    Param(
+        "max_brightness", Number(0.0, 1.0), 1.0, "brightest face LEDs, a fraction 0..1 (0.8: 80 %)"
+    ),
 )
 EXAMPLE = "e.g. safety: {still_within_mm: 100, stop_above_n: 12, max_volume: 0.9}"
 
@@ -64,6 +66,15 @@ def check_safety(
             (section.get("slow_within_mm") or section).mark,
             f"slow_within_mm {slow:g} is closer than still_within_mm {still:g}",
             "arms slow down farther out than they stop: slow_within_mm >= still_within_mm",
+        )
+        return None
+    slowest = min((joints[arm].max_speed_dps for arm in arms), default=None)
+    if slow is not None and slowest is not None and values["slow_speed_dps"] > slowest:
+        checker.problems.add(
+            (section.get("slow_speed_dps") or section).mark,
+            f"slow_speed_dps {values['slow_speed_dps']:g} is faster than an arm may move "
+            f"({slowest:g} deg/s)",
+            f"choose at most {slowest:g}",
         )
         return None
     return SafetyConfig(arms=arms, joint_limits=limits, **values)
@@ -117,13 +128,20 @@ def _joint_limits(
             not isinstance(pair, list)
             or len(pair) != 2
             or any(isinstance(v, bool) or not isinstance(v, int | float) for v in pair)
-            or not pair[0] < pair[1]
         ):
             checker.problems.add(
                 value.mark,
                 f"joint_limits of {name!r} must be [lowest, highest] in degrees, "
                 f"got {describe(value)}",
                 "e.g. [-10, 70]",
+            )
+            return None
+        if not pair[0] < pair[1]:
+            checker.problems.add(
+                value.mark,
+                f"joint_limits of {name!r}: the lowest angle {pair[0]:g} is not below the "
+                f"highest {pair[1]:g}",
+                f"write them lowest first: [{min(pair):g}, {max(pair):g}]",
             )
             return None
         low, high = float(pair[0]), float(pair[1])
@@ -133,6 +151,14 @@ def _joint_limits(
                 f"joint_limits of {name!r} [{low:g}, {high:g}] reach beyond the servo's "
                 f"{joint.min_deg:g}..{joint.max_deg:g} deg",
                 "safety limits narrow a joint's range; they cannot widen it",
+            )
+            return None
+        if not low <= joint.home_deg <= high:
+            checker.problems.add(
+                where,
+                f"joint_limits of {name!r} [{low:g}, {high:g}] leave out its home_deg "
+                f"{joint.home_deg:g}: a halted behavior could never bring it back to rest",
+                "include home_deg in the limits",
             )
             return None
         limits[name] = (low, high)

@@ -156,10 +156,13 @@ class EnvelopedLeds:
 
 
 class StoppableMove:
-    """A servo move the watcher can stop: it then fails with the safety reason."""
+    """A servo move the watcher can stop (it then fails with the safety reason); a move
+    cancelled half-way (its tree halted) stops the joint where it is, as the watcher does:
+    a cancelled job alone would not stop a servo already told where to go."""
 
-    def __init__(self, job: Job) -> None:
+    def __init__(self, job: Job, hold_still: Callable[[], None]) -> None:
         self.job = job
+        self.hold_still = hold_still
         self.stopped: SafetyRefusedError | None = None
 
     def stop(self, why: str) -> None:
@@ -176,6 +179,8 @@ class StoppableMove:
         return self.job.result()
 
     def cancel(self) -> None:
+        if not self.done():
+            self.hold_still()
         self.job.cancel()
 
 
@@ -191,9 +196,9 @@ class EnvelopedServos:
         if why is not None:
             return ImmediateJob(error=SafetyRefusedError(why))
         speed = self.envelope.speed_dps(joint, speed_dps)
-        move = self.moving[joint] = StoppableMove(
-            self.inner.move(joint, angle_deg, speed_dps=speed)
-        )
+        started = self.inner.move(joint, angle_deg, speed_dps=speed)
+        move = StoppableMove(started, lambda: self.inner.stop(joint))
+        self.moving[joint] = move
         return move
 
     def rest_pose(self, joint: str) -> tuple[float, float | None]:

@@ -43,7 +43,8 @@ class TreeDefinition:
     declared_params: frozenset[str] = frozenset()
     """Parameter names this tree and its subtrees declare (what a profile may set)."""
     priority: int = 0
-    """0..100: higher interrupts lower for the speaker, the face LEDs and the joints."""
+    """0..99 (100: the therapist's buttons): higher interrupts lower for the speaker, the
+    face LEDs and the joints."""
     wait_for_turn_s: float = 0.0
     """How long an action waits for a resource another tree has (0: let it go at once)."""
 

@@ -20,7 +20,8 @@ from engine.loader.substitution import ParamValue, substitute, unresolved
 from engine.values.params import RATE_HZ, CheckContext, Integer, Number, Param, ParamProblem
 
 DEFAULT_RATE_HZ = 10.0
-PRIORITY = Integer(0, 100)
+PRIORITY = Integer(0, 99)
+"""100 is the therapist's buttons': no tree outranks a press."""
 WAIT_FOR_TURN_S = Number(0.0, 60.0, "s")
 SETTINGS = (
     Param(
@@ -33,7 +34,7 @@ SETTINGS = (
         "priority",
         PRIORITY,
         0,
-        "0..100: a tree of higher priority interrupts a lower one for the speaker, the "
+        "0..99: a tree of higher priority interrupts a lower one for the speaker, the "
         "face LEDs or a joint, e.g. priority: 40",
     ),
     Param(

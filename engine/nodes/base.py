@@ -126,7 +126,9 @@ class Leaf(py_trees.behaviour.Behaviour):
     def terminate(self, new_status: Status) -> None:
         """Pre-empted (INVALID): cancel the service job this node started, if still going."""
         job = getattr(self, "job", None)
-        if new_status == Status.INVALID and job is not None and not job.done():
+        if new_status != Status.INVALID or job is None:
+            return
+        if getattr(job, "waiting", False) or not job.done():  # asking a waiting job starts it
             job.cancel()
 
     # -- the safety net -----------------------------------------------------------------

@@ -86,7 +86,7 @@ def tree_schema(registry: NodeRegistry) -> dict[str, Any]:
             "name": {"type": "string"},
             "description": {"type": "string"},
             "rate_hz": _value({"type": "number", "exclusiveMinimum": 0, "maximum": 1000}),
-            "priority": _value({"type": "integer", "minimum": 0, "maximum": 100}),
+            "priority": _value({"type": "integer", "minimum": 0, "maximum": 99}),
             "wait_for_turn_s": _value({"type": "number", "minimum": 0, "maximum": 60}),
             "params": {"type": "object", "description": "parameters used as ${name}"},
             "root": _NODE,

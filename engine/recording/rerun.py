@@ -5,6 +5,9 @@ Everything the robot sensed in the recording (every blackboard write but the tre
 ``/vars/``) is staged again at its moment, on a virtual clock, for the trees given; their
 actions are compared with the recorded ones. A therapist's edit (a threshold, a phrase)
 is then checked against a real session before it meets a child.
+
+The therapist's button presses are not played again: the buttons' own actions, and the
+moves back to rest of the trees they interrupted, are left out of the comparison.
 """
 
 from __future__ import annotations
@@ -20,6 +23,7 @@ from engine.blackboard.catalogue import (
     ULTRASOUND_CM,
     VARIABLES_PREFIX,
 )
+from engine.buttons.button_file import BUTTONS_TREE
 from engine.clock import VirtualClock
 from engine.recording.replay import RecordedAction, Recording
 from engine.runtime.robot import Behaviors, Robot
@@ -107,13 +111,18 @@ def _sensed(recording: Recording) -> list[tuple[float, str, object, bool]]:
     return sorted(rows, key=lambda row: row[0])
 
 
+def _compared(action: RecordedAction) -> bool:
+    """Whether the trees' own logic took ``action`` (not a button, not a rest after a halt)."""
+    return action.tree != BUTTONS_TREE and not action.args.get("rest")
+
+
 def compare(
     recorded: list[RecordedAction], now: list[RecordedAction], tolerance_s: float = TOLERANCE_S
 ) -> list[ActionDifference]:
     """The actions only one side took, in time order (empty: the trees act as before)."""
-    unmatched = list(now)
+    unmatched = [action for action in now if _compared(action)]
     differences = []
-    for action in recorded:
+    for action in filter(_compared, recorded):
         match = next(
             (
                 other

@@ -220,6 +220,11 @@ class Scheduler:
             tree.stats.errors += 1
             _log.error("%s: tick failed: %s: %s", tree.name, type(error).__name__, error)
         tree.stats.record(self._measure() - started, max(0.0, lateness))
+        status = tree.status
+        if status == py_trees.common.Status.FAILURE:  # gave up half-way: nothing left raised
+            tree.context.actions.settle()
+        elif status == py_trees.common.Status.SUCCESS:  # done as the tree meant
+            tree.context.actions.forget()
         for observer in self.after_tick:
             try:
                 observer(tree)

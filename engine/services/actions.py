@@ -196,7 +196,8 @@ class TreeActions:
         if blocked is None:
             turns.take(uses, self.tree, priority)
             job = begin()
-            turns.hold(uses, self.tree, priority, job)
+            if not (job.done() and job.error() is not None):  # a refused call holds nothing
+                turns.hold(uses, self.tree, priority, job)
             return job
         resource, turn = blocked
         if taking.wait_for_turn_s <= 0:
@@ -218,9 +219,10 @@ class TreeActions:
         )
 
     def settle(self) -> list[Job]:
-        """After the tree was halted in the middle: each joint it moved goes back to its
-        rest pose at its safe speed, and the face LEDs it lit go off, unless another tree
-        used them since. Not subject to turns: a halted tree always comes to rest."""
+        """After the tree was halted in the middle, or gave up half-way (its round
+        failed): each joint it moved since its last finished round goes back to its rest
+        pose at its safe speed, and the face LEDs it lit go off, unless another tree used
+        them since. Not subject to turns: a halted tree always comes to rest."""
         jobs: list[Job] = []
         for joint in sorted(self._moved):
             if self._last_user(joint_resource(joint)):
@@ -232,9 +234,13 @@ class TreeActions:
         if self._lit and self._last_user(FACE_LEDS):
             off = lambda: self.services.leds.set_color("off")  # noqa: E731
             jobs.append(self._call("led", {"color": "off", "rest": True}, off))
+        self.forget()
+        return jobs
+
+    def forget(self) -> None:
+        """The tree finished a round as it meant to: what it moved and lit stays so."""
         self._moved.clear()
         self._lit = False
-        return jobs
 
     def _mover(self, joint: str, angle_deg: float, speed_dps: float | None) -> Callable[[], Job]:
         return lambda: self.services.servos.move(joint, angle_deg, speed_dps=speed_dps)

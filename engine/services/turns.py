@@ -20,7 +20,7 @@ from typing import Any
 
 from engine.clock import Clock
 from engine.errors import ServiceError
-from engine.services.jobs import Job
+from engine.services.jobs import ImmediateJob, Job
 
 SPEAKER = "speaker"
 FACE_LEDS = "face LEDs"
@@ -83,8 +83,10 @@ class Turns:
             turn = self.holder(resource, tree)
             if turn is not None and turn.priority < priority:
                 self.tell(tree, f"interrupts {turn.tree} to use the {resource}")
+                # the resource is the newcomer's before the halted tree comes to rest, so
+                # that tree does not send it home just before the newcomer's own move
+                self._held[resource] = Turn(tree, priority, ImmediateJob())
                 self.interrupt(turn.tree)
-                self._held.pop(resource, None)
 
     def hold(self, resources: Sequence[str], tree: str, priority: int, job: Job) -> None:
         for resource in resources:
@@ -126,6 +128,11 @@ class WaitingJob:
         self._job: Job | None = None
         self._error: BaseException | None = None
 
+    @property
+    def waiting(self) -> bool:
+        """Still waiting for its turn (asking :meth:`done` may start it)."""
+        return self._job is None and self._error is None
+
     def done(self) -> bool:
         if self._job is not None:
             return self._job.done()
@@ -134,9 +141,10 @@ class WaitingJob:
         blocked = self._turns.blocking(self._resources, self._tree, self._priority)
         if blocked is None:
             self._turns.take(self._resources, self._tree, self._priority)
-            self._job = self._start()
-            self._turns.hold(self._resources, self._tree, self._priority, self._job)
-            return self._job.done()
+            job = self._job = self._start()
+            if not (job.done() and job.error() is not None):
+                self._turns.hold(self._resources, self._tree, self._priority, job)
+            return job.done()
         if self._turns.clock.now() >= self._deadline_s:
             resource, turn = blocked
             self._error = let_go(self._turns, self._tree, self._what, resource, turn)

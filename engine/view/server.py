@@ -27,6 +27,7 @@ import ipaddress
 import json
 import logging
 import math
+import queue
 import re
 import shutil
 import socket
@@ -52,6 +53,9 @@ STATIC = {
     "/buttons.css": ("buttons.css", "text/css; charset=utf-8"),
 }
 MAX_PRESS_BYTES = 1024
+POST_READ_TIMEOUT_S = 5.0
+KEEPALIVE_S = 15.0
+"""A stream with nothing to say writes a comment this often: a page that left is noticed."""
 DOT_TIMEOUT_S = 20.0
 CSP = "default-src 'self'; img-src 'self' data:; style-src 'self' 'unsafe-inline'"
 """Only the page's own files run: a drawing cannot carry a script or a javascript: link."""
@@ -217,6 +221,10 @@ def _handler_for(view: ViewServer) -> type[BaseHTTPRequestHandler]:
                 self._route(url.path, query)
 
         def do_POST(self) -> None:
+            with contextlib.suppress(BrokenPipeError, ConnectionResetError, TimeoutError):
+                self._post()
+
+        def _post(self) -> None:
             url = urlparse(self.path)
             query = {key: values[-1] for key, values in parse_qs(url.query).items()}
             if not self._allowed(url.path, query):
@@ -233,17 +241,23 @@ def _handler_for(view: ViewServer) -> type[BaseHTTPRequestHandler]:
             if kind != "application/json" or length is None or length > MAX_PRESS_BYTES:
                 self._send(400, b'send JSON: {"button": N}\n', "text/plain")
                 return
+            self.connection.settimeout(POST_READ_TIMEOUT_S)  # a body promised but not sent
+            body = self.rfile.read(length)
             try:
-                number = json.loads(self.rfile.read(length)).get("button")
-            except (ValueError, AttributeError):
+                number = json.loads(body).get("button") if len(body) == length else None
+            except (ValueError, AttributeError, RecursionError):
                 number = None
             if isinstance(number, bool) or not isinstance(number, int):
                 self._send(400, b'send JSON: {"button": N}\n', "text/plain")
                 return
-            button = view.wizard.press(number)
-            if button is None:
+            if view.wizard.board.button(number) is None:
                 self._send(404, b"no such button\n", "text/plain")
                 return
+            if number not in view.wizard.state()["shown"]:
+                self._send(409, b"that button is not shown now\n", "text/plain")
+                return
+            button = view.wizard.press(number)
+            assert button is not None
             self._send(202, json.dumps({"pressed": button.label}).encode(), "application/json")
 
         def _route(self, path: str, query: dict[str, str]) -> None:
@@ -269,7 +283,8 @@ def _handler_for(view: ViewServer) -> type[BaseHTTPRequestHandler]:
                 buttons = [button.to_json() for button in board.buttons]
                 self._json({"buttons": buttons, "state": view.wizard.state()})
             elif path == "/api/buttons/events" and view.wizard is not None:
-                self._button_events(view.wizard)
+                with contextlib.suppress(BrokenPipeError, ConnectionResetError):
+                    self._button_events(view.wizard)
             else:
                 self._send(404, b"not found\n", "text/plain")
 
@@ -313,7 +328,12 @@ def _handler_for(view: ViewServer) -> type[BaseHTTPRequestHandler]:
             try:
                 self._stream_start()
                 while True:
-                    state = page.get()
+                    try:
+                        state = page.get(timeout=KEEPALIVE_S)
+                    except queue.Empty:
+                        self.wfile.write(b": still here\n\n")  # raises once the page left
+                        self.wfile.flush()
+                        continue
                     self.wfile.write(b"data: " + json.dumps(state).encode() + b"\n\n")
                     self.wfile.flush()
                     if state.get("ended"):

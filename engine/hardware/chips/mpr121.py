@@ -16,7 +16,7 @@ from engine.hardware.chips.kind import ChipKind, SimPlacement
 from engine.hardware.config import ChipSpec, DeviceConfig
 from engine.hardware.managed_buses import ManagedI2C
 from engine.hardware.readings import PollParts, PollSetup, Staged
-from engine.hardware.touch_pads import pad_names
+from engine.hardware.touch_pads import default_pad_name, pad_names
 from engine.values.params import Integer, Param
 
 _PAD_NAME = re.compile(r"[a-z][a-z0-9_]*\Z")
@@ -99,6 +99,13 @@ def _check_pad_names(fields: ChipFields) -> tuple[str, ...] | None:
                 f"pad name {describe(item)} (electrode {electrode}) must be a lower-case word "
                 "like left_shoulder",
                 "letters, digits and _, starting with a letter",
+            )
+            return None
+        if re.fullmatch(r"pad_[0-9]+", name) and name != default_pad_name(electrode):
+            fields.checker.problems.add(
+                item.mark,
+                f"pad name {name!r} (electrode {electrode}) is the name of another electrode",
+                "name it after where it is, e.g. upper_back",
             )
             return None
         if name in names:
