@@ -104,9 +104,7 @@ buttons:
     assert "running: takes a tree's name" in told
 
 
-def test_safety_limits_that_would_keep_an_arm_from_rest_or_its_speed_are_refused(
-    tmp_path, capsys
-):
+def test_safety_limits_that_would_keep_an_arm_from_rest_or_its_speed_are_refused(tmp_path, capsys):
     config = SIM.read_text().replace(
         "  slow_speed_dps: 30", "  slow_speed_dps: 100\n  joint_limits: {left_arm: [10, 70]}"
     )
