@@ -35,7 +35,7 @@ def test_dot_render_has_one_graph_node_per_tree_node(capsys, monkeypatch):
     dot = capsys.readouterr().out
     assert dot.startswith('digraph "wave_greeting" {')
     # Sequence, OnEvent, Cooldown, the subtree's Parallel, SetLed and Say
-    assert dot.count("label=") == 6 + 1  # and the title
+    assert dot.count("label=") == 6 + 1 + 2 + 4  # the title, a subtree frame, the legend
 
 
 def test_svg_render_needs_graphviz_and_says_so_when_it_is_missing(tmp_path, monkeypatch, capsys):
@@ -75,3 +75,21 @@ def test_an_output_file_that_cannot_be_written_is_named_with_the_reason(capsys, 
     monkeypatch.chdir(ROOT)
     assert main(["render", "trees/hug.yaml", "-o", "/nonexistent/hug.txt"]) == 1
     assert "-o /nonexistent/hug.txt: No such file or directory" in capsys.readouterr().err
+
+
+def test_a_drawing_speaks_plainly_frames_subtrees_and_has_a_legend(capsys, monkeypatch):
+    monkeypatch.chdir(ROOT)
+    assert main(["render", "trees/wave_greeting.yaml", "--format", "dot"]) == 0
+    dot = capsys.readouterr().out
+    assert 'label="in order"' in dot  # a Sequence
+    assert 'label="at the same time"' in dot  # the subtree's Parallel
+    assert 'label="rest 2 s after acting"' in dot  # the Cooldown
+    assert 'label="parts/greet.yaml"' in dot  # the subtree, framed
+    assert "cluster_legend" in dot and "a question (yes / no)" in dot
+    assert "(10 times a second, priority 30)" in dot
+
+
+def test_a_wide_tree_is_laid_out_left_to_right(capsys, monkeypatch):
+    monkeypatch.chdir(ROOT)
+    assert main(["render", "trees/finger_game.yaml", "--format", "dot"]) == 0
+    assert "rankdir=LR" in capsys.readouterr().out

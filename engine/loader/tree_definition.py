@@ -28,6 +28,8 @@ class NodeDefinition:
     args: dict[str, Any]
     children: list[NodeDefinition]
     mark: Mark
+    subtree: str | None = None
+    """For the root of an included subtree: the file it came from, as written."""
 
 
 @dataclass

@@ -2,11 +2,19 @@
 
 Nodes are numbered in depth-first order, ``n0`` being the root: the dot source names
 each node so, and :func:`preorder` walks a tree's definitions in that same order.
+
+The drawing is for people who do not program: composites and decorators say what they do
+in plain words ("in order", "first that works", "at the same time", "rest 5 s"), labels
+are wrapped to a few words a line, an included subtree is framed with its file's name, a
+legend says what the shapes mean, and a tree wider than it is deep is laid out left to
+right so twenty nodes stay readable.
 """
 
 from __future__ import annotations
 
+import textwrap
 from collections.abc import Iterator
+from typing import Any
 
 from engine.loader.tree_definition import NodeDefinition, TreeDefinition
 from engine.values.templates import CompiledTemplate
@@ -43,6 +51,61 @@ def label(node: NodeDefinition) -> str:
     return " ".join(parts)
 
 
+_PLAIN = {
+    "Sequence": "in order",
+    "Selector": "first that works",
+    "Parallel": "at the same time",
+    "Inverter": "not",
+    "ForceSuccess": "either way",
+    "OneShot": "only once",
+}
+WRAP = 26
+"""Characters a drawn label's line holds."""
+LEGEND = (
+    ("condition", "a question (yes / no)"),
+    ("action", "something the robot does"),
+    ("composite", "how its children run"),
+    ("decorator", "a rule for its child"),
+)
+
+
+def plain_label(node: NodeDefinition) -> str:
+    """What a node does, in a few words a line (for drawings people read)."""
+    args, kind = node.args, node.type.name
+    if kind in _PLAIN:
+        head = _PLAIN[kind]
+        if kind == "OneShot" and args.get("after") == "completion":
+            head = "only once, even failed"
+    elif kind == "Cooldown":
+        start = " (from the start)" if args.get("counting_from") == "start" else ""
+        head = f"rest {args['seconds']:g} s after acting{start}"
+    elif kind == "Timeout":
+        head = f"at most {args['seconds']:g} s"
+    elif kind in ("Repeat", "Retry"):
+        head = f"{'repeat' if kind == 'Repeat' else 'retry'} {args['times']} times"
+    else:
+        parts = [kind]
+        for param in node.type.params:
+            value = args.get(param.name)
+            if value is None or value == param.default:
+                continue
+            parts.append(f"{param.name}: {_shown(value)}")
+        head = "\n".join(
+            "\n".join(textwrap.wrap(part, WRAP, break_on_hyphens=False)) for part in parts
+        )
+    if node.name != node.type.name:
+        head = f"{node.name}\n{head}"
+    return head
+
+
+def _shown(value: Any) -> str:
+    if isinstance(value, CompiledTemplate):
+        return f'"{value.source}"'
+    if isinstance(value, list):
+        return ", ".join(str(item) for item in value)
+    return f"{value:g}" if isinstance(value, float) else str(value)
+
+
 def ascii_tree(definition: TreeDefinition) -> str:
     lines = [f"{definition.name} ({definition.rate_hz:g} Hz)"]
 
@@ -63,26 +126,64 @@ def escape(text: str) -> str:
 
 
 def dot_source(definition: TreeDefinition) -> str:
+    """The tree as Graphviz dot, nodes named ``n0..`` depth-first (the live view colors
+    them by these names)."""
     name = escape(definition.name)
+    widest = max(_widths(definition.root).values())
+    deepest = max(depth for _, depth in preorder(definition.root))
+    direction = "LR" if widest > 6 and widest > deepest else "TB"
+    priority = f", priority {definition.priority}" if definition.priority else ""
     lines = [
         f'digraph "{name}" {{',
-        "  graph [rankdir=TB, fontname=Helvetica];",
-        "  node [style=filled, fontname=Helvetica, fontsize=11];",
-        f'  title [shape=plaintext, style="", label="{name} ({definition.rate_hz:g} Hz)"];',
+        f"  graph [rankdir={direction}, ordering=out, fontname=Helvetica, nodesep=0.25,"
+        " ranksep=0.35];",
+        '  node [style=filled, fontname=Helvetica, fontsize=11, margin="0.12,0.06"];',
+        "  edge [arrowsize=0.6];",
+        f'  title [shape=plaintext, style="", fontsize=13, '
+        f'label="{name} ({definition.rate_hz:g} times a second{priority})"];',
     ]
     counter = iter(range(1_000_000))
+    clusters = iter(range(1_000_000))
 
-    def walk(node: NodeDefinition) -> str:
+    def walk(node: NodeDefinition, indent: str) -> str:
         ident = f"n{next(counter)}"
+        if node.subtree is not None:
+            lines.append(f"{indent}subgraph cluster_{next(clusters)} {{")
+            lines.append(
+                f'{indent}  label="{escape(node.subtree)}"; style="rounded,dashed"; '
+                'color="#78909C"; fontname=Helvetica; fontsize=10;'
+            )
+            inner = indent + "  "
+        else:
+            inner = indent
         kind = node.type.kind
         lines.append(
-            f'  {ident} [shape={_SHAPES[kind]}, fillcolor="{_COLORS[kind]}", '
-            f'label="{escape(label(node))}"];'
+            f'{inner}{ident} [shape={_SHAPES[kind]}, fillcolor="{_COLORS[kind]}", '
+            f'label="{escape(plain_label(node)).replace(chr(92) * 2 + "n", chr(92) + "n")}"];'
         )
-        for child in node.children:
-            lines.append(f"  {ident} -> {walk(child)};")
+        edges = [f"{inner}{ident} -> {walk(child, inner)};" for child in node.children]
+        lines.extend(edges)
+        if node.subtree is not None:
+            lines.append(f"{indent}}}")
         return ident
 
-    root = walk(definition.root)
-    lines += [f"  title -> {root} [style=invis];", "}"]
+    root = walk(definition.root, "  ")
+    lines.append(f"  title -> {root} [style=invis];")
+    lines.append('  subgraph cluster_legend { label="legend"; fontname=Helvetica; fontsize=10;')
+    lines.append('    style="rounded"; color="#B0BEC5";')
+    for index, (kind, meaning) in enumerate(LEGEND):
+        lines.append(
+            f'    legend{index} [shape={_SHAPES[kind]}, fillcolor="{_COLORS[kind]}", '
+            f'fontsize=9, label="{meaning}"];'
+        )
+    lines.append("  }")
+    lines.append("}")
     return "\n".join(lines) + "\n"
+
+
+def _widths(root: NodeDefinition) -> dict[int, int]:
+    """How many nodes each depth holds."""
+    widths: dict[int, int] = {}
+    for _, depth in preorder(root):
+        widths[depth] = widths.get(depth, 0) + 1
+    return widths

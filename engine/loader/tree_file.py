@@ -350,4 +350,6 @@ class TreeLoader:
         raw_name = body.get("name")
         if root is not None and isinstance(raw_name, YScalar) and raw_name.value:
             root.name = str(raw_name.value)
+        if root is not None:
+            root.subtree = str(file_value.value)
         return root
