@@ -19,6 +19,7 @@ import yaml
 
 from engine.files.problems import LoadError, Mark, Problem
 from engine.files.yaml_events import STANDARD_TAGS, NeedsCarefulReading, compose_fast
+from engine.files.yaml_slips import explain
 from engine.files.yaml_values import (
     LONE_SURROGATE,
     YList,
@@ -351,6 +352,10 @@ def parse_yaml(text: str, name: str) -> YValue | None:
         mark = error.problem_mark or error.context_mark
         where = _mark(name, mark) if mark is not None else Mark(name, 1, 1)
         problem = error.problem or "cannot be read"
+        slip = explain(text, where.line, problem, error.context)
+        if slip is not None:
+            where = Mark(name, slip.line, slip.column)
+            raise LoadError([Problem(where, slip.message, slip.hint)]) from None
         message = f"YAML syntax error: {problem}"
         if error.context:
             message += f" ({error.context})"

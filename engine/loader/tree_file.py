@@ -216,6 +216,10 @@ class TreeLoader:
     def _node(
         self, raw: YValue, path: Path, problems: Problems, stack: list[Path], seen: _Seen
     ) -> NodeDefinition | None:
+        misplaced = self._dedented_parameter(raw)
+        if misplaced is not None:
+            problems.add(*misplaced)
+            return None
         if not isinstance(raw, YMap) or len(raw) != 1:
             got = (
                 describe(raw)
@@ -261,6 +265,24 @@ class TreeLoader:
         if args is None or children is None:
             return None
         return NodeDefinition(node_type, name, args, children, mark)
+
+    def _dedented_parameter(self, raw: YValue) -> tuple[Mark, str, str] | None:
+        """A node's parameter written one level too far left (beside the node's type,
+        not under it): its place, what is wrong, and how to fix it."""
+        if not isinstance(raw, YMap) or len(raw) < 2:
+            return None
+        type_name, *others = list(raw.entries)
+        node_type = self.registry.get(type_name)
+        if node_type is None:
+            return None
+        for key in others:
+            if node_type.param(key) is not None or key in ("name", "child", "children"):
+                return (
+                    raw.key_marks[key],
+                    f"{key!r} belongs to {type_name} but is not indented under it",
+                    f"indent {key}: as far as {type_name}'s other settings",
+                )
+        return None
 
     def load_node(
         self, raw: YMap, path: Path, *, name: str, rate_hz: float, priority: int
