@@ -185,3 +185,14 @@ def test_mistakes_in_a_button_file_are_named_at_their_place(tmp_path, capsys):
 def test_the_shipped_button_file_is_valid(capsys, monkeypatch):
     monkeypatch.chdir(ROOT)
     assert main(["validate", str(BUTTONS)]) == 0
+
+
+def test_validate_checks_a_scenario_s_presses_against_the_buttons_given(tmp_path, capsys):
+    buttons = tmp_path / "sam.yaml"
+    buttons.write_text("buttons:\n  - {label: Hello Sam, say: Hello Sam!}\n")
+    scenario = tmp_path / "scenario.yaml"
+    scenario.write_text("duration_s: 2\nevents:\n  - {at: 1.0, press: Hello Sam}\n")
+    assert main(["validate", "--buttons", str(buttons), str(scenario)]) == 0
+    scenario.write_text("duration_s: 2\nevents:\n  - {at: 1.0, press: Hello Tom}\n")
+    assert main(["validate", "--buttons", str(buttons), str(scenario)]) == 1
+    assert "no button labelled 'Hello Tom'" in capsys.readouterr().err

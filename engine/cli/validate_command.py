@@ -69,6 +69,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help=f"robot config the trees and scenarios run on (default: {DEFAULT_HARDWARE} "
         "when there is one)",
     )
+    parser.add_argument(
+        "--buttons",
+        type=Path,
+        default=None,
+        metavar="FILE",
+        help=f"the buttons scenarios press (default: {DEFAULT_BUTTONS} when there is one)",
+    )
 
 
 def yaml_files(paths: list[Path]) -> list[Path]:
@@ -128,6 +135,9 @@ class Validator:
         """Parameters the trees checked so far declare."""
         self.files = ParsedFiles()
         """Each file is parsed once, however many checks look at it."""
+        self.buttons_file: Path | None = None
+        """The buttons a scenario's presses are checked against (--buttons, else the
+        default)."""
         self.trees: list[TreeDefinition] = []
         """The trees checked, to find those that would take turns by chance."""
 
@@ -186,7 +196,9 @@ class Validator:
                 scenario = load_scenario(path)
                 if self.config is not None:
                     self.problems.extend(check_scenario_events(scenario.events, self.config))
-                buttons = DEFAULT_BUTTONS if DEFAULT_BUTTONS.is_file() else None
+                buttons = self.buttons_file or (
+                    DEFAULT_BUTTONS if DEFAULT_BUTTONS.is_file() else None
+                )
                 board = self.buttons(buttons) if buttons is not None else None
                 self.problems.extend(check_presses(scenario.events, board, buttons))
             elif kind == "robot config":
@@ -254,6 +266,7 @@ def main(args: argparse.Namespace) -> int:
     config = load_config(hardware, problems) if hardware is not None else None
     dialogs = dialogs_folder(args.dialogs) if args.dialogs is not None else None
     validator = Validator(default_registry(), config, dialogs, problems)
+    validator.buttons_file = args.buttons
     profile = resolve_profile(args.profile, args.paths)
     if profile is not None:
         try:

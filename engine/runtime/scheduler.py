@@ -222,7 +222,7 @@ class Scheduler:
         tree.stats.record(self._measure() - started, max(0.0, lateness))
         status = tree.status
         if status == py_trees.common.Status.FAILURE:  # gave up half-way: nothing left raised
-            tree.context.actions.settle()
+            tree.context.actions.settle(lights=False)  # a timed light goes out by itself
         elif status == py_trees.common.Status.SUCCESS:  # done as the tree meant
             tree.context.actions.forget()
         for observer in self.after_tick:

@@ -218,11 +218,12 @@ class TreeActions:
             f"saying {text!r}",
         )
 
-    def settle(self) -> list[Job]:
+    def settle(self, *, lights: bool = True) -> list[Job]:
         """After the tree was halted in the middle, or gave up half-way (its round
         failed): each joint it moved since its last finished round goes back to its rest
-        pose at its safe speed, and the face LEDs it lit go off, unless another tree used
-        them since. Not subject to turns: a halted tree always comes to rest."""
+        pose at its safe speed, and (``lights``) the face LEDs it lit go off, unless
+        another tree used them since. Not subject to turns: a halted tree always comes to
+        rest."""
         jobs: list[Job] = []
         for joint in sorted(self._moved):
             if self._last_user(joint_resource(joint)):
@@ -231,7 +232,7 @@ class TreeActions:
                 if speed_dps is not None:
                     args["speed_dps"] = speed_dps
                 jobs.append(self._call("servo", args, self._mover(joint, angle_deg, speed_dps)))
-        if self._lit and self._last_user(FACE_LEDS):
+        if lights and self._lit and self._last_user(FACE_LEDS):
             off = lambda: self.services.leds.set_color("off")  # noqa: E731
             jobs.append(self._call("led", {"color": "off", "rest": True}, off))
         self.forget()
