@@ -23,7 +23,6 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
-import logging
 import queue
 import threading
 from collections.abc import Callable
@@ -35,7 +34,6 @@ from engine.runtime.robot import Robot
 from engine.runtime.scheduler import RunningTree
 from engine.scenario.scenario_file import ScenarioEvent
 
-_log = logging.getLogger("vest.buttons")
 PressListener = Callable[[float, ScenarioEvent], None]
 PAGE_QUEUE = 16
 """State updates a page may fall behind by before it is sent only the newest."""

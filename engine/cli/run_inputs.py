@@ -10,7 +10,7 @@ problem; ``vest validate`` runs these same functions and lists the same problems
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Iterator, Sequence
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -24,7 +24,7 @@ from engine.hardware.config_file import load_robot_config
 from engine.hardware.fault_events import check_fault_events
 from engine.hardware.touch_pads import name_scenario_pads, robot_pad_names, unknown_pad
 from engine.loader.tree_checks import variable_problems
-from engine.loader.tree_definition import NodeDefinition, TreeDefinition
+from engine.loader.tree_definition import TreeDefinition
 from engine.loader.tree_file import TreeLoader
 from engine.nodes.registry import NodeRegistry, default_registry
 from engine.nodes.remote import COMMAND_TYPES
@@ -122,7 +122,7 @@ def check_items(definition: TreeDefinition, lengths: dict[str, int]) -> list[Pro
     """``item:`` beyond the list it picks from (``item: 12`` of 12 pads) would never be
     true: each such node, at its place."""
     problems: list[Problem] = []
-    for node in _nodes(definition.root):
+    for node in definition.root.walk():
         key, item = node.args.get("key"), node.args.get("item")
         length = lengths.get(key) if isinstance(key, str) else None
         if length is not None and isinstance(item, int) and not 0 <= item < length:
@@ -151,7 +151,7 @@ def check_joints(definition: TreeDefinition, config: RobotConfig) -> list[Proble
     envelope will always refuse: each at its node's place."""
     joints = {joint.name: joint for device in config for joint in device.joints}
     problems: list[Problem] = []
-    for node in _nodes(definition.root):
+    for node in definition.root.walk():
         if node.type.name not in ("MoveServo", "LookToward") or not joints:
             continue
         name = str(node.args.get("joint"))
@@ -183,7 +183,7 @@ def check_tree_pads(definition: TreeDefinition, config: RobotConfig) -> list[Pro
     at its node's place."""
     names = robot_pad_names(config)
     problems: list[Problem] = []
-    for node in _nodes(definition.root):
+    for node in definition.root.walk():
         if node.type.name != "OnTouch":
             continue
         for param in ("pads", "except_pads"):
@@ -191,12 +191,6 @@ def check_tree_pads(definition: TreeDefinition, config: RobotConfig) -> list[Pro
                 if name not in names:
                     problems.append(Problem(node.mark, *unknown_pad(str(name), names, config)))
     return problems
-
-
-def _nodes(node: NodeDefinition) -> Iterator[NodeDefinition]:
-    yield node
-    for child in node.children:
-        yield from _nodes(child)
 
 
 def check_scenario_events(events: Iterable[ScenarioEvent], config: RobotConfig) -> list[Problem]:

@@ -10,7 +10,6 @@
 from __future__ import annotations
 
 import re
-from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import Any
 
@@ -34,12 +33,6 @@ class Write:
     kind: type | None
 
 
-def _nodes(node: NodeDefinition) -> Iterator[NodeDefinition]:
-    yield node
-    for child in node.children:
-        yield from _nodes(child)
-
-
 def _kind(value: Any) -> type | None:
     if isinstance(value, bool):
         return bool
@@ -54,7 +47,7 @@ def variable_writes(trees: list[TreeDefinition], catalogue: KeyCatalogue) -> dic
     """Every ``/vars/`` key some tree writes, with each writer."""
     writes: dict[str, list[Write]] = {}
     for tree in trees:
-        for node in _nodes(tree.root):
+        for node in tree.root.walk():
             _, written = node.type.keys(node.args)
             for key in written:
                 if not key.startswith(VARIABLES_PREFIX):
@@ -80,7 +73,7 @@ def variable_problems(trees: list[TreeDefinition], catalogue: KeyCatalogue) -> l
     writes = variable_writes(trees, catalogue)
     problems: list[Problem] = []
     for tree in trees:
-        for node in _nodes(tree.root):
+        for node in tree.root.walk():
             read, _ = node.type.keys(node.args)
             for key in dict.fromkeys(k for k in read if k.startswith(VARIABLES_PREFIX)):
                 if key not in writes:
@@ -124,7 +117,7 @@ def spoken_quote_warnings(trees: list[TreeDefinition]) -> list[str]:
     """Typographic quotes in what the robot says, each as a warning line with its place."""
     warnings: list[str] = []
     for tree in trees:
-        for node in _nodes(tree.root):
+        for node in tree.root.walk():
             for value in node.args.values():
                 text = value.source if isinstance(value, CompiledTemplate) else None
                 if text is not None and CURLY_QUOTES.search(text):

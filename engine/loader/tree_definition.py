@@ -7,6 +7,7 @@ robot that runs it.
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import SimpleNamespace
@@ -30,6 +31,12 @@ class NodeDefinition:
     mark: Mark
     subtree: str | None = None
     """For the root of an included subtree: the file it came from, as written."""
+
+    def walk(self) -> Iterator[NodeDefinition]:
+        """This node and every node under it, depth-first."""
+        yield self
+        for child in self.children:
+            yield from child.walk()
 
 
 @dataclass

@@ -4,10 +4,9 @@ first, which a therapist rarely means: :func:`collisions` names them at load tim
 
 from __future__ import annotations
 
-from collections.abc import Iterator
 from dataclasses import dataclass
 
-from engine.loader.tree_definition import NodeDefinition, TreeDefinition
+from engine.loader.tree_definition import TreeDefinition
 from engine.services.turns import FACE_LEDS, SPEAKER, joint_resource
 
 ANY_JOINT = joint_resource("any")
@@ -21,7 +20,7 @@ def tree_resources(definition: TreeDefinition) -> set[str]:
     """The resources the built-in action nodes of ``definition`` use (plugins' own nodes
     are not known here)."""
     used: set[str] = set()
-    for node in _nodes(definition.root):
+    for node in definition.root.walk():
         kind = node.type.name
         if kind in _SPEAKS or kind in _REMOTE:
             used.add(SPEAKER)
@@ -73,9 +72,3 @@ def _shared(first: set[str], second: set[str]) -> set[str]:
     if ANY_JOINT in second:
         shared |= joints & first
     return shared
-
-
-def _nodes(node: NodeDefinition) -> Iterator[NodeDefinition]:
-    yield node
-    for child in node.children:
-        yield from _nodes(child)
