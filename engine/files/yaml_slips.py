@@ -121,3 +121,16 @@ def explain(text: str, line: int, problem: str, context: str | None) -> Slip | N
                 "start it with '- ', as each child of a Sequence, Selector or Parallel",
             )
     return None
+
+
+def hint_for(problem: str) -> str | None:
+    """A general hint for a YAML error no slip above explains."""
+    if "\\t" in problem or "tab" in problem:
+        return "indent with spaces, not tabs"
+    if "mapping values are not allowed" in problem:
+        return "put text containing ': ' in quotes"
+    if "could not find expected ':'" in problem:
+        return "each entry needs 'key: value'"
+    if "expected <block end>" in problem or "did not find expected" in problem:
+        return "check the indentation of this line and the one above"
+    return None

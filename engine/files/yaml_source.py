@@ -19,7 +19,7 @@ import yaml
 
 from engine.files.problems import LoadError, Mark, Problem
 from engine.files.yaml_events import STANDARD_TAGS, NeedsCarefulReading, compose_fast
-from engine.files.yaml_slips import explain
+from engine.files.yaml_slips import explain, hint_for
 from engine.files.yaml_values import (
     LONE_SURROGATE,
     YList,
@@ -56,18 +56,6 @@ beyond what anyone writes; deeper ones would exhaust Python's stack)."""
 
 def _mark(file: str, yaml_mark: Any) -> Mark:
     return Mark(file, yaml_mark.line + 1, yaml_mark.column + 1)
-
-
-def _hint_for(problem: str) -> str | None:
-    if "\\t" in problem or "tab" in problem:
-        return "indent with spaces, not tabs"
-    if "mapping values are not allowed" in problem:
-        return "put text containing ': ' in quotes"
-    if "could not find expected ':'" in problem:
-        return "each entry needs 'key: value'"
-    if "expected <block end>" in problem or "did not find expected" in problem:
-        return "check the indentation of this line and the one above"
-    return None
 
 
 class _Refused(Exception):  # noqa: N818 - a problem found while composing, not a failure
@@ -359,7 +347,7 @@ def parse_yaml(text: str, name: str) -> YValue | None:
         message = f"YAML syntax error: {problem}"
         if error.context:
             message += f" ({error.context})"
-        raise LoadError([Problem(where, message, _hint_for(problem))]) from None
+        raise LoadError([Problem(where, message, hint_for(problem))]) from None
     except yaml.reader.ReaderError as error:
         before = text[: error.position]
         where = Mark(name, before.count("\n") + 1, error.position - (before.rfind("\n") + 1) + 1)
