@@ -37,7 +37,9 @@ TEMPERATURE_C = "/sensors/temperature/c"
 TEMPERATURE_F = "/sensors/temperature/f"
 ULTRASOUND_CM = "/sensors/ultrasound/cm"
 SPEECH_HEARD = "/speech/heard"
+SPEECH_NOT_LISTENED = "/speech/not_listened"
 IOT_INBOX = "/iot/inbox"
+IOT_CANCELED = "/iot/canceled"
 HAND_FINGERS = "/vision/hand/fingers"
 HAND_CONFIDENCE = "/vision/hand/confidence"
 HAND_SHOWN = "/vision/hand/shown"
@@ -271,11 +273,29 @@ def default_catalogue() -> KeyCatalogue:
                 kind="event",
             ),
             KeySpec(
+                SPEECH_NOT_LISTENED,
+                dict,
+                "",
+                "speech listener",
+                "someone spoke while the robot was speaking and was not listened to: "
+                "{from_s, until_s, why} (clock seconds)",
+                kind="event",
+            ),
+            KeySpec(
                 IOT_INBOX,
                 dict,
                 "",
                 "IoT client",
                 "a remote command: {id, type, args}",
+                kind="event",
+            ),
+            KeySpec(
+                IOT_CANCELED,
+                str,
+                "",
+                "IoT client",
+                "the id of a remote command the operator canceled while the robot carried "
+                "it out (the tree carrying it out stops)",
                 kind="event",
             ),
             KeySpec(

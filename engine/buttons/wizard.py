@@ -14,7 +14,9 @@ carried out between ticks by the scheduler hook :meth:`Wizard.__call__`:
 - ``pause`` halts every autonomous tree and keeps them from ticking until ``resume``;
   ``stop`` also halts what a button started.
 
-Every press is told to ``on_press`` (the timeline, the recording) as a ``button`` event.
+Every press is published on the robot's session stream (a
+:class:`~engine.session.events.ButtonPressed`: the timeline, the recording, the report and
+the live view show it), and so are pauses and resumes.
 Which buttons show depends on what the robot is doing; the page hears the set whenever it
 changes (:meth:`subscribe`).
 """
@@ -25,16 +27,14 @@ import contextlib
 import dataclasses
 import queue
 import threading
-from collections.abc import Callable
 from typing import Any
 
-from engine.buttons.button_file import BUTTONS_TREE, Button, ButtonBoard, When
+from engine.buttons.button_file import Button, ButtonBoard, When
 from engine.loader.tree_definition import TreeDefinition
 from engine.runtime.robot import Robot
 from engine.runtime.scheduler import RunningTree
-from engine.scenario.scenario_file import ScenarioEvent
+from engine.session.events import BehaviorsPaused, ButtonPressed
 
-PressListener = Callable[[float, ScenarioEvent], None]
 PAGE_QUEUE = 16
 """State updates a page may fall behind by before it is sent only the newest."""
 
@@ -42,17 +42,14 @@ PAGE_QUEUE = 16
 class Wizard:
     """The buttons of ``board`` on ``robot``, on a tree of their own named ``buttons``."""
 
-    def __init__(
-        self, board: ButtonBoard, robot: Robot, *, on_press: PressListener | None = None
-    ) -> None:
+    def __init__(self, board: ButtonBoard, robot: Robot) -> None:
         self.board = board
         self.robot = robot
         self.idle = board.idle
-        self.on_press = on_press
         self.autonomous = list(robot.trees)
-        # first in each step: a press takes what it needs before the behaviors it halted
-        # tick again (and yield)
-        self.tree: RunningTree = robot.add_tree(board.idle, first=True)
+        # priority 100: first in each step, so a press takes what it needs before the
+        # behaviors it halted tick again (and yield)
+        self.tree: RunningTree = robot.add_tree(board.idle)
         self.paused = False
         self.doing: Button | None = None
         self.presses = 0
@@ -121,11 +118,9 @@ class Wizard:
 
     def _carry_out(self, button: Button, now_s: float, by: str) -> None:
         self.presses += 1
-        if self.on_press is not None and by != "scenario":  # the scenario tells its own
-            event = ScenarioEvent(now_s, "button", {"label": button.label, "by": by}, button.mark)
-            self.on_press(now_s, event)
-        if not self._shown(button):
-            self.robot.turns.tell(BUTTONS_TREE, f"{button.label!r} is not shown now: nothing done")
+        shown = self._shown(button)
+        self.robot.session.publish(ButtonPressed(now_s, button.label, by, done=shown))
+        if not shown:
             return
         if button.control == "pause":
             self._pause(True)
@@ -133,7 +128,7 @@ class Wizard:
             self._pause(False)
         elif button.control == "stop":
             self._pause(True)
-            self.tree.halt()
+            self.tree.halt(f"the therapist pressed {button.label!r}")
             self._swap(self.idle)
             self.doing = None
         elif button.tree is not None:
@@ -146,13 +141,11 @@ class Wizard:
         self.paused = paused
         for tree in self.autonomous:
             if paused:
-                tree.halt()
+                tree.halt("the therapist paused the behaviors")
             else:  # afresh: what happened while paused (a pat, a word) is not answered late
                 tree.replace(dataclasses.replace(tree.definition))
             tree.paused = paused
-        self.robot.turns.tell(
-            BUTTONS_TREE, "pauses the behaviors" if paused else "resumes the behaviors"
-        )
+        self.robot.session.publish(BehaviorsPaused(self.robot.clock.now(), paused))
 
     def _swap(self, definition: TreeDefinition) -> None:
         self.tree.swap(definition, definition.build(self.tree.context))

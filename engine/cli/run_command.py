@@ -19,6 +19,7 @@ on stderr, the run goes on, and it exits 1.
 from __future__ import annotations
 
 import argparse
+import re
 import sys
 from collections.abc import Callable
 from pathlib import Path
@@ -48,6 +49,9 @@ from engine.scenario.scenario_file import ScenarioEvent
 from engine.services.cloud_link import CloudLink
 from engine.services.interfaces import Speech
 from engine.services.simulated import simulated_services
+from engine.session.events import WorldEvent
+from engine.session.sentences import TOLD_KINDS
+from engine.session.stream import SessionStream
 from engine.speech.robot_speech import RobotSpeech, audio_folder, build_speech, speech_settings
 from engine.view.hub import ViewHub
 from engine.view.server import LiveSource, ViewServer
@@ -133,6 +137,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="record the session (trees, statuses, blackboard, actions) for vest replay",
     )
     parser.add_argument(
+        "--person",
+        type=_pseudonym,
+        default=None,
+        metavar="PSEUDONYM",
+        help="whose session this is, by pseudonym (e.g. kid-17; never a name): kept in the "
+        "recording and shown in its report",
+    )
+    parser.add_argument(
         "--hardware",
         type=Path,
         default=DEFAULT_HARDWARE,
@@ -141,20 +153,30 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
 
 
-EventListener = Callable[[float, ScenarioEvent], None]
-
-
 def _profile_name(behaviors: Behaviors) -> str:
     profile = behaviors.loader.profile
     return "" if profile is None else str(profile.path or profile.name)
 
 
-def _both(first: EventListener, second: EventListener) -> EventListener:
-    def both(at_s: float, event: ScenarioEvent) -> None:
-        first(at_s, event)
-        second(at_s, event)
+def _world_events(session: SessionStream) -> Callable[[float, ScenarioEvent], None]:
+    """What a scenario makes happen, published as the world's events; a scenario's press
+    is the therapist's, published by the buttons when they carry it out."""
 
-    return both
+    def publish(at_s: float, event: ScenarioEvent) -> None:
+        if event.kind != "press":
+            session.publish(WorldEvent(at_s, event.kind, event.describe(), event.value))
+
+    return publish
+
+
+def _pseudonym(text: str) -> str:
+    """A pseudonym: 1..40 letters, digits, '-', '_' or '.', starting with a letter or digit."""
+    if not re.fullmatch(r"[A-Za-z0-9][A-Za-z0-9._-]{0,39}", text):
+        raise argparse.ArgumentTypeError(
+            f"{text!r} is not a pseudonym: use 1 to 40 letters, digits, '-', '_' or '.' "
+            "(e.g. kid-17), never a person's name"
+        )
+    return text
 
 
 def _positive_seconds(text: str) -> float:
@@ -228,9 +250,9 @@ def main(args: argparse.Namespace) -> int:
         iot=link if link is not None else simulated.iot,
         fallback=simulated,
     )
-    robot, blackboard = assembled.robot, assembled.blackboard
+    robot, session = assembled.robot, assembled.robot.session
     wizard = None
-    if inputs.buttons is not None:  # ticks after the behaviors built from the trees
+    if inputs.buttons is not None:  # priority 100: ticks before the behaviors
         wizard = Wizard(inputs.buttons, robot)
         robot.scheduler.hooks.append(wizard)
         assembled.world.listeners.append(wizard)
@@ -252,47 +274,35 @@ def main(args: argparse.Namespace) -> int:
         if assembled.speech is not None:
             for part, why in assembled.speech.problems.items():
                 tell(f"warning: speech {part}: {shown(why)}")
-        robot.action_log.listeners.append(timeline.action)
-        robot.action_log.failure_listeners.append(timeline.failed)
-        robot.turns.listeners.append(timeline.turn)
-        blackboard.watchers.append(
-            lambda key, value: timeline.blackboard_write(key, value, clock.now())
-        )
+        session.subscribe(timeline, TOLD_KINDS)  # every reader reads the one session stream
         timeline.on_closed = robot.scheduler.stop
-        on_event: EventListener = timeline.world
         if args.view or (args.buttons is not None and not args.fast):  # a page when asked
-            hub = ViewHub(clock, blackboard.catalogue, device_stats=assembled.hardware.stats)
+            hub = ViewHub(clock, device_stats=assembled.hardware.stats)
             hub.begin(start_s, robot.trees)
-            robot.scheduler.after_tick.append(hub.tree_ticked)
+            session.subscribe(hub)
             robot.scheduler.hooks.append(hub.stats_hook)
-            blackboard.watchers.append(hub.blackboard_write)
-            robot.action_log.listeners.append(hub.action)
-            robot.action_log.failure_listeners.append(hub.failed)
-            on_event = _both(on_event, hub.world)
             view = start_view(LiveSource(hub), args, wizard=wizard)
         if args.record is not None:
-            recorder = SessionRecorder(args.record, clock, blackboard.catalogue)
+            recorder = SessionRecorder(args.record, clock)
             recorder.describe(
                 robot_config=str(args.hardware),
                 profile=_profile_name(behaviors),
                 scenario=str(scenario.path),
                 started=f"{EpochClock().now():.3f}",
+                person=args.person or "",
             )
-            recorder.begin(start_s, robot.trees)
-            robot.scheduler.after_tick.append(recorder.tree_ticked)
-            blackboard.watchers.append(recorder.blackboard_write)
-            robot.action_log.listeners.append(recorder.action)
-            robot.action_log.failure_listeners.append(recorder.failed)
-            on_event = _both(on_event, recorder.world)
-        if wizard is not None:
-            wizard.on_press = on_event  # the timeline and the recording hear each press
+            recorder.begin(start_s)
+            session.subscribe(recorder)
         # the world moves first, then the pollers read it, then the trees tick
         robot.scheduler.hooks.insert(
-            0, ScenarioPlayer(scenario, assembled.world, start_s=start_s, on_event=on_event)
+            0,
+            ScenarioPlayer(
+                scenario, assembled.world, start_s=start_s, on_event=_world_events(session)
+            ),
         )
         if not args.fast:  # reload work runs beside the scheduler, swaps between ticks
             behaving = [tree for tree in robot.trees if wizard is None or tree is not wizard.tree]
-            reloader = TreeReloader(behaviors.loader, behaving, clock)
+            reloader = TreeReloader(behaviors.loader, behaving, clock, session=session)
             robot.scheduler.hooks.append(reloader)
             reloader.start()
         duration = args.duration if args.duration is not None else scenario.duration_s
@@ -300,9 +310,10 @@ def main(args: argparse.Namespace) -> int:
         args.stop_signals.on_stop(robot.scheduler.stop)
         timeline.start()
         first_tick_s = clock.now()
+        robot.begin_session(start_s)  # every reader hears of every tree
         assembled.start(origin_s=first_tick_s)  # readings staged just before each tick
         if link is not None:
-            link.bind(blackboard)
+            link.bind(assembled.blackboard, session)
             link.start()
         robot.scheduler.run(until_s=start_s + duration, start_s=first_tick_s)
         timeline.summary(robot.trees)

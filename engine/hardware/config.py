@@ -253,10 +253,13 @@ class SafetyConfig:
     speeds in deg/s, volume and brightness as fractions 0..1. None: that rule is off.
 
     ``arms`` are the joints the distance and force rules cover; ``joint_limits`` narrow a
-    joint's angles (deg) below what its servo allows.
+    joint's angles (deg) below what its servo allows. ``when_unsure`` is what an arm move
+    does when a sensor a rule reads cannot be trusted (offline, stale, implausible):
+    ``refuse`` (the default) or ``slow`` (at ``slow_speed_dps``).
     """
 
     arms: tuple[str, ...] = ()
+    when_unsure: str = "refuse"
     still_within_mm: float | None = None
     slow_within_mm: float | None = None
     slow_speed_dps: float = 20.0

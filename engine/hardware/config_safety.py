@@ -9,13 +9,17 @@
       slow_within_mm: 300           # closer than this, arms move at most slow_speed_dps
       slow_speed_dps: 30
       stop_above_n: 12              # a side force above this stops the arms where they are
+      when_unsure: refuse           # a range or force sensor offline, stale or implausible
+                                    # counts as the worst case: refuse arm moves (or slow)
       max_volume: 0.9               # speech at most this loud (0..1)
       max_brightness: 0.8           # face LEDs at most this bright (0..1)
       joint_limits:                 # narrower than the servos allow, in degrees
         left_arm: [-10, 70]
 
 Each rule is checked on every service call (trees, remote commands, buttons) and by a
-watcher between ticks (:mod:`engine.hardware.safety_envelope`).
+watcher between ticks (:mod:`engine.hardware.safety_envelope`). A distance rule needs the
+chest's range sensors and the force rule the side force pads: a config that sets a rule
+without its sensors is refused (every arm move would be).
 """
 
 from __future__ import annotations
@@ -25,7 +29,7 @@ from typing import Any
 from engine.files.yaml_source import YList, YMap, describe, plain
 from engine.hardware.chips.fields import ConfigChecks
 from engine.hardware.config import DeviceConfig, SafetyConfig
-from engine.values.params import Number, Param, did_you_mean
+from engine.values.params import Choice, Number, Param, did_you_mean
 
 OWN_CHECKS = ("arms", "joint_limits")
 FIELDS: tuple[Param[Any], ...] = (
@@ -33,6 +37,13 @@ FIELDS: tuple[Param[Any], ...] = (
     Param("slow_within_mm", Number(0.0, 5000.0, "mm"), None, "slow arm moves this close"),
     Param("slow_speed_dps", Number(0.1, 1000.0, "deg/s"), 20.0, "arm speed near a person"),
     Param("stop_above_n", Number(0.1, 1000.0, "N"), None, "side force that stops the arms"),
+    Param(
+        "when_unsure",
+        Choice(("refuse", "slow")),
+        "refuse",
+        "arm moves when a sensor a rule reads is offline, stale or implausible: refuse, "
+        "or slow (at slow_speed_dps)",
+    ),
     Param("max_volume", Number(0.0, 1.0), 1.0, "loudest speech, a fraction 0..1 (0.9: 90 %)"),
     Param(
         "max_brightness", Number(0.0, 1.0), 1.0, "brightest face LEDs, a fraction 0..1 (0.8: 80 %)"
@@ -68,6 +79,8 @@ def check_safety(
             "arms slow down farther out than they stop: slow_within_mm >= still_within_mm",
         )
         return None
+    if not _rules_have_sensors(checker, section, values, devices):
+        return None
     slowest = min((joints[arm].max_speed_dps for arm in arms), default=None)
     if slow is not None and slowest is not None and values["slow_speed_dps"] > slowest:
         checker.problems.add(
@@ -78,6 +91,31 @@ def check_safety(
         )
         return None
     return SafetyConfig(arms=arms, joint_limits=limits, **values)
+
+
+def _rules_have_sensors(
+    checker: ConfigChecks, section: YMap, values: dict[str, Any], devices: dict[str, DeviceConfig]
+) -> bool:
+    """A distance rule without a range sensor, or the force rule without a force pad,
+    could never be trusted: every arm move would be refused. Each such rule is a problem."""
+    ranges = [d for d in devices.values() if d.role == "range" and "range" in d.keys]
+    forces = [pad for d in devices.values() if d.role == "force" for pad in d.pads]
+    needs = {
+        "still_within_mm": ("a range sensor (vl53l0x)", ranges),
+        "slow_within_mm": ("a range sensor (vl53l0x)", ranges),
+        "stop_above_n": ("a force pad (ads1115 or mcp3008 with pads)", forces),
+    }
+    fine = True
+    for rule, (sensor, present) in needs.items():
+        if values.get(rule) is not None and not present:
+            checker.problems.add(
+                (section.get(rule) or section).mark,
+                f"safety rule {rule} reads {sensor}, and this robot has none: every arm "
+                "move would be refused",
+                f"add the sensor under devices:, or remove {rule}",
+            )
+            fine = False
+    return fine
 
 
 def _unknown_joint(checker: ConfigChecks, item: Any, name: str, joints: dict[str, Any]) -> None:

@@ -3,112 +3,201 @@ between ticks stops the arms when a person comes too close or presses too hard.
 
 It wraps the robot's services (:func:`with_envelope`), so trees, remote commands and
 wizard-of-oz buttons all meet the same limits; no tree can reach the services around it.
-A move the envelope refuses fails with :class:`SafetyRefusedError` and the reason (the
-timeline prints it); a loud phrase is spoken at ``max_volume``, a bright color shown at
-``max_brightness``, an arm near a person moved at ``slow_speed_dps``.
+A move the envelope refuses fails with :class:`SafetyRefusedError` and the reason; a loud
+phrase is spoken at ``max_volume``, a bright color shown at ``max_brightness``, an arm near
+a person moved at ``slow_speed_dps``. It fails safe: a sensor a rule reads that is offline,
+stale or implausible counts as the worst case (someone at the chest, a hard press), and
+arm moves are refused or slowed as the config's ``when_unsure`` says. Every refusal, slow
+down and stop is published on the session stream with its rule and devices.
 """
 
 from __future__ import annotations
 
 import dataclasses
-import math
 from collections.abc import Callable
+from dataclasses import dataclass
 from typing import Any
 
 from engine.blackboard.board import Blackboard
 from engine.colors import parse_color
 from engine.errors import ServiceError
 from engine.hardware.config import RobotConfig, SafetyConfig
+from engine.hardware.safety_guards import (
+    Guard,
+    GuardReading,
+    force_guards,
+    range_guards,
+    read_guard,
+)
 from engine.services.interfaces import Leds, Services, Servos, Speech
 from engine.services.jobs import ImmediateJob, Job
+from engine.session.events import SafetyAction, SafetyKind
+from engine.session.stream import SessionStream
 
 
 class SafetyRefusedError(ServiceError):
-    """The safety envelope refused an action; the message says which rule and why."""
+    """The safety envelope refused an action; the message says which rule and why (it
+    starts with ``safety``)."""
+
+
+@dataclass(frozen=True)
+class Verdict:
+    """Why the envelope holds the arms still or slows them: the ``rule`` (a field of
+    ``safety:``), the ``devices`` it read, the reason in words, and whether it comes from
+    readings that cannot be trusted (``unsure``)."""
+
+    rule: str
+    devices: tuple[str, ...]
+    why: str
+    unsure: bool = False
 
 
 class SafetyEnvelope:
     """The rules of ``config`` read against the committed blackboard: the chest's range
-    sensors (``range_keys``, mm) and the side force pads (``force_keys``, N)."""
+    sensors (mm) and the side force pads (N), each reading trusted only when its device is
+    working and the reading fresh and plausible (:mod:`engine.hardware.safety_guards`).
+    What it decides is published on ``stream`` as
+    :class:`~engine.session.events.SafetyAction`."""
 
     def __init__(
         self,
         config: SafetyConfig,
         blackboard: Blackboard,
         *,
-        range_keys: tuple[str, ...] = (),
-        force_keys: tuple[str, ...] = (),
+        ranges: tuple[Guard, ...] = (),
+        forces: tuple[Guard, ...] = (),
+        stream: SessionStream | None = None,
     ) -> None:
         self.config = config
         self.blackboard = blackboard
-        self.range_keys = range_keys
-        self.force_keys = force_keys
+        self.ranges = ranges
+        self.forces = forces
+        self.stream = stream
 
     @classmethod
-    def of(cls, robot: RobotConfig, blackboard: Blackboard) -> SafetyEnvelope:
-        """The envelope of a robot config, reading its range and force devices' keys."""
-        ranges = tuple(d.keys["range"] for d in robot.with_role("range") if "range" in d.keys)
-        forces = tuple(pad.key for d in robot.with_role("force") for pad in d.pads)
-        return cls(robot.safety, blackboard, range_keys=ranges, force_keys=forces)
+    def of(
+        cls, robot: RobotConfig, blackboard: Blackboard, stream: SessionStream | None = None
+    ) -> SafetyEnvelope:
+        """The envelope of a robot config, reading its range and force devices."""
+        return cls(
+            robot.safety,
+            blackboard,
+            ranges=range_guards(robot),
+            forces=force_guards(robot),
+            stream=stream,
+        )
 
-    def _numbers(self, keys: tuple[str, ...]) -> list[float]:
-        values = (self.blackboard.get(key) for key in keys)
-        return [
-            float(v)
-            for v in values
-            if isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v)
-        ]
+    def _read(self, guards: tuple[Guard, ...]) -> list[GuardReading]:
+        now = self.blackboard.clock.now()
+        return [read_guard(guard, self.blackboard, now) for guard in guards]
 
     def nearest_mm(self) -> float | None:
-        """The closest thing the chest's range sensors see, mm (None: nothing in range)."""
-        seen = self._numbers(self.range_keys)
+        """The closest thing the chest's trusted range sensors see, mm (None: nothing)."""
+        seen = [r.value for r in self._read(self.ranges) if r.doubt is None and r.value is not None]
         return min(seen) if seen else None
 
     def side_force_n(self) -> float | None:
-        """The larger of the side pads' forces, N."""
-        felt = self._numbers(self.force_keys)
+        """The larger of the side pads' trusted forces, N."""
+        felt = [r.value for r in self._read(self.forces) if r.doubt is None and r.value is not None]
         return max(felt) if felt else None
 
-    def hold_still(self) -> str | None:
-        """Why the arms must not move now (a hard press, someone very close), or None."""
-        rules = self.config
-        force = self.side_force_n()
-        if rules.stop_above_n is not None and force is not None and force > rules.stop_above_n:
-            return f"a side force of {force:.1f} N is above {rules.stop_above_n:g} N"
-        near = self.nearest_mm()
-        if rules.still_within_mm is not None and near is not None and near < rules.still_within_mm:
-            return (
-                f"something is {near:.0f} mm from the chest, closer than "
-                f"{rules.still_within_mm:g} mm"
-            )
+    def _doubts(self, rule: str, readings: list[GuardReading]) -> Verdict | None:
+        doubtful = [r for r in readings if r.doubt is not None]
+        if not doubtful:
+            return None
+        what = "; ".join(str(r.doubt) for r in doubtful)
+        return Verdict(
+            rule,
+            tuple(dict.fromkeys(r.guard.device for r in doubtful)),
+            f"{what}: it cannot be trusted, so {rule} counts the worst case",
+            unsure=True,
+        )
+
+    def _force_rule(self) -> Verdict | None:
+        limit = self.config.stop_above_n
+        if limit is None:
+            return None
+        readings = self._read(self.forces)
+        doubt = self._doubts("stop_above_n", readings)
+        if doubt is not None:
+            return doubt
+        for reading in readings:
+            if reading.value is not None and reading.value > limit:
+                return Verdict(
+                    "stop_above_n",
+                    (reading.guard.device,),
+                    f"a side force of {reading.value:.1f} N is above {limit:g} N",
+                )
         return None
 
-    def refusal(self, joint: str, angle_deg: float) -> str | None:
+    def _distance_rule(self, rule: str, limit: float | None) -> Verdict | None:
+        if limit is None:
+            return None
+        readings = self._read(self.ranges)
+        doubt = self._doubts(rule, readings)
+        if doubt is not None:
+            return doubt
+        near = [r for r in readings if r.value is not None and r.value < limit]
+        if not near:
+            return None
+        nearest = min(near, key=lambda r: r.value or 0.0)
+        return Verdict(
+            rule,
+            (nearest.guard.device,),
+            f"something is {nearest.value:.0f} mm from the chest, closer than {limit:g} mm",
+        )
+
+    def hold_still(self) -> Verdict | None:
+        """Why the arms must not move now (a hard press, someone very close, or a sensor
+        that cannot be trusted when unsure moves are refused), or None."""
+        rules = self.config
+        for verdict in (
+            self._force_rule(),
+            self._distance_rule("still_within_mm", rules.still_within_mm),
+        ):
+            if verdict is not None and (not verdict.unsure or rules.when_unsure == "refuse"):
+                return verdict
+        return None
+
+    def slow_down(self) -> Verdict | None:
+        """Why an arm moves at most ``slow_speed_dps`` now (someone near, or a sensor that
+        cannot be trusted when unsure moves are slowed), or None."""
+        rules = self.config
+        for verdict in (
+            self._force_rule(),
+            self._distance_rule("still_within_mm", rules.still_within_mm),
+            self._distance_rule("slow_within_mm", rules.slow_within_mm),
+        ):
+            if verdict is not None and (verdict.unsure or verdict.rule == "slow_within_mm"):
+                return verdict
+        return None
+
+    def refusal(self, joint: str, angle_deg: float) -> Verdict | None:
         """Why moving ``joint`` to ``angle_deg`` is refused now, or None."""
         limits = self.config.joint_limits.get(joint)
         if limits is not None and not limits[0] <= angle_deg <= limits[1]:
-            return (
-                f"safety: {joint} may move within {limits[0]:g}..{limits[1]:g} deg only, "
-                f"not to {angle_deg:g} deg"
+            return Verdict(
+                "joint_limits",
+                (),
+                f"{joint} may move within {limits[0]:g}..{limits[1]:g} deg only, "
+                f"not to {angle_deg:g} deg",
             )
         if joint in self.config.arms:
-            why = self.hold_still()
-            if why is not None:
-                return f"safety: {why}: the arms stay still"
+            verdict = self.hold_still()
+            if verdict is not None:
+                return Verdict(verdict.rule, verdict.devices, f"{verdict.why}: the arms stay still")
         return None
 
-    def speed_dps(self, joint: str, speed_dps: float | None) -> float | None:
-        """The speed a move of ``joint`` may have now (slower near a person)."""
-        rules = self.config
-        near = self.nearest_mm()
-        if (
-            joint in rules.arms
-            and rules.slow_within_mm is not None
-            and near is not None
-            and near < rules.slow_within_mm
-        ):
-            return min(speed_dps if speed_dps is not None else math.inf, rules.slow_speed_dps)
-        return speed_dps
+    def speed_dps(self, joint: str, speed_dps: float | None) -> tuple[float | None, Verdict | None]:
+        """The speed a move of ``joint`` may have now (slower near a person, or when a
+        sensor cannot be trusted), and why it was slowed (None: as asked)."""
+        if joint not in self.config.arms:
+            return speed_dps, None
+        verdict = self.slow_down()
+        slow = self.config.slow_speed_dps
+        if verdict is None or (speed_dps is not None and speed_dps <= slow):
+            return speed_dps, None
+        return slow, verdict
 
     def volume(self, volume: float | None) -> float | None:
         """``volume`` no louder than ``max_volume`` (None: the robot's default, capped)."""
@@ -135,8 +224,17 @@ class SafetyEnvelope:
         """Why a move of ``joint`` to ``angle_deg`` can never be made (for validate)."""
         limits = self.config.joint_limits.get(joint)
         if limits is not None and not limits[0] <= angle_deg <= limits[1]:
-            return self.refusal(joint, angle_deg)
+            verdict = self.refusal(joint, angle_deg)
+            return None if verdict is None else f"safety: {verdict.why}"
         return None
+
+    def tell(self, action: SafetyKind, joint: str, verdict: Verdict) -> None:
+        """Publish what the envelope did to a move of ``joint``."""
+        if self.stream is not None:
+            now = self.blackboard.clock.now()
+            self.stream.publish(
+                SafetyAction(now, action, joint, verdict.rule, verdict.devices, verdict.why)
+            )
 
 
 class EnvelopedSpeech:
@@ -158,11 +256,15 @@ class EnvelopedLeds:
 class StoppableMove:
     """A servo move the watcher can stop (it then fails with the safety reason); a move
     cancelled half-way (its tree halted) stops the joint where it is, as the watcher does:
-    a cancelled job alone would not stop a servo already told where to go."""
+    a cancelled job alone would not stop a servo already told where to go. ``speed_dps``
+    is the speed it was sent at (None: the joint's full speed)."""
 
-    def __init__(self, job: Job, hold_still: Callable[[], None]) -> None:
+    def __init__(
+        self, job: Job, hold_still: Callable[[], None], speed_dps: float | None = None
+    ) -> None:
         self.job = job
         self.hold_still = hold_still
+        self.speed_dps = speed_dps
         self.stopped: SafetyRefusedError | None = None
 
     def stop(self, why: str) -> None:
@@ -192,12 +294,15 @@ class EnvelopedServos:
         self.moving: dict[str, StoppableMove] = {}
 
     def move(self, joint: str, angle_deg: float, *, speed_dps: float | None = None) -> Job:
-        why = self.envelope.refusal(joint, angle_deg)
-        if why is not None:
-            return ImmediateJob(error=SafetyRefusedError(why))
-        speed = self.envelope.speed_dps(joint, speed_dps)
+        refused = self.envelope.refusal(joint, angle_deg)
+        if refused is not None:
+            self.envelope.tell("refused", joint, refused)
+            return ImmediateJob(error=SafetyRefusedError(f"safety: {refused.why}"))
+        speed, slowed = self.envelope.speed_dps(joint, speed_dps)
         started = self.inner.move(joint, angle_deg, speed_dps=speed)
-        move = StoppableMove(started, lambda: self.inner.stop(joint))
+        if slowed is not None:
+            self.envelope.tell("slowed", joint, slowed)
+        move = StoppableMove(started, lambda: self.inner.stop(joint), speed)
         self.moving[joint] = move
         return move
 
@@ -220,33 +325,35 @@ def with_envelope(services: Services, envelope: SafetyEnvelope) -> Services:
 
 class EnvelopeWatcher:
     """A scheduler hook: between ticks, when the arms must hold still, every arm move
-    under way is stopped where the arm is (its node then fails), and ``tell(who, what)``
-    hears it once per stop."""
+    under way is stopped where the arm is (its node then fails); when a sensor cannot be
+    trusted and unsure moves are slowed, every arm move faster than ``slow_speed_dps`` is
+    stopped. Each stop is published as a ``stopped``
+    :class:`~engine.session.events.SafetyAction`."""
 
-    def __init__(
-        self,
-        servos: EnvelopedServos,
-        envelope: SafetyEnvelope,
-        tell: Callable[[str, str], Any] = lambda who, what: None,
-    ) -> None:
+    def __init__(self, servos: EnvelopedServos, envelope: SafetyEnvelope) -> None:
         self.servos = servos
         self.envelope = envelope
-        self.tell = tell
         self.stops = 0
 
     def __call__(self, now_s: float) -> None:
         moving = [
-            joint
-            for joint, job in self.servos.moving.items()
-            if joint in self.envelope.config.arms and not job.done()
+            (joint, move)
+            for joint, move in self.servos.moving.items()
+            if joint in self.envelope.config.arms and not move.done()
         ]
         if not moving:
             return
-        why = self.envelope.hold_still()
-        if why is None:
-            return
-        for joint in moving:
+        verdict = self.envelope.hold_still()
+        slow = self.envelope.config.slow_speed_dps
+        if verdict is None:
+            unsure = self.envelope.slow_down()
+            if unsure is None or not unsure.unsure:
+                return
+            verdict = unsure
+            moving = [(j, m) for j, m in moving if m.speed_dps is None or m.speed_dps > slow]
+        for joint, move in moving:
             self.servos.stop(joint)
-            self.servos.moving.pop(joint).stop(why)
+            self.servos.moving.pop(joint)
+            move.stop(verdict.why)
             self.stops += 1
-            self.tell("safety", f"stops {joint} where it is: {why}")
+            self.envelope.tell("stopped", joint, verdict)

@@ -56,6 +56,9 @@ class TreeDefinition:
     face LEDs and the joints."""
     wait_for_turn_s: float = 0.0
     """How long an action waits for a resource another tree has (0: let it go at once)."""
+    when_interrupted: str = "let_go"
+    """A round a higher tree cut short: ``let_go`` (the events that started it are spent)
+    or ``try_again`` (it starts again with them)."""
 
     def build(self, ctx: TreeContext) -> py_trees.trees.BehaviourTree:
         """A fresh py_trees tree whose nodes use ``ctx``."""

@@ -145,6 +145,7 @@ class TreeLoader:
             frozenset(seen.declared),
             priority=settings.priority,
             wait_for_turn_s=settings.wait_for_turn_s,
+            when_interrupted=settings.when_interrupted,
         )
 
     # -- file level -----------------------------------------------------------------------

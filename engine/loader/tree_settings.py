@@ -5,6 +5,8 @@
     rate_hz: 20            # ticks per second
     priority: 40           # higher interrupts lower for the speaker, face LEDs, joints
     wait_for_turn_s: 2     # how long an action waits for a busy resource (0: let it go)
+    when_interrupted: try_again   # a round a higher tree cut short starts again (default:
+                                  # let_go, the events that started it are spent)
 
 Each may be a ``${parameter}``, so a profile can set it.
 """
@@ -17,7 +19,15 @@ from typing import Any
 from engine.files.problems import Problems
 from engine.files.yaml_source import YMap, plain
 from engine.loader.substitution import ParamValue, substitute, unresolved
-from engine.values.params import RATE_HZ, CheckContext, Integer, Number, Param, ParamProblem
+from engine.values.params import (
+    RATE_HZ,
+    CheckContext,
+    Choice,
+    Integer,
+    Number,
+    Param,
+    ParamProblem,
+)
 
 DEFAULT_RATE_HZ = 10.0
 PRIORITY = Integer(0, 99)
@@ -44,6 +54,14 @@ SETTINGS = (
         "seconds an action waits while another tree has the speaker, LEDs or joint "
         "(0: let the action go at once), e.g. wait_for_turn_s: 2",
     ),
+    Param(
+        "when_interrupted",
+        Choice(("let_go", "try_again")),
+        "let_go",
+        "what a round that a higher tree cut short does: let_go (what started it is spent) "
+        "or try_again (it starts again with the same events, its actions waiting up to "
+        "wait_for_turn_s for their turn), e.g. when_interrupted: try_again",
+    ),
 )
 
 
@@ -52,6 +70,7 @@ class TreeSettings:
     rate_hz: float = DEFAULT_RATE_HZ
     priority: int = 0
     wait_for_turn_s: float = 0.0
+    when_interrupted: str = "let_go"
 
 
 def read_settings(

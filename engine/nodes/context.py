@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING
 from engine.blackboard.board import Blackboard
 from engine.clock import Clock
 from engine.services.actions import TreeActions
+from engine.session.stream import SessionStream
 
 if TYPE_CHECKING:
     from engine.dialogs.library import DialogLibrary
@@ -73,3 +74,5 @@ class TreeContext:
     dialogs: DialogLibrary | None = None
     on_node_error: NodeErrorHandler = field(default=log_node_error)
     on_node_warning: NodeWarningHandler = field(default=log_node_warning)
+    session: SessionStream | None = None
+    """Where nodes tell what happened that only they know (a sentence no rule matched)."""

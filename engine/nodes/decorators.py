@@ -15,6 +15,7 @@ from py_trees.common import OneShotPolicy, Status
 from engine.clock import Clock
 from engine.nodes.context import TreeContext
 from engine.nodes.spec import NodeType
+from engine.services.turns import TurnYieldedError
 from engine.values.params import REQUIRED, SECONDS, Choice, Integer, Param
 
 
@@ -44,7 +45,9 @@ class Cooldown(py_trees.decorators.Decorator):
     The child acted when it succeeded, or when it failed after one of its actions ran
     (the LEDs failed but the robot spoke): the robot rests either way, rather than
     trying again on the next tick and stuttering. A child that failed before any action
-    ran (a check inside it said no) starts no rest.
+    ran (a check inside it said no), or whose actions all let their turn go to a tree of
+    higher priority (it did not act), starts no rest; nor does a child a higher tree
+    interrupted (it is halted, not finished).
 
     ``counting_from`` is ``"end"`` (the rest starts when the child finished) or
     ``"start"`` (it starts when the child started: with a 5 s rest and 1.5 s of moves, a
@@ -85,12 +88,22 @@ class Cooldown(py_trees.decorators.Decorator):
 
 
 def _an_action_ran(node: Behaviour) -> bool:
-    """Whether an action leaf under ``node`` was ticked in the round that just ended (its
-    status is kept until the next round starts)."""
+    """Whether an action leaf under ``node`` acted in the round that just ended (its
+    status is kept until the next round starts): it was ticked, and did not let its turn
+    go to another tree."""
     return any(
-        getattr(leaf, "kind", None) == "action" and leaf.status != Status.INVALID
+        getattr(leaf, "kind", None) == "action"
+        and leaf.status != Status.INVALID
+        and not _lost_its_turn(leaf)
         for leaf in node.iterate()
     )
+
+
+def _lost_its_turn(leaf: Behaviour) -> bool:
+    job = getattr(leaf, "job", None)
+    if job is None or getattr(job, "waiting", False):  # asking a waiting job starts it
+        return False
+    return job.done() and isinstance(job.error(), TurnYieldedError)
 
 
 def _child(children: list[Any]) -> Any:

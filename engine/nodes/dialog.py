@@ -11,6 +11,7 @@ from engine.dialogs.model import Dialog, FollowUp
 from engine.errors import ServiceError
 from engine.nodes.base import Leaf
 from engine.services.jobs import ImmediateJob, Job
+from engine.session.events import NotUnderstood
 from engine.values.params import CheckContext, Key, Param, ParamIssue, Text, did_you_mean
 from engine.values.templates import CompiledTemplate
 
@@ -80,6 +81,10 @@ class Reply(Leaf):
         if match is None:
             why = verdict.reason if verdict is not None else "nothing was heard"
             self.feedback_message = f"no rule matches {heard!r}: {why}"
+            if heard and self.ctx.session is not None:
+                self.ctx.session.publish(
+                    NotUnderstood(self.ctx.clock.now(), self.ctx.tree, str(heard), why)
+                )
             said = asked.otherwise if asked is not None else None
             said = said if said is not None else dialog.fallback
             if said is not None:

@@ -20,6 +20,7 @@ from engine.blackboard.catalogue import (
     FORCE_LEFT_N,
     FORCE_RIGHT_N,
     GESTURE_LAST,
+    IOT_CANCELED,
     RANGE_CENTER_MM,
     RANGE_LEFT_MM,
     RANGE_RIGHT_MM,
@@ -31,6 +32,7 @@ from engine.blackboard.events import EventLog
 from engine.errors import ServiceError
 from engine.nodes.actions import MoveServo, Say, SetLed
 from engine.nodes.base import Leaf, ServiceAction, declared_params
+from engine.nodes.event_reader import EventReader
 from engine.services.jobs import ImmediateJob, Job
 from engine.values.params import SECONDS, CheckContext, Key, Param, ParamProblem, did_you_mean
 from engine.values.templates import Template
@@ -87,8 +89,9 @@ class CarryOut(ServiceAction):
     """Carry out a remote command (say, led, move, read).
 
     RUNNING while the service works; SUCCESS when done, with the result saved to
-    ``save_result_as``; FAILURE when the command is malformed, the service failed or the
-    command took longer than ``timeout_s``, with ``{"error": why}`` saved there instead.
+    ``save_result_as``; FAILURE when the command is malformed, the service failed, the
+    command took longer than ``timeout_s`` or the operator canceled it meanwhile (its
+    action is cut short), with ``{"error": why}`` saved there instead.
     Arguments are checked by the declarations of Say, SetLed and MoveServo. The result
     saved always belongs to this command (it is cleared when the command starts).
     """
@@ -98,13 +101,29 @@ class CarryOut(ServiceAction):
         "save_result_as", Key(access="write"), None, "a /vars/ key for the result"
     )
     timeout_s = Param("timeout_s", SECONDS, 60.0, "FAILURE when a command takes longer, in seconds")
-    reads: ClassVar = tuple(key for keys in POLLED_READINGS.values() for key in keys)
+    reads: ClassVar = (*(key for keys in POLLED_READINGS.values() for key in keys), IOT_CANCELED)
+
+    def __init__(self, *a: Any) -> None:
+        super().__init__(*a)
+        self.cancels = EventReader(self, IOT_CANCELED, None)
 
     def initialise(self) -> None:
         if self.save_result_as:
             self.write(self.save_result_as, None)
         self.started_s = self.now()
+        self.cancels.skip_past()  # only a cancel of this command, from now on, counts
         super().initialise()
+
+    def _canceled(self) -> bool:
+        """Whether the operator canceled this command (an ``/iot/canceled`` event)."""
+        command = self.read(self.command)
+        wanted = command.get("id") if isinstance(command, Mapping) else None
+        while True:
+            found, command_id = self.cancels.take()
+            if not found:
+                return False
+            if command_id == wanted:
+                return True
 
     def start(self) -> Job:
         command = self.read(self.command)
@@ -162,6 +181,17 @@ class CarryOut(ServiceAction):
                 values[key] = value.latest.value if value.latest else None
         return ImmediateJob(values)
 
+    def _cut(self, why: str) -> Status:
+        """Stop the command's action short (told as cut, ``why``): FAILURE."""
+        self.ctx.actions.stop_reason = why
+        try:
+            if self.job is not None:
+                self.job.cancel()
+        finally:
+            self.ctx.actions.stop_reason = ""
+        self.feedback_message = why
+        return Status.FAILURE
+
     def finished(self, job: Job) -> Status:
         result = job.result()  # a reading is staged by the sensor service, not written here
         if self.save_result_as:
@@ -170,11 +200,10 @@ class CarryOut(ServiceAction):
 
     def update(self) -> Status:
         status = super().update()
+        if status == Status.RUNNING and self._canceled():
+            status = self._cut("canceled by the operator")
         if status == Status.RUNNING and self.now() - self.started_s > self.timeout_s:
-            if self.job is not None:
-                self.job.cancel()
-            self.feedback_message = f"timed out after {self.timeout_s:g} s"
-            status = Status.FAILURE
+            status = self._cut(f"timed out after {self.timeout_s:g} s")
         if status == Status.FAILURE and self.save_result_as:
             self.write(self.save_result_as, {"error": self.feedback_message})
         return status

@@ -1,14 +1,17 @@
 """Recording a session as it runs (``vest run --record FILE``), without costing the tick.
 
-The scheduler's thread only notes what changed (a node's status after a tick, a committed
-blackboard write, a service call) and puts it on a bounded queue; a writer thread beside
-it stores the notes in the SQLite file (:mod:`engine.recording.session_file`) in batches.
+A reader of the session stream (:mod:`engine.session.events`): the scheduler's thread
+only turns each event into a row (a tree version, a node's status, a blackboard change, an
+action and how it ended, a scenario event, a turn, a safety decision, a press...) and puts
+it on a bounded queue; a writer thread beside it stores the rows in the SQLite file
+(:mod:`engine.recording.session_file`) in batches.
 Should the disk fall so far behind that the queue fills, notes are dropped and counted,
 never waited for: the robot's ticks come first, and the file says how many were lost.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import json
 import logging
@@ -18,37 +21,42 @@ import threading
 from pathlib import Path
 from typing import Any
 
-from engine.blackboard.catalogue import KeyCatalogue
 from engine.clock import Clock
-from engine.loader.tree_definition import TreeDefinition
-from engine.loader.tree_drawing import dot_source
-from engine.recording.session_file import ChangedKeys, create
-from engine.runtime.scheduler import RunningTree
-from engine.runtime.tree_watch import TreeWatch, WatchedTree
-from engine.scenario.scenario_file import ScenarioEvent
-from engine.services.actions import ActionRecord
+from engine.recording.session_file import create
+from engine.session.events import (
+    ActionEnded,
+    ActionStarted,
+    KeyChanged,
+    NodeStatus,
+    SessionEvent,
+    TreeStarted,
+    WorldEvent,
+)
 
 log = logging.getLogger(__name__)
 CAPACITY = 200_000
 """Notes the queue holds before it drops (minutes of a busy session's changes)."""
 Row = tuple[str, tuple[Any, ...]]
+KEPT_AS_EVENTS = frozenset(
+    {"turn", "safety", "press", "pause", "not_understood", "not_listened", "reload"}
+)
+"""The kinds of session events kept in the ``events`` table (the others have tables of
+their own, or are kept as the blackboard keys they came from)."""
 
 
 class SessionRecorder:
-    """Records one session into ``path``; times are clock seconds minus ``start_s``."""
+    """Records one session into ``path``: a session reader (``on_event``); times are
+    clock seconds minus ``start_s``."""
 
-    def __init__(
-        self, path: Path, clock: Clock, catalogue: KeyCatalogue, *, capacity: int = CAPACITY
-    ) -> None:
+    def __init__(self, path: Path, clock: Clock, *, capacity: int = CAPACITY) -> None:
         self.path = path
         self.clock = clock
         self.start_s = clock.now()
         self.dropped = 0
         self._broken = False
         self._connection: sqlite3.Connection | None = create(path)
+        self._seq = 0  # the order of the session's events across tables
         self._queue: queue.Queue[Row | None] = queue.Queue(maxsize=capacity)
-        self._watch = TreeWatch()
-        self._changed = ChangedKeys(catalogue)
         self._thread = threading.Thread(target=self._write, name="recorder", daemon=True)
         self._thread.start()
 
@@ -58,36 +66,112 @@ class SessionRecorder:
         for key, value in facts.items():
             self._note("INSERT OR REPLACE INTO meta VALUES (?, ?)", (key, value))
 
-    def begin(self, start_s: float, trees: list[RunningTree]) -> None:
-        """Times count from ``start_s`` (clock seconds); record every tree as it is now."""
+    def begin(self, start_s: float) -> None:
+        """Times count from ``start_s`` (clock seconds)."""
         self.start_s = start_s
-        for tree in trees:
-            self._record_tree(self._watch.watch(tree))
 
-    def _at(self) -> float:
-        return round(self.clock.now() - self.start_s, 6)
+    def _at(self, t_s: float) -> float:
+        return round(t_s - self.start_s, 6)
 
-    def _record_tree(self, watched: WatchedTree) -> None:
-        definition = watched.definition
+    # -- as the robot runs (the scheduler's thread) ---------------------------------------
+    def on_event(self, event: SessionEvent) -> None:
+        if isinstance(event, NodeStatus):
+            self._note(
+                "INSERT INTO statuses VALUES (?, ?, ?, ?, ?, ?, ?)",
+                (
+                    self._at(event.t_s),
+                    event.tree,
+                    event.version,
+                    event.tick,
+                    event.node,
+                    event.status,
+                    event.feedback,
+                ),
+            )
+        elif isinstance(event, KeyChanged):
+            self._note(
+                "INSERT INTO blackboard VALUES (?, ?, ?, ?, ?)",
+                (self._at(event.t_s), event.key, event.text, event.event, self._next()),
+            )
+        elif isinstance(event, ActionStarted):
+            self._note(
+                "INSERT INTO actions VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
+                (
+                    self._at(event.t_s),
+                    event.tree,
+                    event.action,
+                    json.dumps(event.args, default=str),
+                    None,
+                    event.action_id,
+                    None,
+                    None,
+                    None,
+                    self._next(),
+                ),
+            )
+        elif isinstance(event, ActionEnded):
+            self._note(
+                "UPDATE actions SET outcome = ?, ended_s = ?, error = ?, why = ? "
+                "WHERE action_id = ?",
+                (
+                    event.outcome,
+                    self._at(event.t_s),
+                    event.why if event.outcome == "failed" else None,
+                    event.why,
+                    event.action_id,
+                ),
+            )
+        elif isinstance(event, WorldEvent):
+            self._note(
+                "INSERT INTO world VALUES (?, ?, ?, ?)",
+                (self._at(event.t_s), event.scenario_event, event.description, self._next()),
+            )
+        elif isinstance(event, TreeStarted):
+            self._record_tree(event)
+        elif event.kind in KEPT_AS_EVENTS:
+            data = {
+                name: getattr(event, name)
+                for name in (field.name for field in dataclasses.fields(event))
+                if name not in ("t_s", "tree")
+            }
+            for name in ("from_s", "until_s"):
+                if name in data:
+                    data[name] = self._at(data[name])
+            self._note(
+                "INSERT INTO events VALUES (?, ?, ?, ?, ?)",
+                (
+                    self._at(event.t_s),
+                    event.kind,
+                    str(getattr(event, "tree", "")),
+                    json.dumps(data, default=str),
+                    self._next(),
+                ),
+            )
+
+    def _next(self) -> int:
+        self._seq += 1
+        return self._seq
+
+    def _record_tree(self, event: TreeStarted) -> None:
         self._note(
             "INSERT INTO trees VALUES (?, ?, ?, ?, ?, ?, ?, ?)",
             (
-                watched.name,
-                watched.version,
-                self._at(),
-                str(definition.path),
-                _digest(definition),
-                definition.rate_hz,
-                _source(definition.path),
-                dot_source(definition),
+                event.tree,
+                event.version,
+                self._at(event.t_s),
+                str(event.file),
+                _digest(event.files),
+                event.rate_hz,
+                _source(event.file),
+                event.dot,
             ),
         )
-        for node in watched.info:
+        for node in event.nodes:
             self._note(
                 "INSERT INTO nodes VALUES (?, ?, ?, ?, ?, ?, ?)",
                 (
-                    watched.name,
-                    watched.version,
+                    event.tree,
+                    event.version,
                     node.index,
                     node.path,
                     node.type,
@@ -95,51 +179,6 @@ class SessionRecorder:
                     node.depth,
                 ),
             )
-
-    # -- as the robot runs (the scheduler's thread) ---------------------------------------
-    def tree_ticked(self, tree: RunningTree) -> None:
-        """After ``tree`` ticked: note each node whose status or feedback changed."""
-        watched, new, changes = self._watch.look(tree)
-        if new:  # hot-reloaded
-            self._record_tree(watched)
-        at = tick_moment(tree, self.start_s)
-        for index, status, feedback in changes:
-            self._note(
-                "INSERT INTO statuses VALUES (?, ?, ?, ?, ?, ?, ?)",
-                (at, tree.name, watched.version, watched.ticks, index, status, feedback),
-            )
-
-    def blackboard_write(self, key: str, value: Any) -> None:
-        """A blackboard watcher: a committed write (or event). A state key's write that
-        does not change its value (a sensor polled 20 times a second) is not noted."""
-        news = self._changed.news(key, value)
-        if news is None:
-            return
-        text, event = news
-        self._note("INSERT INTO blackboard VALUES (?, ?, ?, ?)", (self._at(), key, text, event))
-
-    def action(self, record: ActionRecord) -> None:
-        """An action log listener: a service call."""
-        args = json.dumps(record.args, default=str)
-        self._note(
-            "INSERT INTO actions VALUES (?, ?, ?, ?, ?)",
-            (round(record.t - self.start_s, 6), record.tree, record.action, args, None),
-        )
-
-    def failed(self, record: ActionRecord, error: BaseException) -> None:
-        """An action log failure listener: the call turned out to have failed."""
-        self._note(
-            "UPDATE actions SET error = ? WHERE rowid = (SELECT max(rowid) FROM actions "
-            "WHERE at_s = ? AND tree = ? AND action = ?)",
-            (record.error, round(record.t - self.start_s, 6), record.tree, record.action),
-        )
-
-    def world(self, at_s: float, event: ScenarioEvent) -> None:
-        """A scenario event, as the timeline hears it."""
-        self._note(
-            "INSERT INTO world VALUES (?, ?, ?)",
-            (round(at_s - self.start_s, 6), event.kind, event.describe()),
-        )
 
     def _note(self, sql: str, row: tuple[Any, ...]) -> None:
         if self._broken:
@@ -177,7 +216,7 @@ class SessionRecorder:
         """Write what is still queued, how long the session was and what was lost."""
         if self._connection is None:
             return
-        self.describe(duration_s=f"{self._at():.3f}", dropped=str(self.dropped))
+        self.describe(duration_s=f"{self._at(self.clock.now()):.3f}", dropped=str(self.dropped))
         if not self._broken:  # a writer that stopped reads no more: nothing to wait for
             self._queue.put(None)
             self._thread.join()
@@ -189,16 +228,10 @@ class SessionRecorder:
             )
 
 
-def tick_moment(tree: RunningTree, start_s: float) -> float:
-    """When the tick that just ended was due (s since ``start_s``): its statuses hold from
-    then, so a moment shows a tree's actions and the statuses that led to them together."""
-    return round(tree.next_deadline_s - start_s, 6)
-
-
-def _digest(definition: TreeDefinition) -> str:
+def _digest(files: tuple[Path, ...]) -> str:
     """SHA-256 over the tree's files (its own and its subtrees'), in order."""
     digest = hashlib.sha256()
-    for path in definition.files or [definition.path]:
+    for path in files:
         try:
             digest.update(path.read_bytes())
         except OSError:

@@ -58,11 +58,24 @@ class KeyState:
 
 @dataclass(frozen=True)
 class RecordedAction:
+    """A service call: when, by which tree, what; how it ended (``outcome``: done,
+    failed, cut, or None when the session ended first or the format did not say) and
+    when (``ended_s``), and why it failed (``error``)."""
+
     at_s: float
     tree: str
     action: str
     args: dict[str, Any]
     error: str | None
+    outcome: str | None = None
+    ended_s: float | None = None
+    why: str = ""
+    seq: int = 0
+    """Its place in the session's order of events (format 2; 0 in format 1)."""
+
+    @property
+    def cut(self) -> bool:
+        return self.outcome == "cut"
 
 
 class Recording:
@@ -187,6 +200,14 @@ class Recording:
         rows = self._rows("SELECT at_s, kind, description FROM world ORDER BY rowid")
         return [(at, kind, description) for at, kind, description in rows]
 
+    def ordered_rows(self, table: str, columns: str, until_s: float) -> list[Any]:
+        """Rows of ``table`` up to ``until_s`` with their order across tables (format 2's
+        ``seq``; 0 in format 1) last."""
+        seq = "seq" if self.format >= 2 else "0"
+        return self._rows(
+            f"SELECT {columns}, {seq} FROM {table} WHERE at_s <= ? ORDER BY rowid", (until_s,)
+        )
+
     def key_history(self, key: str) -> list[tuple[float, Any]]:
         """Each (moment, value) ``key`` took (each event, for an event key), in order."""
         rows = self._rows("SELECT at_s, value FROM blackboard WHERE key = ? ORDER BY rowid", (key,))
@@ -213,11 +234,52 @@ class Recording:
 
     def actions(self, until_s: float | None = None) -> list[RecordedAction]:
         """The service calls, in order (up to ``until_s`` when given)."""
+        until = float("inf") if until_s is None else until_s
+        if self.format < 2:
+            rows = self._rows(
+                "SELECT at_s, tree, action, args, error, NULL, NULL, NULL, NULL FROM actions "
+                "WHERE at_s <= ? ORDER BY rowid",
+                (until,),
+            )
+        else:
+            rows = self._rows(
+                "SELECT at_s, tree, action, args, error, outcome, ended_s, why, seq FROM actions "
+                "WHERE at_s <= ? ORDER BY rowid",
+                (until,),
+            )
+        return [_action(*row) for row in rows]
+
+    def events(
+        self, until_s: float | None = None
+    ) -> list[tuple[float, int, str, str, dict[str, Any]]]:
+        """(moment, order, kind, tree, fields) of each event kept in the ``events`` table
+        (turns, safety, presses, pauses, not understood, not listened to, reloads); none
+        in format 1, which did not keep them."""
+        if self.format < 2:
+            return []
         rows = self._rows(
-            "SELECT at_s, tree, action, args, error FROM actions WHERE at_s <= ? ORDER BY rowid",
+            "SELECT at_s, seq, kind, tree, data FROM events WHERE at_s <= ? ORDER BY rowid",
             (float("inf") if until_s is None else until_s,),
         )
-        return [RecordedAction(t, tree, a, json.loads(args), e) for t, tree, a, args, e in rows]
+        return [(at, seq or 0, kind, tree, json.loads(data)) for at, seq, kind, tree, data in rows]
+
+
+def _action(
+    at: float,
+    tree: str,
+    action: str,
+    args: str,
+    error: str | None,
+    outcome: str | None,
+    ended_s: float | None,
+    why: str | None,
+    seq: int | None,
+) -> RecordedAction:
+    if outcome is None and error is not None:  # format 1 kept only the error
+        outcome = "failed"
+    return RecordedAction(
+        at, tree, action, json.loads(args), error, outcome, ended_s, why or error or "", seq or 0
+    )
 
 
 def moment(recording: Recording, at_s: float) -> str:

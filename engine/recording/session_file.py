@@ -9,25 +9,32 @@ Times are seconds since the session started (its first tick's clock time). Table
 - ``nodes``: each node of each tree version, numbered in depth-first order as
   ``vest render`` numbers them (``n0`` is the root), with its path and type;
 - ``statuses``: a node's status (and feedback message) each time it changes after a tick;
+
+(format 2: ``seq`` in ``blackboard``, ``actions``, ``world`` and ``events`` numbers the
+session's events in the order they happened, across tables)
 - ``blackboard``: each write that changed a key's value, and every event, as JSON;
-- ``actions``: each service call (say, led, move, ...), and its error when it failed;
-- ``world``: what happened around the robot (a scenario's events).
+- ``actions``: each service call (say, led, move, ...) with how it ended (``outcome``:
+  done, failed or cut short; ``ended_s``) and its error when it failed;
+- ``world``: what happened around the robot (a scenario's events);
+- ``events`` (format 2): the rest of the session's account, one row per event with its
+  fields as JSON: turns (interrupts, waits, yields), safety refusals, slow-downs and stops,
+  the therapist's presses, pauses, sentences not understood or not listened to, reloads.
 
 A later version of vest reads every earlier format; it refuses a newer one by name.
+Format 1 (before the session's events were kept) has no ``events`` table and no outcome
+of an action but its error.
 """
 
 from __future__ import annotations
 
-import json
 import sqlite3
 from pathlib import Path
-from typing import Any
 
-from engine.blackboard.catalogue import KeyCatalogue
 from engine.errors import ConfigError
 
-FORMAT_VERSION = 1
+FORMAT_VERSION = 2
 TABLES = ("meta", "trees", "nodes", "statuses", "blackboard", "actions", "world")
+"""The tables every format has (format 2 adds ``events``)."""
 SCHEMA = """
 CREATE TABLE meta (key TEXT PRIMARY KEY, value TEXT NOT NULL);
 CREATE TABLE trees (
@@ -46,42 +53,24 @@ CREATE TABLE statuses (
 );
 CREATE INDEX statuses_by_time ON statuses (at_s);
 CREATE TABLE blackboard (
-    at_s REAL NOT NULL, key TEXT NOT NULL, value TEXT NOT NULL, event INTEGER NOT NULL
+    at_s REAL NOT NULL, key TEXT NOT NULL, value TEXT NOT NULL, event INTEGER NOT NULL,
+    seq INTEGER
 );
 CREATE INDEX blackboard_by_time ON blackboard (at_s);
 CREATE TABLE actions (
     at_s REAL NOT NULL, tree TEXT NOT NULL, action TEXT NOT NULL, args TEXT NOT NULL,
-    error TEXT
+    error TEXT, action_id INTEGER, outcome TEXT, ended_s REAL, why TEXT, seq INTEGER
 );
-CREATE TABLE world (at_s REAL NOT NULL, kind TEXT NOT NULL, description TEXT NOT NULL);
+CREATE INDEX actions_by_id ON actions (action_id);
+CREATE TABLE world (
+    at_s REAL NOT NULL, kind TEXT NOT NULL, description TEXT NOT NULL, seq INTEGER
+);
+CREATE TABLE events (
+    at_s REAL NOT NULL, kind TEXT NOT NULL, tree TEXT NOT NULL, data TEXT NOT NULL,
+    seq INTEGER
+);
+CREATE INDEX events_by_time ON events (at_s);
 """
-
-
-def as_json(value: Any) -> str:
-    """A blackboard value as JSON; what JSON cannot hold is kept as its text."""
-    try:
-        return json.dumps(value, allow_nan=False, default=str)
-    except ValueError:  # NaN or infinity
-        return json.dumps(str(value))
-
-
-class ChangedKeys:
-    """Which blackboard writes say something new: every event, and a state key's write
-    only when its value changed (a sensor polled 20 times a second mostly repeats)."""
-
-    def __init__(self, catalogue: KeyCatalogue) -> None:
-        self.catalogue = catalogue
-        self._values: dict[str, str] = {}
-
-    def news(self, key: str, value: Any) -> tuple[str, bool] | None:
-        """(the value as JSON, whether ``key`` is an event key), or None: nothing new."""
-        spec = self.catalogue.lookup(key)
-        event = spec is not None and spec.kind == "event"
-        text = as_json(value)
-        if not event and self._values.get(key) == text:
-            return None
-        self._values[key] = text
-        return text, event
 
 
 def create(path: Path) -> sqlite3.Connection:

@@ -27,6 +27,8 @@ from engine.files.problems import LoadError, Mark, Problem
 from engine.loader.tree_definition import TreeDefinition
 from engine.loader.tree_file import TreeLoader
 from engine.runtime.scheduler import RunningTree
+from engine.session.events import TreeReloaded
+from engine.session.stream import SessionStream
 
 _log = logging.getLogger("vest.reload")
 
@@ -62,12 +64,15 @@ class TreeReloader:
         *,
         check_every_s: float = 1.0,
         on_reload: Callable[[str, LoadError | None], None] | None = None,
+        session: SessionStream | None = None,
     ) -> None:
         self.loader = loader
         self.trees = trees
         self.clock = clock
         self.check_every_s = check_every_s
         self.on_reload = on_reload or _log_reload
+        self.session = session
+        """Where each reload (or refused change) is published as a TreeReloaded."""
         self._next_check_s = clock.now() + check_every_s
         self._stamps: dict[Path, dict[Path, Stamp]] = {
             tree.definition.path: _stamps(tree.definition.files or [tree.definition.path])
@@ -108,6 +113,9 @@ class TreeReloader:
                 except Exception as error:  # whatever went wrong, the running robot goes on
                     problem = _crashed(self.loader.shown(prepared.tree.definition.path), error)
             self.on_reload(prepared.tree.name, problem)
+            if self.session is not None:
+                why = "" if problem is None else _first_problem(problem)
+                self.session.publish(TreeReloaded(self.clock.now(), prepared.tree.name, why))
 
     # -- the worker's side ------------------------------------------------------------------
     def start(self) -> None:
@@ -173,6 +181,13 @@ def _crashed(shown: str, error: Exception) -> LoadError:
     return LoadError(
         [Problem(Mark(shown, 1, 1), f"could not reload: {type(error).__name__}: {error}")]
     )
+
+
+def _first_problem(error: LoadError) -> str:
+    """The first problem of a refused change, and how many more there are."""
+    first = str(error.problems[0]) if error.problems else str(error)
+    more = len(error.problems) - 1
+    return first + (f" (and {more} more)" if more > 0 else "")
 
 
 def _log_reload(name: str, error: LoadError | None) -> None:

@@ -17,10 +17,14 @@ from engine.loader.tree_file import TreeLoader
 from engine.nodes.context import NodeErrorHandler, NodeErrorLog, TreeContext
 from engine.nodes.registry import NodeRegistry, default_registry
 from engine.runtime.scheduler import RunningTree, Scheduler
+from engine.runtime.tree_watch import TreeNews
 from engine.services.actions import ActionLog, TreeActions, TurnTaking
 from engine.services.interfaces import Services
 from engine.services.staged_readings import with_staged_readings
 from engine.services.turns import Turns
+from engine.session.blackboard_news import BlackboardNews
+from engine.session.events import TurnTaken
+from engine.session.stream import SessionStream
 
 
 def tree_files(paths: list[Path]) -> list[Path]:
@@ -121,7 +125,8 @@ def load_behaviors(
 
 
 class Robot:
-    """Built trees on one blackboard and clock, ticked by one scheduler."""
+    """Built trees on one blackboard and clock, ticked by one scheduler; what happens is
+    published on one session stream (``session``), which every reader subscribes to."""
 
     def __init__(
         self,
@@ -130,27 +135,29 @@ class Robot:
         clock: Clock,
         services: Services,
         blackboard: Blackboard,
-        action_log: ActionLog | None = None,
+        session: SessionStream | None = None,
         on_node_error: NodeErrorHandler | None = None,
     ) -> None:
         self.behaviors = behaviors
         self.clock = clock
         self.services = services
         self.blackboard = blackboard
-        self.action_log = action_log or ActionLog()
+        self.session = session or SessionStream(clock)
+        self.action_log = ActionLog(self.session)
         self.scheduler = Scheduler(clock, blackboard)
-        self.turns = Turns(clock)
-        """Who has the speaker, the face LEDs and each joint; ``turns.listeners`` hear who
-        interrupted, waited for or yielded to whom."""
-        self.turns.interrupt = self.interrupt
+        self.turns = Turns(clock, stream=self.session, interrupt=self.interrupt)
+        """Who has the speaker, the face LEDs and each joint."""
+        self.tree_news = TreeNews(self.session)
+        self.scheduler.after_tick.append(self.tree_news)
+        blackboard.watchers.append(BlackboardNews(self.session, blackboard.catalogue, clock))
         self._staged = with_staged_readings(services, blackboard)  # readings reach every tree
         self._node_errors = on_node_error or NodeErrorLog()  # one count per node and error
         for definition in behaviors.trees:
             self.add_tree(definition)
 
-    def add_tree(self, definition: TreeDefinition, *, first: bool = False) -> RunningTree:
+    def add_tree(self, definition: TreeDefinition) -> RunningTree:
         """Build ``definition`` on this robot (its clock, blackboard, services and turns)
-        and schedule it; ``first``: it ticks before the others due at the same moment."""
+        and schedule it (within a step, trees tick by priority)."""
         context = TreeContext(
             tree=definition.name,
             clock=self.clock,
@@ -164,17 +171,27 @@ class Robot:
             ),
             dialogs=self.behaviors.dialogs,
             on_node_error=self._node_errors,
+            session=self.session,
         )
-        tree = self.scheduler.add(RunningTree(definition, context, definition.build(context)))
-        if first:
-            self.scheduler.trees.insert(0, self.scheduler.trees.pop())
-        return tree
+        return self.scheduler.add(RunningTree(definition, context, definition.build(context)))
 
     @property
     def trees(self) -> list[RunningTree]:
         return self.scheduler.trees
 
-    def interrupt(self, name: str) -> None:
-        """Halt tree ``name`` cleanly (pre-empted): its actions stop, its joints go back
-        to rest and its LEDs off; it starts afresh at its next tick."""
-        self.scheduler.tree(name).halt()
+    def begin_session(self, start_s: float) -> None:
+        """The session starts at clock time ``start_s``: readers count from it, and every
+        tree is published as it is now."""
+        self.session.start_s = start_s
+        for tree in self.trees:
+            self.tree_news.started(tree)
+
+    def interrupt(self, name: str, by: str, resource: str) -> None:
+        """Halt tree ``name`` cleanly because ``by`` takes ``resource``: its actions stop
+        (cut short), its joints go back to rest and its LEDs off. It starts afresh at its
+        next tick: with the events of the round cut short when it tries again."""
+        tree = self.scheduler.tree(name)
+        tree.halt(f"{by} interrupted it")
+        if tree.tries_again:
+            tree.try_again()
+            self.session.publish(TurnTaken(self.clock.now(), name, "tries_again", resource, by))

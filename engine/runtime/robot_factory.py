@@ -31,8 +31,8 @@ from engine.hardware.safety_envelope import (
 from engine.hardware.sim_vest import SimVest, UnwiredSenses, build_sim_vest
 from engine.runtime.robot import Behaviors, Robot
 from engine.scenario.world import World
-from engine.services.actions import ActionLog
 from engine.services.interfaces import IotResults, Services, Speech
+from engine.session.stream import SessionStream
 from engine.speech.robot_speech import RobotSpeech
 from engine.vision.robot_vision import RobotVision, build_vision
 
@@ -79,13 +79,15 @@ def build_robot(
     speech: Speech | RobotSpeech,
     iot: IotResults,
     fallback: Services | None = None,
-    action_log: ActionLog | None = None,
+    session: SessionStream | None = None,
 ) -> AssembledRobot:
     """The robot of ``config`` running ``behaviors`` on ``clock``.
 
     ``config.simulated`` builds the register-level simulated vest behind the same buses;
-    ``fallback`` serves what the config has no device for (e.g. simulated LEDs).
+    ``fallback`` serves what the config has no device for (e.g. simulated LEDs). What
+    happens is published on ``session`` (a new stream when not given: ``robot.session``).
     """
+    session = session or SessionStream(clock)
     blackboard = Blackboard(behaviors.loader.catalogue, clock)
     blackboard.reset()
     world = World()
@@ -100,10 +102,10 @@ def build_robot(
     try:
         service = robot_speech.speaker if robot_speech is not None else speech
         services = hardware.services(speech=service, iot=iot, fallback=fallback)  # type: ignore[arg-type]
-        envelope = SafetyEnvelope.of(config, blackboard)
+        envelope = SafetyEnvelope.of(config, blackboard, session)
         services = with_envelope(services, envelope)  # no tree reaches around it
         robot = Robot(
-            behaviors, clock=clock, services=services, blackboard=blackboard, action_log=action_log
+            behaviors, clock=clock, services=services, blackboard=blackboard, session=session
         )
     except BaseException:
         hardware.close()
@@ -112,7 +114,7 @@ def build_robot(
         raise
     robot.scheduler.hooks.extend(hardware.hooks)
     assert isinstance(services.servos, EnvelopedServos)
-    robot.scheduler.hooks.append(EnvelopeWatcher(services.servos, envelope, robot.turns.tell))
+    robot.scheduler.hooks.append(EnvelopeWatcher(services.servos, envelope))
     if robot_speech is not None:  # the microphone hears the room the world just changed
         robot.scheduler.hooks.append(robot_speech)
     vision = None

@@ -4,6 +4,12 @@ Deadlines are ``origin + k * period`` (never "last tick + period"), so small del
 not add up. Before the trees due at a deadline tick, the hooks run (the scenario, hot
 reload) and the blackboard's staged writes are committed: every tree ticked at one
 deadline sees the same snapshot. A tick that overran whole periods skips them (counted).
+
+Within one step the trees due tick in order of priority, highest first (the therapist's
+buttons, then the behaviors): what several trees claim at one moment (the speaker, the
+face LEDs, a joint) is settled by priority before a lower tree starts anything, never by
+a tree's name or the order the trees were loaded. Trees of one priority keep the order
+they were added in (``vest validate`` warns when two of them can want one resource).
 """
 
 from __future__ import annotations
@@ -12,6 +18,7 @@ import logging
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
+from typing import Any
 
 import py_trees
 
@@ -40,6 +47,9 @@ class RunningTree:
     stats: TickStats = field(default_factory=TickStats)
     paused: bool = False
     """A paused tree keeps its deadlines but is not ticked (the therapist paused it)."""
+    _round_start: list[tuple[Any, int]] = field(default_factory=list)
+    _readers: list[Any] = field(default_factory=list)
+    _readers_of: Any = None
 
     @property
     def name(self) -> str:
@@ -54,8 +64,35 @@ class RunningTree:
         return self.origin_s + self.period_index * self.period_s
 
     @property
+    def priority(self) -> int:
+        return self.definition.priority
+
+    @property
     def status(self) -> py_trees.common.Status:
         return self.tree.root.status
+
+    @property
+    def tries_again(self) -> bool:
+        """Whether a round cut short by a higher tree is started again (``when_interrupted:
+        try_again``) rather than let go."""
+        return self.definition.when_interrupted == "try_again"
+
+    def round_starts(self) -> None:
+        """A new round begins at this tick: remember which events the tree had handled,
+        so that a round cut short can be tried again with the same events (only for a tree
+        that tries again: the others pay nothing)."""
+        if not self.tries_again:
+            return
+        if self._readers_of is not self.tree.root:  # the nodes that read events, once a version
+            self._readers = [n for n in self.tree.root.iterate() if hasattr(n, "events")]
+            self._readers_of = self.tree.root
+        self._round_start = [(node, node.events.handled_seq) for node in self._readers]
+
+    def try_again(self) -> None:
+        """Hand the events of the round that was cut short back to its nodes: at its next
+        tick the tree starts the round again as if they had just come."""
+        for node, seq in self._round_start:
+            node.events.handled_seq = min(node.events.handled_seq, seq)
 
     def replace(self, definition: TreeDefinition) -> None:
         """Swap in a new version of the tree between ticks (statistics kept).
@@ -68,7 +105,7 @@ class RunningTree:
         """Swap in ``new_tree``, built from ``definition`` (beside the scheduler, for hot
         reload), halting the running one cleanly; call between ticks."""
         old_root = self.tree.root
-        self.halt()
+        self.halt("its tree was replaced")
         for node in old_root.iterate():  # the old nodes' blackboard clients go with them
             for client in node.blackboards:
                 client.unregister(clear=False)
@@ -84,13 +121,19 @@ class RunningTree:
                 wait_for_turn_s=definition.wait_for_turn_s,
             )
 
-    def halt(self) -> None:
-        """Stop whatever is running (cancels service jobs: speech, moves, lights), then
-        send the joints it moved back to rest and turn off the LEDs it lit."""
+    def halt(self, why: str = "its tree was stopped") -> None:
+        """Stop whatever is running (cancels service jobs: speech, moves, lights; each is
+        told as cut short, ``why``), then send the joints it moved back to rest and turn
+        off the LEDs it lit."""
         root = self.tree.root
         if root.status == py_trees.common.Status.RUNNING:
-            root.stop(py_trees.common.Status.INVALID)
-            self.context.actions.settle()
+            actions = self.context.actions
+            actions.stop_reason = why
+            try:
+                root.stop(py_trees.common.Status.INVALID)
+            finally:
+                actions.stop_reason = ""
+            actions.settle()
 
 
 class Scheduler:
@@ -200,7 +243,10 @@ class Scheduler:
                 self.hook_errors += 1
                 _log.exception("scheduler hook %r failed: %s", hook, error)
         self.blackboard.commit()
-        due = [tree for tree in self.trees if tree.next_deadline_s <= now + 1e-9]
+        due = sorted(
+            (tree for tree in self.trees if tree.next_deadline_s <= now + 1e-9),
+            key=lambda tree: -tree.priority,  # stable: one priority keeps the added order
+        )
         for tree in due:
             if tree.paused:  # its deadlines go by untouched
                 tree.period_index = math.floor((now - tree.origin_s) / tree.period_s)
@@ -213,6 +259,8 @@ class Scheduler:
     def _tick(self, tree: RunningTree) -> None:
         now = self.clock.now()  # hooks and earlier trees of this step count as lateness
         lateness = now - tree.next_deadline_s
+        if tree.status != py_trees.common.Status.RUNNING:
+            tree.round_starts()
         started = self._measure()
         try:
             tree.tree.tick()

@@ -1,9 +1,11 @@
-"""What changed in the running trees since the last look: for recordings and the live view.
+"""What changed in the running trees since the last look, published as session events.
 
-After each tick the scheduler's observers ask :class:`TreeWatch` which nodes of that tree
-changed status or feedback message. Nodes are numbered depth-first, as ``vest render``
-numbers them (``n0`` is the root); a hot reload makes a new version of the tree, its
-nodes numbered afresh. Looking costs a walk over the tree's nodes, no copy of the tree.
+After each tick :class:`TreeNews` asks :class:`TreeWatch` which nodes of that tree changed
+status or feedback message and publishes each change as a
+:class:`~engine.session.events.NodeStatus`. Nodes are numbered depth-first, as ``vest
+render`` numbers them (``n0`` is the root); a hot reload makes a new version of the tree
+(a :class:`~engine.session.events.TreeStarted`), its nodes numbered afresh. Looking costs a
+walk over the tree's nodes, no copy of the tree, and only when a reader wants statuses.
 """
 
 from __future__ import annotations
@@ -13,20 +15,11 @@ from dataclasses import dataclass, field
 import py_trees
 
 from engine.loader.tree_definition import TreeDefinition
-from engine.loader.tree_drawing import label, preorder
+from engine.loader.tree_drawing import dot_source, label, preorder
 from engine.nodes.base import node_path
 from engine.runtime.scheduler import RunningTree
-
-
-@dataclass(frozen=True)
-class NodeInfo:
-    """One node of a tree version: its number, path, type, label (as drawn) and depth."""
-
-    index: int
-    path: str
-    type: str
-    label: str
-    depth: int
+from engine.session.events import NodeInfo, NodeStatus, TreeStarted
+from engine.session.stream import SessionStream
 
 
 @dataclass
@@ -99,3 +92,44 @@ def _preorder_nodes(root: py_trees.behaviour.Behaviour) -> list[py_trees.behavio
     for child in root.children:
         nodes.extend(_preorder_nodes(child))
     return nodes
+
+
+class TreeNews:
+    """Publishes each tree version as it starts and each node's changes after a tick."""
+
+    def __init__(self, stream: SessionStream) -> None:
+        self.stream = stream
+        self.watch = TreeWatch()
+
+    def started(self, tree: RunningTree) -> None:
+        """Publish ``tree`` as it is now (at the session's start)."""
+        self._publish_tree(self.watch.watch(tree), self.stream.clock.now())
+
+    def _publish_tree(self, watched: WatchedTree, t_s: float) -> None:
+        definition = watched.definition
+        self.stream.publish(
+            TreeStarted(
+                t_s,
+                watched.name,
+                watched.version,
+                definition.path,
+                tuple(definition.files or [definition.path]),
+                definition.rate_hz,
+                definition.priority,
+                tuple(watched.info),
+                dot_source(definition),
+            )
+        )
+
+    def __call__(self, tree: RunningTree) -> None:
+        """After ``tree`` ticked (a scheduler after-tick observer)."""
+        if not self.stream.wants(NodeStatus.kind) and not self.stream.wants(TreeStarted.kind):
+            return
+        watched, new, changes = self.watch.look(tree)
+        if new:  # hot-reloaded, or a button's action swapped in
+            self._publish_tree(watched, self.stream.clock.now())
+        at = tree.next_deadline_s  # the statuses hold from the tick's deadline
+        for index, status, feedback in changes:
+            self.stream.publish(
+                NodeStatus(at, tree.name, watched.version, watched.ticks, index, status, feedback)
+            )

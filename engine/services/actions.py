@@ -1,10 +1,11 @@
-"""What trees ask of services, recorded: the robot's timeline.
+"""What trees ask of services, recorded: the robot's actions on the session stream.
 
 :class:`TreeActions` is the one door from a tree's nodes to the services. Each call
-becomes an :class:`ActionRecord` (time, tree, action, args) handed to every listener of
-the :class:`ActionLog`: the timeline printer, the ``--json`` writer, the test harness.
-When the service later turns out to have failed the call, the log marks that record
-(``record.error``) and tells its ``failure_listeners``.
+becomes an :class:`ActionRecord` (time, tree, action, args) kept by the :class:`ActionLog`,
+which publishes it as an :class:`~engine.session.events.ActionStarted` and, once the job
+is seen to end, its :class:`~engine.session.events.ActionEnded`: done, failed (the
+service could not, the safety envelope refused or stopped it) or cut short (its tree was
+halted: interrupted by a higher one, paused, reloaded, stopped).
 """
 
 from __future__ import annotations
@@ -25,6 +26,8 @@ from engine.services.turns import (
     joint_resource,
     let_go,
 )
+from engine.session.events import ActionEnded, ActionStarted, Outcome
+from engine.session.stream import SessionStream
 
 _log = logging.getLogger("vest.actions")
 
@@ -33,8 +36,8 @@ _log = logging.getLogger("vest.actions")
 class ActionRecord:
     """One service call: ``t`` in clock seconds, the tree, the action name and its arguments.
 
-    ``error`` is None while the call is under way or when it succeeded, and says why once
-    the service is seen to have failed it (the action was asked for but not done).
+    ``outcome`` is None while the call is under way, then ``done``, ``failed`` or ``cut``;
+    ``error`` says why it failed (the action was asked for but not done).
     """
 
     t: float
@@ -42,74 +45,80 @@ class ActionRecord:
     action: str
     args: dict[str, Any]
     error: str | None = None
+    outcome: Outcome | None = None
+    action_id: int = 0
 
     @property
     def failed(self) -> bool:
         return self.error is not None
 
-    def to_json(self) -> dict[str, Any]:
-        shown = {"t": round(self.t, 3), "tree": self.tree, "action": self.action, "args": self.args}
-        if self.error is not None:
-            shown["error"] = self.error
-        return shown
-
-
-ActionListener = Callable[[ActionRecord], None]
-FailureListener = Callable[[ActionRecord, BaseException], None]
+    @property
+    def cut(self) -> bool:
+        return self.outcome == "cut"
 
 
 @dataclass
 class ActionLog:
-    """Keeps every record and tells listeners as they come.
+    """Keeps every record and publishes each call and its outcome on ``stream``."""
 
-    ``listeners`` hear of each call when it is made; ``failure_listeners`` hear
-    ``(record, error)`` when a call's job is first seen failed (``record.error`` is set by
-    then). A cancelled call (its node was pre-empted) is not a failure.
-    """
-
+    stream: SessionStream | None = None
     records: list[ActionRecord] = field(default_factory=list)
-    listeners: list[ActionListener] = field(default_factory=list)
-    failure_listeners: list[FailureListener] = field(default_factory=list)
 
     def add(self, record: ActionRecord) -> None:
+        record.action_id = len(self.records) + 1
         self.records.append(record)
-        for listener in self.listeners:
-            try:
-                listener(record)
-            except Exception:  # a broken display must not stop the robot acting
-                _log.exception("action listener %r failed", listener)
+        if self.stream is not None:
+            self.stream.publish(
+                ActionStarted(record.t, record.action_id, record.tree, record.action, record.args)
+            )
 
-    def failed(self, record: ActionRecord, error: BaseException) -> None:
-        """The service could not do ``record``'s call: mark it and tell the listeners."""
-        record.error = str(error) or type(error).__name__
-        for listener in self.failure_listeners:
-            try:
-                listener(record, error)
-            except Exception:  # a broken display must not stop the robot acting
-                _log.exception("action failure listener %r failed", listener)
+    def ended(self, record: ActionRecord, outcome: Outcome, at_s: float, why: str = "") -> None:
+        """``record``'s job ended (first time only): done, failed (``why``) or cut."""
+        if record.outcome is not None:
+            return
+        record.outcome = outcome
+        if outcome == "failed":
+            record.error = why
+        if self.stream is not None:
+            self.stream.publish(
+                ActionEnded(
+                    at_s,
+                    record.action_id,
+                    record.tree,
+                    record.action,
+                    record.args,
+                    record.t,
+                    outcome,
+                    why,
+                )
+            )
 
     @property
     def done(self) -> list[ActionRecord]:
-        """The records of calls not (yet) seen failed."""
-        return [record for record in self.records if record.error is None]
+        """The records of calls not (yet) seen failed or cut short."""
+        return [record for record in self.records if record.error is None and not record.cut]
 
 
 class _WatchedJob:
-    """A service's job seen through the log: its first failure marks the record."""
+    """A service's job seen through the log: how it ended is told once."""
 
-    def __init__(self, job: Job, record: ActionRecord, log: ActionLog) -> None:
+    def __init__(
+        self, job: Job, record: ActionRecord, log: ActionLog, actions: TreeActions
+    ) -> None:
         self._job = job
         self._record = record
         self._log = log
-        self._settled = False
+        self._actions = actions
 
     def _settle(self) -> None:
-        if self._settled or not self._job.done():
+        if self._record.outcome is not None or not self._job.done():
             return
-        self._settled = True
         error = self._job.error()
+        now = self._actions.clock.now()
         if error is not None:
-            self._log.failed(self._record, error)
+            self._log.ended(self._record, "failed", now, str(error) or type(error).__name__)
+        else:
+            self._log.ended(self._record, "done", now)
 
     def done(self) -> bool:
         done = self._job.done()
@@ -126,8 +135,9 @@ class _WatchedJob:
         return self._job.result()
 
     def cancel(self) -> None:
-        if not self._job.done():
-            self._settled = True  # pre-empted: stopped on purpose, not failed
+        if not self._job.done():  # stopped on purpose before it was done: cut, not failed
+            now = self._actions.clock.now()
+            self._log.ended(self._record, "cut", now, self._actions.stop_reason)
         self._job.cancel()
 
 
@@ -168,6 +178,8 @@ class TreeActions:
         self.taking = taking
         self._moved: set[str] = set()
         self._lit = False
+        self.stop_reason = ""
+        """Why the tree is being halted, while it is (its cut actions say so)."""
 
     def _call(
         self,
@@ -184,7 +196,7 @@ class TreeActions:
                 job = start()
             except Exception as error:  # a service refusing work is a failed action
                 job = ImmediateJob(error=error)
-            watched = _WatchedJob(job, record, self.log)
+            watched = _WatchedJob(job, record, self.log, self)
             watched.done()  # a call refused at once is marked failed at once
             return watched
 
@@ -202,7 +214,7 @@ class TreeActions:
         resource, turn = blocked
         if taking.wait_for_turn_s <= 0:
             return ImmediateJob(error=let_go(turns, self.tree, what, resource, turn))
-        turns.tell(self.tree, f"waits for the {resource}: {turn.tree} has it")
+        turns.tell(self.tree, "waits", resource, turn.tree)
         deadline_s = self.clock.now() + taking.wait_for_turn_s
         return WaitingJob(turns, begin, uses, self.tree, priority, deadline_s, what)
 

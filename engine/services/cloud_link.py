@@ -6,11 +6,20 @@ Three worker threads, none of them in a tick:
   service cannot be reached;
 - the *reporter* sends each result (``report``, the :class:`IotResults` service) until the
   service has it, in order, retrying the same way;
-- the *telemetry* thread pushes the blackboard's sensor and device keys about once a second.
+- the *telemetry* thread pushes the sensor and device keys about once a second: the
+  latest values as the scheduler committed them, handed over by a session reader
+  (:class:`TelemetrySnapshot`), never read from the live blackboard on this thread. A push
+  that fails is logged (once per streak) and counted (``telemetry_failures``).
+
+While the robot carries a command out it tells the service so every few seconds; when the
+operator has canceled it meanwhile, the command's id is staged on ``/iot/canceled``: the
+tree carrying it out stops, and its result is not reported (the command ended CANCELED).
 
 A command is carried out once: finished ids and their results are kept in a small file
 (``done_file``), so a command delivered again (its lease ran out, or the robot restarted)
-is answered with the result it had, not carried out twice.
+is answered with the result it had, not carried out twice. A damaged file is set aside
+(named in the log) and, since the robot can no longer tell what it already did, a command
+delivered again is refused (reported FAILED with why) rather than risk running it twice.
 """
 
 from __future__ import annotations
@@ -26,10 +35,12 @@ from typing import Any
 import requests
 
 from engine.blackboard.board import Blackboard
-from engine.blackboard.catalogue import DEVICES_PREFIX, IOT_INBOX, SENSORS_PREFIX
+from engine.blackboard.catalogue import DEVICES_PREFIX, IOT_CANCELED, IOT_INBOX, SENSORS_PREFIX
 from engine.blackboard.events import EventLog
 from engine.clock import Clock
 from engine.services.jobs import ImmediateJob, Job
+from engine.session.events import KeyChanged, SessionEvent
+from engine.session.stream import SessionStream
 
 log = logging.getLogger(__name__)
 FIRST_BACKOFF_S, MAX_BACKOFF_S = 0.5, 30.0
@@ -43,6 +54,9 @@ the command), so the service neither delivers it again nor shows it QUEUED."""
 DEFAULT_LEASE_S = 30.0
 TELEMETRY_PREFIXES = (SENSORS_PREFIX, DEVICES_PREFIX)
 DONE_KEPT = 1000
+PROGRESS_EVERY_S = 2.0
+"""How often the robot tells the service it is still at a command (at most a third of
+the lease): an operator's cancel stops the robot within this."""
 
 
 def _positive(value: Any, default: float) -> float:
@@ -69,18 +83,54 @@ def _json_safe(value: Any) -> Any:
 
 
 class DoneCommands:
-    """Finished command ids and their reports, kept in a JSON file across restarts."""
+    """Finished command ids and their reports, kept in a JSON file across restarts.
+
+    A file that is there but cannot be read as such is set aside as ``FILE.damaged``
+    (``.damaged.1``... when one is there already) and ``damaged`` names where it went."""
 
     def __init__(self, path: Path) -> None:
         self.path = path
         self._done: dict[str, dict[str, Any]] = {}
-        try:
-            loaded = json.loads(path.read_text(encoding="utf-8"))
-            if isinstance(loaded, dict):
-                self._done = {str(k): v for k, v in loaded.items() if isinstance(v, dict)}
-        except (OSError, ValueError):
-            pass  # none yet, or unreadable: start afresh (the ledger refuses a contrary report)
+        self.damaged: Path | None = None
         self._lock = threading.Lock()
+        try:
+            text = path.read_text(encoding="utf-8")
+        except FileNotFoundError:
+            return  # none yet
+        except (OSError, UnicodeDecodeError) as error:
+            self._set_aside(f"cannot be read ({error})")
+            return
+        try:
+            loaded = json.loads(text)
+        except ValueError as error:
+            self._set_aside(f"is not JSON ({error})")
+            return
+        if not isinstance(loaded, dict) or not all(isinstance(v, dict) for v in loaded.values()):
+            self._set_aside("does not hold finished commands by id")
+            return
+        self._done = {str(k): v for k, v in loaded.items()}
+
+    def _set_aside(self, why: str) -> None:
+        aside = self.path.with_name(self.path.name + ".damaged")
+        number = 0
+        while aside.exists():
+            number += 1
+            aside = self.path.with_name(f"{self.path.name}.damaged.{number}")
+        try:
+            self.path.replace(aside)
+            self.damaged = aside
+            kept = f"kept aside as {aside}"
+        except OSError as error:
+            self.damaged = self.path
+            kept = f"left where it is ({error}); it will be replaced"
+        log.error(
+            "the robot's record of finished commands %s %s; %s. A command delivered again "
+            "will not be carried out again (it may have been already): it is reported "
+            "failed instead",
+            self.path,
+            why,
+            kept,
+        )
 
     def get(self, command_id: str) -> dict[str, Any] | None:
         with self._lock:
@@ -98,6 +148,25 @@ class DoneCommands:
             temporary.replace(self.path)
         except OSError as error:
             log.warning("cannot keep finished commands in %s: %s", self.path, error)
+
+
+class TelemetrySnapshot:
+    """A session reader: the latest committed value of each sensor and device key, kept
+    for the telemetry thread, which takes a copy (:meth:`take`)."""
+
+    def __init__(self) -> None:
+        self._values: dict[str, Any] = {}
+        self._lock = threading.Lock()
+
+    def on_event(self, event: SessionEvent) -> None:
+        if isinstance(event, KeyChanged) and event.key.startswith(TELEMETRY_PREFIXES):
+            value = _json_safe(event.value)
+            with self._lock:
+                self._values[event.key] = value
+
+    def take(self) -> dict[str, Any]:
+        with self._lock:
+            return dict(self._values)
 
 
 class CloudLink:
@@ -120,6 +189,10 @@ class CloudLink:
         self.http.headers["Authorization"] = f"Bearer {token}"
         self.done = DoneCommands(done_file)
         self.blackboard: Blackboard | None = None
+        self.telemetry = TelemetrySnapshot()
+        self.telemetry_failures = 0
+        """Pushes of telemetry that failed (the service unreachable or refusing)."""
+        self._canceled: set[str] = set()  # canceled by the operator while carried out
         self._reports: queue.Queue[tuple[str, dict[str, Any]] | None] = queue.Queue()
         self._stop = clock.event()
         self._threads: list[threading.Thread] = []
@@ -130,9 +203,11 @@ class CloudLink:
         self._lease_s = DEFAULT_LEASE_S
         self.reachable = False
 
-    def bind(self, blackboard: Blackboard) -> None:
-        """The blackboard commands are staged on and telemetry is read from."""
+    def bind(self, blackboard: Blackboard, session: SessionStream) -> None:
+        """The blackboard commands are staged on, and the session whose committed sensor
+        and device values are pushed as telemetry."""
         self.blackboard = blackboard
+        session.subscribe(self.telemetry, (KeyChanged.kind,))
 
     def start(self) -> None:
         for name, target in (
@@ -162,11 +237,16 @@ class CloudLink:
             if command_id not in self._from_cloud:
                 log.debug("command %s did not come from the cloud; not reported there", command_id)
                 return ImmediateJob()
+            canceled = command_id in self._canceled
+            self._canceled.discard(command_id)
+            if canceled:  # it ended CANCELED at the service; that is its end here too
+                report = {"status": "CANCELED", "result": None}
             self.done.add(command_id, report)  # a delivery again is answered from here on
             self._from_cloud.discard(command_id)
             if not self._from_cloud:
                 self._idle.set()
-        self._reports.put((command_id, report))
+        if not canceled:
+            self._reports.put((command_id, report))
         return ImmediateJob()
 
     # -- workers -----------------------------------------------------------------------------
@@ -212,7 +292,10 @@ class CloudLink:
                 self._idle.clear()
                 self._lease_s = _positive(command.get("lease_s"), DEFAULT_LEASE_S)
         if earlier is not None:  # delivered again: answer as before, never twice
-            self._reports.put((command_id, earlier))
+            if earlier.get("status") != "CANCELED":  # the service knows it ended so
+                self._reports.put((command_id, earlier))
+            return
+        if self._unsure_if_done(command, command_id, running):
             return
         if running:  # delivered again while still being carried out
             log.debug("command %s is still being carried out; its report will follow", command_id)
@@ -223,11 +306,32 @@ class CloudLink:
                 {"id": command_id, "type": command.get("type"), "args": command.get("args") or {}},
             )
 
+    def _unsure_if_done(self, command: dict[str, Any], command_id: str, running: bool) -> bool:
+        """A command delivered again after the record of finished commands was damaged
+        may have been carried out already: it is refused (reported FAILED with why)."""
+        delivered = command.get("deliveries")
+        again = isinstance(delivered, int) and delivered > 1
+        if self.done.damaged is None or running or not again:
+            return False
+        with self._carrying_out:
+            self._from_cloud.discard(command_id)
+            if not self._from_cloud:
+                self._idle.set()
+        why = (
+            f"not carried out again: the robot's record of finished commands was damaged "
+            f"(kept as {self.done.damaged.name}), so it cannot tell whether it already did it"
+        )
+        log.warning("command %s delivered again: %s", command_id, why)
+        report = {"status": "FAILED", "result": {"error": why}}
+        self.done.add(command_id, report)
+        self._reports.put((command_id, report))
+        return True
+
     def _wait_idle(self) -> None:
         """Until the command being carried out is reported (or BUSY_AT_MOST_S passed: a
         robot without the iot_command tree must not stop taking commands for good)."""
         deadline_s = self.clock.now() + BUSY_AT_MOST_S
-        extend_every_s = self._lease_s / 3
+        extend_every_s = min(self._lease_s / 3, PROGRESS_EVERY_S)
         extend_at_s = self.clock.now() + extend_every_s
         while not self._idle.is_set() and not self._stop.is_set():
             now_s = self.clock.now()
@@ -254,8 +358,23 @@ class CloudLink:
             except requests.RequestException as error:
                 self._unreachable(error)
                 continue
-            if answer.status_code == 200 and answer.json().get("state") == "CANCELED":
-                log.info("command %s was canceled while the robot carried it out", command_id)
+            try:
+                state = answer.json().get("state") if answer.status_code == 200 else None
+            except ValueError:  # not JSON (a proxy's page): asked again at the next turn
+                state = None
+            if state == "CANCELED":
+                self._cancel(command_id)
+
+    def _cancel(self, command_id: str) -> None:
+        """The operator canceled a command the robot is carrying out: the tree carrying it
+        out is told to stop (``/iot/canceled``), and no result is reported."""
+        with self._carrying_out:
+            if command_id not in self._from_cloud or command_id in self._canceled:
+                return
+            self._canceled.add(command_id)
+        log.info("command %s was canceled by the operator; the robot stops it", command_id)
+        if self.blackboard is not None:
+            self.blackboard.stage_event(IOT_CANCELED, command_id)
 
     def _send_reports(self) -> None:
         delay_s = FIRST_BACKOFF_S
@@ -284,19 +403,28 @@ class CloudLink:
                 break
 
     def _push_telemetry(self) -> None:
+        failing = False
         while not self.clock.wait(self._stop, TELEMETRY_EVERY_S):
-            board = self.blackboard
-            if board is None:
+            values = self.telemetry.take()
+            if not values:
                 continue
+            why = ""
             try:
-                values = {
-                    key: _json_safe(value)
-                    for key, value in board.snapshot().items()
-                    if key.startswith(TELEMETRY_PREFIXES)
-                }
-                self.http.post(f"{self.api}/robot/telemetry", json={"values": values}, timeout=5.0)
-            except (requests.RequestException, RuntimeError):
-                continue  # the next push carries the latest values anyway
+                answer = self.http.post(
+                    f"{self.api}/robot/telemetry", json={"values": values}, timeout=5.0
+                )
+                if answer.status_code >= 300:
+                    why = f"the service answered {answer.status_code}: {answer.text[:200]}"
+            except requests.RequestException as error:
+                why = str(error)
+            if why:  # the next push carries the latest values anyway
+                self.telemetry_failures += 1
+                if not failing:
+                    log.warning("telemetry could not be pushed (%s); the robot retries", why)
+                failing = True
+            elif failing:
+                log.info("telemetry is pushed again after %d failures", self.telemetry_failures)
+                failing = False
 
     def _unreachable(self, error: Exception) -> None:
         if self.reachable:

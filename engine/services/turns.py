@@ -8,8 +8,9 @@ asks for a resource that is held:
 - a tree of the same or lower priority waits for its turn up to its ``wait_for_turn_s``
   and then lets the action go (the node fails with the reason), or lets it go at once.
 
-Every interruption, wait and yield is told to the ``listeners`` as
-``(t_s, tree, text)``: the timeline prints who yielded to whom.
+Every interruption, wait and yield is published on the session stream as a
+:class:`~engine.session.events.TurnTaken`: the timeline prints who yielded to whom, the
+recording keeps it, the live view shows it.
 """
 
 from __future__ import annotations
@@ -21,6 +22,8 @@ from typing import Any
 from engine.clock import Clock
 from engine.errors import ServiceError
 from engine.services.jobs import ImmediateJob, Job
+from engine.session.events import TurnKind, TurnTaken
+from engine.session.stream import SessionStream
 
 SPEAKER = "speaker"
 FACE_LEDS = "face LEDs"
@@ -29,9 +32,6 @@ FACE_LEDS = "face LEDs"
 def joint_resource(joint: str) -> str:
     """The resource of one joint: ``left_arm joint``."""
     return f"{joint} joint"
-
-
-TurnListener = Callable[[float, str, str], None]
 
 
 class TurnYieldedError(ServiceError):
@@ -50,14 +50,21 @@ class Turn:
 class Turns:
     """Who holds each resource now, and the rules for taking turns.
 
-    ``interrupt`` halts a tree by name (the robot sets it: halt cleanly, joints to rest).
+    ``interrupt(tree, by, resource)`` halts a tree by name because tree ``by`` takes
+    ``resource`` from it (the robot's: halt cleanly, joints to rest).
     """
 
-    def __init__(self, clock: Clock) -> None:
+    def __init__(
+        self,
+        clock: Clock,
+        *,
+        stream: SessionStream | None = None,
+        interrupt: Callable[[str, str, str], None] = lambda tree, by, resource: None,
+    ) -> None:
         self.clock = clock
+        self.stream = stream
+        self.interrupt = interrupt
         self._held: dict[str, Turn] = {}
-        self.interrupt: Callable[[str], None] = lambda tree: None
-        self.listeners: list[TurnListener] = []
 
     def holder(self, resource: str, tree: str) -> Turn | None:
         """Another tree's turn on ``resource`` that is still running, or None."""
@@ -82,11 +89,11 @@ class Turns:
         for resource in resources:
             turn = self.holder(resource, tree)
             if turn is not None and turn.priority < priority:
-                self.tell(tree, f"interrupts {turn.tree} to use the {resource}")
+                self.tell(tree, "interrupts", resource, turn.tree)
                 # the resource is the newcomer's before the halted tree comes to rest, so
                 # that tree does not send it home just before the newcomer's own move
                 self._held[resource] = Turn(tree, priority, ImmediateJob())
-                self.interrupt(turn.tree)
+                self.interrupt(turn.tree, tree, resource)
 
     def hold(self, resources: Sequence[str], tree: str, priority: int, job: Job) -> None:
         for resource in resources:
@@ -97,10 +104,10 @@ class Turns:
         turn = self._held.get(resource)
         return turn.tree if turn is not None else None
 
-    def tell(self, tree: str, text: str) -> None:
-        now = self.clock.now()
-        for listener in self.listeners:
-            listener(now, tree, text)
+    def tell(self, tree: str, turn: TurnKind, resource: str, other: str, what: str = "") -> None:
+        """Publish one turn event (``tree`` interrupts, waits for, yields...)."""
+        if self.stream is not None:
+            self.stream.publish(TurnTaken(self.clock.now(), tree, turn, resource, other, what))
 
 
 class WaitingJob:
@@ -169,5 +176,5 @@ class WaitingJob:
 def let_go(turns: Turns, tree: str, what: str, resource: str, turn: Turn) -> TurnYieldedError:
     """Tell that ``tree`` lets ``what`` go because ``turn`` has ``resource``; the error
     its node fails with."""
-    turns.tell(tree, f"yields the {resource} to {turn.tree}: not {what}")
+    turns.tell(tree, "yields", resource, turn.tree, what)
     return TurnYieldedError(f"{turn.tree} has the {resource} (priority {turn.priority})")

@@ -1,12 +1,13 @@
 """What the live view shows, kept current as the robot runs: one data model for live and
-replay (:mod:`engine.view.sources`).
+replay (:mod:`engine.view.replay_source`).
 
-The scheduler's thread tells the hub what changed (a node's status after a tick, a
-committed blackboard write, a service call, a scenario event; every second the tick and
-bus statistics). The hub keeps the present state for a page that connects, and puts each
-change on every connected page's bounded queue. A page that cannot keep up loses changes
-(its queue overflows, and it is told to fetch the state again), never a tick: nothing here
-waits for a browser.
+A reader of the session stream: the scheduler's thread tells the hub each event (a tree
+version, a node's status after a tick, a blackboard change, and everything told in words:
+actions and how they ended, turns, safety, presses, what was heard; every second the tick
+and bus statistics come from its hook). The hub keeps the present state for a page that
+connects, and puts each change on every connected page's bounded queue. A page that
+cannot keep up loses changes (its queue overflows, and it is told to fetch the state
+again), never a tick: nothing here waits for a browser.
 """
 
 from __future__ import annotations
@@ -19,22 +20,32 @@ from collections.abc import Callable
 from dataclasses import asdict
 from typing import Any
 
-from engine.blackboard.catalogue import VARIABLES_PREFIX, KeyCatalogue
 from engine.clock import Clock
 from engine.drivers.device_stats import DeviceStats
-from engine.loader.tree_drawing import dot_source
-from engine.recording.recorder import tick_moment
-from engine.recording.session_file import ChangedKeys, as_json
 from engine.runtime.scheduler import RunningTree
-from engine.runtime.tree_watch import TreeWatch, WatchedTree
-from engine.scenario.scenario_file import ScenarioEvent
-from engine.services.actions import ActionRecord
+from engine.session.events import KeyChanged, NodeStatus, SessionEvent, TreeStarted
+from engine.session.sentences import event_line, tone
 
 Change = dict[str, Any]
 QUEUE_CHANGES = 5000
 """Changes a page may be behind before it is told to start again from the state."""
-RECENT_ACTIONS = 100
+RECENT_HAPPENINGS = 100
 STATS_EVERY_S = 1.0
+
+
+def happened(event: SessionEvent, start_s: float) -> Change | None:
+    """``event`` as a line of the page's "what happened" (None: not told in words)."""
+    line = event_line(event)
+    if line is None:
+        return None
+    who, what = line
+    return {
+        "kind": "happened",
+        "at": round(event.t_s - start_s, 3),
+        "who": who,
+        "what": what,
+        "tone": tone(event),
+    }
 
 
 class Subscription:
@@ -57,129 +68,87 @@ class Subscription:
 
 
 class ViewHub:
-    """The live state of one robot, and the pages watching it. Times are clock seconds
-    minus ``start_s`` (the session's start, as in the timeline and in recordings)."""
+    """The live state of one robot, and the pages watching it: a session reader
+    (``on_event``). Times are clock seconds minus ``start_s`` (the session's start, as in
+    the timeline and in recordings)."""
 
     def __init__(
         self,
         clock: Clock,
-        catalogue: KeyCatalogue,
         *,
         device_stats: Callable[[], dict[str, DeviceStats]] | None = None,
         capacity: int = QUEUE_CHANGES,
     ) -> None:
         self.clock = clock
-        self.catalogue = catalogue
         self.start_s = clock.now()
         self.device_stats = device_stats
         self.capacity = capacity
         self._lock = threading.Lock()
-        self._watch = TreeWatch()
         self._pages: list[Subscription] = []
         self._trees: dict[str, Change] = {}
         self._dots: dict[tuple[str, int], str] = {}
         self._statuses: dict[str, dict[int, Change]] = {}
         self._keys: dict[str, Change] = {}
-        self._changed = ChangedKeys(catalogue)
-        self._actions: deque[Change] = deque(maxlen=RECENT_ACTIONS)
-        self._world: deque[Change] = deque(maxlen=RECENT_ACTIONS)
+        self._happened: deque[Change] = deque(maxlen=RECENT_HAPPENINGS)
         self._stats: Change = {"kind": "stats", "at": 0.0, "trees": {}, "devices": {}}
         self._running: list[RunningTree] = []
         self._next_stats_s = 0.0
 
     # -- the scheduler's thread -------------------------------------------------------------
     def begin(self, start_s: float, trees: list[RunningTree]) -> None:
+        """Times count from ``start_s`` (clock seconds); ``trees``' statistics are sent."""
         self.start_s = start_s
         self._running = trees
-        for tree in trees:
-            self._tree(self._watch.watch(tree))
 
-    def _at(self) -> float:
-        return round(self.clock.now() - self.start_s, 3)
+    def _at(self, t_s: float) -> float:
+        return round(t_s - self.start_s, 3)
 
-    def _tree(self, watched: WatchedTree) -> None:
-        change: Change = {
-            "kind": "tree",
-            "at": self._at(),
-            "tree": watched.name,
-            "version": watched.version,
-            "rate_hz": watched.definition.rate_hz,
-            "file": str(watched.definition.path),
-            "nodes": [asdict(node) for node in watched.info],
-        }
-        with self._lock:
-            self._dots[(watched.name, watched.version)] = dot_source(watched.definition)
-            self._trees[watched.name] = change
-            self._statuses[watched.name] = {}
-        self._publish(change)
-
-    def tree_ticked(self, tree: RunningTree) -> None:
-        watched, new, changes = self._watch.look(tree)
-        if new:
-            self._tree(watched)
-        if not changes:
-            return
-        at = round(tick_moment(tree, self.start_s), 3)
-        for index, status, feedback in changes:
+    def on_event(self, event: SessionEvent) -> None:
+        if isinstance(event, NodeStatus):
             change = {
                 "kind": "status",
-                "at": at,
-                "tree": tree.name,
-                "version": watched.version,
-                "node": index,
-                "status": status,
-                "feedback": feedback,
+                "at": self._at(event.t_s),
+                "tree": event.tree,
+                "version": event.version,
+                "node": event.node,
+                "status": event.status,
+                "feedback": event.feedback,
             }
             with self._lock:
-                self._statuses.setdefault(tree.name, {})[index] = change
-            self._publish(change)
-
-    def blackboard_write(self, key: str, value: Any) -> None:
-        news = self._changed.news(key, value)
-        if news is None:
-            return
-        text, event = news
-        spec = self.catalogue.lookup(key)
-        writer = "trees" if key.startswith(VARIABLES_PREFIX) else (spec.writer if spec else "")
-        change = {
-            "kind": "key",
-            "at": self._at(),
-            "key": key,
-            "value": text,
-            "event": event,
-            "writer": writer,
-        }
-        with self._lock:
-            self._keys[key] = change
-        self._publish(change)
-
-    def action(self, record: ActionRecord) -> None:
-        change = {
-            "kind": "action",
-            "at": round(record.t - self.start_s, 3),
-            "tree": record.tree,
-            "action": record.action,
-            "args": as_json(record.args),
-            "error": None,
-        }
-        with self._lock:
-            self._actions.append(change)
-        self._publish(change)
-
-    def failed(self, record: ActionRecord, error: BaseException) -> None:
-        change = {
-            "kind": "action_failed",
-            "at": round(record.t - self.start_s, 3),
-            "tree": record.tree,
-            "action": record.action,
-            "error": record.error,
-        }
-        self._publish(change)
-
-    def world(self, at_s: float, event: ScenarioEvent) -> None:
-        change = {"kind": "world", "at": round(at_s - self.start_s, 3), "what": event.describe()}
-        with self._lock:
-            self._world.append(change)
+                self._statuses.setdefault(event.tree, {})[event.node] = change
+        elif isinstance(event, KeyChanged):
+            change = {
+                "kind": "key",
+                "at": self._at(event.t_s),
+                "key": event.key,
+                "value": event.text,
+                "event": event.event,
+                "writer": event.writer,
+            }
+            with self._lock:
+                self._keys[event.key] = change
+        elif isinstance(event, TreeStarted):
+            change = {
+                "kind": "tree",
+                "at": self._at(event.t_s),
+                "tree": event.tree,
+                "version": event.version,
+                "rate_hz": event.rate_hz,
+                "priority": event.priority,
+                "file": str(event.file),
+                "nodes": [asdict(node) for node in event.nodes],
+            }
+            with self._lock:
+                self._dots[(event.tree, event.version)] = event.dot
+                self._trees[event.tree] = change
+                self._statuses[event.tree] = {}
+        else:
+            told = happened(event, self.start_s)
+            if told is None:
+                return
+            change = told
+            with self._lock:
+                self._happened.append(change)
         self._publish(change)
 
     def stats_hook(self, now_s: float) -> None:
@@ -191,7 +160,7 @@ class ViewHub:
         devices: dict[str, Any] = {}
         if self.device_stats is not None:
             devices = {name: asdict(stats) for name, stats in self.device_stats().items()}
-        change = {"kind": "stats", "at": self._at(), "trees": trees, "devices": devices}
+        change = {"kind": "stats", "at": self._at(now_s), "trees": trees, "devices": devices}
         with self._lock:
             self._stats = change
         self._publish(change)
@@ -216,25 +185,24 @@ class ViewHub:
 
     def close(self) -> None:
         """Tell every page the session ended."""
-        self._publish({"kind": "end", "at": self._at()})
+        self._publish({"kind": "end", "at": self._at(self.clock.now())})
         with self._lock:
             pages, self._pages = list(self._pages), []
         for page in pages:
             page.close()
 
     def snapshot(self) -> Change:
-        """The present state: every tree with its nodes' statuses, the blackboard, the
-        recent actions, the statistics."""
+        """The present state: every tree with its nodes' statuses, the blackboard, what
+        happened lately (in words), the statistics."""
         with self._lock:
             return {
-                "now": self._at(),
+                "now": self._at(self.clock.now()),
                 "trees": [
                     {**tree, "statuses": list(self._statuses.get(name, {}).values())}
                     for name, tree in sorted(self._trees.items())
                 ],
                 "keys": sorted(self._keys.values(), key=lambda change: change["key"]),
-                "actions": list(self._actions),
-                "world": list(self._world),
+                "happened": list(self._happened),
                 "stats": self._stats,
             }
 

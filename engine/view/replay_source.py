@@ -7,8 +7,8 @@ from typing import Any
 
 from engine.blackboard.catalogue import VARIABLES_PREFIX, default_catalogue
 from engine.recording.replay import Recording
-from engine.recording.session_file import as_json
-from engine.view.hub import RECENT_ACTIONS, Change
+from engine.recording.told import told_events
+from engine.view.hub import RECENT_HAPPENINGS, Change, happened
 
 STEP_S = 0.01
 """Moments closer than this are one step of the replay (one tick's changes)."""
@@ -85,28 +85,13 @@ class ReplaySource:
                     else (spec.writer if spec else ""),
                 }
             )
-        actions = [
-            {
-                "kind": "action",
-                "at": action.at_s,
-                "tree": action.tree,
-                "action": action.action,
-                "args": as_json(action.args),
-                "error": action.error,
-            }
-            for action in recording.actions(at_s)[-RECENT_ACTIONS:]
-        ]
-        world = [
-            {"kind": "world", "at": at, "what": what}
-            for at, _, what in self.recording.world()
-            if at <= at_s
-        ]
+        told = [happened(event, 0.0) for event in told_events(recording, at_s)]
+        lines = [line for line in told if line is not None]
         return {
             "now": at_s,
-            "world": world[-RECENT_ACTIONS:],
             "trees": trees,
             "keys": keys,
-            "actions": actions,
+            "happened": lines[-RECENT_HAPPENINGS:],
             "stats": {"kind": "stats", "at": at_s, "trees": {}, "devices": {}},
         }
 

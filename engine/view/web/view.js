@@ -10,7 +10,7 @@ const api = (path, params = {}) => {
 };
 const $ = (selector) => document.querySelector(selector);
 
-const state = { trees: new Map(), keys: new Map(), actions: [], world: [], stats: null, now: 0 };
+const state = { trees: new Map(), keys: new Map(), happened: [], stats: null, now: 0 };
 const history = new Map(); // "tree/version/node" -> [{at, status, feedback}], live only
 let info = { mode: "live" };
 let chosen = null; // {tree, version, node}
@@ -33,8 +33,7 @@ function load(snapshot) {
     tree.byNode = new Map(tree.statuses.map((change) => [change.node, change]));
   }
   state.keys = new Map(snapshot.keys.map((change) => [change.key, change]));
-  state.actions = snapshot.actions;
-  state.world = snapshot.world ?? [];
+  state.happened = snapshot.happened ?? [];
   state.stats = snapshot.stats;
 }
 
@@ -165,17 +164,13 @@ function drawTables() {
     [stats.lateness_p99_ms.toFixed(2)], [String(stats.skipped)],
   ], false, name]) : [[[["(tick statistics are not in recordings)"]], false, ""]]);
   const list = $("#actions");
-  const happened = [...state.actions, ...state.world].sort((a, b) => a.at - b.at).slice(-40);
-  list.replaceChildren(...happened.reverse().map((entry) => {
+  const recent = state.happened.slice(-40);
+  // each line says who did what in words; its kind is written out too, never colour alone
+  list.replaceChildren(...recent.reverse().map((entry) => {
     const item = document.createElement("li");
-    if (entry.kind === "world") {
-      item.textContent = `${entry.at.toFixed(2)} s around the robot: ${entry.what}`;
-      item.className = "world";
-      return item;
-    }
-    item.textContent = `${entry.at.toFixed(2)} s ${entry.tree}: ${entry.action} ${entry.args}`
-      + (entry.error ? ` (failed: ${entry.error})` : "");
-    if (entry.error) item.className = "failed";
+    item.className = `tone-${entry.tone}`;
+    item.dataset.tone = entry.tone;
+    item.textContent = `${entry.at.toFixed(2)} s ${entry.who}: ${entry.what}`;
     return item;
   }));
 }
@@ -244,15 +239,9 @@ function apply(change) {
     dirtyTrees.add(tree);
   } else if (change.kind === "key") {
     state.keys.set(change.key, change);
-  } else if (change.kind === "action") {
-    state.actions.push(change);
-    if (state.actions.length > 100) state.actions.shift();
-  } else if (change.kind === "action_failed") {
-    const match = [...state.actions].reverse().find((a) => a.at === change.at && a.tree === change.tree);
-    if (match) match.error = change.error;
-  } else if (change.kind === "world") {
-    state.world.push(change);
-    if (state.world.length > 100) state.world.shift();
+  } else if (change.kind === "happened") {
+    state.happened.push(change);
+    if (state.happened.length > 100) state.happened.shift();
   } else if (change.kind === "stats") {
     state.stats = change;
   }

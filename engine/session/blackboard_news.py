@@ -1,0 +1,105 @@
+"""What the blackboard's commits say, as session events.
+
+A blackboard watcher: each committed write that says something new becomes a
+:class:`~engine.session.events.KeyChanged` (every event, and a state key's write only when
+its value changed: a sensor polled 20 times a second mostly repeats), and the writes that
+are happenings of their own become their own events: what the robot heard, a hand it saw,
+someone it could not listen to, a device going offline or coming back.
+"""
+
+from __future__ import annotations
+
+import json
+from typing import Any
+
+from engine.blackboard.catalogue import (
+    DEVICES_PREFIX,
+    HAND_SHOWN,
+    SPEECH_HEARD,
+    SPEECH_NOT_LISTENED,
+    VARIABLES_PREFIX,
+    KeyCatalogue,
+)
+from engine.clock import Clock
+from engine.session.events import DeviceChanged, HandShown, Heard, KeyChanged, NotListened
+from engine.session.stream import SessionStream
+
+
+def as_json(value: Any) -> str:
+    """A blackboard value as JSON; what JSON cannot hold is kept as its text."""
+    try:
+        return json.dumps(value, allow_nan=False, default=str)
+    except ValueError:  # NaN or infinity
+        return json.dumps(str(value))
+
+
+class ChangedKeys:
+    """Which blackboard writes say something new: every event, and a state key's write
+    only when its value changed."""
+
+    def __init__(self, catalogue: KeyCatalogue) -> None:
+        self.catalogue = catalogue
+        self._values: dict[str, str] = {}
+
+    def news(self, key: str, value: Any) -> tuple[str, bool] | None:
+        """(the value as JSON, whether ``key`` is an event key), or None: nothing new."""
+        spec = self.catalogue.lookup(key)
+        event = spec is not None and spec.kind == "event"
+        text = as_json(value)
+        if not event and self._values.get(key) == text:
+            return None
+        self._values[key] = text
+        return text, event
+
+
+def device_of(key: str) -> str | None:
+    """The device whose health ``key`` is (``/devices/<name>/ok``), or None."""
+    if key.startswith(DEVICES_PREFIX) and key.endswith("/ok"):
+        return key.removeprefix(DEVICES_PREFIX).removesuffix("/ok")
+    return None
+
+
+class BlackboardNews:
+    """A blackboard watcher publishing what each committed write means on ``stream``."""
+
+    def __init__(self, stream: SessionStream, catalogue: KeyCatalogue, clock: Clock) -> None:
+        self.stream = stream
+        self.catalogue = catalogue
+        self.clock = clock
+        self._changed = ChangedKeys(catalogue)
+        self._device_ok: dict[str, bool] = {}
+
+    def __call__(self, key: str, value: Any) -> None:
+        now = self.clock.now()
+        publish = self.stream.publish
+        if self.stream.wants(KeyChanged.kind):  # JSON for every write costs: only if read
+            news = self._changed.news(key, value)
+            if news is not None:
+                text, event = news
+                publish(KeyChanged(now, key, value, text, event, self._writer(key)))
+        if key == SPEECH_HEARD:
+            publish(Heard(now, str(value)))
+        elif key == HAND_SHOWN and isinstance(value, int):
+            publish(HandShown(now, value))
+        elif key == SPEECH_NOT_LISTENED and isinstance(value, dict):
+            publish(
+                NotListened(
+                    now,
+                    float(value.get("from_s", now)),
+                    float(value.get("until_s", now)),
+                    str(value.get("why", "")),
+                )
+            )
+        device = device_of(key)
+        if device is not None:
+            ok = bool(value)
+            previous = self._device_ok.get(device)
+            self._device_ok[device] = ok
+            if previous != ok:
+                publish(DeviceChanged(now, device, ok, first=previous is None))
+
+    def _writer(self, key: str) -> str:
+        if key.startswith(VARIABLES_PREFIX):
+            return "trees"
+        spec = self.catalogue.lookup(key)
+        return spec.writer if spec is not None else ""

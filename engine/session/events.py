@@ -1,0 +1,308 @@
+"""What happened in a session, as typed events: the one account every reader shares.
+
+BehaviorTree.CPP gives all its loggers one base (``StatusChangeLogger``): the console,
+file, SQLite and Groot2 loggers read the same status changes. vest does the same for the
+whole session: producers (the scheduler, the action log, the turns, the safety envelope,
+the buttons, the blackboard, hot reload, the scenario) publish these events on the
+:class:`~engine.session.stream.SessionStream`, and the readers (the terminal timeline,
+``--json``, the recorder, the live view, the cloud's telemetry) each turn them into what
+they show or keep. Nobody keeps a second account of what happened.
+
+Every event is immutable and carries ``t_s``, the clock time it happened (seconds; a
+node's status holds from its tick's deadline). Its ``kind`` names it on the wire and in
+recordings.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, ClassVar, Literal
+
+
+@dataclass(frozen=True, slots=True)
+class NodeInfo:
+    """One node of a tree version: its number (depth-first, as ``vest render`` numbers
+    them; ``n0`` is the root), path, type, label (as drawn) and depth."""
+
+    index: int
+    path: str
+    type: str
+    label: str
+    depth: int
+
+
+@dataclass(frozen=True, slots=True)
+class TreeStarted:
+    """A version of a tree began running: at the start, and after each hot reload."""
+
+    kind: ClassVar[str] = "tree"
+    t_s: float
+    tree: str
+    version: int
+    file: Path
+    files: tuple[Path, ...]
+    rate_hz: float
+    priority: int
+    nodes: tuple[NodeInfo, ...]
+    dot: str
+    """The tree drawn as ``vest render`` draws it (Graphviz source)."""
+
+
+@dataclass(frozen=True, slots=True)
+class NodeStatus:
+    """A node's status or feedback message changed in a tick (due at ``t_s``)."""
+
+    kind: ClassVar[str] = "status"
+    t_s: float
+    tree: str
+    version: int
+    tick: int
+    node: int
+    status: str
+    feedback: str
+
+
+@dataclass(frozen=True, slots=True)
+class ActionStarted:
+    """A tree asked a service to act (say, led, servo, read, report); ``action_id``
+    pairs it with its :class:`ActionEnded`."""
+
+    kind: ClassVar[str] = "action"
+    t_s: float
+    action_id: int
+    tree: str
+    action: str
+    args: dict[str, Any]
+
+
+Outcome = Literal["done", "failed", "cut"]
+"""How an action ended: done as asked; failed (the service could not, or the safety
+envelope refused or stopped it); cut short before it was done (its tree was interrupted,
+paused, reloaded or stopped)."""
+
+
+@dataclass(frozen=True, slots=True)
+class ActionEnded:
+    """An action's outcome, with why when it was not done."""
+
+    kind: ClassVar[str] = "outcome"
+    t_s: float
+    action_id: int
+    tree: str
+    action: str
+    args: dict[str, Any]
+    started_s: float
+    outcome: Outcome
+    why: str = ""
+
+
+TurnKind = Literal["interrupts", "waits", "yields", "tries_again"]
+
+
+@dataclass(frozen=True, slots=True)
+class TurnTaken:
+    """One voice at a time: ``tree`` interrupts ``other`` for ``resource``, waits for
+    it, yields it (``what`` it lets go), or will try again once it is free."""
+
+    kind: ClassVar[str] = "turn"
+    t_s: float
+    tree: str
+    turn: TurnKind
+    resource: str
+    other: str
+    what: str = ""
+
+    @property
+    def text(self) -> str:
+        """As the timeline says it, after the tree's name."""
+        if self.turn == "interrupts":
+            return f"interrupts {self.other} to use the {self.resource}"
+        if self.turn == "waits":
+            return f"waits for the {self.resource}: {self.other} has it"
+        if self.turn == "tries_again":
+            return f"will try again once the {self.resource} is free ({self.other} has it)"
+        return f"yields the {self.resource} to {self.other}: not {self.what}"
+
+
+SafetyKind = Literal["refused", "stopped", "slowed"]
+
+
+@dataclass(frozen=True, slots=True)
+class SafetyAction:
+    """The safety envelope refused a move, stopped one under way, or slowed one.
+
+    ``rule`` is the config field that decided (``still_within_mm``, ``stop_above_n``,
+    ``joint_limits``...), ``devices`` the sensors it read (or could not trust), ``why``
+    the whole reason in words."""
+
+    kind: ClassVar[str] = "safety"
+    t_s: float
+    action: SafetyKind
+    joint: str
+    rule: str
+    devices: tuple[str, ...]
+    why: str
+    tree: str = ""
+
+
+@dataclass(frozen=True, slots=True)
+class ButtonPressed:
+    """The therapist pressed a button (on the page, a key, or a scenario's ``press``);
+    ``done`` is False when it was not shown then, so nothing was done."""
+
+    kind: ClassVar[str] = "press"
+    t_s: float
+    label: str
+    by: str
+    done: bool = True
+
+
+@dataclass(frozen=True, slots=True)
+class BehaviorsPaused:
+    """The therapist paused (``paused``) or resumed the autonomous behaviors."""
+
+    kind: ClassVar[str] = "pause"
+    t_s: float
+    paused: bool
+
+
+@dataclass(frozen=True, slots=True)
+class DeviceChanged:
+    """A device went offline or came back (``/devices/<name>/ok`` changed); ``first``:
+    its first report, at start-up."""
+
+    kind: ClassVar[str] = "device"
+    t_s: float
+    device: str
+    ok: bool
+    first: bool = False
+
+
+@dataclass(frozen=True, slots=True)
+class Heard:
+    """The recognizer heard ``text`` (a ``/speech/heard`` event)."""
+
+    kind: ClassVar[str] = "heard"
+    t_s: float
+    text: str
+
+
+@dataclass(frozen=True, slots=True)
+class NotUnderstood:
+    """A dialog had no rule for what was heard; the robot answered with its fallback
+    ("Sorry, I did not understand") when the dialog has one."""
+
+    kind: ClassVar[str] = "not_understood"
+    t_s: float
+    tree: str
+    text: str
+    why: str
+
+
+@dataclass(frozen=True, slots=True)
+class NotListened:
+    """Someone spoke while the robot was speaking, and the robot did not listen (its
+    microphone is ignored while it speaks, so it never answers its own voice)."""
+
+    kind: ClassVar[str] = "not_listened"
+    t_s: float
+    from_s: float
+    until_s: float
+    why: str
+
+
+@dataclass(frozen=True, slots=True)
+class HandShown:
+    """The camera saw ``fingers`` held up (a ``/vision/hand/shown`` event)."""
+
+    kind: ClassVar[str] = "hand"
+    t_s: float
+    fingers: int
+
+
+@dataclass(frozen=True, slots=True)
+class TreeReloaded:
+    """A changed tree file was swapped in, or (``problem``) kept out: the running
+    version goes on."""
+
+    kind: ClassVar[str] = "reload"
+    t_s: float
+    tree: str
+    problem: str = ""
+
+
+@dataclass(frozen=True, slots=True)
+class WorldEvent:
+    """Something a scenario made happen around the simulated robot."""
+
+    kind: ClassVar[str] = "world"
+    t_s: float
+    scenario_event: str
+    """The scenario event's kind (touch, squeeze, hear, unplug...)."""
+    description: str
+    value: Any = None
+
+
+@dataclass(frozen=True, slots=True)
+class KeyChanged:
+    """A committed blackboard write that says something new: every event, and a state
+    key's write when its value changed. ``text`` is the value as JSON."""
+
+    kind: ClassVar[str] = "key"
+    t_s: float
+    key: str
+    value: Any
+    text: str
+    event: bool
+    writer: str
+
+
+@dataclass(frozen=True, slots=True)
+class SessionEnded:
+    """The session is over (the run ended or was stopped)."""
+
+    kind: ClassVar[str] = "end"
+    t_s: float
+    facts: dict[str, str] = field(default_factory=dict)
+
+
+SessionEvent = (
+    TreeStarted
+    | NodeStatus
+    | ActionStarted
+    | ActionEnded
+    | TurnTaken
+    | SafetyAction
+    | ButtonPressed
+    | BehaviorsPaused
+    | DeviceChanged
+    | Heard
+    | NotUnderstood
+    | NotListened
+    | HandShown
+    | TreeReloaded
+    | WorldEvent
+    | KeyChanged
+    | SessionEnded
+)
+EVENT_TYPES: tuple[type[SessionEvent], ...] = (
+    TreeStarted,
+    NodeStatus,
+    ActionStarted,
+    ActionEnded,
+    TurnTaken,
+    SafetyAction,
+    ButtonPressed,
+    BehaviorsPaused,
+    DeviceChanged,
+    Heard,
+    NotUnderstood,
+    NotListened,
+    HandShown,
+    TreeReloaded,
+    WorldEvent,
+    KeyChanged,
+    SessionEnded,
+)
+KINDS = tuple(event_type.kind for event_type in EVENT_TYPES)
