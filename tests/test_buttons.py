@@ -11,6 +11,8 @@ from pathlib import Path
 
 from engine.cli import main
 from engine.recording.replay import Recording
+from engine.recording.told import told_events
+from engine.session.events import ButtonPressed
 
 ROOT = Path(__file__).resolve().parents[1]
 BUTTONS = ROOT / "trees" / "buttons" / "session.yaml"
@@ -41,16 +43,23 @@ def test_a_button_pressed_mid_hug_speaks_at_once_and_the_hug_gives_way(
         "{at: 1.0, squeeze: {left_n: 6.0, right_n: 6.0, seconds: 2.0}}",
         "{at: 1.2, press: Well done}",
     )
-    assert lines_after(out, "presses the button")[:6] == [
+    assert lines_after(out, "presses the button")[:9] == [
         "therapist presses the button 'Well done'",
         "buttons interrupts hug to use the face LEDs",  # the button's green replaces pink
+        "hug cut short: lights the face pink for 2 s (buttons interrupted it)",
+        'hug cut short: says "I love hugs!" (buttons interrupted it)',
         "buttons lights the face green for 1 s",
         'buttons says "Well done! That was great."',
+        # the hug, still going on, gives way once (no stutter) and is answered once the
+        # button's face and voice are both free
         "hug yields the face LEDs to buttons: not lighting the face pink",
-        "hug yields the speaker to buttons: not saying 'I love hugs!'",
+        "hug lights the face pink for 2 s",
+        'hug says "I love hugs!"',
     ]
     pressed_at = next(line for line in out.splitlines() if 'says "Well done!' in line)
     assert pressed_at.split()[0] == "1.20"  # within the tick the press came in
+    answered_at = next(line for line in out.splitlines() if 'hug            says "I' in line)
+    assert answered_at.split()[0] == "1.00"  # the first answer, before the press
 
 
 def test_while_paused_a_pat_is_not_answered_not_even_after_resuming(tmp_path, capsys, monkeypatch):
@@ -110,7 +119,8 @@ def test_a_press_is_kept_in_the_session_recording(tmp_path, capsys, monkeypatch)
     run(tmp_path, capsys, "{at: 1.0, press: Hello}", extra=("--record", str(recorded)))
     recording = Recording.open(recorded)
     try:
-        assert (1.0, "press", "presses the button 'Hello'") in recording.world()
+        [press] = [e for e in told_events(recording) if isinstance(e, ButtonPressed)]
+        assert (press.t_s, press.label, press.by) == (1.0, "Hello", "scenario")
         said = [a for a in recording.actions() if a.action == "say"]
         assert [(a.tree, a.args["text"]) for a in said] == [
             ("buttons", "Hello! I am happy to see you.")
@@ -139,7 +149,10 @@ def test_a_button_pressed_while_a_game_waits_for_a_hand_leaves_the_game_going(
 def test_a_button_not_shown_now_does_nothing_and_says_so(tmp_path, capsys, monkeypatch):
     monkeypatch.chdir(ROOT)
     out, _ = run(tmp_path, capsys, "{at: 1.0, press: Show me your hand}")  # no game runs
-    assert "buttons        'Show me your hand' is not shown now: nothing done" in out
+    assert (
+        "therapist      presses the button 'Show me your hand', which is not shown now: "
+        "nothing done" in out
+    )
     assert "Can you show me your hand?" not in out
 
 

@@ -15,7 +15,7 @@ import pytest
 from engine.cli import main
 from engine.cli.output import finite_json, shown
 from engine.cli.timeline import Timeline
-from engine.services.actions import ActionRecord
+from engine.session.events import ActionStarted
 
 ROOT = Path(__file__).resolve().parents[1]
 VEST = [sys.executable, "-c", "from engine.cli import main; raise SystemExit(main())"]
@@ -49,8 +49,8 @@ class FullDisk:
         """Nothing is buffered."""
 
 
-def record(text: str, tree: str = "hug", **args: Any) -> ActionRecord:
-    return ActionRecord(t=1.5, tree=tree, action="say", args={"text": text, **args})
+def record(text: str, tree: str = "hug", **args: Any) -> ActionStarted:
+    return ActionStarted(1.5, 1, tree, "say", {"text": text, **args})
 
 
 @pytest.mark.parametrize(
@@ -90,8 +90,8 @@ def test_a_timeline_on_a_full_disk_stops_writing_but_never_stops_the_robot() -> 
     stopped: list[bool] = []
     timeline = Timeline(disk, start_s=0.0, on_closed=lambda: stopped.append(True))  # type: ignore[arg-type]
     timeline.start()
-    timeline.action(record("Thank you"))
-    timeline.action(record("I love hugs!"))
+    timeline.on_event(record("Thank you"))
+    timeline.on_event(record("I love hugs!"))
     assert stopped == []  # the scheduler was not asked to stop
     assert disk.attempts == 1  # told once, then the timeline is given up
     assert timeline.write_error is not None
@@ -101,7 +101,7 @@ def test_spoken_text_with_a_newline_and_a_terminal_escape_stays_on_its_own_line(
     out = _Lines()
     timeline = Timeline(out, start_s=0.0)  # type: ignore[arg-type]
     forged = 'hi"\n    9.99  hug            says "I was never said\x1b[2J'
-    timeline.action(record(forged, tree="evil\r\x1b]0;title\x07"))
+    timeline.on_event(record(forged, tree="evil\r\x1b]0;title\x07"))
     assert len(out.lines) == 1
     line = out.lines[0]
     assert "\n" not in line.rstrip("\n") and "\x1b" not in line and "\r" not in line
@@ -119,13 +119,14 @@ def test_ordinary_text_in_any_script_is_shown_as_written() -> None:
 def test_json_lines_are_strict_json_with_null_for_numbers_that_are_not_finite() -> None:
     out = _Lines()
     timeline = Timeline(out, start_s=0.0, as_json=True)  # type: ignore[arg-type]
-    reading = ActionRecord(
-        t=2.0,
-        tree="iot_command",
-        action="report",
-        args={"id": "cmd-1", "result": {"c": float("nan"), "cm": [float("inf"), 1.5]}},
+    reading = ActionStarted(
+        2.0,
+        1,
+        "iot_command",
+        "report",
+        {"id": "cmd-1", "result": {"c": float("nan"), "cm": [float("inf"), 1.5]}},
     )
-    timeline.action(reading)
+    timeline.on_event(reading)
 
     def refuse(constant: str) -> None:
         raise AssertionError(f"{constant} is not JSON")

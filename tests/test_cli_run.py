@@ -17,9 +17,11 @@ ROOT = Path(__file__).resolve().parents[1]
 VEST = [sys.executable, "-c", "from engine.cli import main; raise SystemExit(main())"]
 
 
-def run_json(capsys, *args: str) -> list[dict]:
+def run_json(capsys, *args: str, event: str = "action") -> list[dict]:
+    """The --json lines of one kind of event (every line says its ``event``)."""
     assert main(["run", "--fast", "--json", *args]) == 0
-    return [json.loads(line) for line in capsys.readouterr().out.splitlines()]
+    lines = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
+    return [line for line in lines if line["event"] == event]
 
 
 def test_every_demo_event_is_answered_by_the_right_behavior_once(capsys, monkeypatch):
@@ -58,15 +60,18 @@ def test_every_demo_event_is_answered_by_the_right_behavior_once(capsys, monkeyp
     assert reports[1]["result"]["/sensors/temperature/c"] == pytest.approx(22.2, abs=0.0625)
 
 
-def test_json_lines_carry_time_tree_action_and_args(capsys, monkeypatch):
+def test_json_lines_carry_time_event_tree_action_and_args(capsys, monkeypatch):
     monkeypatch.chdir(ROOT)
     first = run_json(capsys, "--duration", "2")[0]
     assert first == {
         "t": 1.0,
+        "event": "action",
         "tree": "touch_thanks",
         "action": "say",
         "args": {"text": "Thank you", "volume": 0.8},
     }
+    [world] = run_json(capsys, "--duration", "2", event="world")
+    assert world["description"] == "middle_back touched for 0.3 s"
 
 
 def test_a_profile_changes_what_the_robot_says(capsys, monkeypatch):
@@ -213,9 +218,10 @@ def test_a_move_beyond_the_neck_s_limits_is_refused_shown_and_reported_failed(
         "duration_s: 3\nevents:\n"
         "  - {at: 1.0, cloud: {type: move, args: {joint: neck, angle_deg: 170}}}\n"
     )
+    ended = run_json(capsys, "--scenario", str(scenario), event="outcome")
+    refused = [a for a in ended if a["action"] == "servo" and a["outcome"] == "failed"]
+    assert "outside its limits -60..60 deg" in refused[0]["why"]
     actions = run_json(capsys, "--scenario", str(scenario))
-    refused = [a for a in actions if a["action"] == "servo" and "error" in a]
-    assert "outside its limits -60..60 deg" in refused[0]["error"]
     report = next(a for a in actions if a["action"] == "report")
     assert report["args"]["status"] == "failed"
     assert main(["run", "--fast", "--scenario", str(scenario)]) == 0

@@ -68,7 +68,11 @@ def tickles(tmp_path: Path, *, priority: int, wait: float = 0) -> Path:
 
 def said(out: str) -> list[tuple[float, str, str]]:
     lines = [json.loads(line) for line in out.splitlines()]
-    return [(a["t"], a["tree"], a["args"]["text"]) for a in lines if a["action"] == "say"]
+    return [
+        (a["t"], a["tree"], a["args"]["text"])
+        for a in lines
+        if a["event"] == "action" and a["action"] == "say"
+    ]
 
 
 def test_when_two_trees_answer_one_pat_the_higher_priority_speaks_and_the_lower_yields(
@@ -101,9 +105,13 @@ def test_a_higher_priority_tree_interrupts_the_lower_one_whose_arm_goes_back_to_
     lines = out.splitlines()
     interrupt = next(i for i, line in enumerate(lines) if "interrupts tickles" in line)
     assert "back_thanks    interrupts tickles to use the speaker" in lines[interrupt]
-    assert "tickles        turns left_arm to 0 deg" in lines[interrupt + 1]
-    assert "(back to rest)" in lines[interrupt + 1]
-    assert 'back_thanks    says "Thank you"' in lines[interrupt + 2]
+    # what it was saying is cut short (and said so), its arm comes back to rest, and only
+    # then does the higher tree speak
+    assert "tickles        cut short: says" in lines[interrupt + 1]
+    assert "(back_thanks interrupted it)" in lines[interrupt + 1]
+    assert "tickles        turns left_arm to 0 deg" in lines[interrupt + 2]
+    assert "(back to rest)" in lines[interrupt + 2]
+    assert 'back_thanks    says "Thank you"' in lines[interrupt + 3]
 
 
 def test_a_tree_that_waits_its_turn_speaks_when_the_speaker_is_free(tmp_path, capsys, monkeypatch):

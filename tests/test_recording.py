@@ -84,7 +84,7 @@ def test_a_recording_from_a_newer_vest_is_refused_by_its_format(demo: Path, caps
     with sqlite3.connect(demo) as db:
         db.execute("UPDATE meta SET value = '99' WHERE key = 'format'")
     assert main(["replay", str(demo)]) == 1
-    assert "recorded in format 99, newer than this vest reads (1)" in capsys.readouterr().err
+    assert "recorded in format 99, newer than this vest reads (2)" in capsys.readouterr().err
 
 
 def test_recording_into_a_missing_folder_stops_before_the_robot_starts(

@@ -19,7 +19,7 @@ def test_with_the_face_leds_unplugged_a_long_hug_is_answered_once(
     assert (
         main(["run", "--fast", "--json", "--scenario", "examples/scenarios/unplug_leds.yaml"]) == 0
     )
-    actions = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
-    hug = [(a["action"], a.get("error") is not None) for a in actions if a["tree"] == "hug"]
+    lines = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
+    hug = [(a["event"], a["action"]) for a in lines if a.get("tree") == "hug"]
     # the call to the dark face, its failure, and one answer: no second try while hugged
-    assert hug == [("led", False), ("led", True), ("say", False)]
+    assert hug == [("action", "led"), ("outcome", "led"), ("action", "say")]

@@ -14,7 +14,12 @@ from pathlib import Path
 import pytest
 
 from engine.blackboard.board import Blackboard
-from engine.blackboard.catalogue import FORCE_LEFT_N, RANGE_CENTER_MM, default_catalogue
+from engine.blackboard.catalogue import (
+    FORCE_LEFT_N,
+    FORCE_RIGHT_N,
+    RANGE_CENTER_MM,
+    default_catalogue,
+)
 from engine.cli import main
 from engine.clock import VirtualClock
 from engine.hardware.config_file import load_robot_config
@@ -80,7 +85,7 @@ def test_a_remote_command_to_move_the_arm_is_refused_and_reported_failed_with_th
         as_json=True,
     )
     actions = [json.loads(line) for line in lines.splitlines()]
-    report = next(a for a in actions if a["action"] == "report")
+    report = next(a for a in actions if a["event"] == "action" and a["action"] == "report")
     assert report["args"]["status"] == "failed"
     assert "safety: something is" in str(report["args"]["result"])
 
@@ -102,20 +107,31 @@ def test_a_hard_squeeze_stops_an_arm_move_under_way_where_the_arm_is(tmp_path, c
 
 @pytest.fixture
 def envelope() -> tuple[SafetyEnvelope, Blackboard]:
+    """The simulated vest's envelope, its range sensors and force pads working and read
+    just now: nobody near, nobody pressing."""
     clock = VirtualClock()
     blackboard = Blackboard(default_catalogue(), clock)
     blackboard.reset()
+    for device in ("range_left", "range_center", "range_right", "force"):
+        blackboard.set(f"/devices/{device}/ok", True)
+    for side in ("left", "center", "right"):
+        blackboard.set(f"/sensors/range/{side}_mm", None)
+    blackboard.set(FORCE_LEFT_N, 0.0)
+    blackboard.set(FORCE_RIGHT_N, 0.0)
     return SafetyEnvelope.of(load_robot_config(SIM), blackboard), blackboard
 
 
 def test_an_arm_near_a_person_moves_slowly_and_one_farther_away_at_its_asked_speed(envelope):
     rules, blackboard = envelope
     blackboard.set(RANGE_CENTER_MM, 200.0)
-    assert rules.speed_dps("left_arm", 60.0) == 30.0
-    assert rules.speed_dps("left_arm", None) == 30.0  # the joint's limit would be faster
-    assert rules.speed_dps("neck", 90.0) == 90.0  # the neck is not an arm
+    assert rules.speed_dps("left_arm", 60.0)[0] == 30.0
+    assert rules.speed_dps("left_arm", None)[0] == 30.0  # the joint's limit would be faster
+    assert rules.speed_dps("neck", 90.0) == (90.0, None)  # the neck is not an arm
+    slowed = rules.speed_dps("left_arm", 60.0)[1]
+    assert slowed is not None and slowed.rule == "slow_within_mm"
+    assert slowed.devices == ("range_center",)
     blackboard.set(RANGE_CENTER_MM, 500.0)
-    assert rules.speed_dps("left_arm", 60.0) == 60.0
+    assert rules.speed_dps("left_arm", 60.0) == (60.0, None)
 
 
 def test_speech_is_never_louder_and_the_face_never_brighter_than_the_config_allows(envelope):

@@ -55,7 +55,11 @@ def said(capsys, trees: list[Path], scenario_path: Path) -> list[tuple[float, st
     args = ["run", "--fast", "--json", "--hardware", str(SIM), "--scenario", str(scenario_path)]
     assert main([*args, "--speech", "text", "--trees", *map(str, trees)]) == 0
     lines = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
-    return [(a["t"], a["tree"], a["args"]["text"]) for a in lines if a["action"] == "say"]
+    return [
+        (a["t"], a["tree"], a["args"]["text"])
+        for a in lines
+        if a["event"] == "action" and a["action"] == "say"
+    ]
 
 
 def test_a_pat_on_a_named_shoulder_is_answered_and_a_pat_on_the_back_is_not(tmp_path, capsys):

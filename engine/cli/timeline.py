@@ -19,17 +19,19 @@ from typing import Any, TextIO
 
 from engine.cli.output import discard, finite_json, reason, shown, tell
 from engine.runtime.scheduler import RunningTree
-from engine.session.events import ActionEnded, SafetyAction, SessionEvent
-from engine.session.sentences import event_line
+from engine.session.events import ActionEnded, DeviceChanged, SessionEvent
+from engine.session.sentences import TOLD_KINDS, event_line
 
 
 def event_json(event: SessionEvent, start_s: float) -> dict[str, Any] | None:
     """``event`` as one ``--json`` object (times in seconds since ``start_s``); None for
     the events the timeline does not show."""
-    if event_line(event) is None and not isinstance(event, ActionEnded | SafetyAction):
+    if event.kind not in TOLD_KINDS:
         return None
     if isinstance(event, ActionEnded) and event.outcome == "done":
-        return None
+        return None  # an action's line says it began; only one that did not end well is told
+    if isinstance(event, DeviceChanged) and event.first:
+        return None  # the first report at start-up
     fields: dict[str, Any] = {"t": round(event.t_s - start_s, 3), "event": event.kind}
     for name in (field.name for field in dataclasses.fields(event)):
         value = getattr(event, name)

@@ -105,7 +105,7 @@ class SafetyEnvelope:
         doubtful = [r for r in readings if r.doubt is not None]
         if not doubtful:
             return None
-        what = "; ".join(str(r.doubt) for r in doubtful)
+        what = "; ".join(dict.fromkeys(str(r.doubt) for r in doubtful))  # a chip's pads: once
         return Verdict(
             rule,
             tuple(dict.fromkeys(r.guard.device for r in doubtful)),

@@ -1,14 +1,18 @@
 """A recorded session as a therapist reads it (``vest report FILE``): one static HTML page.
 
-What the person did (touched, hugged, waved, said, showed fingers) and how the robot
-answered, with how long it took; how often each behaviour acted; what the robot did not
-understand; devices that dropped out; and the sensors over the session, drawn as inline
-SVG. Everything comes from the recording's blackboard and actions, so a session on the
-robot reads the same as one on the simulated vest. Printable on A4.
+Who, when and with which profile; what the person did (touched, hugged, waved, said,
+showed fingers), what the therapist did (the buttons pressed) and how the robot answered,
+with how long it took, one line each (a sentence it did not understand is answered as
+such; a time it could not listen because it was speaking is a line of its own); how often
+each behaviour acted; what the robot did not understand; devices that dropped out; and the
+sensors over the session, drawn as inline SVG. Everything comes from the recording's
+account of the session (:mod:`engine.recording.told`), its blackboard and actions, so a
+session on the robot reads the same as one on the simulated vest. Printable on A4.
 """
 
 from __future__ import annotations
 
+import datetime
 import html
 import json
 from collections import Counter
@@ -27,6 +31,9 @@ from engine.blackboard.catalogue import (
     TOUCH_ANY,
 )
 from engine.recording.replay import RecordedAction, Recording
+from engine.recording.report_plots import numbers, plot
+from engine.recording.told import told_events
+from engine.session.events import ButtonPressed, NotListened, NotUnderstood
 
 ANSWER_WITHIN_S = 10.0
 """An action this soon after what the person did counts as the robot's answer."""
@@ -36,12 +43,17 @@ PRESSED_N = 1.0
 
 @dataclass(frozen=True)
 class Moment:
-    """Something the person did, and the robot's answer: the actions of the first tree
-    that acted after it and before the person's next act (none: no answer)."""
+    """Something someone did (``who``: the person, the therapist, the operator), and the
+    robot's answer: the actions of the first tree that acted after it and before the next
+    thing anyone did (none: no answer). ``not_understood`` is what the robot heard and
+    had no rule for; ``not_listened`` says the robot could not listen (it was speaking)."""
 
     at_s: float
     did: str
     answers: tuple[RecordedAction, ...]
+    who: str = "the person"
+    not_understood: str | None = None
+    not_listened: bool = False
 
     @property
     def answer(self) -> RecordedAction | None:
@@ -56,37 +68,66 @@ def _rows(recording: Recording, key: str) -> list[tuple[float, Any]]:
     return recording.key_history(key)
 
 
-PERSON_EVENTS = ("touch", "squeeze", "gesture", "hear", "show_hand", "obstacle", "cloud")
-"""Scenario events that are someone doing something (not a device failing)."""
+PERSON_EVENTS = ("touch", "squeeze", "gesture", "hear", "show_hand", "obstacle")
+"""Scenario events that are the person doing something (not a device failing)."""
 
 
 def person_moments(recording: Recording) -> list[Moment]:
-    """What the person did, in order, each with the robot's first answer: a simulated
-    session's scenario events (so an answer's time counts from the act itself), else
-    what the sensors and the recognizer saw."""
-    done = [
-        (at, description) for at, kind, description in recording.world() if kind in PERSON_EVENTS
-    ] or sensed(recording)
+    """What the person, the therapist and the operator did, in order, each with the
+    robot's first answer: a simulated session's scenario events (so an answer's time
+    counts from the act itself), else what the sensors and the recognizer saw; the
+    therapist's presses; each time the robot could not listen."""
+    told = told_events(recording)
+    done: list[tuple[float, str, str, str]] = [
+        (at, "the person", description, kind)
+        for at, kind, description in recording.world()
+        if kind in PERSON_EVENTS
+    ]
+    done += [
+        (at, "the operator", description.removeprefix("operator "), kind)
+        for at, kind, description in recording.world()
+        if kind == "cloud"
+    ]
+    if not done:
+        done = sensed(recording)
+    done += [
+        (event.t_s, "the therapist", f"pressed the button \u201c{event.label}\u201d", "press")
+        for event in told
+        if isinstance(event, ButtonPressed)
+    ]
+    done += [
+        (event.from_s, "the person", "spoke while the robot was speaking", "not_listened")
+        for event in told
+        if isinstance(event, NotListened)
+    ]
+    misunderstood = [event for event in told if isinstance(event, NotUnderstood)]
     actions = recording.actions()
-    ordered = sorted(done)
+    ordered = sorted(done, key=lambda item: item[0])
     moments = []
-    for index, (at, did) in enumerate(ordered):
-        later = [t for t, _ in ordered[index + 1 :] if t > at]
+    for index, (at, who, did, kind) in enumerate(ordered):
+        if kind == "not_listened":  # a line of its own: nothing to answer
+            moments.append(Moment(at, did, (), who, not_listened=True))
+            continue
+        later = [t for t, _, _, k in ordered[index + 1 :] if t > at and k != "not_listened"]
         until = min([at + ANSWER_WITHIN_S, *later[:1]])
         window = [a for a in actions if at <= a.at_s < until]
         tree = window[0].tree if window else None
         answers = tuple(a for a in window if a.tree == tree)[:3]
-        moments.append(Moment(at, did, answers))
+        heard = next(
+            (e.text for e in misunderstood if at <= e.t_s < until and kind == "hear"), None
+        )
+        moments.append(Moment(at, did, answers, who, heard))
     return moments
 
 
-def sensed(recording: Recording) -> list[tuple[float, str]]:
-    """What the person did as the robot sensed it (on a robot in a real room)."""
-    done: list[tuple[float, str]] = []
+def sensed(recording: Recording) -> list[tuple[float, str, str, str]]:
+    """What the person (and the operator) did as the robot sensed it (on a robot in a real
+    room): (moment, who, what, the kind of scenario event it would be)."""
+    done: list[tuple[float, str, str]] = []
     was_touched = False
     for at, touched in _rows(recording, TOUCH_ANY):
         if touched and not was_touched:
-            done.append((at, "touched the vest"))
+            done.append((at, "touched the vest", "touch"))
         was_touched = bool(touched)
     left = dict(_rows(recording, FORCE_LEFT_N))
     right = dict(_rows(recording, FORCE_RIGHT_N))
@@ -99,26 +140,44 @@ def sensed(recording: Recording) -> list[tuple[float, str]]:
         if now and not pressing:
             both = level["left"] > PRESSED_N and level["right"] > PRESSED_N
             what = "hugged the robot" if both else "pressed a side"
-            done.append((at, f"{what} ({level['left']:.1f} N left, {level['right']:.1f} N right)"))
+            done.append(
+                (
+                    at,
+                    f"{what} ({level['left']:.1f} N left, {level['right']:.1f} N right)",
+                    "squeeze",
+                )
+            )
         pressing = now
     for at, gesture in _rows(recording, GESTURE_LAST):
-        done.append((at, f"made a gesture: {gesture}"))
+        done.append((at, f"made a gesture: {gesture}", "gesture"))
     for at, text in _rows(recording, SPEECH_HEARD):
-        done.append((at, f"said \u201c{text}\u201d"))
+        done.append((at, f"said \u201c{text}\u201d", "hear"))
     for at, fingers in _rows(recording, HAND_SHOWN):
-        done.append((at, f"showed {fingers} finger{'' if fingers == 1 else 's'}"))
+        done.append((at, f"showed {fingers} finger{'' if fingers == 1 else 's'}", "show_hand"))
+    found = [(at, "the person", what, kind) for at, what, kind in done]
     for at, command in _rows(recording, IOT_INBOX):
         kind = command.get("type", "?") if isinstance(command, dict) else command
-        done.append((at, f"(the operator sent {kind})"))
-    return done
+        found.append((at, "the operator", f"sent {kind}", "cloud"))
+    return found
 
 
 def not_understood(recording: Recording) -> list[tuple[float, str]]:
-    """(moment, what the robot was told) for each utterance no dialog rule matched."""
-    return [
-        (at, feedback.split("no rule matches ", 1)[1].split(": ", 1)[0])
-        for at, feedback in recording.feedback_containing("no rule matches ")
-    ]
+    """(moment, what the robot heard) for each utterance no dialog rule matched, once
+    each (a format 1 recording: read from the dialog node's feedback)."""
+    if recording.format >= 2:
+        return [
+            (event.t_s, event.text)
+            for event in told_events(recording)
+            if isinstance(event, NotUnderstood)
+        ]
+    found: list[tuple[float, str]] = []
+    last: tuple[float, str] | None = None
+    for at, feedback in recording.feedback_containing("no rule matches "):
+        if last is not None and last[1] == feedback and at - last[0] <= ANSWER_WITHIN_S:
+            continue  # the same node's next status (RUNNING, then done) says it again
+        last = (at, feedback)
+        found.append((at, feedback.split("no rule matches ", 1)[1].split(": ", 1)[0]))
+    return found
 
 
 def outages(recording: Recording) -> list[tuple[str, float, float | None]]:
@@ -145,6 +204,11 @@ def _lasted(since: float, back: float | None) -> str:
 
 
 def _answer_text(action: RecordedAction) -> str:
+    cut = " (cut short)" if action.cut else ""
+    return _action_text(action) + cut
+
+
+def _action_text(action: RecordedAction) -> str:
     args = action.args
     if action.action == "say":
         return f"said \u201c{args.get('text', '')}\u201d"
@@ -159,77 +223,29 @@ def _answer_text(action: RecordedAction) -> str:
     return f"{action.action} {json.dumps(args)}"
 
 
-def _plot(
-    title: str,
-    unit: str,
-    series: list[tuple[str, str, list[tuple[float, float | None]]]],
-    end_s: float,
-) -> str:
-    """A small line plot (SVG) of step-wise series over the session."""
-    width, height, left, bottom = 680, 150, 48, 22
-    values = [v for _, _, points in series for _, v in points if v is not None]
-    if not values:
-        return ""
-    top = max(values) if max(values) > 0 else 1.0
-
-    def x(t: float) -> float:
-        return left + (width - left - 24) * (t / end_s if end_s else 0.0)
-
-    def y(v: float) -> float:
-        return 8 + (height - bottom - 8) * (1 - v / (top * 1.1))
-
-    def text(at_x: float, at_y: float, words: str, anchor: str = "end", fill: str = "") -> str:
-        colour = f' style="fill: {fill}"' if fill else ""
-        return (
-            f'<text x="{at_x:.1f}" y="{at_y:.1f}" class="tick" text-anchor="{anchor}"{colour}>'
-            f"{html.escape(words)}</text>"
-        )
-
-    base = height - bottom
-    parts = [
-        f'<svg viewBox="0 0 {width} {height}" role="img" aria-label="{html.escape(title)}">',
-        f'<text x="{left}" y="12" class="plot-title">{html.escape(title)} ({unit})</text>',
-        f'<line x1="{left}" y1="{base}" x2="{width - 8}" y2="{base}" class="axis"/>',
-        text(left - 4, y(top) + 4, f"{top:.3g}"),
-        text(left - 4, base + 4, "0"),
-    ]
-    step = max(1.0, round(end_s / 8))
-    t = 0.0
-    while t <= end_s + 1e-9:
-        parts.append(text(x(t), height - 6, f"{t:g} s", "middle"))
-        t += step
-    for index, (name, colour, points) in enumerate(series):
-        dash = ' stroke-dasharray="5 3"' if index else ""
-        for run in _runs(points, end_s):  # no reading (nothing in range): no line
-            joined = " ".join(f"{x(at):.1f},{y(value):.1f}" for at, value in run)
-            parts.append(f'<polyline fill="none" stroke="{colour}"{dash} points="{joined}"/>')
-        parts.append(text(width - 10, 20 + 12 * index, name, "end", colour))
-    parts.append("</svg>")
-    return "".join(parts)
+def _answer_cell(moment: Moment) -> tuple[str, str]:
+    """The robot's answer to ``moment`` as the report shows it (HTML), and its delay."""
+    if moment.not_listened:
+        return '<span class="none">could not listen: it was speaking</span>', "-"
+    if moment.answer is None and moment.not_understood is None:
+        return '<span class="none">no answer</span>', "-"
+    parts = []
+    if moment.not_understood is not None:
+        parts.append(f"did not understand \u201c{moment.not_understood}\u201d")
+    if moment.answer is not None:
+        done = ", ".join(_answer_text(action) for action in moment.answers)
+        parts.append(f"{moment.answer.tree}: {done}")
+    took = f"{moment.response_s:.2f} s" if moment.response_s is not None else "-"
+    return html.escape("; ".join(parts)), took
 
 
-def _runs(
-    points: list[tuple[float, float | None]], end_s: float
-) -> list[list[tuple[float, float]]]:
-    """Step-wise line pieces between the moments a value was absent."""
-    runs: list[list[tuple[float, float]]] = []
-    current: list[tuple[float, float]] = []
-    for index, (at, value) in enumerate(points):
-        until = points[index + 1][0] if index + 1 < len(points) else end_s
-        if value is None:
-            if current:
-                runs.append(current)
-            current = []
-            continue
-        current += [(at, value), (until, value)]
-    if current:
-        runs.append(current)
-    return runs
-
-
-def _numbers(rows: list[tuple[float, Any]], scale: float = 1.0) -> list[tuple[float, float | None]]:
-    """Readings as numbers (True is 1); None where the sensor saw nothing."""
-    return [(at, float(v) * scale if isinstance(v, int | float) else None) for at, v in rows]
+def _started(epoch: str | None) -> str:
+    """When the session was recorded, as a date a person reads (UTC)."""
+    try:
+        stamp = datetime.datetime.fromtimestamp(float(epoch or ""), tz=datetime.UTC)
+    except (ValueError, OverflowError, OSError):
+        return "date unknown"
+    return stamp.strftime("%d %B %Y, %H:%M UTC")
 
 
 STYLE = (Path(__file__).resolve().parent / "report.css").read_text
@@ -240,18 +256,14 @@ def report_html(recording: Recording) -> str:
     """The report as one HTML document (no outside files)."""
     end = recording.duration_s
     moments = person_moments(recording)
-    answered = [m.response_s for m in moments if m.response_s is not None]
+    answered = [m.response_s for m in moments if m.response_s is not None and not m.not_listened]
     rows = []
     for moment in moments:
-        if moment.answer is None:
-            answer, took = '<span class="none">no answer</span>', "-"
-        else:
-            done = ", ".join(_answer_text(action) for action in moment.answers)
-            answer = html.escape(f"{moment.answer.tree}: {done}")
-            took = f"{moment.response_s:.2f} s"
+        answer, took = _answer_cell(moment)
         rows.append(
-            f"<tr><td class='num'>{moment.at_s:.1f} s</td><td>{html.escape(moment.did)}</td>"
-            f"<td>{answer}</td><td class='num'>{took}</td></tr>"
+            f"<tr><td class='num'>{moment.at_s:.1f} s</td><td>{html.escape(moment.who)}</td>"
+            f"<td>{html.escape(moment.did)}</td><td>{answer}</td>"
+            f"<td class='num'>{took}</td></tr>"
         )
     rows_html = "".join(rows)
     fired = Counter({tree.name: 0 for tree in recording.trees})
@@ -271,31 +283,40 @@ def report_html(recording: Recording) -> str:
         for device, since, back in outages(recording)
     )
     median = sorted(answered)[len(answered) // 2] if answered else None
+    acts = [m for m in moments if not m.not_listened]
+    unheard = len(moments) - len(acts)
     summary = (
-        f"{len(moments)} things the person did; the robot answered {len(answered)}"
+        f"{len(acts)} things done (by the person, the therapist or an operator); the robot "
+        f"answered {len(answered)}"
         + (f", typically within {median:.2f} s" if median is not None else "")
         + "."
+        + (
+            f" {unheard} time{'s' if unheard != 1 else ''} the person spoke while the robot "
+            "was speaking, and it could not listen."
+            if unheard
+            else ""
+        )
     )
     plots = [
-        _plot(
+        plot(
             "Squeeze on the side pads",
             "N",
             [
-                ("left", "#c62828", _numbers(_rows(recording, FORCE_LEFT_N))),
-                ("right", "#1565c0", _numbers(_rows(recording, FORCE_RIGHT_N))),
+                ("left", "#c62828", numbers(_rows(recording, FORCE_LEFT_N))),
+                ("right", "#1565c0", numbers(_rows(recording, FORCE_RIGHT_N))),
             ],
             end,
         ),
-        _plot(
+        plot(
             "Touched",
             "yes = 1",
-            [("any pad", "#2e7d32", _numbers(_rows(recording, TOUCH_ANY)))],
+            [("any pad", "#2e7d32", numbers(_rows(recording, TOUCH_ANY)))],
             end,
         ),
-        _plot(
+        plot(
             "Someone in front",
             "cm",
-            [("center distance", "#6a1b9a", _numbers(_rows(recording, RANGE_CENTER_MM), 0.1))],
+            [("center distance", "#6a1b9a", numbers(_rows(recording, RANGE_CENTER_MM), 0.1))],
             end,
         ),
     ]
@@ -303,21 +324,23 @@ def report_html(recording: Recording) -> str:
     profile = meta.get("profile") or "no profile"
     recorded = html.escape(recording.path.name)
     robot = html.escape(meta.get("robot_config", "?"))
+    person = html.escape(meta.get("person") or "no person named")
+    when = html.escape(_started(meta.get("started")))
     return "\n".join(
         [
             '<!doctype html>\n<html lang="en"><head><meta charset="utf-8">',
             f"<title>Session report: {recorded}</title>",
             f"<style>{STYLE(encoding='utf-8')}</style></head><body>",
             "<h1>Session report</h1>",
-            f'<p class="meta">{recorded} &middot; {end:.1f} s &middot; '
-            f"{html.escape(profile)} &middot; robot {robot}</p>",
+            f'<p class="meta">{when} &middot; {person} &middot; {end:.1f} s &middot; '
+            f"profile {html.escape(profile)} &middot; robot {robot} &middot; {recorded}</p>",
             f"<p>{html.escape(summary)}</p>",
             "<h2>What the person did, and how the robot answered</h2>",
             _table(
-                ["when", "the person", "the robot", "answer after"],
+                ["when", "who", "did", "the robot", "answer after"],
                 rows_html,
                 "nothing",
-                numeric={0, 3},
+                numeric={0, 4},
             ),
             "<h2>How often each behaviour acted</h2>",
             _table(["behaviour", "actions"], behaviours, "none acted", numeric={1}),

@@ -21,7 +21,9 @@ from engine.services.jobs import ImmediateJob, Job
 from engine.services.turns import (
     FACE_LEDS,
     SPEAKER,
+    Turn,
     Turns,
+    TurnYieldedError,
     WaitingJob,
     joint_resource,
     let_go,
@@ -95,8 +97,8 @@ class ActionLog:
 
     @property
     def done(self) -> list[ActionRecord]:
-        """The records of calls not (yet) seen failed or cut short."""
-        return [record for record in self.records if record.error is None and not record.cut]
+        """The records of calls not (yet) seen failed (one cut short was begun)."""
+        return [record for record in self.records if record.error is None]
 
 
 class _WatchedJob:
@@ -159,7 +161,9 @@ class TreeActions:
     reports FAILURE rather than stopping the tick. The jobs returned mark their record in
     the log when they are seen failed. With ``taking`` the speaker, the face LEDs and the
     joints are shared with the other trees by priority; an action waiting for its turn
-    is recorded when it starts.
+    is recorded when it starts. A tree gives way to another once: while what it gave way
+    to goes on, asking again (a hug still going on) fails at once, unsaid, and the tree
+    acts again once every resource it gave way for is free.
     """
 
     def __init__(
@@ -180,6 +184,9 @@ class TreeActions:
         self._lit = False
         self.stop_reason = ""
         """Why the tree is being halted, while it is (its cut actions say so)."""
+        self._gave_way: dict[str, Turn] = {}
+        """The turns this tree gave way to: while one lasts, its actions fail at once,
+        without waiting or saying so again (no stutter, no half answer)."""
 
     def _call(
         self,
@@ -204,19 +211,38 @@ class TreeActions:
         if taking is None or not uses:
             return begin()
         turns, priority = taking.turns, taking.priority
+        giving_way = self._still_giving_way(turns)
         blocked = turns.blocking(uses, self.tree, priority)
+        if blocked is not None:
+            resource, turn = blocked
+            known = self._gave_way.get(resource) is turn
+            self._gave_way[resource] = turn
+            if known:
+                giving_way = blocked
+        if giving_way is not None:  # asked again while what it gave way to goes on
+            resource, turn = giving_way
+            return ImmediateJob(error=TurnYieldedError(f"{turn.tree} still has the {resource}"))
         if blocked is None:
             turns.take(uses, self.tree, priority)
             job = begin()
             if not (job.done() and job.error() is not None):  # a refused call holds nothing
                 turns.hold(uses, self.tree, priority, job)
             return job
-        resource, turn = blocked
+        resource, turn = blocked  # said once; the tree acts again once all are free
         if taking.wait_for_turn_s <= 0:
             return ImmediateJob(error=let_go(turns, self.tree, what, resource, turn))
         turns.tell(self.tree, "waits", resource, turn.tree)
         deadline_s = self.clock.now() + taking.wait_for_turn_s
         return WaitingJob(turns, begin, uses, self.tree, priority, deadline_s, what)
+
+    def _still_giving_way(self, turns: Turns) -> tuple[str, Turn] | None:
+        """A resource this tree gave way for whose holder still has it, or None (then it
+        has forgotten them all: every one is free, or taken by someone else since)."""
+        for resource, turn in list(self._gave_way.items()):
+            if turns.holder(resource, self.tree) is turn:
+                return resource, turn
+            del self._gave_way[resource]
+        return None
 
     def say(self, text: str, *, volume: float | None = None) -> Job:
         args: dict[str, Any] = {"text": text}
@@ -276,17 +302,19 @@ class TreeActions:
         )
 
     def move_servo(self, joint: str, angle_deg: float, *, speed_dps: float | None = None) -> Job:
-        self._moved.add(joint)
         args: dict[str, Any] = {"joint": joint, "angle_deg": angle_deg}
         if speed_dps is not None:
             args["speed_dps"] = speed_dps
-        return self._call(
+        job = self._call(
             "servo",
             args,
             lambda: self.services.servos.move(joint, angle_deg, speed_dps=speed_dps),
             (joint_resource(joint),),
             f"turning {joint} to {angle_deg:g} deg",
         )
+        if getattr(job, "waiting", False) or not (job.done() and job.error() is not None):
+            self._moved.add(joint)  # a move refused at once moved nothing to bring back
+        return job
 
     def read_sensor(self, sensor: str) -> Job:
         return self._call("read", {"sensor": sensor}, lambda: self.services.sensors.read(sensor))

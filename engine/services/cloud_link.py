@@ -24,7 +24,6 @@ delivered again is refused (reported FAILED with why) rather than risk running i
 
 from __future__ import annotations
 
-import json
 import logging
 import math
 import queue
@@ -38,6 +37,7 @@ from engine.blackboard.board import Blackboard
 from engine.blackboard.catalogue import DEVICES_PREFIX, IOT_CANCELED, IOT_INBOX, SENSORS_PREFIX
 from engine.blackboard.events import EventLog
 from engine.clock import Clock
+from engine.services.done_commands import DoneCommands
 from engine.services.jobs import ImmediateJob, Job
 from engine.session.events import KeyChanged, SessionEvent
 from engine.session.stream import SessionStream
@@ -53,7 +53,6 @@ extends the lease of the one it carries out three times a lease (``lease_s`` com
 the command), so the service neither delivers it again nor shows it QUEUED."""
 DEFAULT_LEASE_S = 30.0
 TELEMETRY_PREFIXES = (SENSORS_PREFIX, DEVICES_PREFIX)
-DONE_KEPT = 1000
 PROGRESS_EVERY_S = 2.0
 """How often the robot tells the service it is still at a command (at most a third of
 the lease): an operator's cancel stops the robot within this."""
@@ -80,74 +79,6 @@ def _json_safe(value: Any) -> Any:
     if value is None or isinstance(value, bool | int | float | str):
         return value
     return str(value)
-
-
-class DoneCommands:
-    """Finished command ids and their reports, kept in a JSON file across restarts.
-
-    A file that is there but cannot be read as such is set aside as ``FILE.damaged``
-    (``.damaged.1``... when one is there already) and ``damaged`` names where it went."""
-
-    def __init__(self, path: Path) -> None:
-        self.path = path
-        self._done: dict[str, dict[str, Any]] = {}
-        self.damaged: Path | None = None
-        self._lock = threading.Lock()
-        try:
-            text = path.read_text(encoding="utf-8")
-        except FileNotFoundError:
-            return  # none yet
-        except (OSError, UnicodeDecodeError) as error:
-            self._set_aside(f"cannot be read ({error})")
-            return
-        try:
-            loaded = json.loads(text)
-        except ValueError as error:
-            self._set_aside(f"is not JSON ({error})")
-            return
-        if not isinstance(loaded, dict) or not all(isinstance(v, dict) for v in loaded.values()):
-            self._set_aside("does not hold finished commands by id")
-            return
-        self._done = {str(k): v for k, v in loaded.items()}
-
-    def _set_aside(self, why: str) -> None:
-        aside = self.path.with_name(self.path.name + ".damaged")
-        number = 0
-        while aside.exists():
-            number += 1
-            aside = self.path.with_name(f"{self.path.name}.damaged.{number}")
-        try:
-            self.path.replace(aside)
-            self.damaged = aside
-            kept = f"kept aside as {aside}"
-        except OSError as error:
-            self.damaged = self.path
-            kept = f"left where it is ({error}); it will be replaced"
-        log.error(
-            "the robot's record of finished commands %s %s; %s. A command delivered again "
-            "will not be carried out again (it may have been already): it is reported "
-            "failed instead",
-            self.path,
-            why,
-            kept,
-        )
-
-    def get(self, command_id: str) -> dict[str, Any] | None:
-        with self._lock:
-            return self._done.get(command_id)
-
-    def add(self, command_id: str, report: dict[str, Any]) -> None:
-        with self._lock:
-            self._done[command_id] = report
-            while len(self._done) > DONE_KEPT:
-                self._done.pop(next(iter(self._done)))
-            text = json.dumps(self._done)
-        try:
-            temporary = self.path.with_suffix(".tmp")
-            temporary.write_text(text, encoding="utf-8")
-            temporary.replace(self.path)
-        except OSError as error:
-            log.warning("cannot keep finished commands in %s: %s", self.path, error)
 
 
 class TelemetrySnapshot:

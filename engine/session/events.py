@@ -130,7 +130,8 @@ SafetyKind = Literal["refused", "stopped", "slowed"]
 
 @dataclass(frozen=True, slots=True)
 class SafetyAction:
-    """The safety envelope refused a move, stopped one under way, or slowed one.
+    """The safety envelope refused a move, stopped one under way, or slowed one (the
+    tree's action and its outcome follow with the tree's name).
 
     ``rule`` is the config field that decided (``still_within_mm``, ``stop_above_n``,
     ``joint_limits``...), ``devices`` the sensors it read (or could not trust), ``why``
@@ -143,7 +144,6 @@ class SafetyAction:
     rule: str
     devices: tuple[str, ...]
     why: str
-    tree: str = ""
 
 
 @dataclass(frozen=True, slots=True)

@@ -59,7 +59,7 @@ def describe_action(action: str, args: dict[str, Any]) -> str:
         return f"reads the {args['sensor']} sensor"
     if action == "report":
         result = f": {args['result']}" if args.get("result") is not None else ""
-        return f"reports {args['id']} {args['status']}{result}"
+        return f"reports {args.get('id')} {args.get('status')}{result}"
     return f"{action} {args}"
 
 

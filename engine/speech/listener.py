@@ -4,7 +4,12 @@ The microphone hands audio to :meth:`Listener.hear` from its own thread (or, on 
 simulated vest, from a tick hook). Voice activity is found at once (Silero is cheap);
 each finished utterance is recognized in the listener's worker, never in a tick, and
 ``on_heard`` gets the text. While the robot speaks, the microphone is ignored
-(:class:`~engine.speech.speaker.SelfHearing`): it never answers its own voice.
+(:class:`~engine.speech.speaker.SelfHearing`): it never answers its own voice. Someone
+who speaks over the robot is therefore not heard; what can be known of it is told to
+``on_not_listened(from_s, until_s, why)``: here, speech already under way when the robot
+stops (its start was lost). Telling speech *within* the robot's voice apart from its echo
+needs echo cancellation, which a microphone here does not have; the simulated room knows
+who spoke when, and tells it itself (:mod:`engine.speech.robot_speech`).
 """
 
 from __future__ import annotations
@@ -23,6 +28,10 @@ from engine.speech.speaker import SelfHearing
 from engine.speech.vad import SpeechDetector, Utterance
 
 log = logging.getLogger(__name__)
+ALREADY_S = 0.15
+"""Speech this soon after the robot fell silent was already under way while it spoke."""
+NotListenedListener = Callable[[float, float, str], None]
+"""Told ``(from_s, until_s, why)`` (clock seconds) of speech the robot did not listen to."""
 
 
 @dataclass(frozen=True)
@@ -47,6 +56,7 @@ class Listener:
         *,
         self_hearing: SelfHearing | None = None,
         settling: Settling | None = None,
+        on_not_listened: NotListenedListener | None = None,
     ) -> None:
         self.detector = detector
         self.recognizer = recognizer
@@ -60,6 +70,9 @@ class Listener:
         self._thread: threading.Thread | None = None
         self.ignored_s = 0.0
         """Seconds of microphone audio ignored because the robot was speaking."""
+        self.on_not_listened = on_not_listened
+        self._deaf_since_s: float | None = None
+        self._listening_since_s: float | None = None
 
     def hear(self, audio: Audio, ends_at_s: float) -> None:
         """A piece of the microphone stream (16 kHz) that ended at ``ends_at_s``."""
@@ -68,10 +81,37 @@ class Listener:
             if self.detector.in_speech:
                 self.detector.reset()  # what was being heard ran into the robot's voice
             self.ignored_s += audio.seconds
+            if self._deaf_since_s is None:
+                self._deaf_since_s = starts_at_s
+            self._listening_since_s = None
             return
-        for utterance in self.detector.feed(audio.samples):
+        if self._deaf_since_s is not None:  # the robot stopped speaking: listening again
+            self._listening_since_s, self._deaf_since_s = starts_at_s, None
+        utterances = self.detector.feed(audio.samples)
+        self._already_speaking(ends_at_s)
+        for utterance in utterances:
             late_s = (self.detector.position - utterance.end_sample) / audio.rate_hz
             self._submit(utterance, ends_at_s - late_s)
+
+    def _already_speaking(self, now_s: float) -> None:
+        """Speech found within :data:`ALREADY_S` of the robot falling silent began while
+        it spoke: its start was not heard (told once)."""
+        since = self._listening_since_s
+        if since is None or self.on_not_listened is None:
+            return
+        if self.detector.in_speech:
+            self._listening_since_s = None
+            try:
+                self.on_not_listened(
+                    since,
+                    since,
+                    "someone was already speaking when the robot stopped speaking; the "
+                    "start of it was not heard",
+                )
+            except Exception:  # whoever listens must not stop the robot hearing
+                log.exception("telling what was not listened to failed")
+        elif now_s - since > ALREADY_S:
+            self._listening_since_s = None
 
     def settled(self) -> bool:
         """No utterance waits for recognition."""

@@ -16,7 +16,7 @@ from pathlib import Path
 from typing import Any
 
 from engine.blackboard.board import Blackboard
-from engine.blackboard.catalogue import SPEECH_HEARD
+from engine.blackboard.catalogue import SPEECH_HEARD, SPEECH_NOT_LISTENED
 from engine.clock import Clock
 from engine.drivers.audio_devices import AlsaMicrophone, AlsaSpeaker, AudioDeviceError
 from engine.drivers.sim.room import RoomSpeaker, SimulatedRoom
@@ -25,7 +25,7 @@ from engine.files.yaml_values import plain
 from engine.hardware.config import AudioConfig
 from engine.loader.substitution import Profile
 from engine.speech.audio import Audio, read_wav, with_noise, write_wav
-from engine.speech.listener import Heard, Listener
+from engine.speech.listener import Heard, Listener, NotListenedListener
 from engine.speech.recognizer import RecognizerError, WhisperRecognizer
 from engine.speech.settings import SPEECH_PROFILE_PARAMS
 from engine.speech.settling import Settling
@@ -38,6 +38,10 @@ log = logging.getLogger(__name__)
 HEARD_KEPT = 100
 LEAD_S = 0.3
 """Quiet before a person's scripted utterance starts (noise is mixed over it too)."""
+DEAF_STEP_S = 0.05
+NOT_LISTENED_AT_LEAST_S = 0.2
+"""A person's speech that overlaps the robot's by less is not told as not listened to
+(the robot's last syllable over the first of an answer)."""
 
 
 class NoPlayback:
@@ -84,6 +88,11 @@ class RobotSpeech:
     _spoken: dict[str, Audio] = field(default_factory=dict)
     heard: deque[Heard] = field(default_factory=lambda: deque(maxlen=HEARD_KEPT))
     """The last utterances heard (text and times), for whoever inspects the robot."""
+    self_hearing: SelfHearing = field(default_factory=SelfHearing)
+    on_not_listened: NotListenedListener | None = None
+    _spoken_in_room: list[tuple[float, float]] = field(default_factory=list)
+    """When each person in the simulated room spoke (clock seconds), until it is checked
+    against when the robot was not listening."""
 
     def __call__(self, now_s: float) -> None:
         """A tick hook: the simulated microphone hears the room up to now; on a virtual
@@ -93,8 +102,33 @@ class RobotSpeech:
             self.settling.wait(self.settled)
         if self.room is not None and self.listener is not None:
             self.listener.hear(self.room.capture(now_s), now_s)
+            self._not_listened_in_room(now_s)
         if self.settle:
             self.settling.wait(self.settled)
+
+    def _not_listened_in_room(self, now_s: float) -> None:
+        """The simulated room knows who spoke when: each person's speech that ended by
+        ``now_s`` and fell, for :data:`NOT_LISTENED_AT_LEAST_S` or more, into a time the
+        robot was speaking (and so not listening) is told to ``on_not_listened``."""
+        ended = [span for span in self._spoken_in_room if span[1] <= now_s]
+        if not ended:
+            return
+        self._spoken_in_room = [span for span in self._spoken_in_room if span[1] > now_s]
+        for from_s, until_s in ended:
+            steps = max(1, round((until_s - from_s) / DEAF_STEP_S))
+            deaf = [
+                from_s + index * DEAF_STEP_S
+                for index in range(steps)
+                if self.self_hearing.deaf_at(from_s + index * DEAF_STEP_S)
+            ]
+            if len(deaf) * DEAF_STEP_S >= NOT_LISTENED_AT_LEAST_S and self.on_not_listened:
+                missed = len(deaf) * DEAF_STEP_S
+                self.on_not_listened(
+                    deaf[0],
+                    deaf[-1] + DEAF_STEP_S,
+                    f"someone spoke while the robot was speaking ({missed:.1f} s of "
+                    f"{until_s - from_s:.1f} s); it does not listen while it speaks",
+                )
 
     def settled(self) -> bool:
         listener = self.listener
@@ -119,6 +153,7 @@ class RobotSpeech:
         if snr_db is not None:
             audio = with_noise(audio, snr_db, seed=round(at_s * 1000))
         self.room.add(audio.scaled(0.5), at_s)
+        self._spoken_in_room.append((at_s + LEAD_S, at_s + LEAD_S + spoken.seconds))
 
     def prepare(self, text: str) -> Audio:
         """Synthesize what a person will say before it is said (a scenario's lines)."""
@@ -134,8 +169,16 @@ class RobotSpeech:
             if heard.text:
                 blackboard.stage_event(SPEECH_HEARD, heard.text)
 
+        def not_listened(from_s: float, until_s: float, why: str) -> None:
+            blackboard.stage_event(
+                SPEECH_NOT_LISTENED, {"from_s": from_s, "until_s": until_s, "why": why}
+            )
+
+        self.on_not_listened = not_listened  # the simulated room tells what it knows
         if self.listener is not None:
             self.listener.on_heard = stage
+            if self.room is None:  # a real microphone: what the listener can tell
+                self.listener.on_not_listened = not_listened
 
     def world_changed(self, world: object, what: str) -> None:
         """Nothing the room carries changes with the polled senses."""
@@ -220,7 +263,9 @@ def build_speech(
         )
     except (RecognizerError, ImportError) as error:
         problems["recognizer"] = str(error)
-    speech = RobotSpeech(speaker, listener, room, settling, settle, voice, problems)
+    speech = RobotSpeech(
+        speaker, listener, room, settling, settle, voice, problems, self_hearing=self_hearing
+    )
     for part in (playback, *getattr(playback, "parts", ())):
         if isinstance(part, AlsaSpeaker):
             speech.closers.append(part.close)

@@ -155,6 +155,8 @@ class Robot:
         """Reads the timeline until an action for which ``wanted(action)`` is true."""
         while (line := self._lines.get(timeout=120)) is not None:
             action = json.loads(line)
+            if action["event"] != "action":
+                continue  # the session's other events
             self.actions.append(action)
             if wanted(action):
                 return action
@@ -165,7 +167,7 @@ class Robot:
         self.process.wait(timeout=60)
         self._reader.join(timeout=10)
         while (line := self._lines.get_nowait()) is not None:
-            if line.strip():
+            if line.strip() and json.loads(line)["event"] == "action":
                 self.actions.append(json.loads(line))
         assert self.process.returncode == 0
         return self.actions

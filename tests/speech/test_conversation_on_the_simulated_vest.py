@@ -29,7 +29,8 @@ def run(tmp_path: Path, capsys: pytest.CaptureFixture[str], events: str, *extra:
         *extra,
     ]
     assert main(args) == 0
-    return [json.loads(line) for line in capsys.readouterr().out.splitlines() if line]
+    lines = [json.loads(line) for line in capsys.readouterr().out.splitlines() if line]
+    return [line for line in lines if line["event"] == "action"]
 
 
 def said(actions: list[dict]) -> list[str]:

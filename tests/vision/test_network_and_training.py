@@ -43,7 +43,9 @@ def test_the_exported_model_answers_as_pytorch_does(tmp_path: Path) -> None:
     with torch.no_grad():
         expected = WithSoftmax(network)(torch.from_numpy(images)).numpy()
     got = model.probabilities(images)
-    np.testing.assert_allclose(got, expected, atol=1e-6)
+    # float32 sums in another order (ONNX Runtime's kernels for this CPU, PyTorch's): a few
+    # parts in a million apart on some machines, the same answer on all of them
+    np.testing.assert_allclose(got, expected, atol=1e-5)
     np.testing.assert_allclose(got.sum(axis=1), 1.0, atol=1e-5)
 
 

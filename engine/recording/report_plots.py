@@ -1,0 +1,79 @@
+"""The report's small line plots of the sensors over a session, as inline SVG."""
+
+from __future__ import annotations
+
+import html
+from typing import Any
+
+
+def plot(
+    title: str,
+    unit: str,
+    series: list[tuple[str, str, list[tuple[float, float | None]]]],
+    end_s: float,
+) -> str:
+    """A small line plot (SVG) of step-wise series over the session."""
+    width, height, left, bottom = 680, 150, 48, 22
+    values = [v for _, _, points in series for _, v in points if v is not None]
+    if not values:
+        return ""
+    top = max(values) if max(values) > 0 else 1.0
+
+    def x(t: float) -> float:
+        return left + (width - left - 24) * (t / end_s if end_s else 0.0)
+
+    def y(v: float) -> float:
+        return 8 + (height - bottom - 8) * (1 - v / (top * 1.1))
+
+    def text(at_x: float, at_y: float, words: str, anchor: str = "end", fill: str = "") -> str:
+        colour = f' style="fill: {fill}"' if fill else ""
+        return (
+            f'<text x="{at_x:.1f}" y="{at_y:.1f}" class="tick" text-anchor="{anchor}"{colour}>'
+            f"{html.escape(words)}</text>"
+        )
+
+    base = height - bottom
+    parts = [
+        f'<svg viewBox="0 0 {width} {height}" role="img" aria-label="{html.escape(title)}">',
+        f'<text x="{left}" y="12" class="plot-title">{html.escape(title)} ({unit})</text>',
+        f'<line x1="{left}" y1="{base}" x2="{width - 8}" y2="{base}" class="axis"/>',
+        text(left - 4, y(top) + 4, f"{top:.3g}"),
+        text(left - 4, base + 4, "0"),
+    ]
+    step = max(1.0, round(end_s / 8))
+    t = 0.0
+    while t <= end_s + 1e-9:
+        parts.append(text(x(t), height - 6, f"{t:g} s", "middle"))
+        t += step
+    for index, (name, colour, points) in enumerate(series):
+        dash = ' stroke-dasharray="5 3"' if index else ""
+        for run in _runs(points, end_s):  # no reading (nothing in range): no line
+            joined = " ".join(f"{x(at):.1f},{y(value):.1f}" for at, value in run)
+            parts.append(f'<polyline fill="none" stroke="{colour}"{dash} points="{joined}"/>')
+        parts.append(text(width - 10, 20 + 12 * index, name, "end", colour))
+    parts.append("</svg>")
+    return "".join(parts)
+
+
+def _runs(
+    points: list[tuple[float, float | None]], end_s: float
+) -> list[list[tuple[float, float]]]:
+    """Step-wise line pieces between the moments a value was absent."""
+    runs: list[list[tuple[float, float]]] = []
+    current: list[tuple[float, float]] = []
+    for index, (at, value) in enumerate(points):
+        until = points[index + 1][0] if index + 1 < len(points) else end_s
+        if value is None:
+            if current:
+                runs.append(current)
+            current = []
+            continue
+        current += [(at, value), (until, value)]
+    if current:
+        runs.append(current)
+    return runs
+
+
+def numbers(rows: list[tuple[float, Any]], scale: float = 1.0) -> list[tuple[float, float | None]]:
+    """Readings as numbers (True is 1); None where the sensor saw nothing."""
+    return [(at, float(v) * scale if isinstance(v, int | float) else None) for at, v in rows]
