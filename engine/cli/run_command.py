@@ -240,7 +240,7 @@ def main(args: argparse.Namespace) -> int:
             **speech_settings(behaviors.loader.profile),
         )
         for event in scenario.events:
-            if event.kind == "hear" and event.value["text"] is not None:
+            if event.kind == "hear" and event.value["wav"] is None:
                 speech.prepare(event.value["text"])
     assembled = build_robot(
         behaviors,

@@ -105,7 +105,13 @@ EVENT_FIELDS: dict[str, tuple[Param[Any], ...] | ParamType[Any]] = {
     ),
     "hear": (
         Param("text", Text(), None, "what is said, spoken by the robot's TTS voice"),
-        Param("wav", Text(), None, "a WAV recording of it (relative to the scenario file)"),
+        Param(
+            "wav",
+            Text(),
+            None,
+            "a WAV recording of it (relative to the scenario file); with text, the recording "
+            "of that text: the same sound on every machine",
+        ),
         Param("snr_db", Number(-10.0, 60.0, "dB"), None, "white noise this far below the speech"),
     ),
     "unplug": (
@@ -309,11 +315,12 @@ def _event(
 
 
 def _check_hearing(value: dict[str, Any], body: YValue, folder: Path, problems: Problems) -> bool:
-    """Exactly one of text (with words) and wav; a wav that is a WAV file we can use (read
-    now, so a bad one is named before the run), made absolute."""
-    if (value["text"] is None) == (value["wav"] is None):
+    """Text (with words), a wav, or both (the wav is then what the text says: the timeline
+    shows the text, the microphone hears the recording); a wav that is a WAV file we can
+    use (read now, so a bad one is named before the run), made absolute."""
+    if value["text"] is None and value["wav"] is None:
         problems.add(
-            body.mark, "hear takes one of text and wav", "e.g. {text: hello} or {wav: question.wav}"
+            body.mark, "hear takes text, wav or both", "e.g. {text: hello} or {wav: question.wav}"
         )
         return False
     if value["text"] is not None and not any(c.isalnum() for c in value["text"]):

@@ -123,6 +123,7 @@ class CloudLink:
         self.telemetry = TelemetrySnapshot()
         self.telemetry_failures = 0
         """Pushes of telemetry that failed (the service unreachable or refusing)."""
+        self._telemetry_failing = False
         self._canceled: set[str] = set()  # canceled by the operator while carried out
         self._reports: queue.Queue[tuple[str, dict[str, Any]] | None] = queue.Queue()
         self._stop = clock.event()
@@ -138,6 +139,10 @@ class CloudLink:
         """The blackboard commands are staged on, and the session whose committed sensor
         and device values are pushed as telemetry."""
         self.blackboard = blackboard
+        self.telemetry_from(session)
+
+    def telemetry_from(self, session: SessionStream) -> None:
+        """Push the sensor and device values ``session`` tells as committed."""
         session.subscribe(self.telemetry, (KeyChanged.kind,))
 
     def start(self) -> None:
@@ -334,28 +339,35 @@ class CloudLink:
                 break
 
     def _push_telemetry(self) -> None:
-        failing = False
         while not self.clock.wait(self._stop, TELEMETRY_EVERY_S):
-            values = self.telemetry.take()
-            if not values:
-                continue
-            why = ""
-            try:
-                answer = self.http.post(
-                    f"{self.api}/robot/telemetry", json={"values": values}, timeout=5.0
-                )
-                if answer.status_code >= 300:
-                    why = f"the service answered {answer.status_code}: {answer.text[:200]}"
-            except requests.RequestException as error:
-                why = str(error)
-            if why:  # the next push carries the latest values anyway
-                self.telemetry_failures += 1
-                if not failing:
-                    log.warning("telemetry could not be pushed (%s); the robot retries", why)
-                failing = True
-            elif failing:
-                log.info("telemetry is pushed again after %d failures", self.telemetry_failures)
-                failing = False
+            self.push_telemetry()
+
+    def push_telemetry(self) -> bool:
+        """Push the latest committed sensor and device values once; False when the push
+        failed (counted in ``telemetry_failures``, logged once per streak: the next push
+        carries the latest values anyway)."""
+        values = self.telemetry.take()
+        if not values:
+            return True
+        why = ""
+        try:
+            answer = self.http.post(
+                f"{self.api}/robot/telemetry", json={"values": values}, timeout=5.0
+            )
+            if answer.status_code >= 300:
+                why = f"the service answered {answer.status_code}: {answer.text[:200]}"
+        except requests.RequestException as error:
+            why = str(error)
+        if why:
+            self.telemetry_failures += 1
+            if not self._telemetry_failing:
+                log.warning("telemetry could not be pushed (%s); the robot retries", why)
+            self._telemetry_failing = True
+            return False
+        if self._telemetry_failing:
+            log.info("telemetry is pushed again after %d failures", self.telemetry_failures)
+            self._telemetry_failing = False
+        return True
 
     def _unreachable(self, error: Exception) -> None:
         if self.reachable:

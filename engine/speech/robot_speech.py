@@ -9,6 +9,7 @@ without a speaker its answers fail with the reason.
 from __future__ import annotations
 
 import logging
+import threading
 from collections import deque
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
@@ -38,6 +39,10 @@ log = logging.getLogger(__name__)
 HEARD_KEPT = 100
 LEAD_S = 0.3
 """Quiet before a person's scripted utterance starts (noise is mixed over it too)."""
+HEARD_AFTER_LINE_S = 0.4
+"""On a virtual clock, a scripted line is heard this long after its recording ends: the
+VAD's 0.3 s of silence, and 0.1 s (three of its 32 ms frames) to spare. See
+:meth:`RobotSpeech.heard_when`."""
 DEAF_STEP_S = 0.05
 NOT_LISTENED_AT_LEAST_S = 0.2
 """A person's speech that overlaps the robot's by less is not told as not listened to
@@ -89,10 +94,16 @@ class RobotSpeech:
     heard: deque[Heard] = field(default_factory=lambda: deque(maxlen=HEARD_KEPT))
     """The last utterances heard (text and times), for whoever inspects the robot."""
     self_hearing: SelfHearing = field(default_factory=SelfHearing)
+    blackboard: Blackboard | None = None
     on_not_listened: NotListenedListener | None = None
     _spoken_in_room: list[tuple[float, float]] = field(default_factory=list)
     """When each person in the simulated room spoke (clock seconds), until it is checked
     against when the robot was not listening."""
+    _lines: list[tuple[float, float]] = field(default_factory=list)
+    """When each scripted line is spoken in the simulated room (clock seconds)."""
+    _due: list[tuple[float, str]] = field(default_factory=list)
+    """On a virtual clock: what was heard, and when it is staged."""
+    _due_lock: threading.Lock = field(default_factory=threading.Lock)
 
     def __call__(self, now_s: float) -> None:
         """A tick hook: the simulated microphone hears the room up to now; on a virtual
@@ -105,6 +116,29 @@ class RobotSpeech:
             self._not_listened_in_room(now_s)
         if self.settle:
             self.settling.wait(self.settled)
+            self._stage_due(now_s)
+
+    def heard_when(self, ended_s: float) -> float | None:
+        """On a virtual clock, when an utterance whose end the VAD found at ``ended_s``
+        (clock seconds) is heard: the end of the scripted line it belongs to plus
+        :data:`HEARD_AFTER_LINE_S`. The VAD finds the end of speech by its model's floating
+        point, which differs a little from one CPU to another: a frame later, and the line
+        would be heard a tick later on one machine than on another. Snapped to the line's
+        end (known from its recording), the timeline is the same on every machine as long
+        as the VAD finds the end within 0.1 s of where it does here. None: the utterance
+        is no scripted line's (heard at once)."""
+        for start_s, end_s in self._lines:
+            if start_s <= ended_s <= end_s + HEARD_AFTER_LINE_S:
+                return end_s + HEARD_AFTER_LINE_S
+        return None
+
+    def _stage_due(self, now_s: float) -> None:
+        with self._due_lock:
+            due = [item for item in self._due if item[0] <= now_s + 1e-9]
+            self._due = [item for item in self._due if item[0] > now_s + 1e-9]
+        for _, text in sorted(due):
+            if self.blackboard is not None:
+                self.blackboard.stage_event(SPEECH_HEARD, text)
 
     def _not_listened_in_room(self, now_s: float) -> None:
         """The simulated room knows who spoke when: each person's speech that ended by
@@ -153,7 +187,9 @@ class RobotSpeech:
         if snr_db is not None:
             audio = with_noise(audio, snr_db, seed=round(at_s * 1000))
         self.room.add(audio.scaled(0.5), at_s)
-        self._spoken_in_room.append((at_s + LEAD_S, at_s + LEAD_S + spoken.seconds))
+        line = (at_s + LEAD_S, at_s + LEAD_S + spoken.seconds)
+        self._spoken_in_room.append(line)
+        self._lines.append(line)
 
     def prepare(self, text: str) -> Audio:
         """Synthesize what a person will say before it is said (a scenario's lines)."""
@@ -164,10 +200,18 @@ class RobotSpeech:
     def hears_into(self, blackboard: Blackboard) -> None:
         """What the robot hears is staged on ``blackboard`` as a ``/speech/heard`` event."""
 
+        self.blackboard = blackboard
+
         def stage(heard: Heard) -> None:
             self.heard.append(heard)
-            if heard.text:
+            if not heard.text:
+                return
+            due_s = self.heard_when(heard.ended_s) if self.settle else None
+            if due_s is None:
                 blackboard.stage_event(SPEECH_HEARD, heard.text)
+                return
+            with self._due_lock:  # staged by the tick hook at its time
+                self._due.append((due_s, heard.text))
 
         def not_listened(from_s: float, until_s: float, why: str) -> None:
             blackboard.stage_event(

@@ -141,6 +141,9 @@ class Robot:
             text=True,
         )
         self.actions: list[dict[str, Any]] = []
+        """The robot's actions, as --json tells them."""
+        self.events: list[dict[str, Any]] = []
+        """Every --json line (actions, how they ended, turns, safety...), once finished."""
         self._lines: queue.Queue[str | None] = queue.Queue()
         self._reader = threading.Thread(target=self._read, daemon=True)
         self._reader.start()
@@ -155,6 +158,7 @@ class Robot:
         """Reads the timeline until an action for which ``wanted(action)`` is true."""
         while (line := self._lines.get(timeout=120)) is not None:
             action = json.loads(line)
+            self.events.append(action)
             if action["event"] != "action":
                 continue  # the session's other events
             self.actions.append(action)
@@ -167,8 +171,10 @@ class Robot:
         self.process.wait(timeout=60)
         self._reader.join(timeout=10)
         while (line := self._lines.get_nowait()) is not None:
-            if line.strip() and json.loads(line)["event"] == "action":
-                self.actions.append(json.loads(line))
+            if line.strip():
+                self.events.append(json.loads(line))
+                if self.events[-1]["event"] == "action":
+                    self.actions.append(self.events[-1])
         assert self.process.returncode == 0
         return self.actions
 

@@ -13,7 +13,7 @@ from cloud.services import CloudStore
 from cloud.settings import Settings
 from cloud.store.ledger import SUCCEEDED
 from engine.cli import main
-from engine.services.cloud_link import DoneCommands
+from engine.services.done_commands import DoneCommands
 
 ROOT = Path(__file__).resolve().parents[2]
 

@@ -26,8 +26,8 @@ def scenario_problems(tmp_path: Path, event: str) -> list[str]:
 @pytest.mark.parametrize(
     ("event", "message"),
     [
-        ('{at: 1, hear: {text: "hi", wav: "a.wav"}}', "hear takes one of text and wav"),
-        ("{at: 1, hear: {snr_db: 10}}", "hear takes one of text and wav"),
+        ('{at: 1, hear: {text: "hi", wav: "a.wav"}}', "a.wav: file not found"),
+        ("{at: 1, hear: {snr_db: 10}}", "hear takes text, wav or both"),
         ("{at: 1, hear: {wav: missing.wav}}", "missing.wav: file not found"),
         ('{at: 1, hear: "  "}', "hear has no words to say"),
         ('{at: 1, hear: {text: "hi", snr_db: 99}}', "'snr_db'"),

@@ -1,0 +1,130 @@
+"""The robot's cloud link tells the truth: an operator's cancel stops the robot, a damaged
+record of finished commands is named and never makes a command run twice, and telemetry
+is what the scheduler committed, its failures counted."""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import pytest
+import requests
+
+from cloud.services import CloudStore
+from cloud.settings import Settings
+from cloud.store.ledger import CANCELED, FAILED
+from engine.cli import main
+from engine.clock import VirtualClock
+from engine.services.cloud_link import CloudLink
+from engine.session.events import KeyChanged, Heard
+from engine.session.stream import SessionStream
+
+ROOT = Path(__file__).resolve().parents[2]
+A_LONG_SENTENCE = " ".join(["one two three four five"] * 8)  # 40 words: 12 s at 0.3 s each
+
+
+def service(
+    tmp_path: Path, start_service: Callable[..., Any], **settings: float
+) -> tuple[str, CloudStore, int, Path]:
+    """A service on loopback with one robot; (url, store, the robot's id, its token file)."""
+    running = start_service(
+        Settings(db_url=f"sqlite:///{tmp_path / 'c.db'}", max_wait_s=1.0, recheck_s=0.2, **settings)
+    )
+    store = running.store
+    store.directory.add_operator("ana")
+    token_file = tmp_path / "robot.token"
+    token_file.write_text(store.directory.add_robot("hbs2", operator="ana") + "\n")
+    robot = store.directory.authenticate(token_file.read_text().strip())
+    assert robot is not None
+    return running.url, store, robot.id, token_file
+
+
+def quiet(tmp_path: Path, seconds: float) -> Path:
+    path = tmp_path / "quiet.yaml"
+    path.write_text(f"duration_s: {seconds}\nevents: []\n")
+    return path
+
+
+def test_an_operator_s_cancel_stops_the_tree_carrying_the_command_out(
+    tmp_path: Path, start_service: Callable[..., Any], start_robot: Callable[..., Any]
+) -> None:
+    url, store, robot_id, token_file = service(tmp_path, start_service)
+    command, _ = store.ledger.submit(robot_id, "say", {"text": A_LONG_SENTENCE})
+    robot = start_robot(url, token_file, quiet(tmp_path, 8), ["trees/iot_command.yaml"])
+
+    robot.until(lambda a: a["action"] == "say")  # it has begun the long sentence
+    store.ledger.cancel(robot_id, command.id)
+    robot.finish()
+
+    [ended] = [e for e in robot.events if e["event"] == "outcome"]
+    assert (ended["action"], ended["outcome"]) == ("say", "cut")
+    assert ended["why"] == "canceled by the operator"
+    assert ended["t"] - ended["started"] < 3.0  # within a progress report (2 s) and a tick
+    [report] = [a for a in robot.actions if a["action"] == "report"]
+    assert report["args"]["result"] == {"error": "canceled by the operator"}
+    finished = store.ledger.get(robot_id, command.id)  # that report is not sent: it ended
+    assert finished is not None and finished.state == CANCELED and finished.result is None
+
+
+def test_a_damaged_record_is_kept_aside_and_a_command_delivered_again_is_not_run_again(
+    tmp_path: Path,
+    start_service: Callable[..., Any],
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+    caplog: pytest.LogCaptureFixture,
+) -> None:
+    url, store, robot_id, token_file = service(tmp_path, start_service, lease_s=0.5)
+    done = tmp_path / "robot.token.done.json"
+    done.write_text('{"cmd-1": {"status": "SUCC')  # cut off mid-write by a full disk
+    command, _ = store.ledger.submit(robot_id, "say", {"text": "hello twice?"})
+    taken = store.ledger.claim_next(robot_id)  # delivered once before the robot restarted
+    assert taken is not None and taken.deliveries == 1
+
+    monkeypatch.chdir(ROOT)
+    args = ["run", "--trees", "trees/iot_command.yaml", "--scenario", str(quiet(tmp_path, 4))]
+    args += ["--speech", "text", "--json", "--cloud", url, "--token-file", str(token_file)]
+    with caplog.at_level(logging.ERROR):
+        assert main(args) == 0
+
+    assert "hello twice?" not in capsys.readouterr().out  # never said, rather than twice
+    finished = store.ledger.get(robot_id, command.id)
+    assert finished is not None and finished.state == FAILED and finished.deliveries == 2
+    assert "record of finished commands was damaged" in finished.result["error"]
+    aside = tmp_path / "robot.token.done.json.damaged"
+    assert aside.read_text() == '{"cmd-1": {"status": "SUCC'  # kept for whoever looks into it
+    assert f"kept aside as {aside}" in caplog.text
+
+
+class FailingHttp(requests.Session):
+    """A session whose every request fails as an unreachable service does."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.posts = 0
+
+    def post(self, *args: Any, **kwargs: Any) -> requests.Response:  # type: ignore[override]
+        self.posts += 1
+        raise requests.ConnectionError("connection refused")
+
+
+def test_telemetry_is_what_the_scheduler_committed_and_its_failures_are_counted(
+    tmp_path: Path, caplog: pytest.LogCaptureFixture
+) -> None:
+    clock = VirtualClock()
+    http = FailingHttp()
+    link = CloudLink("http://127.0.0.1:9", "t", clock, done_file=tmp_path / "d.json", http=http)
+    stream = SessionStream(clock)
+    link.telemetry_from(stream)
+    assert link.push_telemetry()  # nothing committed yet: nothing to push
+    stream.publish(KeyChanged(1.0, "/sensors/force/left_n", 6.5, "6.5", False, "force poller"))
+    stream.publish(KeyChanged(1.0, "/vars/mood", "happy", '"happy"', False, "trees"))
+    stream.publish(Heard(1.0, "hello"))
+    assert link.telemetry.take() == {"/sensors/force/left_n": 6.5}  # sensors and devices only
+
+    with caplog.at_level(logging.WARNING):
+        assert not link.push_telemetry()
+        assert not link.push_telemetry()
+    assert (http.posts, link.telemetry_failures) == (2, 2)
+    assert caplog.text.count("telemetry could not be pushed") == 1  # once per streak
