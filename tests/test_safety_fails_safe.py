@@ -22,8 +22,8 @@ from engine.cli import main
 from engine.clock import VirtualClock
 from engine.hardware.config_file import load_robot_config
 from engine.hardware.safety_envelope import SafetyEnvelope
-from engine.recording.told import told_events
 from engine.recording.replay import Recording
+from engine.recording.told import told_events
 from engine.session.events import SafetyAction
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -98,7 +98,9 @@ def test_an_operator_s_arm_move_is_refused_while_the_force_pads_are_unplugged(
     )
     [refused] = refusals(lines)
     assert refused["rule"] == "stop_above_n" and refused["devices"] == ["force"]
-    report = next(line for line in lines if line["event"] == "action" and line["action"] == "report")
+    report = next(
+        line for line in lines if line["event"] == "action" and line["action"] == "report"
+    )
     assert report["args"]["status"] == "failed"
     assert "force is offline" in str(report["args"]["result"])
 
@@ -212,7 +214,11 @@ def test_a_robot_that_may_move_slowly_when_unsure_moves_at_its_slow_speed(
 ):
     monkeypatch.chdir(ROOT)
     config = tmp_path / "slow.yaml"
-    config.write_text(SIM.read_text().replace("  slow_speed_dps: 30\n", "  slow_speed_dps: 30\n  when_unsure: slow\n"))
+    config.write_text(
+        SIM.read_text().replace(
+            "  slow_speed_dps: 30\n", "  slow_speed_dps: 30\n  when_unsure: slow\n"
+        )
+    )
     lines = run(
         tmp_path,
         capsys,

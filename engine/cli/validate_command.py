@@ -303,5 +303,15 @@ def main(args: argparse.Namespace) -> int:
 
 def turn_warnings(trees: list[TreeDefinition]) -> list[str]:
     """Trees run together that can want the same speaker, LEDs or joint at the same
-    priority, each pair as a warning line."""
-    return [f"warning: {shown_path(c.second.path)}: {c.describe()}" for c in collisions(trees)]
+    priority, each pair as a warning line; and trees that would try again at once, when
+    the tree that cut them short is still at it."""
+    warnings = [f"warning: {shown_path(c.second.path)}: {c.describe()}" for c in collisions(trees)]
+    for tree in trees:
+        if tree.when_interrupted == "try_again" and tree.wait_for_turn_s <= 0:
+            warnings.append(
+                f"warning: {shown_path(tree.path)}: when_interrupted: try_again starts the "
+                "round again while the tree that cut it short still speaks or moves, and "
+                "with wait_for_turn_s: 0 its actions let go at once (give it "
+                "wait_for_turn_s: 3, say)"
+            )
+    return warnings

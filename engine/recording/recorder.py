@@ -95,7 +95,7 @@ class SessionRecorder:
             )
         elif isinstance(event, ActionStarted):
             self._note(
-                "INSERT INTO actions VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
+                "INSERT INTO actions VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
                 (
                     self._at(event.t_s),
                     event.tree,
@@ -107,17 +107,19 @@ class SessionRecorder:
                     None,
                     None,
                     self._next(),
+                    None,
                 ),
             )
         elif isinstance(event, ActionEnded):
             self._note(
-                "UPDATE actions SET outcome = ?, ended_s = ?, error = ?, why = ? "
+                "UPDATE actions SET outcome = ?, ended_s = ?, error = ?, why = ?, ended_seq = ? "
                 "WHERE action_id = ?",
                 (
                     event.outcome,
                     self._at(event.t_s),
                     event.why if event.outcome == "failed" else None,
                     event.why,
+                    self._next(),
                     event.action_id,
                 ),
             )

@@ -72,6 +72,8 @@ class RecordedAction:
     why: str = ""
     seq: int = 0
     """Its place in the session's order of events (format 2; 0 in format 1)."""
+    ended_seq: int = 0
+    """Its end's place in that order."""
 
     @property
     def cut(self) -> bool:
@@ -237,13 +239,14 @@ class Recording:
         until = float("inf") if until_s is None else until_s
         if self.format < 2:
             rows = self._rows(
-                "SELECT at_s, tree, action, args, error, NULL, NULL, NULL, NULL FROM actions "
+                "SELECT at_s, tree, action, args, error, NULL, NULL, NULL, NULL, NULL FROM actions "
                 "WHERE at_s <= ? ORDER BY rowid",
                 (until,),
             )
         else:
             rows = self._rows(
-                "SELECT at_s, tree, action, args, error, outcome, ended_s, why, seq FROM actions "
+                "SELECT at_s, tree, action, args, error, outcome, ended_s, why, seq, ended_seq "
+                "FROM actions "
                 "WHERE at_s <= ? ORDER BY rowid",
                 (until,),
             )
@@ -274,11 +277,21 @@ def _action(
     ended_s: float | None,
     why: str | None,
     seq: int | None,
+    ended_seq: int | None,
 ) -> RecordedAction:
     if outcome is None and error is not None:  # format 1 kept only the error
         outcome = "failed"
     return RecordedAction(
-        at, tree, action, json.loads(args), error, outcome, ended_s, why or error or "", seq or 0
+        at,
+        tree,
+        action,
+        json.loads(args),
+        error,
+        outcome,
+        ended_s,
+        why or error or "",
+        seq or 0,
+        ended_seq or seq or 0,
     )
 
 

@@ -30,6 +30,7 @@ from engine.blackboard.catalogue import (
     SPEECH_HEARD,
     TOUCH_ANY,
 )
+from engine.buttons.button_file import BUTTONS_TREE
 from engine.recording.replay import RecordedAction, Recording
 from engine.recording.report_plots import numbers, plot
 from engine.recording.told import told_events
@@ -102,15 +103,18 @@ def person_moments(recording: Recording) -> list[Moment]:
     ]
     misunderstood = [event for event in told if isinstance(event, NotUnderstood)]
     actions = recording.actions()
+    reporting = {a.tree for a in actions if a.action == "report"}
     ordered = sorted(done, key=lambda item: item[0])
     moments = []
     for index, (at, who, did, kind) in enumerate(ordered):
         if kind == "not_listened":  # a line of its own: nothing to answer
             moments.append(Moment(at, did, (), who, not_listened=True))
             continue
-        later = [t for t, _, _, k in ordered[index + 1 :] if t > at and k != "not_listened"]
-        until = min([at + ANSWER_WITHIN_S, *later[:1]])
-        window = [a for a in actions if at <= a.at_s < until]
+        later = [  # the next thing the same one did ends the wait for an answer
+            t for t, w, _, k in ordered[index + 1 :] if t > at and w == who and k != "not_listened"
+        ]
+        until = min([at + ANSWER_WITHIN_S, *later])
+        window = [a for a in actions if at <= a.at_s < until and _answers(who, a, reporting)]
         tree = window[0].tree if window else None
         answers = tuple(a for a in window if a.tree == tree)[:3]
         heard = next(
@@ -118,6 +122,17 @@ def person_moments(recording: Recording) -> list[Moment]:
         )
         moments.append(Moment(at, did, answers, who, heard))
     return moments
+
+
+def _answers(who: str, action: RecordedAction, reporting: set[str]) -> bool:
+    """Whether ``action`` can be the answer to something ``who`` did: a press is answered
+    by the buttons, an operator's command by the trees that report commands
+    (``reporting``), the person by the other trees."""
+    if who == "the therapist":
+        return action.tree == BUTTONS_TREE
+    if who == "the operator":
+        return action.tree in reporting
+    return action.tree != BUTTONS_TREE and action.tree not in reporting
 
 
 def sensed(recording: Recording) -> list[tuple[float, str, str, str]]:

@@ -59,7 +59,8 @@ CREATE TABLE blackboard (
 CREATE INDEX blackboard_by_time ON blackboard (at_s);
 CREATE TABLE actions (
     at_s REAL NOT NULL, tree TEXT NOT NULL, action TEXT NOT NULL, args TEXT NOT NULL,
-    error TEXT, action_id INTEGER, outcome TEXT, ended_s REAL, why TEXT, seq INTEGER
+    error TEXT, action_id INTEGER, outcome TEXT, ended_s REAL, why TEXT, seq INTEGER,
+    ended_seq INTEGER
 );
 CREATE INDEX actions_by_id ON actions (action_id);
 CREATE TABLE world (

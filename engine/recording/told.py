@@ -91,7 +91,7 @@ def told_events(recording: Recording, until_s: float | None = None) -> list[Sess
             event = ActionEnded(
                 ended, 0, action.tree, action.action, args, action.at_s, outcome, action.why
             )
-            found.append((ended, action.seq, index, event))
+            found.append((ended, action.ended_seq, index, event))
     for at, kind, description, seq in recording.ordered_rows(
         "world", "at_s, kind, description", until
     ):

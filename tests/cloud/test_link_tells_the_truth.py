@@ -18,7 +18,7 @@ from cloud.store.ledger import CANCELED, FAILED
 from engine.cli import main
 from engine.clock import VirtualClock
 from engine.services.cloud_link import CloudLink
-from engine.session.events import KeyChanged, Heard
+from engine.session.events import Heard, KeyChanged
 from engine.session.stream import SessionStream
 
 ROOT = Path(__file__).resolve().parents[2]

@@ -1,0 +1,135 @@
+"""One account of every session: the terminal timeline, --json, the recording, the live
+view and the report all read the one session event stream, so none of them tells a
+different story.
+
+The story: the demo, recorded, with a therapist's press, a tree cut short by a higher one,
+and a question the robot did not understand; then read back as a replay and a report.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from engine.cli import main
+from engine.clock import VirtualClock
+from engine.recording.replay import Recording
+from engine.recording.report import not_understood, person_moments, report_html
+from engine.recording.told import told_events
+from engine.session.events import (
+    ActionEnded,
+    ButtonPressed,
+    SafetyAction,
+    TurnTaken,
+)
+from engine.session.sentences import event_line
+from engine.session.stream import SessionStream
+from engine.view.hub import ViewHub
+
+ROOT = Path(__file__).resolve().parents[1]
+STORY = """\
+duration_s: 12
+events:
+  - {at: 1.0, press: Hello}
+  - {at: 2.0, hear: "what is the weather like on the moon"}
+  - {at: 4.0, hear: "what's your name?"}
+  - {at: 4.4, cloud: {type: say, args: {text: "hello from the cloud"}}}
+"""
+
+
+@pytest.fixture
+def session(tmp_path: Path, capsys, monkeypatch) -> tuple[Path, str]:
+    """The story run on a virtual clock, recorded, with --person; (recording, timeline)."""
+    monkeypatch.chdir(ROOT)
+    scenario = tmp_path / "story.yaml"
+    scenario.write_text(STORY)
+    recording = tmp_path / "kid-17.db"
+    args = ["run", "--fast", "--speech", "text", "--scenario", str(scenario)]
+    args += ["--record", str(recording), "--person", "kid-17"]
+    assert main(args) == 0
+    return recording, capsys.readouterr().out.split("\n\n")[0]
+
+
+def test_the_recording_tells_what_the_terminal_told_line_for_line(session) -> None:
+    path, timeline = session
+    printed = [line.split(None, 2)[1:] for line in timeline.splitlines()[1:]]
+    told = [list(line) for e in told_events(Recording.open(path)) if (line := event_line(e))]
+    assert [[who, what] for who, what in printed] == told
+
+
+def test_an_utterance_cut_short_is_told_as_cut_in_the_timeline_the_json_and_the_record(
+    session, tmp_path, capsys
+) -> None:
+    path, timeline = session
+    assert 'dialog         cut short: says "My name is H B S 2" (iot_command interrupted it)' in (
+        timeline
+    )
+    [cut] = [e for e in told_events(Recording.open(path)) if isinstance(e, ActionEnded)]
+    assert (cut.tree, cut.outcome, cut.why) == ("dialog", "cut", "iot_command interrupted it")
+    assert (
+        main(
+            [
+                "run",
+                "--fast",
+                "--speech",
+                "text",
+                "--json",
+                "--scenario",
+                str(tmp_path / "story.yaml"),
+            ]
+        )
+        == 0
+    )
+    lines = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
+    [outcome] = [line for line in lines if line["event"] == "outcome"]
+    assert outcome["outcome"] == "cut" and outcome["args"]["text"] == "My name is H B S 2"
+    assert outcome["started"] < outcome["t"]
+
+
+def test_the_report_lists_the_therapist_s_press_and_a_sentence_not_understood_once(
+    session,
+) -> None:
+    path, _ = session
+    recording = Recording.open(path)
+    moments = person_moments(recording)
+    press = next(m for m in moments if m.who == "the therapist")
+    assert press.did == "pressed the button \u201cHello\u201d"
+    assert press.answer is not None and press.answer.tree == "buttons"
+    moon = next(m for m in moments if "moon" in m.did)
+    assert moon.not_understood == "what is the weather like on the moon"
+    assert moon.answer is not None and moon.answer.args["text"] == "Sorry, I did not understand."
+    assert not_understood(recording) == [(pytest.approx(2.0, abs=0.1), moon.not_understood)]
+    page = report_html(recording)
+    assert "did not understand \u201cwhat is the weather like on the moon\u201d" in page
+    assert "kid-17" in page and "UTC" in page  # whose session, and when
+    assert "no answer" not in page
+
+
+def test_the_live_view_tells_turns_safety_and_presses_in_words() -> None:
+    clock = VirtualClock()
+    stream = SessionStream(clock)
+    hub = ViewHub(clock)
+    stream.subscribe(hub)
+    stream.publish(ButtonPressed(1.0, "Well done", "page"))
+    stream.publish(TurnTaken(1.0, "hug", "yields", "speaker", "buttons", "saying 'Hi'"))
+    stream.publish(
+        SafetyAction(2.0, "stopped", "left_arm", "still_within_mm", ("range_center",), "why")
+    )
+    happened = hub.snapshot()["happened"]
+    assert [(h["who"], h["what"], h["tone"]) for h in happened] == [
+        ("therapist", "presses the button 'Well done'", "therapist"),
+        ("hug", "yields the speaker to buttons: not saying 'Hi'", "turn"),
+        ("safety", "stops left_arm where it is: why", "safety"),
+    ]
+
+
+def test_a_recording_of_the_first_format_still_replays_and_reports(tmp_path) -> None:
+    kept = Path(__file__).parent / "recordings" / "unplug_touch.format1.db"
+    recording = Recording.open(kept)
+    assert recording.format == 1
+    told = [event_line(e) for e in told_events(recording)]
+    assert ("touch_thanks", 'says "Thank you"') in told
+    assert ("vest", "touch is offline") in told
+    assert "Session report" in report_html(recording)
