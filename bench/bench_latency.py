@@ -1,6 +1,6 @@
 """Sensor -> action latency on the simulated vest in real time, and on-request sensor answers.
 
-Run: ``.venv/bin/python bench/bench_latency.py`` (``--events N``, ``--help``); about 75 s.
+Run: ``.venv/bin/python bench/bench_latency.py`` (``--events N``, ``--help``); about 100 s.
 
 The robot is wired as ``vest run`` wires it without ``--fast``: every tree in trees/ on a
 ``RealClock``, the simulated vest of examples/robots/sim.yaml (register-level chips behind
@@ -8,27 +8,33 @@ simulated buses), ``build_hardware`` with one worker thread per bus and one thre
 poller, the hardware hooks (LED timer) and the hot-reload hook, simulated speech with
 realistic durations. The scheduler runs on its own thread.
 
-Three kinds of events, side by side, each from a thread of its own that changes the
-``World`` at random moments (as a person would; a scenario hook would only change it at
-the scheduler's wake-ups, which are the trees' deadlines, and so would always hit the same
-phase):
+Three kinds of events, each changing the ``World`` at random moments from a thread (as
+a person would; a scenario hook would only change it at the scheduler's wake-ups, which
+are the trees' deadlines, and so would always hit the same phase):
 
 - squeeze -> Say: both force pads to 6 N; the ``hug`` tree says its phrase;
-- touch -> Say: one touch pad (a different one each time); ``touch_thanks`` says thanks;
+- pat -> Say: a hand comes onto one touch pad (a different one each time): a pat event;
+  ``touch_thanks`` says thanks;
 - obstacle -> MoveServo: something at 500 mm on the left, then (next event) on the right,
   nothing in between; ``tracking`` turns the neck toward it.
 
+Squeezes and pats take turns on one thread: both answers need the speaker, and one voice
+at a time means a pat during a hug is let go (touch_thanks has the lower priority), which
+would be turn-taking, not latency. Obstacles run beside them (the neck is no one else's).
+
 Latency is measured from the clock time right after the world change was applied (the
-chips hold the new state from then on) to the ``ActionRecord`` of the matching action
-(its ``t``, the clock time of the service call). After each action the world goes back to
-rest, the driver waits until the tree is idle again (not running, every ``Cooldown`` over)
-and the release has had time to be sensed (one poll period + one tree period), then a
-random pause of 0..100 ms, so each event lands at a random phase of polls and ticks.
+chips hold the new state from then on) to the matching action on the session stream (the
+``ActionStarted``'s ``t_s``, the clock time of the service call). After each action the
+world goes back to rest, the driver waits until the tree is idle again (not running,
+every ``Cooldown`` over) and the release has had time to be sensed (one poll period + one
+tree period), then a random pause of 0..100 ms, so each event lands at a random phase of
+polls and ticks.
 
 To fit many events in a bounded run, the trees are loaded with a profile of short rests
 (``hug_rest_s`` and ``thanks_rest_s`` 0.1 s instead of 10 s and 3 s); the trees themselves
 are unchanged. The hug's LEDs stay lit 2 s, so a hug takes about 2.2 s: ``--events N`` is
-the number of hugs, and the faster kinds go on until the hugs are done (they get more).
+the number of hugs and of pats (each after the other), and obstacles go on until they are
+done (they get more).
 
 Target (issue 3): p99 <= one tree period + one poll period, from the tree's ``rate_hz``
 and the device's ``rate_hz`` in sim.yaml. Baseline printed beside it: the latency floor of
@@ -95,8 +101,8 @@ from engine.runtime.robot_factory import build_robot
 from engine.runtime.scheduler import RunningTree
 from engine.runtime.stats import percentile
 from engine.scenario.world import World
-from engine.services.actions import ActionLog, ActionRecord
 from engine.services.simulated import simulated_services
+from engine.session.events import ActionStarted, SessionEvent
 
 ROOT = Path(__file__).resolve().parents[1]
 TREES_DIR = ROOT / "trees"
@@ -129,7 +135,7 @@ class Instruments:
         self.polls: dict[str, list[tuple[float, float]]] = {}
         self.ticks: dict[str, list[float]] = {}
         self.steps: list[float] = []
-        self.actions: dict[str, queue.SimpleQueue[ActionRecord]] = {}
+        self.actions: dict[str, queue.SimpleQueue[ActionStarted]] = {}
 
     def watch_poller(self, poller: Any) -> None:
         spans: list[tuple[float, float]] = []
@@ -156,8 +162,10 @@ class Instruments:
         """The last hook: runs right before the scheduler commits the staged writes."""
         self.steps.append(self.clock.now())
 
-    def action(self, record: ActionRecord) -> None:
-        self.actions.setdefault(record.tree, queue.SimpleQueue()).put(record)
+    def on_event(self, event: SessionEvent) -> None:
+        """A session reader: each action, by tree."""
+        if isinstance(event, ActionStarted):
+            self.actions.setdefault(event.tree, queue.SimpleQueue()).put(event)
 
 
 @dataclass
@@ -219,8 +227,8 @@ def build_rig(profile: Path) -> Rig:
         speech=simulated.speech,
         iot=simulated.iot,
         fallback=simulated,
-        action_log=ActionLog(listeners=[instruments.action]),
     )
+    assembled.robot.session.subscribe(instruments, (ActionStarted.kind,))
     robot, world, hardware = assembled.robot, assembled.world, assembled.hardware
     assert assembled.vest is not None
     vest = assembled.vest
@@ -260,7 +268,7 @@ def _unsqueeze(world: World) -> None:
     world.changed("force")
 
 
-def _touch(world: World, index: int) -> str:
+def _pat(world: World, index: int) -> str:
     world.touched[index % len(world.touched)] = True
     world.changed("touch")
     return "touch"
@@ -286,13 +294,19 @@ def _clear(world: World) -> None:
 
 KINDS = (
     Kind("squeeze -> Say", "hug", "say", _squeeze, _unsqueeze),
-    Kind("touch -> Say", "touch_thanks", "say", _touch, _untouch),
+    Kind("pat -> Say", "touch_thanks", "say", _pat, _untouch),
     Kind("obstacle -> MoveServo", "tracking", "servo", _obstacle, _clear),
 )
 
 
+TAKING_TURNS = ((KINDS[0], KINDS[1]), (KINDS[2],))
+"""The kinds each driver plays, one after the other: squeezes and pats both want the
+speaker, so they take turns; obstacles move the neck beside them."""
+
+
 @dataclass
 class Sample:
+    kind: Kind
     changed_s: float
     device: str
     acted_s: float | None  # None: no action within ACTION_TIMEOUT_S
@@ -300,14 +314,17 @@ class Sample:
 
 @dataclass
 class Driver:
-    """Plays one kind of event again and again, on its own thread."""
+    """Plays its kinds of event one after the other, again and again, on its own thread."""
 
-    kind: Kind
+    kinds: tuple[Kind, ...]
     rig: Rig
     rng: random.Random
     settle_s: float
     samples: list[Sample] = field(default_factory=list)
     error: BaseException | None = None
+
+    def of(self, kind: Kind) -> list[Sample]:
+        return [sample for sample in self.samples if sample.kind is kind]
 
     def run(self, enough: Callable[[Driver], bool], deadline_s: float) -> None:
         try:
@@ -317,33 +334,34 @@ class Driver:
 
     def _run(self, enough: Callable[[Driver], bool], deadline_s: float) -> None:
         clock, world = self.rig.clock, self.rig.world
-        tree = self.rig.robot.scheduler.tree(self.kind.tree)
-        actions = self.rig.instruments.actions.setdefault(self.kind.tree, queue.SimpleQueue())
         index = 0
         while not enough(self) and clock.now() < deadline_s:
+            kind = self.kinds[index % len(self.kinds)]
+            tree = self.rig.robot.scheduler.tree(kind.tree)
+            actions = self.rig.instruments.actions.setdefault(kind.tree, queue.SimpleQueue())
             clock.sleep(self.rng.uniform(0.0, JITTER_S))
             while not actions.empty():  # anything said or done before this event
                 actions.get_nowait()
-            device = self.kind.press(world, index)
+            device = kind.press(world, index // len(self.kinds))
             changed_s = clock.now()
-            acted_s = self._wait_action(actions, changed_s + ACTION_TIMEOUT_S)
-            self.kind.release(world)
+            acted_s = self._wait_action(kind, actions, changed_s + ACTION_TIMEOUT_S)
+            kind.release(world)
             released_s = clock.now()
-            self.samples.append(Sample(changed_s, device, acted_s))
+            self.samples.append(Sample(kind, changed_s, device, acted_s))
             self._wait_idle(tree, released_s + self.settle_s)
             index += 1
 
     def _wait_action(
-        self, actions: queue.SimpleQueue[ActionRecord], until_s: float
+        self, kind: Kind, actions: queue.SimpleQueue[ActionStarted], until_s: float
     ) -> float | None:
         clock = self.rig.clock
         while (left_s := until_s - clock.now()) > 0:
             try:
-                record = actions.get(timeout=left_s)
+                started = actions.get(timeout=left_s)
             except queue.Empty:
                 return None
-            if record.action == self.kind.action:
-                return record.t
+            if started.action == kind.action:
+                return started.t_s
         return None
 
     def _wait_idle(self, tree: RunningTree, not_before_s: float) -> None:
@@ -439,7 +457,8 @@ def report_events(
     )
     print(
         f"sensor -> action latency on the simulated vest, real time (RealClock, threaded "
-        f"pollers; {phasing}): {len(drivers)} kinds side by side for {elapsed_s:.0f} s; "
+        f"pollers; {phasing}): {len(KINDS)} kinds, squeezes and pats taking turns, obstacles "
+        f"beside them, for {elapsed_s:.0f} s; "
         f"Python {platform.python_version()}, {os.cpu_count()} CPUs"
     )
     print(
@@ -448,16 +467,16 @@ def report_events(
     )
     all_ok = True
     splits: dict[str, tuple[list[Split], float]] = {}
-    for driver in drivers:
-        kind = driver.kind
+    for driver, kind in ((d, k) for d in drivers for k in d.kinds):
+        samples = driver.of(kind)
         tree = rig.robot.scheduler.tree(kind.tree)
-        devices = sorted({sample.device for sample in driver.samples})
+        devices = sorted({sample.device for sample in samples})
         poll_period_s = max(1.0 / float(config.device(name).rate_hz or 1.0) for name in devices)
         tree_period_s = tree.period_s
         target_s = tree_period_s + poll_period_s
         floor_s = poll_period_s / 2 + tree_period_s / 2
-        latencies = [s.acted_s - s.changed_s for s in driver.samples if s.acted_s is not None]
-        missed = len(driver.samples) - len(latencies)
+        latencies = [s.acted_s - s.changed_s for s in samples if s.acted_s is not None]
+        missed = len(samples) - len(latencies)
         p99 = percentile(latencies, 0.99)
         ok = bool(latencies) and missed == 0 and p99 <= target_s
         all_ok = all_ok and ok
@@ -473,7 +492,7 @@ def report_events(
         splits[kind.label] = (
             [
                 cut
-                for sample in driver.samples
+                for sample in samples
                 if sample.acted_s is not None
                 and (cut := split(sample, kind.tree, instruments)) is not None
             ],
@@ -563,7 +582,7 @@ def main(argv: list[str] | None = None) -> int:
         "--events",
         type=int,
         default=30,
-        help="hugs (the slowest kind, ~2.2 s each); the other kinds run meanwhile (default 30)",
+        help="hugs (~2.2 s each) and pats, taking turns; obstacles run meanwhile (default 30)",
     )
     parser.add_argument(
         "--reads", type=int, default=50, help="temperature and ultrasound reads each (default 50)"
@@ -594,26 +613,26 @@ def main(argv: list[str] | None = None) -> int:
         slowest_poll_s = max(poller.period_s for poller in rig.hardware.pollers)
         drivers = [
             Driver(
-                kind,
+                kinds,
                 rig,
                 random.Random(rng.random()),
                 settle_s=slowest_poll_s
-                + rig.robot.scheduler.tree(kind.tree).period_s
+                + max(rig.robot.scheduler.tree(kind.tree).period_s for kind in kinds)
                 + SETTLE_MARGIN_S,
             )
-            for kind in KINDS
+            for kinds in TAKING_TURNS
         ]
 
         def enough(_: Driver) -> bool:
-            return all(len(driver.samples) >= args.events for driver in drivers)
+            return all(len(d.of(k)) >= args.events for d in drivers for k in d.kinds)
 
         started = clock.now()
-        deadline_s = started + 5.0 + args.events * 4.0
+        deadline_s = started + 5.0 + args.events * 6.0
         threads = [
             threading.Thread(
                 target=driver.run,
                 args=(enough, deadline_s),
-                name=f"driver-{driver.kind.tree}",
+                name=f"driver-{driver.kinds[0].tree}",
                 daemon=True,
             )
             for driver in drivers

@@ -263,7 +263,7 @@ def main(args: argparse.Namespace) -> int:
         start_s = clock.now()  # after start-up, which takes simulated time too
         timeline = Timeline(sys.stdout, start_s=start_s, as_json=args.json)
         warnings = turn_warnings(behaviors.trees) + spoken_quote_warnings(behaviors.trees)
-        if inputs.buttons is not None:
+        if inputs.buttons is not None and args.buttons is not None:  # the default: no noise
             warnings += button_warnings(inputs.buttons, [t.name for t in behaviors.trees])
         for warning in warnings:
             tell(warning)
