@@ -79,11 +79,29 @@ def test_with_every_chest_range_sensor_unplugged_a_tree_never_lifts_an_arm(
     assert all(m["args"]["joint"] != "left_arm" or m["args"].get("rest") for m in moved[1:])
 
 
-def test_one_range_sensor_unplugged_is_enough_to_hold_the_arms(tmp_path, capsys, monkeypatch):
+@pytest.mark.parametrize(
+    ("fault", "device", "rule"),
+    [
+        ("unplug: {device: range_left, seconds: 4}", "range_left", "still_within_mm"),
+        ("unplug: {device: range_center, seconds: 4}", "range_center", "still_within_mm"),
+        ("unplug: {device: range_right, seconds: 4}", "range_right", "still_within_mm"),
+        ("unplug: {device: force, seconds: 4}", "force", "stop_above_n"),
+        (
+            "fault: {device: range_center, kind: nack, seconds: 4}",
+            "range_center",
+            "still_within_mm",
+        ),
+        ("fault: {device: force, kind: garbage, seconds: 4}", "force", "stop_above_n"),
+    ],
+)
+def test_any_one_guarding_sensor_failing_is_enough_to_hold_the_arms(
+    tmp_path, capsys, monkeypatch, fault, device, rule
+):
     monkeypatch.chdir(ROOT)
-    lines = run(tmp_path, capsys, *unplugged("range_right"), "{at: 2.0, gesture: wave}")
+    lines = run(tmp_path, capsys, f"{{at: 1.0, {fault}}}", "{at: 2.0, gesture: wave}")
     [refused] = refusals(lines)
-    assert refused["devices"] == ["range_right"]
+    assert (refused["rule"], refused["devices"]) == (rule, [device])
+    assert "counts the worst case" in refused["why"]
 
 
 def test_an_operator_s_arm_move_is_refused_while_the_force_pads_are_unplugged(
@@ -214,11 +232,7 @@ def test_a_robot_that_may_move_slowly_when_unsure_moves_at_its_slow_speed(
 ):
     monkeypatch.chdir(ROOT)
     config = tmp_path / "slow.yaml"
-    config.write_text(
-        SIM.read_text().replace(
-            "  slow_speed_dps: 30\n", "  slow_speed_dps: 30\n  when_unsure: slow\n"
-        )
-    )
+    config.write_text(SIM.read_text().replace("when_unsure: refuse", "when_unsure: slow"))
     lines = run(
         tmp_path,
         capsys,
