@@ -35,6 +35,9 @@ a robotic voice in noise ("do you like *puppy*", 0.001), which the second decodi
 keeps. A wrong answer becomes "I did not understand"; a right one stays."""
 
 
+WORD_AT_LEAST_S = 0.05
+"""A word takes at least this long to say; a sentence after the first whose words take less
+(Whisper squeezes made-up words into the audio's last frames) is not speech."""
 SEGMENT_BELOW = 0.3
 """A segment after the first whose words average less probability than this is dropped:
 Whisper invents a closing line after short clips ("...then we'll see you next time",
@@ -210,9 +213,13 @@ class WhisperRecognizer:
             said = [Word(w.word.strip(), float(w.probability)) for w in segment.words or ()]
             if not said:
                 continue
+            timed = segment.words or ()
+            span_s = float(timed[-1].end - timed[0].start) if timed else 0.0
             if index > 0 and (  # "and then we'll see you in the next video": made up
                 sum(w.probability for w in said) / len(said) < SEGMENT_BELOW
                 or segment.no_speech_prob > NO_SPEECH_AFTER
+                # words that take no time were never said: six words in 40 ms at the end
+                or span_s < WORD_AT_LEAST_S * len(said)
             ):
                 continue
             words += said
