@@ -35,6 +35,19 @@ def test_each_thing_the_person_did_is_paired_with_the_robot_s_answer(
     assert all(m.response_s is not None and m.response_s >= 0 for m in before_the_game)
 
 
+def test_the_demo_s_report_lists_the_therapist_s_press_as_what_the_therapist_did(
+    tmp_path: Path, capsys, monkeypatch
+) -> None:
+    path = record(tmp_path, "examples/scenarios/demo.yaml", capsys, monkeypatch)
+    moments = person_moments(Recording.open(path))
+    [press] = [m for m in moments if m.who == "the therapist"]
+    assert (round(press.at_s, 1), press.did) == (7.0, "pressed the button \u201cWell done\u201d")
+    assert press.answer is not None and press.answer.tree == "buttons"
+    assert main(["report", str(path)]) == 0
+    page = path.with_suffix(".html").read_text()
+    assert "<td>the therapist</td><td>pressed the button \u201cWell done\u201d</td>" in page
+
+
 def test_a_device_that_dropped_out_is_listed_with_how_long(
     tmp_path: Path, capsys, monkeypatch
 ) -> None:

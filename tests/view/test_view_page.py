@@ -102,12 +102,19 @@ def test_the_replay_slider_shows_the_robot_at_a_moment(page: Page, replay: str) 
     expect(page.locator("#actions")).to_contain_text("I love hugs!")
 
     page.locator("#next-action").click()  # the next thing the robot did: the wave's greeting
-    expect(page.locator("#actions li:not(.world)").first).to_contain_text("wave_greeting")
+    expect(page.locator("#actions li:not(.tone-world)").first).to_contain_text("wave_greeting")
 
     page.locator("#back").click()
     page.locator("#back").click()
     clock = float(page.locator("#clock").inner_text().split()[0])
     assert clock < 6.0
+
+    # what happened reads as the terminal's timeline: sentences, each saying what it is
+    page.locator("#slider").evaluate(
+        "(slider) => { slider.value = '7.5'; slider.dispatchEvent(new Event('input')); }"
+    )
+    press = page.locator("#actions li[data-tone=therapist]").first
+    expect(press).to_contain_text("therapist: presses the button 'Well done'")
 
 
 def test_a_view_on_another_address_needs_its_token(page: Page) -> None:
