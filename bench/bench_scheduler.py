@@ -47,7 +47,6 @@ from engine.runtime.stats import TickStats, percentile
 from engine.scenario.player import ScenarioPlayer
 from engine.scenario.scenario_file import load_scenario
 from engine.scenario.world import BlackboardSenses, World
-from engine.services.actions import ActionLog
 from engine.services.simulated import simulated_services
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -87,7 +86,6 @@ class EngineRun:
         senses = BlackboardSenses(blackboard, self.world)
         self.world.listeners.append(senses)
         senses.start()
-        self.log = ActionLog()
         services = simulated_services(self.clock, readers=senses.readers(), realistic=True)
         self.node_errors: list[str] = []
         self.robot = Robot(
@@ -95,9 +93,9 @@ class EngineRun:
             clock=self.clock,
             services=services,
             blackboard=blackboard,
-            action_log=self.log,
             on_node_error=lambda tree, path, error: self.node_errors.append(path),
         )
+        self.log = self.robot.action_log
         self.rows = [Row(tree.name, tree.definition.rate_hz) for tree in self.robot.trees]
         for tree, row in zip(self.robot.trees, self.rows, strict=True):
             tree.tree.add_pre_tick_handler(_start_recorder(tree, row, self.clock))
