@@ -8,6 +8,8 @@ from engine.clock import VirtualClock
 from engine.runtime.reload import TreeReloader
 from engine.runtime.robot import Robot, load_behaviors
 from engine.services.simulated import simulated_services
+from engine.session.events import TreeReloaded
+from engine.session.stream import EventCollector
 
 GREETER = """\
     name: greeter
@@ -152,3 +154,19 @@ def test_creating_the_subtree_a_refused_edit_named_reloads_the_tree(tmp_path):
     robot.scheduler.run(until_s=3.5)
     assert reports[-1] == ("greeter", None)
     assert said(robot)[-1] == "Brand new"
+
+
+def test_each_reload_and_each_refused_edit_is_told_on_the_session_stream(tmp_path):
+    robot, tree_file, _ = start(tmp_path)
+    heard = EventCollector()
+    robot.session.subscribe(heard, ("reload",))
+    reloader = TreeReloader(robot.behaviors.loader, robot.trees, robot.clock, session=robot.session)
+    robot.scheduler.hooks.append(reloader)
+    robot.scheduler.run(until_s=0.05, halt_at_end=False)
+    edit(tree_file, GREETER.replace("PHRASE", "Good morning"), 1)
+    robot.scheduler.run(until_s=1.05, halt_at_end=False)
+    edit(tree_file, GREETER.replace("Check:", "Chek:"), 2)
+    robot.scheduler.run(until_s=2.05, halt_at_end=False)
+    reloads = heard.of(TreeReloaded)
+    assert [(r.tree, r.problem == "") for r in reloads] == [("greeter", True), ("greeter", False)]
+    assert "unknown node type 'Chek'" in reloads[1].problem
