@@ -12,6 +12,7 @@ import argparse
 import math
 from pathlib import Path
 
+from engine.buttons.button_file import BUTTONS_TREE
 from engine.cli.view_options import add_view_arguments, start_view
 from engine.clock import RealClock
 from engine.errors import UsageError
@@ -64,7 +65,8 @@ def main(args: argparse.Namespace) -> int:
             print(f"{args.recording}: a session of {duration:.2f} s (format {recording.format})")
             for tree in trees:
                 versions = [t for t in recording.trees if t.name == tree.name]
-                reloads = f", reloaded {len(versions) - 1}x" if len(versions) > 1 else ""
+                changed = "button actions" if tree.name == BUTTONS_TREE else "reloaded"
+                reloads = f", {changed} {len(versions) - 1}x" if len(versions) > 1 else ""
                 nodes = f"{len(tree.nodes)} node{'' if len(tree.nodes) == 1 else 's'}"
                 print(f"  {tree.name}: {nodes} at {tree.rate_hz:g} Hz{reloads}")
             print(f"  {len(recording.actions())} actions; vest replay {args.recording} --at S")

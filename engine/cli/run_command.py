@@ -8,8 +8,10 @@ Speech goes through the real models: a scenario's hear: is spoken into the simul
 room, heard by Silero VAD and Whisper, and the answers are synthesized (--audio-out DIR
 keeps a WAV per utterance, replacing those of an earlier run); --speech text skips the
 models, hands the trees the text and gives each spoken word 0.3 s.
---fast runs on a virtual clock as fast as the machine allows; --json prints one JSON
-object per robot action: {"t": seconds, "tree": name, "action": ..., "args": {...}}.
+--fast runs on a virtual clock as fast as the machine allows; --json prints the session
+as JSON lines, one object per event the timeline tells: {"t": seconds, "event": "action",
+"tree": name, "action": ..., "args": {...}}, and how actions ended, turns, safety, presses,
+what was heard (docs/view-and-recordings.md lists them).
 In real time, a changed tree file is reloaded between ticks (an invalid change keeps the
 running tree); Ctrl-C or SIGTERM stops cleanly at any moment, start-up included. The
 timeline never stops the robot: if it cannot be written (a full disk), that is said once
@@ -94,7 +96,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--fast", action="store_true", help="virtual clock: run as fast as the machine allows"
     )
-    parser.add_argument("--json", action="store_true", help="one JSON object per action")
+    parser.add_argument(
+        "--json",
+        action="store_true",
+        help="the session as JSON lines: one object per event (action, outcome, turn, "
+        "safety, press, heard...)",
+    )
     parser.add_argument(
         "--speech",
         choices=("models", "text"),
@@ -223,6 +230,8 @@ def main(args: argparse.Namespace) -> int:
     behaviors, config, scenario = inputs.behaviors, inputs.config, inputs.scenario
     if args.fast and not config.simulated:
         raise ConfigError(f"{args.hardware}: --fast needs a simulated vest (simulated: true)")
+    if args.person is not None and args.record is None:
+        raise UsageError("--person names whose session is recorded: add --record FILE")
     link = _cloud_link(args)
     clock: Clock = VirtualClock() if args.fast else RealClock()
     if link is not None:

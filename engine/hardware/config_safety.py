@@ -100,18 +100,21 @@ def _rules_have_sensors(
     could never be trusted: every arm move would be refused. Each such rule is a problem."""
     ranges = [d for d in devices.values() if d.role == "range" and "range" in d.keys]
     forces = [pad for d in devices.values() if d.role == "force" for pad in d.pads]
+    range_sensor = "a range sensor (vl53l0x)"
     needs = {
-        "still_within_mm": ("a range sensor (vl53l0x)", ranges),
-        "slow_within_mm": ("a range sensor (vl53l0x)", ranges),
-        "stop_above_n": ("a force pad (ads1115 or mcp3008 with pads)", forces),
+        "still_within_mm": (range_sensor, ranges, "refused"),
+        "slow_within_mm": (range_sensor, ranges, "slow"),
+        "stop_above_n": ("a force pad (ads1115 or mcp3008 with pads)", forces, "refused"),
     }
+    if values.get("when_unsure") == "slow":
+        needs = {rule: (sensor, present, "slow") for rule, (sensor, present, _) in needs.items()}
     fine = True
-    for rule, (sensor, present) in needs.items():
+    for rule, (sensor, present, outcome) in needs.items():
         if values.get(rule) is not None and not present:
             checker.problems.add(
                 (section.get(rule) or section).mark,
                 f"safety rule {rule} reads {sensor}, and this robot has none: every arm "
-                "move would be refused",
+                f"move would be {outcome}",
                 f"add the sensor under devices:, or remove {rule}",
             )
             fine = False

@@ -105,13 +105,10 @@ class SafetyEnvelope:
         doubtful = [r for r in readings if r.doubt is not None]
         if not doubtful:
             return None
-        what = "; ".join(dict.fromkeys(str(r.doubt) for r in doubtful))  # a chip's pads: once
-        return Verdict(
-            rule,
-            tuple(dict.fromkeys(r.guard.device for r in doubtful)),
-            f"{what}: it cannot be trusted, so {rule} counts the worst case",
-            unsure=True,
-        )
+        doubts = list(dict.fromkeys(str(r.doubt) for r in doubtful))  # a chip's pads: once
+        devices = tuple(dict.fromkeys(r.guard.device for r in doubtful))
+        they = "they cannot" if len(devices) > 1 else "it cannot"
+        return Verdict(rule, devices, f"{'; '.join(doubts)}: {they} be trusted ({rule})", True)
 
     def _force_rule(self) -> Verdict | None:
         limit = self.config.stop_above_n
@@ -301,7 +298,8 @@ class EnvelopedServos:
         speed, slowed = self.envelope.speed_dps(joint, speed_dps)
         started = self.inner.move(joint, angle_deg, speed_dps=speed)
         if slowed is not None:
-            self.envelope.tell("slowed", joint, slowed)
+            moves = f"{slowed.why}: the arm moves at {speed:g} deg/s"
+            self.envelope.tell("slowed", joint, dataclasses.replace(slowed, why=moves))
         move = StoppableMove(started, lambda: self.inner.stop(joint), speed)
         self.moving[joint] = move
         return move

@@ -4,7 +4,8 @@ Who, when and with which profile; what the person did (touched, hugged, waved, s
 showed fingers), what the therapist did (the buttons pressed) and how the robot answered,
 with how long it took, one line each (a sentence it did not understand is answered as
 such; a time it could not listen because it was speaking is a line of its own); how often
-each behaviour acted; what the robot did not understand; devices that dropped out; and the
+each behaviour acted; what the robot did not understand; what the safety envelope refused,
+slowed or stopped, with its rule and the sensors it read; devices that dropped out; and the
 sensors over the session, drawn as inline SVG. Everything comes from the recording's
 account of the session (:mod:`engine.recording.told`), its blackboard and actions, so a
 session on the robot reads the same as one on the simulated vest. Printable on A4.
@@ -16,183 +17,21 @@ import datetime
 import html
 import json
 from collections import Counter
-from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
 
 from engine.blackboard.catalogue import (
     FORCE_LEFT_N,
     FORCE_RIGHT_N,
-    GESTURE_LAST,
-    HAND_SHOWN,
-    IOT_INBOX,
     RANGE_CENTER_MM,
-    SPEECH_HEARD,
     TOUCH_ANY,
 )
-from engine.buttons.button_file import BUTTONS_TREE
+from engine.recording.moments import Moment, not_understood, person_moments
 from engine.recording.replay import RecordedAction, Recording
 from engine.recording.report_plots import numbers, plot
 from engine.recording.told import told_events
-from engine.session.events import ButtonPressed, NotListened, NotUnderstood
-
-ANSWER_WITHIN_S = 10.0
-"""An action this soon after what the person did counts as the robot's answer."""
-PRESSED_N = 1.0
-"""Force on a side pad above which the person is pressing it."""
-
-
-@dataclass(frozen=True)
-class Moment:
-    """Something someone did (``who``: the person, the therapist, the operator), and the
-    robot's answer: the actions of the first tree that acted after it and before the next
-    thing anyone did (none: no answer). ``not_understood`` is what the robot heard and
-    had no rule for; ``not_listened`` says the robot could not listen (it was speaking)."""
-
-    at_s: float
-    did: str
-    answers: tuple[RecordedAction, ...]
-    who: str = "the person"
-    not_understood: str | None = None
-    not_listened: bool = False
-
-    @property
-    def answer(self) -> RecordedAction | None:
-        return self.answers[0] if self.answers else None
-
-    @property
-    def response_s(self) -> float | None:
-        return None if self.answer is None else self.answer.at_s - self.at_s
-
-
-def _rows(recording: Recording, key: str) -> list[tuple[float, Any]]:
-    return recording.key_history(key)
-
-
-PERSON_EVENTS = ("touch", "squeeze", "gesture", "hear", "show_hand", "obstacle")
-"""Scenario events that are the person doing something (not a device failing)."""
-
-
-def person_moments(recording: Recording) -> list[Moment]:
-    """What the person, the therapist and the operator did, in order, each with the
-    robot's first answer: a simulated session's scenario events (so an answer's time
-    counts from the act itself), else what the sensors and the recognizer saw; the
-    therapist's presses; each time the robot could not listen."""
-    told = told_events(recording)
-    done: list[tuple[float, str, str, str]] = [
-        (at, "the person", description, kind)
-        for at, kind, description in recording.world()
-        if kind in PERSON_EVENTS
-    ]
-    done += [
-        (at, "the operator", description.removeprefix("operator "), kind)
-        for at, kind, description in recording.world()
-        if kind == "cloud"
-    ]
-    if not done:
-        done = sensed(recording)
-    done += [
-        (event.t_s, "the therapist", f"pressed the button \u201c{event.label}\u201d", "press")
-        for event in told
-        if isinstance(event, ButtonPressed)
-    ]
-    done += [
-        (event.from_s, "the person", "spoke while the robot was speaking", "not_listened")
-        for event in told
-        if isinstance(event, NotListened)
-    ]
-    misunderstood = [event for event in told if isinstance(event, NotUnderstood)]
-    actions = recording.actions()
-    reporting = {a.tree for a in actions if a.action == "report"}
-    ordered = sorted(done, key=lambda item: item[0])
-    moments = []
-    for index, (at, who, did, kind) in enumerate(ordered):
-        if kind == "not_listened":  # a line of its own: nothing to answer
-            moments.append(Moment(at, did, (), who, not_listened=True))
-            continue
-        later = [  # the next thing the same one did ends the wait for an answer
-            t for t, w, _, k in ordered[index + 1 :] if t > at and w == who and k != "not_listened"
-        ]
-        until = min([at + ANSWER_WITHIN_S, *later])
-        window = [a for a in actions if at <= a.at_s < until and _answers(who, a, reporting)]
-        tree = window[0].tree if window else None
-        answers = tuple(a for a in window if a.tree == tree)[:3]
-        heard = next(
-            (e.text for e in misunderstood if at <= e.t_s < until and kind == "hear"), None
-        )
-        moments.append(Moment(at, did, answers, who, heard))
-    return moments
-
-
-def _answers(who: str, action: RecordedAction, reporting: set[str]) -> bool:
-    """Whether ``action`` can be the answer to something ``who`` did: a press is answered
-    by the buttons, an operator's command by the trees that report commands
-    (``reporting``), the person by the other trees."""
-    if who == "the therapist":
-        return action.tree == BUTTONS_TREE
-    if who == "the operator":
-        return action.tree in reporting
-    return action.tree != BUTTONS_TREE and action.tree not in reporting
-
-
-def sensed(recording: Recording) -> list[tuple[float, str, str, str]]:
-    """What the person (and the operator) did as the robot sensed it (on a robot in a real
-    room): (moment, who, what, the kind of scenario event it would be)."""
-    done: list[tuple[float, str, str]] = []
-    was_touched = False
-    for at, touched in _rows(recording, TOUCH_ANY):
-        if touched and not was_touched:
-            done.append((at, "touched the vest", "touch"))
-        was_touched = bool(touched)
-    left = dict(_rows(recording, FORCE_LEFT_N))
-    right = dict(_rows(recording, FORCE_RIGHT_N))
-    pressing = False
-    level = {"left": 0.0, "right": 0.0}
-    for at in sorted(set(left) | set(right)):
-        level["left"] = float(left.get(at, level["left"]) or 0.0)
-        level["right"] = float(right.get(at, level["right"]) or 0.0)
-        now = level["left"] > PRESSED_N or level["right"] > PRESSED_N
-        if now and not pressing:
-            both = level["left"] > PRESSED_N and level["right"] > PRESSED_N
-            what = "hugged the robot" if both else "pressed a side"
-            done.append(
-                (
-                    at,
-                    f"{what} ({level['left']:.1f} N left, {level['right']:.1f} N right)",
-                    "squeeze",
-                )
-            )
-        pressing = now
-    for at, gesture in _rows(recording, GESTURE_LAST):
-        done.append((at, f"made a gesture: {gesture}", "gesture"))
-    for at, text in _rows(recording, SPEECH_HEARD):
-        done.append((at, f"said \u201c{text}\u201d", "hear"))
-    for at, fingers in _rows(recording, HAND_SHOWN):
-        done.append((at, f"showed {fingers} finger{'' if fingers == 1 else 's'}", "show_hand"))
-    found = [(at, "the person", what, kind) for at, what, kind in done]
-    for at, command in _rows(recording, IOT_INBOX):
-        kind = command.get("type", "?") if isinstance(command, dict) else command
-        found.append((at, "the operator", f"sent {kind}", "cloud"))
-    return found
-
-
-def not_understood(recording: Recording) -> list[tuple[float, str]]:
-    """(moment, what the robot heard) for each utterance no dialog rule matched, once
-    each (a format 1 recording: read from the dialog node's feedback)."""
-    if recording.format >= 2:
-        return [
-            (event.t_s, event.text)
-            for event in told_events(recording)
-            if isinstance(event, NotUnderstood)
-        ]
-    found: list[tuple[float, str]] = []
-    last: tuple[float, str] | None = None
-    for at, feedback in recording.feedback_containing("no rule matches "):
-        if last is not None and last[1] == feedback and at - last[0] <= ANSWER_WITHIN_S:
-            continue  # the same node's next status (RUNNING, then done) says it again
-        last = (at, feedback)
-        found.append((at, feedback.split("no rule matches ", 1)[1].split(": ", 1)[0]))
-    return found
+from engine.session.events import (
+    SafetyAction,
+)
 
 
 def outages(recording: Recording) -> list[tuple[str, float, float | None]]:
@@ -201,7 +40,7 @@ def outages(recording: Recording) -> list[tuple[str, float, float | None]]:
     for key in recording.keys_like("/devices/%/ok"):
         device = key.removeprefix("/devices/").removesuffix("/ok")
         since: float | None = None
-        for at, ok in _rows(recording, key):
+        for at, ok in recording.key_history(key):
             if ok is False and since is None:
                 since = at
             elif ok is True and since is not None:
@@ -219,22 +58,32 @@ def _lasted(since: float, back: float | None) -> str:
 
 
 def _answer_text(action: RecordedAction) -> str:
+    """An action as the robot's answer: what it did, or tried and could not do, or began
+    and did not finish."""
+    if action.outcome == "failed":
+        return f"could not {_action_text(action, tried=True)} ({action.why})"
     cut = " (cut short)" if action.cut else ""
     return _action_text(action) + cut
 
 
-def _action_text(action: RecordedAction) -> str:
+def _action_text(action: RecordedAction, *, tried: bool = False) -> str:
+    """What an action did (``tried``: what it would have done), in words."""
     args = action.args
+    verbs = (
+        ("say", "light its face", "turn its", "read its")
+        if tried
+        else ("said", "lit its face", "turned its", "read its")
+    )
     if action.action == "say":
-        return f"said \u201c{args.get('text', '')}\u201d"
+        return f"{verbs[0]} \u201c{args.get('text', '')}\u201d"
+    if action.action == "led" and args.get("color") == "off":
+        return "turn its face lights off" if tried else "turned its face lights off"
     if action.action == "led":
-        return f"lit its face {args.get('color', '')}"
+        return f"{verbs[1]} {args.get('color', '')}"
     if action.action == "servo":
-        return f"turned its {args.get('joint', '')} to {args.get('angle_deg', ''):g} deg"
+        return f"{verbs[2]} {args.get('joint', '')} to {args.get('angle_deg', ''):g} deg"
     if action.action == "read":
-        return f"read its {args.get('sensor', '')} sensor"
-    if action.action == "report":
-        return f"told the operator the command {args.get('status', '')}"
+        return f"{verbs[3]} {args.get('sensor', '')} sensor"
     return f"{action.action} {json.dumps(args)}"
 
 
@@ -243,7 +92,8 @@ def _answer_cell(moment: Moment) -> tuple[str, str]:
     if moment.not_listened:
         return '<span class="none">could not listen: it was speaking</span>', "-"
     if moment.answer is None and moment.not_understood is None:
-        return '<span class="none">no answer</span>', "-"
+        why = f": {moment.gave_way}" if moment.gave_way else ""
+        return f'<span class="none">no answer{html.escape(why)}</span>', "-"
     parts = []
     if moment.not_understood is not None:
         parts.append(f"did not understand \u201c{moment.not_understood}\u201d")
@@ -252,6 +102,22 @@ def _answer_cell(moment: Moment) -> tuple[str, str]:
         parts.append(f"{moment.answer.tree}: {done}")
     took = f"{moment.response_s:.2f} s" if moment.response_s is not None else "-"
     return html.escape("; ".join(parts)), took
+
+
+SAFETY_DID = {"refused": "refused a move", "slowed": "slowed a move", "stopped": "stopped a move"}
+
+
+def _safety_rows(recording: Recording) -> str:
+    """Each move the envelope refused, slowed or stopped, as table rows (HTML)."""
+    return "".join(
+        f"<tr><td class='num'>{event.t_s:.1f} s</td>"
+        f"<td>{html.escape(SAFETY_DID.get(event.action, event.action))}</td>"
+        f"<td>{html.escape(event.joint)}</td><td>{html.escape(event.rule)}</td>"
+        f"<td>{html.escape(', '.join(event.devices) or '-')}</td>"
+        f"<td>{html.escape(event.why)}</td></tr>"
+        for event in told_events(recording)
+        if isinstance(event, SafetyAction)
+    )
 
 
 def _started(epoch: str | None) -> str:
@@ -317,26 +183,26 @@ def report_html(recording: Recording) -> str:
             "Squeeze on the side pads",
             "N",
             [
-                ("left", "#c62828", numbers(_rows(recording, FORCE_LEFT_N))),
-                ("right", "#1565c0", numbers(_rows(recording, FORCE_RIGHT_N))),
+                ("left", "#c62828", numbers(recording.key_history(FORCE_LEFT_N))),
+                ("right", "#1565c0", numbers(recording.key_history(FORCE_RIGHT_N))),
             ],
             end,
         ),
         plot(
             "Touched",
             "yes = 1",
-            [("any pad", "#2e7d32", numbers(_rows(recording, TOUCH_ANY)))],
+            [("any pad", "#2e7d32", numbers(recording.key_history(TOUCH_ANY)))],
             end,
         ),
         plot(
             "Someone in front",
             "cm",
-            [("center distance", "#6a1b9a", numbers(_rows(recording, RANGE_CENTER_MM), 0.1))],
+            [("center distance", "#6a1b9a", numbers(recording.key_history(RANGE_CENTER_MM), 0.1))],
             end,
         ),
     ]
     meta = recording.meta
-    profile = meta.get("profile") or "no profile"
+    profile = f"profile {meta['profile']}" if meta.get("profile") else "no profile"
     recorded = html.escape(recording.path.name)
     robot = html.escape(meta.get("robot_config", "?"))
     person = html.escape(meta.get("person") or "no person named")
@@ -348,7 +214,7 @@ def report_html(recording: Recording) -> str:
             f"<style>{STYLE(encoding='utf-8')}</style></head><body>",
             "<h1>Session report</h1>",
             f'<p class="meta">{when} &middot; {person} &middot; {end:.1f} s &middot; '
-            f"profile {html.escape(profile)} &middot; robot {robot} &middot; {recorded}</p>",
+            f"{html.escape(profile)} &middot; robot {robot} &middot; {recorded}</p>",
             f"<p>{html.escape(summary)}</p>",
             "<h2>What the person did, and how the robot answered</h2>",
             _table(
@@ -361,6 +227,13 @@ def report_html(recording: Recording) -> str:
             _table(["behaviour", "actions"], behaviours, "none acted", numeric={1}),
             "<h2>What the robot did not understand</h2>",
             _table(["when", "heard"], missed, "everything it heard matched a rule", numeric={0}),
+            "<h2>What the safety envelope did</h2>",
+            _table(
+                ["when", "did", "joint", "rule", "sensors", "why"],
+                _safety_rows(recording),
+                "nothing: no move was refused, slowed or stopped",
+                numeric={0},
+            ),
             "<h2>Devices that dropped out</h2>",
             _table(["device", "offline at", "back at", "for"], dropped, "none", numeric={1, 2, 3}),
             "<h2>The sensors over the session</h2>",

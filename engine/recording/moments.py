@@ -1,0 +1,209 @@
+"""What was done in a recorded session, and how the robot answered each: the report's rows.
+
+Each thing someone did (the person, on the simulated vest the scenario's events, on a
+robot what its sensors and recognizer saw; the therapist's presses; an operator's
+commands) is paired with the robot's answer: the actions of the first tree that acted on
+it after it and before the same one did something else. Each time the person spoke while
+the robot was speaking, and so was not listened to, is a row of its own.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from engine.blackboard.catalogue import (
+    FORCE_LEFT_N,
+    FORCE_RIGHT_N,
+    GESTURE_LAST,
+    HAND_SHOWN,
+    IOT_INBOX,
+    SPEECH_HEARD,
+    TOUCH_ANY,
+)
+from engine.buttons.button_file import BUTTONS_TREE
+from engine.recording.replay import RecordedAction, Recording
+from engine.recording.told import told_events
+from engine.session.events import ButtonPressed, NotListened, NotUnderstood, TurnTaken
+
+ANSWER_WITHIN_S = 10.0
+"""An action this soon after what the person did counts as the robot's answer."""
+PRESSED_N = 1.0
+"""Force on a side pad above which the person is pressing it."""
+
+
+@dataclass(frozen=True)
+class Moment:
+    """Something someone did (``who``: the person, the therapist, the operator), and the
+    robot's answer: the actions of the first tree that acted after it and before the next
+    thing anyone did (none: no answer). ``not_understood`` is what the robot heard and
+    had no rule for; ``not_listened`` says the robot could not listen (it was speaking)."""
+
+    at_s: float
+    did: str
+    answers: tuple[RecordedAction, ...]
+    who: str = "the person"
+    not_understood: str | None = None
+    not_listened: bool = False
+    gave_way: str | None = None
+    """Why nothing answered: a behaviour gave way to another (one voice at a time)."""
+
+    @property
+    def answer(self) -> RecordedAction | None:
+        return self.answers[0] if self.answers else None
+
+    @property
+    def response_s(self) -> float | None:
+        return None if self.answer is None else self.answer.at_s - self.at_s
+
+
+PERSON_EVENTS = ("touch", "squeeze", "gesture", "hear", "show_hand", "obstacle")
+"""Scenario events that are the person doing something (not a device failing)."""
+
+
+def person_moments(recording: Recording) -> list[Moment]:
+    """What the person, the therapist and the operator did, in order, each with the
+    robot's first answer: a simulated session's scenario events (so an answer's time
+    counts from the act itself), else what the sensors and the recognizer saw; the
+    therapist's presses; each time the robot could not listen."""
+    told = told_events(recording)
+    done: list[tuple[float, str, str, str]] = [
+        (at, "the person", _did(kind, description), kind)
+        for at, kind, description in recording.world()
+        if kind in PERSON_EVENTS
+    ]
+    done += [
+        (at, "the operator", description.removeprefix("operator "), kind)
+        for at, kind, description in recording.world()
+        if kind == "cloud"
+    ]
+    if not done:
+        done = sensed(recording)
+    done += [
+        (event.t_s, "the therapist", f"pressed the button \u201c{event.label}\u201d", "press")
+        for event in told
+        if isinstance(event, ButtonPressed)
+    ]
+    done += [
+        (event.from_s, "the person", "spoke while the robot was speaking", "not_listened")
+        for event in told
+        if isinstance(event, NotListened)
+    ]
+    misunderstood = [event for event in told if isinstance(event, NotUnderstood)]
+    yielded = [e for e in told if isinstance(e, TurnTaken) and e.turn in ("yields", "waits")]
+    actions = recording.actions()
+    reporting = {a.tree for a in actions if a.action == "report"}
+    ordered = sorted(done, key=lambda item: item[0])
+    moments = []
+    for index, (at, who, did, kind) in enumerate(ordered):
+        if kind == "not_listened":  # a line of its own: nothing to answer
+            moments.append(Moment(at, did, (), who, not_listened=True))
+            continue
+        later = [  # the next thing the same one did ends the wait for an answer
+            t for t, w, _, k in ordered[index + 1 :] if t > at and w == who and k != "not_listened"
+        ]
+        until = min([at + ANSWER_WITHIN_S, *later])
+        window = [  # a command's report is bookkeeping for the cloud, not an answer
+            a
+            for a in actions
+            if at <= a.at_s < until and a.action != "report" and _answers(who, a.tree, reporting)
+        ]
+        tree = window[0].tree if window else None
+        answers = tuple(a for a in window if a.tree == tree)[:3]
+        heard = next(
+            (e.text for e in misunderstood if at <= e.t_s < until and kind == "hear"), None
+        )
+        gave_way = next(
+            (
+                f"{e.tree} gave way to {e.other}, who had the {e.resource}"
+                for e in yielded
+                if at <= e.t_s < until and _answers(who, e.tree, reporting)
+            ),
+            None,
+        )
+        moments.append(Moment(at, did, answers, who, heard, gave_way=gave_way))
+    return moments
+
+
+def _did(kind: str, description: str) -> str:
+    """A scenario event's description as what the person did (a verb first)."""
+    if kind == "touch":
+        pad, _, rest = description.partition(" touched")
+        return f"touched {pad}{rest}"
+    if kind == "gesture":
+        return "made a gesture: " + description.removeprefix("gesture ")
+    if kind == "obstacle":
+        return "came near: " + description.removeprefix("obstacle at ")
+    if kind == "show_hand":
+        return "held up " + description
+    return description.removeprefix("someone ")
+
+
+def _answers(who: str, tree: str, reporting: set[str]) -> bool:
+    """Whether ``tree`` can answer something ``who`` did: a press is answered by the
+    buttons, an operator's command by the trees that report commands (``reporting``), the
+    person by the other trees."""
+    if who == "the therapist":
+        return tree == BUTTONS_TREE
+    if who == "the operator":
+        return tree in reporting
+    return tree != BUTTONS_TREE and tree not in reporting
+
+
+def sensed(recording: Recording) -> list[tuple[float, str, str, str]]:
+    """What the person (and the operator) did as the robot sensed it (on a robot in a real
+    room): (moment, who, what, the kind of scenario event it would be)."""
+    done: list[tuple[float, str, str]] = []
+    was_touched = False
+    for at, touched in recording.key_history(TOUCH_ANY):
+        if touched and not was_touched:
+            done.append((at, "touched the vest", "touch"))
+        was_touched = bool(touched)
+    left = dict(recording.key_history(FORCE_LEFT_N))
+    right = dict(recording.key_history(FORCE_RIGHT_N))
+    pressing = False
+    level = {"left": 0.0, "right": 0.0}
+    for at in sorted(set(left) | set(right)):
+        level["left"] = float(left.get(at, level["left"]) or 0.0)
+        level["right"] = float(right.get(at, level["right"]) or 0.0)
+        now = level["left"] > PRESSED_N or level["right"] > PRESSED_N
+        if now and not pressing:
+            both = level["left"] > PRESSED_N and level["right"] > PRESSED_N
+            what = "hugged the robot" if both else "pressed a side"
+            done.append(
+                (
+                    at,
+                    f"{what} ({level['left']:.1f} N left, {level['right']:.1f} N right)",
+                    "squeeze",
+                )
+            )
+        pressing = now
+    for at, gesture in recording.key_history(GESTURE_LAST):
+        done.append((at, f"made a gesture: {gesture}", "gesture"))
+    for at, text in recording.key_history(SPEECH_HEARD):
+        done.append((at, f"said \u201c{text}\u201d", "hear"))
+    for at, fingers in recording.key_history(HAND_SHOWN):
+        done.append((at, f"showed {fingers} finger{'' if fingers == 1 else 's'}", "show_hand"))
+    found = [(at, "the person", what, kind) for at, what, kind in done]
+    for at, command in recording.key_history(IOT_INBOX):
+        kind = command.get("type", "?") if isinstance(command, dict) else command
+        found.append((at, "the operator", f"sent {kind}", "cloud"))
+    return found
+
+
+def not_understood(recording: Recording) -> list[tuple[float, str]]:
+    """(moment, what the robot heard) for each utterance no dialog rule matched, once
+    each (a format 1 recording: read from the dialog node's feedback)."""
+    if recording.format >= 2:
+        return [
+            (event.t_s, event.text)
+            for event in told_events(recording)
+            if isinstance(event, NotUnderstood)
+        ]
+    found: list[tuple[float, str]] = []
+    last: tuple[float, str] | None = None
+    for at, feedback in recording.feedback_containing("no rule matches "):
+        if last is not None and last[1] == feedback and at - last[0] <= ANSWER_WITHIN_S:
+            continue  # the same node's next status (RUNNING, then done) says it again
+        last = (at, feedback)
+        found.append((at, feedback.split("no rule matches ", 1)[1].split(": ", 1)[0]))
+    return found
