@@ -158,3 +158,77 @@ def test_validate_warns_a_tree_that_would_try_again_without_waiting_for_its_turn
     err = capsys.readouterr().err
     assert "when_interrupted: try_again" in err
     assert "wait_for_turn_s" in err
+
+
+WAITER = """\
+name: {name}
+rate_hz: {rate}
+priority: {priority}
+wait_for_turn_s: 5
+root:
+  Sequence:
+    - OnTouch: {{pads: [{pad}]}}
+    - Say: {{text: "{text}"}}
+"""
+
+
+def test_a_free_speaker_goes_to_the_highest_tree_waiting_for_it(tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(ROOT)
+    trees = []
+    for name, rate, priority, pad, text in (
+        ("low", 20, 40, "left_shoulder", "low speaks"),
+        ("middle", 7, 50, "right_shoulder", "middle speaks"),
+        ("high", 3, 60, "upper_back", "high speaks at length, one two three four"),
+    ):
+        path = tmp_path / f"{name}.yaml"
+        path.write_text(WAITER.format(name=name, rate=rate, priority=priority, pad=pad, text=text))
+        trees.append(path)
+    touch = "{{at: {at}, touch: {{pad: {pad}, seconds: 0.3}}}}"
+    lines = run(
+        tmp_path,
+        capsys,
+        trees,
+        touch.format(at=1.0, pad="upper_back"),
+        touch.format(at=1.5, pad="left_shoulder"),  # both wait for high's long sentence
+        touch.format(at=1.6, pad="right_shoulder"),
+    )
+    assert [tree for _, tree, _ in said(lines)] == ["high", "middle", "low"]
+    assert not [line for line in lines if line["event"] == "turn" and line["turn"] == "interrupts"]
+
+
+def test_a_tree_tries_again_once_not_every_time_it_is_cut_short(tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(ROOT)
+    back = tmp_path / "back_thanks.yaml"
+    back.write_text(BACK_THANKS)
+    shoulder = tmp_path / "tickle.yaml"
+    shoulder.write_text(SHOULDER_TICKLE.format(when="try_again"))
+    touch = "{{at: {at}, touch: {{pad: {pad}, seconds: 0.3}}}}"
+    lines = run(
+        tmp_path,
+        capsys,
+        [shoulder, back],
+        touch.format(at=1.0, pad="left_shoulder"),
+        touch.format(at=2.0, pad="middle_back"),  # cut short: tried again at 2.6...
+        touch.format(at=3.0, pad="middle_back"),  # ...and cut short again: let go
+    )
+    assert [tree for _, tree, _ in said(lines)] == [
+        "tickle",
+        "back_thanks",
+        "tickle",
+        "back_thanks",
+    ]
+
+
+def test_a_round_that_only_set_a_value_before_giving_way_did_not_act(tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(ROOT)
+    path = tmp_path / "tickle.yaml"
+    path.write_text(
+        TICKLE.format(priority=30, wait=0, when="let_go").replace(
+            '          Say: {text: "That tickles!"}',
+            "          Sequence:\n"
+            "            - SetValue: {key: /vars/tickled, value: true}\n"
+            '            - Say: {text: "That tickles!"}',
+        )
+    )
+    lines = run(tmp_path, capsys, [path, THANKS], pat(1.0), pat(2.5))
+    assert said(lines) == [(1.0, "touch_thanks", "Thank you"), (2.5, "tickle", "That tickles!")]

@@ -166,3 +166,26 @@ def test_an_event_s_message_is_not_kept_once_the_node_waits_again(demo: Path) ->
     took = [i for i, (_, status, _) in enumerate(changes) if status == "SUCCESS"]
     assert took and "swipe_right" in changes[took[0]][2]
     assert changes[took[0] + 1][1:] == ("FAILURE", "")  # waiting again, with nothing to say
+
+
+@pytest.mark.parametrize(
+    "damage",
+    [
+        "UPDATE actions SET args = '[1,' WHERE rowid = 1",
+        "UPDATE actions SET args = '\"text\"' WHERE rowid = 1",
+        "UPDATE blackboard SET value = '{' WHERE rowid = 1",
+        "UPDATE world SET seq = 'x' WHERE rowid = 1",
+        "INSERT INTO events VALUES (1.0, 'safety', '', 'null', 1)",
+        "INSERT INTO events VALUES (1.0, 'safety', '', '{\"devices\": 5}', 1)",
+    ],
+)
+def test_a_damaged_recording_is_named_in_one_line_by_replay_and_report(
+    demo: Path, capsys, damage: str
+) -> None:
+    with sqlite3.connect(demo) as connection:
+        connection.execute(damage)
+    for command in (["replay", str(demo), "--at", "5"], ["report", str(demo)]):
+        code = main(command)
+        err = capsys.readouterr().err
+        assert "Traceback" not in err
+        assert code == 0 or (code == 1 and "a damaged recording" in err), (command, err)

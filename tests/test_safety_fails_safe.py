@@ -10,6 +10,7 @@ recording and the live view. Trees, remote commands and buttons all meet it.
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 from pathlib import Path
@@ -21,9 +22,10 @@ from engine.blackboard.catalogue import FORCE_LEFT_N, FORCE_RIGHT_N, default_cat
 from engine.cli import main
 from engine.clock import VirtualClock
 from engine.hardware.config_file import load_robot_config
-from engine.hardware.safety_envelope import SafetyEnvelope
+from engine.hardware.safety_envelope import EnvelopeWatcher, SafetyEnvelope, with_envelope
 from engine.recording.replay import Recording
 from engine.recording.told import told_events
+from engine.services.simulated import simulated_services
 from engine.session.events import SafetyAction
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -280,3 +282,40 @@ def test_the_recording_keeps_which_rule_and_which_device_refused(tmp_path, capsy
     [refused] = [e for e in told_events(Recording.open(record)) if isinstance(e, SafetyAction)]
     assert refused.action == "refused" and refused.rule == "still_within_mm"
     assert set(refused.devices) == set(RANGE_SENSORS)
+
+
+def test_a_sensor_that_cannot_be_trusted_never_hides_what_a_trusted_one_sees(envelope):
+    rules, blackboard, _ = envelope
+    rules.config = dataclasses.replace(rules.config, when_unsure="slow")  # doubts only slow
+    blackboard.set("/devices/range_left/ok", False)
+    blackboard.set("/sensors/range/center_mm", 50.0)
+    verdict = rules.refusal("left_arm", 30.0)
+    assert verdict is not None and verdict.devices == ("range_center",)
+    assert "something is 50 mm from the chest" in verdict.why
+
+
+def test_an_arm_held_away_from_rest_goes_back_once_the_envelope_allows(envelope):
+    rules, blackboard, clock = envelope
+    services = with_envelope(simulated_services(clock), rules)
+    watcher = EnvelopeWatcher(services.servos, rules)  # type: ignore[arg-type]
+    blackboard.set("/devices/range_center/ok", False)
+    home, speed = services.servos.rest_pose("left_arm")
+    rest = services.servos.move("left_arm", home, speed_dps=speed)
+    assert not rest.done()  # not refused: held until it may
+    inner = services.servos.inner  # type: ignore[attr-defined]
+    watcher(clock.now())
+    assert inner.calls == []  # still not allowed: the arm stays where it is
+    blackboard.set("/devices/range_center/ok", True)
+    fresh(blackboard)
+    watcher(clock.now())
+    assert inner.calls == [("left_arm", home, speed)]
+
+
+def test_a_newer_move_of_the_arm_drops_the_rest_it_was_held_for(envelope):
+    rules, blackboard, clock = envelope
+    services = with_envelope(simulated_services(clock), rules)
+    blackboard.set("/devices/force/ok", False)
+    home, speed = services.servos.rest_pose("right_arm")
+    rest = services.servos.move("right_arm", home, speed_dps=speed)
+    services.servos.move("right_arm", 20.0)  # refused too, but the rest is moot now
+    assert rest.done() and rest.error() is not None

@@ -76,6 +76,8 @@ VHV_CALIBRATION_START = 0x40
 
 # Bits 6:3 of RESULT_RANGE_STATUS: the device's range status; 11 means a valid range.
 DEVICE_RANGE_STATUS_VALID = 11
+DEVICE_RANGE_STATUS_TOO_CLOSE = frozenset({8, 10})
+"""Device range statuses of a target closer than the chip can range ("min range fail")."""
 RANGE_OUT_OF_RANGE_MM = 8190  # the chip reports 8190 or 8191 when nothing is in range
 RANGE_CODE_MAX = 8191  # the range field never holds more
 MAX_RANGE_MM = 2000  # the chip's reach (long-range mode); a valid range beyond it is garbled
@@ -98,10 +100,16 @@ def device_range_status(status_byte: int) -> int:
 
 
 def decode_range(status_byte: int, range_mm: int) -> int | None:
-    """The distance in mm, or ``None`` when the chip found nothing valid in range."""
+    """The distance in mm, or ``None`` when the chip found nothing valid in range. A
+    target too close to range (the device's "min range" statuses, 8 and 10: a hand over
+    the sensor) is 0 mm: something is right there, the worst case for whoever relies on
+    it."""
+    status = device_range_status(status_byte)
+    if status in DEVICE_RANGE_STATUS_TOO_CLOSE:
+        return 0
     if range_mm >= RANGE_OUT_OF_RANGE_MM:
         return None
-    if device_range_status(status_byte) != DEVICE_RANGE_STATUS_VALID:
+    if status != DEVICE_RANGE_STATUS_VALID:
         return None
     return range_mm
 

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import dataclasses
 from collections.abc import Callable
+from concurrent.futures import CancelledError
 from dataclasses import dataclass
 from typing import Any
 
@@ -111,13 +112,12 @@ class SafetyEnvelope:
         return Verdict(rule, devices, f"{'; '.join(doubts)}: {they} be trusted ({rule})", True)
 
     def _force_rule(self) -> Verdict | None:
+        """What a trusted pad feels beyond ``stop_above_n`` says first; else a pad that
+        cannot be trusted (only stricter, never laxer, than what the others feel)."""
         limit = self.config.stop_above_n
         if limit is None:
             return None
         readings = self._read(self.forces)
-        doubt = self._doubts("stop_above_n", readings)
-        if doubt is not None:
-            return doubt
         for reading in readings:
             if reading.value is not None and reading.value > limit:
                 return Verdict(
@@ -125,18 +125,17 @@ class SafetyEnvelope:
                     (reading.guard.device,),
                     f"a side force of {reading.value:.1f} N is above {limit:g} N",
                 )
-        return None
+        return self._doubts("stop_above_n", readings)
 
     def _distance_rule(self, rule: str, limit: float | None) -> Verdict | None:
+        """What a trusted range sensor sees closer than ``limit`` says first; else a sensor
+        that cannot be trusted."""
         if limit is None:
             return None
         readings = self._read(self.ranges)
-        doubt = self._doubts(rule, readings)
-        if doubt is not None:
-            return doubt
         near = [r for r in readings if r.value is not None and r.value < limit]
         if not near:
-            return None
+            return self._doubts(rule, readings)
         nearest = min(near, key=lambda r: r.value or 0.0)
         return Verdict(
             rule,
@@ -283,15 +282,57 @@ class StoppableMove:
         self.job.cancel()
 
 
+class RestWhenSafe:
+    """A move back to rest that the envelope cannot allow now: made by the watcher as soon
+    as it can (the arm is not left away from rest for good); a newer move of the joint, or
+    a cancel, drops it."""
+
+    def __init__(self, start: Callable[[], Job]) -> None:
+        self._start = start
+        self.job: Job | None = None
+        self.dropped = False
+
+    def begin(self) -> None:
+        if not self.dropped and self.job is None:
+            self.job = self._start()
+
+    def done(self) -> bool:
+        return self.dropped or (self.job is not None and self.job.done())
+
+    def error(self) -> BaseException | None:
+        if self.job is not None:
+            return self.job.error()
+        return CancelledError("dropped before the envelope allowed it") if self.dropped else None
+
+    def result(self) -> Any:
+        return self.job.result() if self.job is not None else None
+
+    def cancel(self) -> None:
+        if self.job is not None:
+            self.job.cancel()
+        self.dropped = True
+
+
 class EnvelopedServos:
-    """Moves checked and slowed by the envelope; the moves under way, for the watcher."""
+    """Moves checked and slowed by the envelope; the moves under way and the moves back
+    to rest still to make, for the watcher."""
 
     def __init__(self, inner: Servos, envelope: SafetyEnvelope) -> None:
         self.inner, self.envelope = inner, envelope
         self.moving: dict[str, StoppableMove] = {}
+        self.resting: dict[str, tuple[float, RestWhenSafe]] = {}
 
     def move(self, joint: str, angle_deg: float, *, speed_dps: float | None = None) -> Job:
+        waiting = self.resting.pop(joint, None)
+        if waiting is not None and waiting[1].job is None:
+            waiting[1].cancel()  # a newer move of the joint: the rest it waited for is moot
         refused = self.envelope.refusal(joint, angle_deg)
+        if refused is not None and (angle_deg, speed_dps) == self.inner.rest_pose(joint):
+            rest = RestWhenSafe(lambda: self.move(joint, angle_deg, speed_dps=speed_dps))
+            self.resting[joint] = (angle_deg, rest)
+            waits = f"{refused.why}: it goes back to rest once it may"
+            self.envelope.tell("held", joint, dataclasses.replace(refused, why=waits))
+            return rest
         if refused is not None:
             self.envelope.tell("refused", joint, refused)
             return ImmediateJob(error=SafetyRefusedError(f"safety: {refused.why}"))
@@ -334,6 +375,12 @@ class EnvelopeWatcher:
         self.stops = 0
 
     def __call__(self, now_s: float) -> None:
+        for joint, (angle_deg, rest) in list(self.servos.resting.items()):
+            if rest.dropped:
+                self.servos.resting.pop(joint, None)
+            elif self.envelope.refusal(joint, angle_deg) is None:  # now it may: back to rest
+                self.servos.resting.pop(joint, None)
+                rest.begin()
         moving = [
             (joint, move)
             for joint, move in self.servos.moving.items()

@@ -89,11 +89,12 @@ class Cooldown(py_trees.decorators.Decorator):
 
 def _an_action_ran(node: Behaviour) -> bool:
     """Whether an action leaf under ``node`` acted in the round that just ended (its
-    status is kept until the next round starts): it was ticked, and did not let its turn
-    go to another tree."""
+    status is kept until the next round starts): it was ticked, asked a service, and did
+    not let its turn go to another tree."""
     return any(
         getattr(leaf, "kind", None) == "action"
         and leaf.status != Status.INVALID
+        and getattr(leaf, "job", None) is not None  # it asked a service (not SetValue, Wait)
         and not _lost_its_turn(leaf)
         for leaf in node.iterate()
     )

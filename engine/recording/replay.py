@@ -171,7 +171,7 @@ class Recording:
             "(SELECT max(rowid) FROM blackboard WHERE at_s <= ? GROUP BY key)",
             (at_s,),
         )
-        return {key: KeyState(json.loads(value), at) for key, value, at in rows}
+        return {key: KeyState(self.json(value), at) for key, value, at in rows}
 
     def dot(self, tree: str, version: int) -> str | None:
         """The Graphviz source of a tree version, as it was drawn when recorded."""
@@ -204,16 +204,30 @@ class Recording:
 
     def ordered_rows(self, table: str, columns: str, until_s: float) -> list[Any]:
         """Rows of ``table`` up to ``until_s`` with their order across tables (format 2's
-        ``seq``; 0 in format 1) last."""
-        seq = "seq" if self.format >= 2 else "0"
-        return self._rows(
+        ``seq``; 0 in format 1) last; ConfigError for a row whose time or order is not a
+        number (a damaged recording)."""
+        seq = "coalesce(seq, 0)" if self.format >= 2 else "0"
+        rows = self._rows(
             f"SELECT {columns}, {seq} FROM {table} WHERE at_s <= ? ORDER BY rowid", (until_s,)
         )
+        for row in rows:
+            if not _numbers(row[0], row[-1]):
+                raise ConfigError(f"{self.path}: a damaged recording ({table} at {row[0]!r})")
+        return rows
+
+    def json(self, text: Any) -> Any:
+        """A value the recording keeps as JSON; ConfigError naming the file when it is not."""
+        try:
+            return json.loads(text)
+        except (TypeError, ValueError, RecursionError):
+            raise ConfigError(
+                f"{self.path}: a damaged recording (not JSON: {text!r:.60})"
+            ) from None
 
     def key_history(self, key: str) -> list[tuple[float, Any]]:
         """Each (moment, value) ``key`` took (each event, for an event key), in order."""
         rows = self._rows("SELECT at_s, value FROM blackboard WHERE key = ? ORDER BY rowid", (key,))
-        return [(at, json.loads(value)) for at, value in rows]
+        return [(at, self.json(value)) for at, value in rows]
 
     def is_event(self, key: str) -> bool:
         """Whether ``key`` was recorded as an event key."""
@@ -250,7 +264,15 @@ class Recording:
                 "WHERE at_s <= ? ORDER BY rowid",
                 (until,),
             )
-        return [_action(*row) for row in rows]
+        actions = []
+        for at, tree, action, text, error, outcome, ended_s, why, seq, ended_seq in rows:
+            args = self.json(text)
+            if not isinstance(args, dict) or not _numbers(at, seq or 0, ended_seq or 0):
+                raise ConfigError(f"{self.path}: a damaged recording (an action at {at!r})")
+            actions.append(
+                _action(at, tree, action, args, error, outcome, ended_s, why, seq, ended_seq)
+            )
+        return actions
 
     def events(
         self, until_s: float | None = None
@@ -264,14 +286,25 @@ class Recording:
             "SELECT at_s, seq, kind, tree, data FROM events WHERE at_s <= ? ORDER BY rowid",
             (float("inf") if until_s is None else until_s,),
         )
-        return [(at, seq or 0, kind, tree, json.loads(data)) for at, seq, kind, tree, data in rows]
+        found = []
+        for at, seq, kind, tree, data in rows:
+            fields = self.json(data)
+            if not isinstance(fields, dict) or not _numbers(at, seq or 0):
+                raise ConfigError(f"{self.path}: a damaged recording (an event of {at!r})")
+            found.append((at, seq or 0, str(kind), str(tree), fields))
+        return found
+
+
+def _numbers(*values: Any) -> bool:
+    """Whether every value is a real number (a time, an order), as recordings keep them."""
+    return all(isinstance(v, int | float) and not isinstance(v, bool) for v in values)
 
 
 def _action(
     at: float,
     tree: str,
     action: str,
-    args: str,
+    args: dict[str, Any],
     error: str | None,
     outcome: str | None,
     ended_s: float | None,
@@ -285,7 +318,7 @@ def _action(
         at,
         tree,
         action,
-        json.loads(args),
+        args,
         error,
         outcome,
         ended_s,

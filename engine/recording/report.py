@@ -104,7 +104,12 @@ def _answer_cell(moment: Moment) -> tuple[str, str]:
     return html.escape("; ".join(parts)), took
 
 
-SAFETY_DID = {"refused": "refused a move", "slowed": "slowed a move", "stopped": "stopped a move"}
+SAFETY_DID = {
+    "refused": "refused a move",
+    "slowed": "slowed a move",
+    "stopped": "stopped a move",
+    "held": "kept an arm from going back to rest until it could",
+}
 
 
 def _safety_rows(recording: Recording) -> str:
@@ -118,6 +123,14 @@ def _safety_rows(recording: Recording) -> str:
         for event in told_events(recording)
         if isinstance(event, SafetyAction)
     )
+
+
+def _count(text: str | None) -> int:
+    """A count kept in the recording's meta (0 when absent or not a count)."""
+    try:
+        return max(0, int(text or 0))
+    except ValueError:
+        return 0
 
 
 def _started(epoch: str | None) -> str:
@@ -137,7 +150,11 @@ def report_html(recording: Recording) -> str:
     """The report as one HTML document (no outside files)."""
     end = recording.duration_s
     moments = person_moments(recording)
-    answered = [m.response_s for m in moments if m.response_s is not None and not m.not_listened]
+    answered = [  # an answer the robot could not give (refused, failed) is no answer
+        m.response_s
+        for m in moments
+        if m.response_s is not None and any(a.outcome != "failed" for a in m.answers)
+    ]
     rows = []
     for moment in moments:
         answer, took = _answer_cell(moment)
@@ -148,7 +165,7 @@ def report_html(recording: Recording) -> str:
         )
     rows_html = "".join(rows)
     fired = Counter({tree.name: 0 for tree in recording.trees})
-    fired.update(action.tree for action in recording.actions())
+    fired.update(action.tree for action in recording.actions() if action.outcome != "failed")
     behaviours = "".join(
         f"<tr><td>{html.escape(tree)}</td><td class='num'>{count}</td></tr>"
         for tree, count in fired.most_common()
@@ -175,6 +192,12 @@ def report_html(recording: Recording) -> str:
             f" {unheard} time{'s' if unheard != 1 else ''} the person spoke while the robot "
             "was speaking, and it could not listen."
             if unheard
+            else ""
+        )
+        + (
+            f" The recording lost {lost} changes (the disk fell behind): this report may "
+            "miss some of what happened."
+            if (lost := _count(recording.meta.get("dropped"))) > 0
             else ""
         )
     )
@@ -224,6 +247,7 @@ def report_html(recording: Recording) -> str:
                 numeric={0, 4},
             ),
             "<h2>How often each behaviour acted</h2>",
+            "<p>Actions it could do (not those refused or failed).</p>",
             _table(["behaviour", "actions"], behaviours, "none acted", numeric={1}),
             "<h2>What the robot did not understand</h2>",
             _table(["when", "heard"], missed, "everything it heard matched a rule", numeric={0}),

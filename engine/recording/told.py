@@ -13,7 +13,6 @@ among them), what was heard and seen, devices.
 from __future__ import annotations
 
 import dataclasses
-import json
 import re
 from typing import Any
 
@@ -64,7 +63,10 @@ def _typed(kind: str, at_s: float, tree: str, fields: dict[str, Any]) -> Session
     if "tree" in names:
         values["tree"] = tree
     if "devices" in values:
-        values["devices"] = tuple(values["devices"])
+        devices = values["devices"]
+        if not isinstance(devices, list) or not all(isinstance(d, str) for d in devices):
+            return None  # a damaged row is left out, not guessed
+        values["devices"] = tuple(devices)
     try:
         return event_type(t_s=at_s, **values)
     except TypeError:  # a field missing: a damaged row is left out, not guessed
@@ -117,7 +119,7 @@ def _from_keys(recording: Recording, until: float) -> list[Ordered]:
     rows = recording.ordered_rows("blackboard", "at_s, key, value", until)
     ok: dict[str, bool] = {}
     for at, key, text, seq in rows:
-        value = json.loads(text)
+        value = recording.json(text)
         if key == SPEECH_HEARD:
             found.append((at, seq, 0, Heard(at, str(value))))
         elif key == HAND_SHOWN and isinstance(value, int):

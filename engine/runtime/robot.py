@@ -189,9 +189,11 @@ class Robot:
     def interrupt(self, name: str, by: str, resource: str) -> None:
         """Halt tree ``name`` cleanly because ``by`` takes ``resource``: its actions stop
         (cut short), its joints go back to rest and its LEDs off. It starts afresh at its
-        next tick: with the events of the round cut short when it tries again."""
+        next tick: with the events of the round cut short when it tries again (once)."""
         tree = self.scheduler.tree(name)
         tree.halt(f"{by} interrupted it")
-        if tree.tries_again:
+        # once: a round cut short again while trying again lets go (no stutter), and
+        # without wait_for_turn_s there would be no waiting for the turn at all
+        if tree.tries_again and tree.definition.wait_for_turn_s > 0 and not tree.retrying:
             tree.try_again()
             self.session.publish(TurnTaken(self.clock.now(), name, "tries_again", resource, by))

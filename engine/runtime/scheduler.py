@@ -47,6 +47,8 @@ class RunningTree:
     stats: TickStats = field(default_factory=TickStats)
     paused: bool = False
     """A paused tree keeps its deadlines but is not ticked (the therapist paused it)."""
+    retrying: bool = False
+    """The round under way is one cut short and tried again (it is tried again once)."""
     _round_start: list[tuple[Any, int]] = field(default_factory=list)
     _readers: list[Any] = field(default_factory=list)
     _readers_of: Any = None
@@ -90,9 +92,11 @@ class RunningTree:
 
     def try_again(self) -> None:
         """Hand the events of the round that was cut short back to its nodes: at its next
-        tick the tree starts the round again as if they had just come."""
+        tick the tree starts the round again as if they had just come (``retrying`` until
+        a round ends)."""
         for node, seq in self._round_start:
             node.events.handled_seq = min(node.events.handled_seq, seq)
+        self.retrying = True
 
     def replace(self, definition: TreeDefinition) -> None:
         """Swap in a new version of the tree between ticks (statistics kept).
@@ -271,8 +275,10 @@ class Scheduler:
         status = tree.status
         if status == py_trees.common.Status.FAILURE:  # gave up half-way: nothing left raised
             tree.context.actions.settle(lights=False)  # a timed light goes out by itself
+            tree.retrying = False
         elif status == py_trees.common.Status.SUCCESS:  # done as the tree meant
             tree.context.actions.forget()
+            tree.retrying = False
         for observer in self.after_tick:
             try:
                 observer(tree)

@@ -161,9 +161,9 @@ class TreeActions:
     reports FAILURE rather than stopping the tick. The jobs returned mark their record in
     the log when they are seen failed. With ``taking`` the speaker, the face LEDs and the
     joints are shared with the other trees by priority; an action waiting for its turn
-    is recorded when it starts. A tree gives way to another once: while what it gave way
-    to goes on, asking again (a hug still going on) fails at once, unsaid, and the tree
-    acts again once every resource it gave way for is free.
+    is recorded when it starts. A free resource goes to the highest tree waiting for it. A
+    tree gives way for a resource once: while that turn lasts, asking for it again (a hug
+    still going on) fails at once, unsaid; its other actions go on as usual.
     """
 
     def __init__(
@@ -185,8 +185,8 @@ class TreeActions:
         self.stop_reason = ""
         """Why the tree is being halted, while it is (its cut actions say so)."""
         self._gave_way: dict[str, Turn] = {}
-        """The turns this tree gave way to: while one lasts, its actions fail at once,
-        without waiting or saying so again (no stutter, no half answer)."""
+        """The turn each resource was last given way to: while it lasts, asking for that
+        resource again fails at once, without waiting or saying so again (no stutter)."""
 
     def _call(
         self,
@@ -211,17 +211,14 @@ class TreeActions:
         if taking is None or not uses:
             return begin()
         turns, priority = taking.turns, taking.priority
-        giving_way = self._still_giving_way(turns)
         blocked = turns.blocking(uses, self.tree, priority)
+        if blocked is None:  # free, but promised to a higher tree waiting for it?
+            blocked = turns.waiting_ahead(uses, self.tree, priority)
         if blocked is not None:
             resource, turn = blocked
-            known = self._gave_way.get(resource) is turn
-            self._gave_way[resource] = turn
-            if known:
-                giving_way = blocked
-        if giving_way is not None:  # asked again while what it gave way to goes on
-            resource, turn = giving_way
-            return ImmediateJob(error=TurnYieldedError(f"{turn.tree} still has the {resource}"))
+            if self._gave_way.get(resource) is turn:  # asked again while that turn lasts
+                return ImmediateJob(error=TurnYieldedError(f"{turn.tree} still has the {resource}"))
+            self._gave_way[resource] = turn  # said once; asked again once it is over
         if blocked is None:
             turns.take(uses, self.tree, priority)
             job = begin()
@@ -234,15 +231,6 @@ class TreeActions:
         turns.tell(self.tree, "waits", resource, turn.tree)
         deadline_s = self.clock.now() + taking.wait_for_turn_s
         return WaitingJob(turns, begin, uses, self.tree, priority, deadline_s, what)
-
-    def _still_giving_way(self, turns: Turns) -> tuple[str, Turn] | None:
-        """A resource this tree gave way for whose holder still has it, or None (then it
-        has forgotten them all: every one is free, or taken by someone else since)."""
-        for resource, turn in list(self._gave_way.items()):
-            if turns.holder(resource, self.tree) is turn:
-                return resource, turn
-            del self._gave_way[resource]
-        return None
 
     def say(self, text: str, *, volume: float | None = None) -> Job:
         args: dict[str, Any] = {"text": text}

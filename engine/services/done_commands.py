@@ -32,7 +32,7 @@ class DoneCommands:
             return
         try:
             loaded = json.loads(text)
-        except ValueError as error:
+        except (ValueError, RecursionError) as error:  # not JSON; nested beyond reading
             self._set_aside(f"is not JSON ({error})")
             return
         if not isinstance(loaded, dict) or not all(isinstance(v, dict) for v in loaded.values()):

@@ -65,6 +65,8 @@ class Turns:
         self.stream = stream
         self.interrupt = interrupt
         self._held: dict[str, Turn] = {}
+        self._in_line: list[WaitingJob] = []
+        """Actions waiting for their turn: a free resource goes to the highest of them."""
 
     def holder(self, resource: str, tree: str) -> Turn | None:
         """Another tree's turn on ``resource`` that is still running, or None."""
@@ -83,6 +85,22 @@ class Turns:
             if turn is not None and turn.priority >= priority:
                 return resource, turn
         return None
+
+    def waiting_ahead(
+        self, resources: Sequence[str], tree: str, priority: int
+    ) -> tuple[str, Turn] | None:
+        """(resource, its place in line) of another tree of higher priority that waits
+        for one of ``resources``, or None: a free resource goes to the highest waiting
+        tree, not to a lower one that happens to ask first."""
+        self._in_line = [job for job in self._in_line if job.waiting]
+        for job in self._in_line:
+            shared = [r for r in resources if r in job.resources]
+            if shared and job.tree != tree and job.priority > priority:
+                return shared[0], job.place
+        return None
+
+    def line_up(self, job: WaitingJob) -> None:
+        self._in_line.append(job)
 
     def take(self, resources: Sequence[str], tree: str, priority: int) -> None:
         """Interrupt every lower-priority tree holding one of ``resources``."""
@@ -127,13 +145,16 @@ class WaitingJob:
     ) -> None:
         self._turns = turns
         self._start = start
-        self._resources = resources
-        self._tree = tree
-        self._priority = priority
+        self.resources = resources
+        self.tree = tree
+        self.priority = priority
         self._deadline_s = deadline_s
         self._what = what
         self._job: Job | None = None
         self._error: BaseException | None = None
+        self.place = Turn(tree, priority, ImmediateJob())
+        """Its place in line, as a turn a lower tree gives way to."""
+        turns.line_up(self)
 
     @property
     def waiting(self) -> bool:
@@ -145,16 +166,20 @@ class WaitingJob:
             return self._job.done()
         if self._error is not None:
             return True
-        blocked = self._turns.blocking(self._resources, self._tree, self._priority)
-        if blocked is None:
-            self._turns.take(self._resources, self._tree, self._priority)
+        turns = self._turns
+        blocked = turns.blocking(self.resources, self.tree, self.priority)
+        ahead = turns.waiting_ahead(self.resources, self.tree, self.priority)
+        if blocked is None and ahead is None:
+            turns.take(self.resources, self.tree, self.priority)
             job = self._job = self._start()
             if not (job.done() and job.error() is not None):
-                self._turns.hold(self._resources, self._tree, self._priority, job)
+                turns.hold(self.resources, self.tree, self.priority, job)
             return job.done()
-        if self._turns.clock.now() >= self._deadline_s:
-            resource, turn = blocked
-            self._error = let_go(self._turns, self._tree, self._what, resource, turn)
+        if turns.clock.now() >= self._deadline_s:
+            place = blocked if blocked is not None else ahead
+            assert place is not None
+            resource, turn = place
+            self._error = let_go(turns, self.tree, self._what, resource, turn)
             return True
         return False
 

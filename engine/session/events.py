@@ -125,7 +125,9 @@ class TurnTaken:
         return f"yields the {self.resource} to {self.other}: not {self.what}"
 
 
-SafetyKind = Literal["refused", "stopped", "slowed"]
+SafetyKind = Literal["refused", "stopped", "slowed", "held"]
+"""refused a move, stopped one under way, slowed one, or held an arm where it is until it
+may go back to rest."""
 
 
 @dataclass(frozen=True, slots=True)

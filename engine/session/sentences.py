@@ -88,6 +88,8 @@ def event_line(event: SessionEvent) -> tuple[str, str] | None:
             return "safety", f"stops {event.joint} where it is: {event.why}"
         if event.action == "slowed":
             return "safety", f"slows {event.joint}: {event.why}"
+        if event.action == "held":
+            return "safety", f"holds {event.joint} where it is: {event.why}"
         return None  # a refusal is said by the action that could not be done
     if isinstance(event, DeviceChanged):
         if event.first:

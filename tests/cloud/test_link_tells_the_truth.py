@@ -18,6 +18,7 @@ from cloud.store.ledger import CANCELED, FAILED
 from engine.cli import main
 from engine.clock import VirtualClock
 from engine.services.cloud_link import CloudLink
+from engine.services.done_commands import DoneCommands
 from engine.session.events import Heard, KeyChanged
 from engine.session.stream import SessionStream
 
@@ -128,3 +129,15 @@ def test_telemetry_is_what_the_scheduler_committed_and_its_failures_are_counted(
         assert not link.push_telemetry()
     assert (http.posts, link.telemetry_failures) == (2, 2)
     assert caplog.text.count("telemetry could not be pushed") == 1  # once per streak
+
+
+@pytest.mark.parametrize(
+    "damaged",
+    ["[" * 100_000 + "]" * 100_000, "", "[1, 2]", '{"cmd-1": "done"}', "\x00\xff"],
+)
+def test_any_damaged_record_of_finished_commands_is_set_aside(tmp_path: Path, damaged: str) -> None:
+    path = tmp_path / "robot.token.done.json"
+    path.write_text(damaged, encoding="utf-8", errors="surrogateescape")
+    done = DoneCommands(path)
+    assert done.damaged == tmp_path / "robot.token.done.json.damaged"
+    assert done.get("cmd-1") is None and not path.exists()

@@ -167,6 +167,8 @@ def test_range_decoding():
     assert decode_range(valid, 8190) is None
     assert decode_range(valid, 8191) is None
     assert decode_range(4 << 3, 20) is None  # a failure status is no reading
+    assert decode_range(8 << 3, 8190) == 0  # too close to range: right at the sensor
+    assert decode_range(10 << 3, 20) == 0
 
 
 def test_signal_rate_limit_is_q9_7():
