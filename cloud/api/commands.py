@@ -63,8 +63,13 @@ def get_command(
 def cancel_command(
     robot: str, command_id: str, store: StoreDep, operator: CurrentOperator
 ) -> CommandPublic:
+    """200 with the command, CANCELED (also when it already was); 409 naming how it ended
+    when it finished first (a report or a timeout won); 404 for a command not there."""
     row = granted(store, operator, robot)
-    command = store.ledger.cancel(row.id, command_id)
+    try:
+        command = store.ledger.cancel(row.id, command_id)
+    except ConflictError as error:
+        raise HTTPException(status.HTTP_409_CONFLICT, str(error)) from None
     if command is None:
         raise HTTPException(status.HTTP_404_NOT_FOUND, f"no command {command_id!r}")
     return CommandPublic.of(command, row.name)

@@ -49,7 +49,10 @@ def report_progress(command_id: str, store: StoreDep, robot: CurrentRobot) -> Co
     """The robot is still carrying the command out: its lease starts again. 200 with the
     command (CANCELED: the operator no longer wants it); 404 for one that is not this
     robot's."""
-    command = store.ledger.extend_lease(robot.id, command_id)
+    try:
+        command = store.ledger.extend_lease(robot.id, command_id)
+    except ConflictError as error:  # changing too fast to change now: ask again
+        raise HTTPException(status.HTTP_409_CONFLICT, str(error)) from None
     if command is None:
         raise HTTPException(status.HTTP_404_NOT_FOUND, f"no command {command_id!r}")
     return CommandPublic.of(command, robot.name)

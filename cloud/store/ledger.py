@@ -6,13 +6,16 @@ States: QUEUED -> IN_PROGRESS (claimed by the robot, under a lease) -> SUCCEEDED
 ``timeout_s``. A robot still carrying a command out extends its lease; a lease that runs
 out (the robot died, or lost its link) puts the command back to QUEUED: it is delivered
 again, and the robot, which remembers what it carried out, reports the result it had.
-``version`` grows with every change.
+``version`` grows with every change, and every change is one compare-and-set on (state,
+version) in the database: of a cancel and a report sent together, or two reports, or a
+claim and a cancel, one wins and the other is told how the command ended (ConflictError,
+HTTP 409), on SQLite and PostgreSQL alike.
 """
 
 from __future__ import annotations
 
 import uuid
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import Any, Protocol
@@ -20,6 +23,7 @@ from typing import Any, Protocol
 from sqlalchemy import select
 from sqlalchemy.exc import IntegrityError
 from sqlalchemy.orm import Session
+from sqlalchemy.orm.exc import StaleDataError
 
 from cloud.store.database import Database
 from cloud.store.tables import CommandRow
@@ -32,6 +36,8 @@ FINISHED = frozenset({SUCCEEDED, FAILED, TIMED_OUT, CANCELED})
 REPORTS = (SUCCEEDED, FAILED)
 DEFAULT_LEASE_S = 30.0
 DEFAULT_TIMEOUT_S = 300.0
+CHANGE_ATTEMPTS = 50
+"""How often a change that lost a race is decided again on what the winner left."""
 EXPIRE_EVERY_S = 0.5
 """Leases and timeouts are looked at no more often than this (every long-poll's re-check
 would otherwise scan the ledger)."""
@@ -181,39 +187,71 @@ class CommandLedger:
             )
             return [Command.of(row) for row in rows]
 
+    def _transition(
+        self, robot_id: int, command_id: str, change: Callable[[CommandRow], bool]
+    ) -> Command | None:
+        """Read the command, let ``change`` change it (True when it did; it may raise
+        ConflictError), and write it back only if nobody changed it meanwhile: one
+        compare-and-set on its version. A change that lost the race is decided again on
+        what the winner left. None when the command is not this robot's."""
+        for _ in range(CHANGE_ATTEMPTS):
+            try:
+                with self._changing() as (session, changed):
+                    row = session.get(CommandRow, command_id)
+                    if row is None or row.robot_id != robot_id:
+                        return None
+                    if change(row):
+                        changed.add(robot_id)
+                        session.flush()  # the compare-and-set: StaleDataError if it lost
+                    return Command.of(row)
+            except StaleDataError:
+                continue
+        raise ConflictError(f"command {command_id} is changing too fast; ask again")
+
     def cancel(self, robot_id: int, command_id: str) -> Command | None:
-        """CANCELED if it had not finished (a finished command stays as it is)."""
-        with self._changing() as (session, changed):
-            row = session.get(CommandRow, command_id)
-            if row is None or row.robot_id != robot_id:
-                return None
-            if row.state not in FINISHED:
-                self._change(row, CANCELED)
-                changed.add(robot_id)
-            return Command.of(row)
+        """CANCELED if it had not finished; ConflictError naming how it ended when it had
+        (a report or a timeout came first)."""
+
+        def cancel(row: CommandRow) -> bool:
+            if row.state == CANCELED:
+                return False  # the same cancel again: answered as before
+            if row.state in FINISHED:
+                raise ConflictError(f"command {command_id} already ended {row.state}")
+            self._change(row, CANCELED)
+            row.lease_until_s = None
+            return True
+
+        return self._transition(robot_id, command_id, cancel)
 
     def claim_next(self, robot_id: int) -> Command | None:
-        """The oldest QUEUED command of this robot, now IN_PROGRESS under a lease."""
+        """The oldest QUEUED command of this robot, now IN_PROGRESS under a lease (one
+        another claim or a cancel took first is passed over)."""
         self._expire_due()
-        with self._changing() as (session, changed):
-            row = session.scalar(
-                select(CommandRow)
-                .where(
-                    CommandRow.robot_id == robot_id,
-                    CommandRow.state == QUEUED,
-                    CommandRow.timeout_at_s > self.clock.now(),
-                )
-                .order_by(CommandRow.created_s, CommandRow.id)
-                .limit(1)
-                .with_for_update(skip_locked=True)
-            )
-            if row is None:
-                return None
-            self._change(row, IN_PROGRESS)
-            row.lease_until_s = self.clock.now() + self.lease_s
-            row.deliveries += 1
-            changed.add(robot_id)
-            return Command.of(row)
+        for _ in range(CHANGE_ATTEMPTS):
+            try:
+                with self._changing() as (session, changed):
+                    row = session.scalar(
+                        select(CommandRow)
+                        .where(
+                            CommandRow.robot_id == robot_id,
+                            CommandRow.state == QUEUED,
+                            CommandRow.timeout_at_s > self.clock.now(),
+                        )
+                        .order_by(CommandRow.created_s, CommandRow.id)
+                        .limit(1)
+                        .with_for_update(skip_locked=True)
+                    )
+                    if row is None:
+                        return None
+                    self._change(row, IN_PROGRESS)
+                    row.lease_until_s = self.clock.now() + self.lease_s
+                    row.deliveries += 1
+                    changed.add(robot_id)
+                    session.flush()  # the compare-and-set
+                    return Command.of(row)
+            except StaleDataError:
+                continue
+        return None  # every one taken meanwhile: the long-poll asks again
 
     def extend_lease(self, robot_id: int, command_id: str) -> Command | None:
         """The robot is still carrying the command out: its lease runs ``lease_s`` from now
@@ -221,59 +259,70 @@ class CommandLedger:
         answered as it is (CANCELED: the operator no longer wants it). None when the command
         is not this robot's."""
         self._expire_due()
-        with self._changing() as (session, changed):
-            row = session.get(CommandRow, command_id)
-            if row is None or row.robot_id != robot_id:
-                return None
+
+        def extend(row: CommandRow) -> bool:
             if row.state == QUEUED:
                 self._change(row, IN_PROGRESS)
-                changed.add(robot_id)
-            if row.state == IN_PROGRESS:
-                row.lease_until_s = self.clock.now() + self.lease_s
-            return Command.of(row)
+            if row.state != IN_PROGRESS:
+                return False
+            row.lease_until_s = self.clock.now() + self.lease_s
+            return True
+
+        return self._transition(robot_id, command_id, extend)
 
     def report(self, robot_id: int, command_id: str, status: str, result: Any) -> Command | None:
         """The robot's report: SUCCEEDED or FAILED with its result. The same report again
-        changes nothing; a different one for a finished command is a ConflictError. None when
-        the command is not this robot's."""
+        changes nothing; a different one for a finished command (another report, a cancel,
+        a timeout came first) is a ConflictError naming how it ended. None when the command
+        is not this robot's."""
         if status not in REPORTS:
             raise ValueError(f"status must be SUCCEEDED or FAILED, got {status!r}")
-        with self._changing() as (session, changed):
-            row = session.get(CommandRow, command_id)
-            if row is None or row.robot_id != robot_id:
-                return None
+
+        def finish(row: CommandRow) -> bool:
             if row.state in FINISHED:
                 if row.state == status and row.result == result:
-                    return Command.of(row)
+                    return False
                 raise ConflictError(f"command {command_id} already ended {row.state}")
             self._change(row, status)
             row.result = result
             row.lease_until_s = None
-            changed.add(robot_id)
-            return Command.of(row)
+            return True
+
+        return self._transition(robot_id, command_id, finish)
 
     def _expire_due(self) -> None:
         if self.clock.now() - self._expired_at_s >= EXPIRE_EVERY_S:
             self.expire()
 
     def expire(self) -> None:
-        """Leases that ran out go back to QUEUED; commands past their timeout, TIMED_OUT."""
+        """Leases that ran out go back to QUEUED; commands past their timeout, TIMED_OUT.
+        Each row is a compare-and-set: one a report or a cancel changed meanwhile is left
+        as that change left it (the whole pass is made again on what is there now)."""
         now = self._expired_at_s = self.clock.now()
-        with self._changing() as (session, changed):
-            late = session.scalars(
-                select(CommandRow).where(
-                    CommandRow.state.in_((QUEUED, IN_PROGRESS)),
-                    (CommandRow.timeout_at_s <= now)
-                    | ((CommandRow.state == IN_PROGRESS) & (CommandRow.lease_until_s <= now)),
-                )
-            )
-            for row in late:
-                if row.timeout_at_s <= now:
-                    self._change(row, TIMED_OUT)
-                else:
-                    self._change(row, QUEUED)  # its robot's long-poll takes it again
-                row.lease_until_s = None
-                changed.add(row.robot_id)
+        for _ in range(CHANGE_ATTEMPTS):
+            try:
+                with self._changing() as (session, changed):
+                    late = session.scalars(
+                        select(CommandRow).where(
+                            CommandRow.state.in_((QUEUED, IN_PROGRESS)),
+                            (CommandRow.timeout_at_s <= now)
+                            | (
+                                (CommandRow.state == IN_PROGRESS)
+                                & (CommandRow.lease_until_s <= now)
+                            ),
+                        )
+                    )
+                    for row in late:
+                        if row.timeout_at_s <= now:
+                            self._change(row, TIMED_OUT)
+                        else:
+                            self._change(row, QUEUED)  # its robot's long-poll takes it again
+                        row.lease_until_s = None
+                        changed.add(row.robot_id)
+                    session.flush()
+                return
+            except StaleDataError:
+                continue
 
     def _by_key(self, robot_id: int, key: str) -> Command | None:
         with self.db.transaction() as session:
@@ -285,8 +334,8 @@ class CommandLedger:
             return Command.of(row) if row is not None else None
 
     def _change(self, row: CommandRow, state: str) -> None:
+        """A new state (``version`` grows as the row is written: the compare-and-set)."""
         row.state = state
-        row.version += 1
         row.updated_s = self.clock.now()
 
 

@@ -50,6 +50,10 @@ class GrantRow(Table):
 
 
 class CommandRow(Table):
+    """One command. ``version`` grows with every change, and every change is a
+    compare-and-set on it (``UPDATE ... WHERE version = <the version read>``): a change
+    that lost a race to another changes nothing and is told so (StaleDataError)."""
+
     __tablename__ = "commands"
     __table_args__ = (
         UniqueConstraint("robot_id", "idempotency_key"),
@@ -69,6 +73,8 @@ class CommandRow(Table):
     timeout_at_s: Mapped[float] = mapped_column(Float)
     lease_until_s: Mapped[float | None] = mapped_column(Float, default=None)
     deliveries: Mapped[int] = mapped_column(Integer, default=0)
+
+    __mapper_args__ = {"version_id_col": version}
 
 
 class TelemetryRow(Table):
