@@ -124,6 +124,9 @@ class CloudLink:
         self.telemetry_failures = 0
         """Pushes of telemetry that failed (the service unreachable or refusing)."""
         self._telemetry_failing = False
+        self.bad_replies = 0
+        """Replies to a poll that were not a command (not JSON, not the contract's)."""
+        self._replies_bad = False
         self._canceled: set[str] = set()  # canceled by the operator while carried out
         self._reports: queue.Queue[tuple[str, dict[str, Any]] | None] = queue.Queue()
         self._stop = clock.event()
@@ -215,8 +218,39 @@ class CloudLink:
                 )
                 delay_s = self._backoff(delay_s)
                 continue
+            command = self._command_in(answer)
+            if command is None:  # a captive portal, a proxy's page: not the service
+                delay_s = self._backoff(delay_s)
+                continue
             self.reachable, delay_s = True, FIRST_BACKOFF_S
-            self._received(answer.json())
+            self._received(command)
+
+    def _command_in(self, answer: requests.Response) -> dict[str, Any] | None:
+        """The command a 200 reply carries, or None for a reply that is not one (counted in
+        ``bad_replies``, logged once per streak): a captive portal's page, a proxy's."""
+        try:
+            command = answer.json()
+        except ValueError:
+            command = None
+        if (
+            isinstance(command, dict)
+            and isinstance(command.get("id"), str)
+            and isinstance(command.get("type"), str)
+            and isinstance(command.get("args", {}), dict)
+        ):
+            self._replies_bad = False
+            return command
+        self.bad_replies += 1
+        if not self._replies_bad:
+            log.warning(
+                "the cloud's reply to a poll is not a command (%s: %.80r); the robot asks "
+                "again with back-off",
+                answer.headers.get("content-type", "no content type"),
+                answer.text,
+            )
+        self._replies_bad = True
+        self.reachable = False
+        return None
 
     def _received(self, command: dict[str, Any]) -> None:
         command_id = str(command.get("id"))

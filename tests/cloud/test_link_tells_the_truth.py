@@ -4,7 +4,10 @@ is what the scheduler committed, its failures counted."""
 
 from __future__ import annotations
 
+import http.server
+import json
 import logging
+import threading
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -141,3 +144,64 @@ def test_any_damaged_record_of_finished_commands_is_set_aside(tmp_path: Path, da
     done = DoneCommands(path)
     assert done.damaged == tmp_path / "robot.token.done.json.damaged"
     assert done.get("cmd-1") is None and not path.exists()
+
+
+class CaptivePortal(http.server.BaseHTTPRequestHandler):
+    """Answers the robot's first polls with a portal's page (200, HTML), then one command,
+    then nothing more; takes any report."""
+
+    polls = 0
+    reports: list[dict[str, Any]] = []
+
+    def do_GET(self) -> None:
+        CaptivePortal.polls += 1
+        if CaptivePortal.polls <= 2:
+            self._send(200, b"<html><body>Welcome! Log in to the clinic wifi</body></html>")
+        elif CaptivePortal.polls == 3:
+            command = {"id": "c-1", "type": "say", "args": {"text": "through the portal"}}
+            self._send(200, json.dumps({**command, "lease_s": 30}).encode(), "application/json")
+        else:
+            self._send(204, b"")
+
+    def do_POST(self) -> None:
+        length = int(self.headers.get("content-length", "0"))
+        body = self.rfile.read(length)
+        if self.path.endswith("/result"):
+            CaptivePortal.reports.append(json.loads(body))
+        self._send(200, b"{}", "application/json")
+
+    def _send(self, code: int, body: bytes, kind: str = "text/html") -> None:
+        self.send_response(code)
+        self.send_header("content-type", kind)
+        self.send_header("content-length", str(len(body)))
+        self.end_headers()
+        self.wfile.write(body)
+
+    def log_message(self, *args: Any) -> None:
+        """Quiet."""
+
+
+def test_a_reply_that_is_not_a_command_is_retried_and_the_robot_keeps_taking_commands(
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+    caplog: pytest.LogCaptureFixture,
+) -> None:
+    server = http.server.ThreadingHTTPServer(("127.0.0.1", 0), CaptivePortal)
+    thread = threading.Thread(target=server.serve_forever, daemon=True)
+    thread.start()
+    token = tmp_path / "robot.token"
+    token.write_text("t0ken\n")
+    monkeypatch.chdir(ROOT)
+    url = f"http://127.0.0.1:{server.server_address[1]}"
+    args = ["run", "--trees", "trees/iot_command.yaml", "--scenario", str(quiet(tmp_path, 5))]
+    args += ["--speech", "text", "--json", "--cloud", url, "--token-file", str(token)]
+    try:
+        with caplog.at_level(logging.WARNING):
+            assert main(args) == 0
+    finally:
+        server.shutdown()
+    said = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
+    assert any(line.get("args", {}).get("text") == "through the portal" for line in said)
+    assert CaptivePortal.reports == [{"status": "SUCCEEDED", "result": None}]
+    assert caplog.text.count("is not a command") == 1  # once for the streak of two
