@@ -28,7 +28,9 @@ class CloudStore:
 
     def __post_init__(self) -> None:
         self.closing = self.clock.event()
-        self.principals = PrincipalCache(self.directory, self.clock)
+        self.principals = PrincipalCache(
+            self.directory, self.clock, ttl_s=self.settings.token_cache_s
+        )
 
     @classmethod
     def open(cls, settings: Settings, clock: Clock) -> CloudStore:

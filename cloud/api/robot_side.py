@@ -26,11 +26,15 @@ async def next_command(
 
     A command is only taken for a caller still there: a long-poll whose client went away,
     or that the same robot replaced with a newer one, ends without taking anything (else the
-    command would wait out its lease before the robot saw it)."""
+    command would wait out its lease before the robot saw it). A robot whose token is revoked
+    while it waits is answered 401 before anything is taken (within the token cache's 5 s)."""
     deadline_s = store.clock.now() + min(wait_s, store.settings.max_wait_s)
+    token = request.headers.get("authorization", "").partition(" ")[2].strip()
     with store.telemetry.polling(robot.id) as superseded:
         store.doorbell.ring(robot.id)  # an older long-poll of this robot wakes and ends
         while not (superseded() or store.closing.is_set() or await request.is_disconnected()):
+            if await run_in_threadpool(store.principals.authenticate, token) is None:
+                raise HTTPException(status.HTTP_401_UNAUTHORIZED, "this robot's token is revoked")
             command = await run_in_threadpool(store.ledger.claim_next, robot.id)
             if command is not None:
                 public = CommandPublic.of(command, robot.name)

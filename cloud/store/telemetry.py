@@ -39,6 +39,7 @@ class Telemetry:
         self.db = db
         self.clock = clock
         self._lock = threading.Lock()
+        self._polls_changed = threading.Condition(self._lock)
         self._latest: dict[int, dict[str, Reading]] = {}
         self._seen: dict[int, float] = {}
         self._unwritten: dict[int, dict[str, Reading]] = {}
@@ -74,6 +75,7 @@ class Telemetry:
         with self._lock:
             self._polling[robot_id] = self._polling.get(robot_id, 0) + 1
             self._newest_poll[robot_id] = poll = self._newest_poll.get(robot_id, 0) + 1
+            self._polls_changed.notify_all()
         try:
             yield lambda: self._newest_poll.get(robot_id) != poll
         finally:
@@ -87,6 +89,12 @@ class Telemetry:
         """True while the robot waits in a long-poll of this worker."""
         with self._lock:
             return robot_id in self._polling
+
+    def wait_until_polling(self, robot_id: int, timeout_s: float) -> bool:
+        """Block (real seconds) until the robot waits in a long-poll of this worker; False
+        when it did not within ``timeout_s``."""
+        with self._polls_changed:
+            return self._polls_changed.wait_for(lambda: robot_id in self._polling, timeout_s)
 
     def latest(self, robot_id: int) -> dict[str, Reading]:
         """key -> {"value", "at_s"}, sorted by key."""

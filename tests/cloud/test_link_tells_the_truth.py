@@ -33,9 +33,8 @@ def service(
     tmp_path: Path, start_service: Callable[..., Any], **settings: float
 ) -> tuple[str, CloudStore, int, Path]:
     """A service on loopback with one robot; (url, store, the robot's id, its token file)."""
-    running = start_service(
-        Settings(db_url=f"sqlite:///{tmp_path / 'c.db'}", max_wait_s=1.0, recheck_s=0.2, **settings)
-    )
+    chosen: dict[str, Any] = {"max_wait_s": 1.0, "recheck_s": 0.2, **settings}
+    running = start_service(Settings(db_url=f"sqlite:///{tmp_path / 'c.db'}", **chosen))
     store = running.store
     store.directory.add_operator("ana")
     token_file = tmp_path / "robot.token"
@@ -205,3 +204,26 @@ def test_a_reply_that_is_not_a_command_is_retried_and_the_robot_keeps_taking_com
     assert any(line.get("args", {}).get("text") == "through the portal" for line in said)
     assert CaptivePortal.reports == [{"status": "SUCCEEDED", "result": None}]
     assert caplog.text.count("is not a command") == 1  # once for the streak of two
+
+
+def test_a_robot_revoked_while_its_long_poll_waits_is_answered_401_and_takes_nothing(
+    tmp_path: Path, start_service: Callable[..., Any]
+) -> None:
+    url, store, robot_id, token_file = service(
+        tmp_path, start_service, max_wait_s=30.0, token_cache_s=0.0
+    )
+    headers = {"Authorization": f"Bearer {token_file.read_text().strip()}"}
+    polling: list[requests.Response] = []
+    poll = threading.Thread(
+        target=lambda: polling.append(
+            requests.get(f"{url}/api/v1/robot/commands/next?wait_s=20", headers=headers)
+        )
+    )
+    poll.start()
+    assert store.telemetry.wait_until_polling(robot_id, timeout_s=30)  # it waits
+    store.directory.revoke("robot", "hbs2")
+    command, _ = store.ledger.submit(robot_id, "say", {"text": "for a revoked robot"})
+    poll.join(timeout=30)
+    assert [answer.status_code for answer in polling] == [401]
+    still = store.ledger.get(robot_id, command.id)
+    assert still is not None and still.state == "QUEUED"  # never taken
