@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import logging
 from collections.abc import AsyncIterator
 from contextlib import asynccontextmanager
 
@@ -10,17 +11,22 @@ from fastapi import FastAPI, Request, Response
 from fastapi.exception_handlers import http_exception_handler
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse
+from sqlalchemy.exc import SQLAlchemyError
 from starlette.exceptions import HTTPException as StarletteHTTPException
 
 from cloud.api import commands, events, robot_side, robots
 from cloud.api.body_limit import BodyLimit
 from cloud.api.page import add_page
+from cloud.api.schemas import ERRORS
 from cloud.services import CloudStore
 from cloud.settings import Settings
 from cloud.store.writer import TelemetryWriter
 from engine.clock import Clock, EpochClock
 
 API = "/api/v1"
+
+
+log = logging.getLogger("vest.cloud")
 
 
 def create_app(
@@ -46,7 +52,7 @@ def create_app(
     app = FastAPI(title="vest cloud", version="1", lifespan=lifespan)
     app.state.store = store
     for router in (robots.router, commands.router, robot_side.router, events.router):
-        app.include_router(router, prefix=API)
+        app.include_router(router, prefix=API, responses=ERRORS)
     add_page(app)
 
     app.add_middleware(BodyLimit, max_bytes=settings.max_body_bytes)
@@ -70,5 +76,17 @@ def create_app(
             problem = {"field": "body", "message": "not JSON this service reads (too deep?)"}
             return JSONResponse({"detail": [problem]}, status_code=422)
         return await http_exception_handler(request, error)
+
+    @app.exception_handler(SQLAlchemyError)
+    @app.exception_handler(OSError)
+    async def cannot_store(request: Request, error: Exception) -> JSONResponse:
+        """The database or the disk failed (full, gone): 503 with why, as JSON the page
+        and the robot read (nothing was changed; ask again later)."""
+        log.error("%s %s failed: %s", request.method, request.url.path, error)
+        reason = str(getattr(error, "orig", None) or error).splitlines()[0][:200]
+        return JSONResponse(
+            {"detail": f"the service cannot store this now ({reason}); try again later"},
+            status_code=503,
+        )
 
     return app

@@ -33,16 +33,22 @@ def checked_json(value: Any, depth: int = 0) -> Any:
 
 
 def valid_text(text: str) -> str:
+    """``text`` if a database can store it: valid Unicode (a lone surrogate is not) and no
+    NUL character (PostgreSQL's text and JSON cannot hold one)."""
     try:
         text.encode("utf-8")
     except UnicodeEncodeError:
         raise ValueError("text must be valid Unicode (a lone surrogate is not)") from None
+    if "\x00" in text:
+        raise ValueError("text must not hold a NUL character (\\u0000)")
     return text
 
 
 Json = Annotated[Any, AfterValidator(checked_json)]
 JsonObject = Annotated[dict[str, Any], AfterValidator(checked_json)]
-TelemetryKey = Annotated[str, StringConstraints(min_length=1, max_length=200)]
+TelemetryKey = Annotated[
+    str, StringConstraints(min_length=1, max_length=200), AfterValidator(valid_text)
+]
 Key = Annotated[str, StringConstraints(min_length=1, max_length=128), AfterValidator(valid_text)]
 
 
@@ -52,7 +58,8 @@ class CommandCreate(BaseModel):
     type: str = Field(min_length=1, max_length=64, pattern=r"^[a-z][a-z0-9_]*$")
     args: JsonObject = Field(default_factory=dict)
     idempotency_key: Key | None = None
-    timeout_s: float | None = Field(default=None, gt=0, le=86400)
+    timeout_s: float | None = Field(default=None, gt=0, le=86400, strict=True)
+    """Seconds, a number (``true`` or ``"5"`` is refused, not taken as 1 or 5)."""
 
 
 class CommandPublic(BaseModel):
@@ -107,3 +114,33 @@ class RobotPublic(BaseModel):
     name: str
     online: bool
     last_seen_s: float | None
+
+
+class Problem(BaseModel):
+    """One thing wrong with a request: the field (``body`` for the whole) and why."""
+
+    field: str
+    message: str
+
+
+class Problems(BaseModel):
+    """A 422: every problem of the request."""
+
+    detail: list[Problem]
+
+
+class Refusal(BaseModel):
+    """A 401, 404, 409, 413 or 503: why, in words."""
+
+    detail: str
+
+
+ERRORS: dict[int | str, dict[str, Any]] = {
+    401: {"model": Refusal, "description": "no token, or one that is unknown or revoked"},
+    404: {"model": Refusal, "description": "nothing of that name this caller may see"},
+    409: {"model": Refusal, "description": "it contradicts how the command already ended"},
+    413: {"model": Refusal, "description": "the body is larger than the service takes"},
+    422: {"model": Problems, "description": "a field is wrong: each one named, with why"},
+    503: {"model": Refusal, "description": "the database cannot store it now: ask again later"},
+}
+"""The answers every route may give besides its own, as the service sends them."""

@@ -104,7 +104,10 @@ class Directory:
 
     def granted_robot(self, operator_id: int, name: str) -> RobotRow | None:
         """The robot called ``name`` if it is granted to the operator, else None (the
-        caller cannot tell a robot it may not see from one that does not exist)."""
+        caller cannot tell a robot it may not see from one that does not exist; a name no
+        robot can have, a NUL in it say, is none)."""
+        if not 1 <= len(name) <= 64 or not set(name) <= NAME_CHARS:
+            return None
         with self.db.transaction() as session:
             return session.scalar(
                 select(RobotRow)

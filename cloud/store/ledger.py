@@ -171,6 +171,8 @@ class CommandLedger:
     def get(self, robot_id: int, command_id: str) -> Command | None:
         """The command, only if it is this robot's."""
         self._expire_due()
+        if not _is_command_id(command_id):
+            return None
         with self.db.transaction() as session:
             row = session.get(CommandRow, command_id)
             return Command.of(row) if row is not None and row.robot_id == robot_id else None
@@ -194,6 +196,8 @@ class CommandLedger:
         ConflictError), and write it back only if nobody changed it meanwhile: one
         compare-and-set on its version. A change that lost the race is decided again on
         what the winner left. None when the command is not this robot's."""
+        if not _is_command_id(command_id):
+            return None
         for _ in range(CHANGE_ATTEMPTS):
             try:
                 with self._changing() as (session, changed):
@@ -337,6 +341,15 @@ class CommandLedger:
         """A new state (``version`` grows as the row is written: the compare-and-set)."""
         row.state = state
         row.updated_s = self.clock.now()
+
+
+def _is_command_id(text: str) -> bool:
+    """Whether ``text`` can be a command's id (a UUID, as the ledger makes them): anything
+    else (a NUL PostgreSQL cannot even compare) names no command."""
+    try:
+        return str(uuid.UUID(text)) == text
+    except (ValueError, TypeError):
+        return False
 
 
 def _same_command(known: Command, type: str, args: dict[str, Any]) -> Command:

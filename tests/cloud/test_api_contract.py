@@ -11,6 +11,7 @@ from typing import Any
 
 import pytest
 import requests
+from sqlalchemy.exc import OperationalError
 
 from cloud.services import CloudStore
 from cloud.settings import Settings
@@ -192,6 +193,8 @@ def test_what_a_caller_may_not_see_answers_404_and_no_token_401(service: Service
         ({"type": "say", "args": []}, "args"),
         ({"type": "Say!", "args": {}}, "type"),
         ({"type": "say", "timeout_s": -1}, "timeout_s"),
+        ({"type": "say", "args": {"text": "hi"}, "timeout_s": True}, "timeout_s"),  # not 1 s
+        ({"type": "say", "args": {"text": "hi"}, "timeout_s": "5"}, "timeout_s"),
         ({"type": "say", "colour": "red"}, "colour"),
         # arguments of built-in types, checked as the robot checks them
         ({"type": "say", "args": {"text": "hi", "volume": 5}}, "args"),
@@ -264,6 +267,13 @@ def post_raw(service: Service, path: str, raw: bytes | Any, who: dict[str, str])
         ("/robots/hbs2/commands", b'{"type": "say", "args": {"\\udfff": 1}}', "args"),
         ("/robots/hbs2/commands", b'{"type": "say", "idempotency_key": "\\ud800"}', "idem"),
         ("/robot/telemetry", b'{"values": {"/s/\\ud800": 1}}', "values"),
+        # a NUL parses, and no PostgreSQL text or JSON can hold it: anywhere it is stored
+        ("/robots/hbs2/commands", b'{"type": "say", "idempotency_key": "k\\u0000"}', "idem"),
+        ("/robots/hbs2/commands", b'{"type": "say", "args": {"text": "a\\u0000b"}}', "args"),
+        ("/robots/hbs2/commands", b'{"type": "say", "args": {"t\\u0000": 1}}', "args"),
+        ("/robot/commands/nope/result", b'{"status": "FAILED", "result": "\\u0000"}', "result"),
+        ("/robot/telemetry", b'{"values": {"/s/\\u0000": 1}}', "values"),
+        ("/robot/telemetry", b'{"values": {"/s": "\\u0000"}}', "values"),
         # JSON no parser here reads: nested past Python's recursion, a 5,000-digit number
         (
             "/robots/hbs2/commands",
@@ -390,3 +400,62 @@ def test_a_long_poll_replaced_by_a_newer_one_of_the_same_robot_takes_nothing(
     ).json()
     fresh.join(timeout=30)
     assert answers["fresh"].status_code == 200 and answers["fresh"].json()["id"] == sent["id"]
+
+
+@pytest.mark.parametrize(
+    ("method", "path", "who"),
+    [
+        ("GET", "/robots/hbs2%00/commands", "operator"),
+        ("GET", "/robots/hbs2/commands/abc%00def", "operator"),
+        ("POST", "/robots/hbs2/commands/abc%00def/cancel", "operator"),
+        ("POST", "/robot/commands/abc%00def/progress", "robot"),
+        ("GET", "/robots/%E2%82%AC%00/telemetry", "operator"),
+    ],
+)
+def test_a_nul_in_a_name_or_an_id_names_nothing(
+    service: Service, method: str, path: str, who: str
+) -> None:
+    headers = service.operator if who == "operator" else service.robot
+    answer = requests.request(method, service.url + path, headers=headers, timeout=10)
+    assert answer.status_code == 404, answer.text
+
+
+def test_a_database_that_cannot_store_answers_503_in_json_and_keeps_what_it_had(
+    service: Service, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    kept = requests.post(
+        f"{service.url}/robots/hbs2/commands",
+        json={"type": "say", "args": {"text": "before"}},
+        headers=service.operator,
+        timeout=10,
+    )
+    assert kept.status_code == 201
+
+    def disk_full(*args: Any, **kwargs: Any) -> Any:
+        raise OperationalError("INSERT INTO commands", {}, Exception("database or disk is full"))
+
+    monkeypatch.setattr(service.store.ledger, "submit", disk_full)  # as a full disk answers
+    answer = requests.post(
+        f"{service.url}/robots/hbs2/commands",
+        json={"type": "say", "args": {"text": "after"}},
+        headers=service.operator,
+        timeout=10,
+    )
+    assert answer.status_code == 503
+    assert "database or disk is full" in answer.json()["detail"]
+    monkeypatch.undo()
+    listed = requests.get(f"{service.url}/robots/hbs2/commands", headers=service.operator)
+    assert [c["args"]["text"] for c in listed.json()] == ["before"]
+
+
+def test_the_openapi_document_describes_the_errors_the_service_sends(service: Service) -> None:
+    spec = requests.get(service.url.removesuffix("/api/v1") + "/openapi.json", timeout=10).json()
+    send = spec["paths"]["/api/v1/robots/{robot}/commands"]["post"]["responses"]
+    assert {"401", "404", "409", "413", "422", "503"} <= set(send)
+    problems = send["422"]["content"]["application/json"]["schema"]["$ref"].split("/")[-1]
+    fields = spec["components"]["schemas"][problems]["properties"]["detail"]["items"]
+    assert fields["$ref"].endswith("/Problem")
+    sent = requests.post(
+        f"{service.url}/robots/hbs2/commands", json={"args": {}}, headers=service.operator
+    )
+    assert set(sent.json()["detail"][0]) == {"field", "message"}  # what the document says
