@@ -10,6 +10,7 @@ from starlette.concurrency import run_in_threadpool
 from cloud.api.deps import CurrentRobot, StoreDep
 from cloud.api.schemas import ClaimedCommand, CommandPublic, ResultReport, TelemetryReport
 from cloud.store.ledger import ConflictError
+from cloud.store.telemetry import TelemetryFullError
 
 router = APIRouter(prefix="/robot", tags=["robot"])
 
@@ -79,5 +80,10 @@ def report_result(
 
 @router.post("/telemetry", status_code=status.HTTP_204_NO_CONTENT)
 async def push_telemetry(body: TelemetryReport, store: StoreDep, robot: CurrentRobot) -> None:
-    """Kept in memory (written in batches): no database, so no worker thread."""
-    store.telemetry.put(robot.id, body.values)
+    """Kept in memory (written in batches). 422 when the robot would hold more keys than
+    the service keeps for one robot (its first push of a worker reads its stored keys)."""
+    try:
+        await run_in_threadpool(store.telemetry.put, robot.id, body.values)
+    except TelemetryFullError as error:
+        problem = {"field": "values", "message": str(error)}
+        raise HTTPException(422, [problem]) from None

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import math
 from typing import Annotated, Any, Literal
 
@@ -104,10 +105,30 @@ class ResultReport(BaseModel):
     result: Json = None
 
 
+MAX_VALUE_BYTES = 1024
+"""The largest telemetry value, as JSON (a sensor's reading, a list of pads: far less)."""
+
+
+def small_values(values: dict[str, Any]) -> dict[str, Any]:
+    """``values`` if each one is at most :data:`MAX_VALUE_BYTES` of JSON."""
+    for key, value in values.items():
+        size = len(json.dumps(value, separators=(",", ":")))
+        if size > MAX_VALUE_BYTES:
+            raise ValueError(
+                f"the value of {key!r} is {size} bytes of JSON; at most {MAX_VALUE_BYTES}"
+            )
+    return values
+
+
 class TelemetryReport(BaseModel):
+    """Up to 500 keys a push, each value at most 1 KiB of JSON; a robot's telemetry holds
+    at most 500 keys in all (a push that would add more is a 422)."""
+
     model_config = ConfigDict(extra="forbid")
 
-    values: Annotated[dict[TelemetryKey, Any], AfterValidator(checked_json)] = Field(max_length=500)
+    values: Annotated[
+        dict[TelemetryKey, Any], AfterValidator(checked_json), AfterValidator(small_values)
+    ] = Field(max_length=500)
 
 
 class RobotPublic(BaseModel):

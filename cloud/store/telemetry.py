@@ -24,6 +24,15 @@ from cloud.store.tables import Table, TelemetryRow
 from engine.clock import Clock
 
 Reading = dict[str, Any]  # {"value": ..., "at_s": seconds since the epoch}
+MAX_KEYS = 500
+"""Keys a robot's telemetry may hold in all (its pushes update them; a push that would add
+more is refused): what a robot reports is bounded, however often it pushes."""
+
+
+class TelemetryFullError(ValueError):
+    """A push would give a robot more than :data:`MAX_KEYS` telemetry keys."""
+
+
 _robots = Table.metadata.tables["robots"]
 _SEEN = (
     update(_robots)
@@ -46,14 +55,31 @@ class Telemetry:
         self._unwritten_seen: dict[int, float] = {}
         self._polling: dict[int, int] = {}
         self._newest_poll: dict[int, int] = {}
+        self._keys: dict[int, set[str]] = {}
+        """Each robot's telemetry keys so far (the database's, and this worker's since)."""
 
     def put(self, robot_id: int, values: dict[str, Any]) -> None:
-        """Keep ``values`` as the robot's latest, stamped now; the robot was seen now."""
+        """Keep ``values`` as the robot's latest, stamped now; the robot was seen now.
+        TelemetryFullError (nothing kept) when the robot would hold more than
+        :data:`MAX_KEYS` keys."""
         if not values:
             self.seen(robot_id)
             return
+        with self._lock:
+            known = self._keys.get(robot_id)
+        if known is None:
+            stored = set(self._stored(robot_id))
+            with self._lock:
+                known = self._keys.setdefault(robot_id, stored)
         now = self.clock.now()
         with self._lock:
+            new = [key for key in values if key not in known]
+            if len(known) + len(new) > MAX_KEYS:
+                raise TelemetryFullError(
+                    f"this robot's telemetry holds {len(known)} keys and may hold {MAX_KEYS}: "
+                    f"a push updates them, it cannot add {len(new)} more ({new[0]!r}...)"
+                )
+            known.update(new)
             latest = self._latest.setdefault(robot_id, {})
             unwritten = self._unwritten.setdefault(robot_id, {})
             for key, value in values.items():
@@ -96,11 +122,15 @@ class Telemetry:
         with self._polls_changed:
             return self._polls_changed.wait_for(lambda: robot_id in self._polling, timeout_s)
 
-    def latest(self, robot_id: int) -> dict[str, Reading]:
-        """key -> {"value", "at_s"}, sorted by key."""
+    def _stored(self, robot_id: int) -> dict[str, Reading]:
+        """The robot's telemetry as the database has it."""
         with self.db.transaction() as session:
             row = session.get(TelemetryRow, robot_id)
-            stored = dict(row.readings) if row is not None else {}
+            return dict(row.readings) if row is not None else {}
+
+    def latest(self, robot_id: int) -> dict[str, Reading]:
+        """key -> {"value", "at_s"}, sorted by key."""
+        stored = self._stored(robot_id)
         with self._lock:
             for key, reading in self._latest.get(robot_id, {}).items():
                 if key not in stored or stored[key]["at_s"] <= reading["at_s"]:

@@ -459,3 +459,18 @@ def test_the_openapi_document_describes_the_errors_the_service_sends(service: Se
         f"{service.url}/robots/hbs2/commands", json={"args": {}}, headers=service.operator
     )
     assert set(sent.json()["detail"][0]) == {"field", "message"}  # what the document says
+
+
+def test_a_robot_s_telemetry_is_bounded_however_often_it_pushes(service: Service) -> None:
+    push = f"{service.url}/robot/telemetry"
+    first = {f"/sensors/k{i}": i for i in range(500)}
+    assert requests.post(push, json={"values": first}, headers=service.robot).status_code == 204
+    again = {key: value + 1 for key, value in first.items()}  # updating them is fine
+    assert requests.post(push, json={"values": again}, headers=service.robot).status_code == 204
+    more = requests.post(push, json={"values": {"/sensors/new": 1}}, headers=service.robot)
+    assert more.status_code == 422
+    assert "may hold 500" in more.json()["detail"][0]["message"]
+    big = requests.post(push, json={"values": {"/sensors/k1": "x" * 2000}}, headers=service.robot)
+    assert big.status_code == 422 and "at most 1024" in big.text
+    seen = requests.get(f"{service.url}/robots/hbs2/telemetry", headers=service.operator)
+    assert len(seen.json()) == 500 and seen.json()["/sensors/k7"]["value"] == 8
