@@ -3,6 +3,7 @@ URL, brought up to the newest schema by the migrations in cloud/migrations/."""
 
 from __future__ import annotations
 
+import fcntl
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -10,6 +11,8 @@ from typing import Any
 
 from alembic import command
 from alembic.config import Config
+from alembic.runtime.migration import MigrationContext
+from alembic.script import ScriptDirectory
 from sqlalchemy import Connection, Engine, create_engine, event, make_url, text
 from sqlalchemy.exc import ArgumentError, DBAPIError
 from sqlalchemy.orm import Session, sessionmaker
@@ -63,11 +66,39 @@ class Database:
         return self.engine.dialect.name == "postgresql"
 
     def migrate(self) -> None:
-        """Bring the schema up to the newest migration (nothing to do when it is)."""
-        with self.engine.begin() as connection:
+        """Bring the schema up to the newest migration (nothing to do when it is), one
+        process at a time (PostgreSQL: an advisory lock; SQLite: a lock file beside the
+        database). ConfigError for a schema a newer vest made (this one cannot read it)."""
+        with self._migration_lock(), self.engine.begin() as connection:
             if self.is_postgresql:  # released when the transaction ends
                 connection.execute(text(f"SELECT pg_advisory_xact_lock({MIGRATION_LOCK})"))
-            command.upgrade(alembic_config(connection), "head")
+            config = alembic_config(connection)
+            current = MigrationContext.configure(connection).get_current_revision()
+            known = {
+                script.revision for script in ScriptDirectory.from_config(config).walk_revisions()
+            }
+            if current is not None and current not in known:
+                raise ConfigError(
+                    f"--db {shown_url(str(self.engine.url))}: its schema (revision "
+                    f"{current!r}) was made by a newer vest than this one; update vest "
+                    "(pip install -U vest-engine) or use a copy made before"
+                )
+            command.upgrade(config, "head")
+
+    @contextmanager
+    def _migration_lock(self) -> Iterator[None]:
+        """For SQLite, an exclusive lock on ``FILE.migrate-lock`` while migrating: two
+        commands opening a new database at once would both create its tables."""
+        database = self.engine.url.database
+        if self.is_postgresql or not database or database == ":memory:":
+            yield
+            return
+        with open(f"{database}.migrate-lock", "a") as lock:
+            fcntl.flock(lock, fcntl.LOCK_EX)
+            try:
+                yield
+            finally:
+                fcntl.flock(lock, fcntl.LOCK_UN)
 
     @contextmanager
     def transaction(self) -> Iterator[Session]:

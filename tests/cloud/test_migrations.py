@@ -3,6 +3,11 @@ carry what a database holds from one schema to the next (and back)."""
 
 from __future__ import annotations
 
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
 import sqlalchemy as sa
 from alembic import command
 from alembic.autogenerate import compare_metadata
@@ -13,6 +18,7 @@ from cloud.store.database import Database, alembic_config, engine_url
 from cloud.store.directory import Directory
 from cloud.store.tables import Table
 from cloud.store.telemetry import Telemetry
+from engine.cli import main
 from engine.clock import VirtualClock
 
 
@@ -70,3 +76,30 @@ def test_telemetry_stored_a_row_per_key_moves_to_a_row_per_robot_and_back(
             ("/sensors/force/left_n", 100.0),
         ]
     engine.dispose()
+
+
+def test_a_database_a_newer_vest_upgraded_is_named_in_one_line(
+    db_url: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    Database(db_url).close()
+    engine = sa.create_engine(engine_url(db_url))
+    with engine.begin() as connection:
+        connection.execute(sa.text("UPDATE alembic_version SET version_num = '0099_future'"))
+    engine.dispose()
+    assert main(["cloud", "add-operator", "ana", "--db", db_url]) == 1
+    err = capsys.readouterr().err
+    assert "'0099_future') was made by a newer vest than this one; update vest" in err
+    assert "Traceback" not in err
+
+
+def test_commands_opening_a_new_sqlite_database_at_once_all_succeed(tmp_path: Path) -> None:
+    opener = "from cloud.store.database import Database; import sys; Database(sys.argv[1]).close()"
+    for round_ in range(4):
+        url = f"sqlite:///{tmp_path / f'new{round_}.db'}"
+        started = [
+            subprocess.Popen([sys.executable, "-c", opener, url], stderr=subprocess.PIPE)
+            for _ in range(3)
+        ]
+        for process in started:
+            _, err = process.communicate(timeout=60)
+            assert process.returncode == 0, err.decode()
