@@ -113,8 +113,18 @@ def test_recording_over_a_file_that_is_not_a_recording_is_refused(
     precious = tmp_path / "hug.yaml"
     precious.write_text("name: hug\n")
     assert main(["run", "--fast", "--speech", "text", "--record", str(precious)]) == 1
-    assert "holds something else; only an old recording is replaced" in capsys.readouterr().err
+    assert "holds something else, which a new recording would replace" in (capsys.readouterr().err)
     assert precious.read_text() == "name: hug\n"
+
+
+def test_recording_again_under_the_name_of_an_earlier_session_keeps_that_session(
+    demo: Path, capsys
+) -> None:
+    before = demo.read_bytes()
+    assert main(["run", "--fast", "--speech", "text", "--record", str(demo)]) == 1
+    err = capsys.readouterr().err
+    assert "holds an earlier session, which a new recording would replace" in err
+    assert demo.read_bytes() == before
 
 
 def test_at_the_moment_of_an_action_the_tree_that_took_it_shows_running(demo: Path) -> None:

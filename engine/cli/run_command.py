@@ -43,6 +43,7 @@ from engine.files.problems import LoadError
 from engine.files.yaml_source import read_text
 from engine.loader.tree_checks import spoken_quote_warnings
 from engine.recording.recorder import SessionRecorder
+from engine.recording.session_file import check_new
 from engine.runtime.reload import TreeReloader
 from engine.runtime.robot import Behaviors
 from engine.runtime.robot_factory import build_robot
@@ -232,6 +233,8 @@ def main(args: argparse.Namespace) -> int:
         raise ConfigError(f"{args.hardware}: --fast needs a simulated vest (simulated: true)")
     if args.person is not None and args.record is None:
         raise UsageError("--person names whose session is recorded: add --record FILE")
+    if args.record is not None:
+        check_new(args.record)  # before anything starts: an earlier session is never lost
     link = _cloud_link(args)
     clock: Clock = VirtualClock() if args.fast else RealClock()
     if link is not None:

@@ -74,18 +74,27 @@ CREATE INDEX events_by_time ON events (at_s);
 """
 
 
-def create(path: Path) -> sqlite3.Connection:
-    """A new, empty recording at ``path`` (replacing one there); ConfigError when the
-    folder is missing or not writable."""
+def check_new(path: Path) -> None:
+    """ConfigError unless a recording can be made at ``path``: never over a file that is
+    there (an earlier session is never lost), never as a folder."""
     if path.is_dir():
         raise ConfigError(f"--record {path}: is a folder; name a file")
-    if path.exists() and not _is_recording(path):
+    folder = path.parent if str(path.parent) else Path(".")
+    if not folder.is_dir():
+        raise ConfigError(f"--record {path}: cannot write a recording there (no folder {folder})")
+    if path.exists() or path.is_symlink():
+        what = "an earlier session" if _is_recording(path) else "something else"
         raise ConfigError(
-            f"--record {path}: holds something else; only an old recording is replaced"
+            f"--record {path}: holds {what}, which a new recording would replace; name "
+            "another file (or remove that one first)"
         )
+
+
+def create(path: Path) -> sqlite3.Connection:
+    """A new, empty recording at ``path``; ConfigError when a file is there already, or the
+    folder is missing or not writable."""
+    check_new(path)
     try:
-        if path.exists():
-            path.unlink()
         connection = sqlite3.connect(str(path), check_same_thread=False)
         connection.executescript(SCHEMA)
         connection.execute("INSERT INTO meta VALUES ('format', ?)", (str(FORMAT_VERSION),))
