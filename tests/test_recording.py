@@ -199,3 +199,19 @@ def test_a_damaged_recording_is_named_in_one_line_by_replay_and_report(
         err = capsys.readouterr().err
         assert "Traceback" not in err
         assert code == 0 or (code == 1 and "a damaged recording" in err), (command, err)
+
+
+def test_a_recording_cut_short_says_where_in_replay_and_report_and_exits_1(
+    demo: Path, capsys
+) -> None:
+    with sqlite3.connect(demo) as connection:  # as a full disk leaves it: never finished
+        connection.execute("DELETE FROM meta WHERE key = 'duration_s'")
+        connection.execute("DELETE FROM actions WHERE at_s > 10")
+        connection.execute("DELETE FROM statuses WHERE at_s > 10")
+        connection.execute("DELETE FROM blackboard WHERE at_s > 10")
+    assert main(["replay", str(demo)]) == 1
+    err = capsys.readouterr().err
+    assert "the recording was cut short at 10.00 s" in err
+    assert main(["report", str(demo)]) == 1
+    assert "cut short at 10.00 s" in capsys.readouterr().err
+    assert "cut short at 10.00 s" in demo.with_suffix(".html").read_text()

@@ -13,6 +13,7 @@ import math
 from pathlib import Path
 
 from engine.buttons.button_file import BUTTONS_TREE
+from engine.cli.output import tell
 from engine.cli.view_options import add_view_arguments, start_view
 from engine.clock import RealClock
 from engine.errors import UsageError
@@ -70,10 +71,19 @@ def main(args: argparse.Namespace) -> int:
                 nodes = f"{len(tree.nodes)} node{'' if len(tree.nodes) == 1 else 's'}"
                 print(f"  {tree.name}: {nodes} at {tree.rate_hz:g} Hz{reloads}")
             print(f"  {len(recording.actions())} actions; vest replay {args.recording} --at S")
-            return 0
+            return _whole(recording)
         if args.at > duration:
             raise UsageError(f"--at {args.at:g}: the session lasted {duration:.2f} s")
         print(moment(recording, args.at))
-        return 0
+        return _whole(recording)
     finally:
         recording.close()
+
+
+def _whole(recording: Recording) -> int:
+    """0 for a whole recording; 1, said on stderr, for one cut short or missing changes."""
+    cut = recording.cut_short
+    if cut is None:
+        return 0
+    tell(f"vest replay: {cut}")
+    return 1

@@ -9,6 +9,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from engine.cli.output import tell
 from engine.errors import ConfigError
 from engine.recording.replay import Recording
 from engine.recording.report import report_html
@@ -33,6 +34,7 @@ def main(args: argparse.Namespace) -> int:
     recording = Recording.open(args.recording)
     try:
         page = report_html(recording)
+        cut = recording.cut_short
     finally:
         recording.close()
     output = args.output or args.recording.with_suffix(".html")
@@ -43,4 +45,7 @@ def main(args: argparse.Namespace) -> int:
             f"{output}: cannot write the report ({error.strerror or error})"
         ) from None
     print(f"report: {output}")
+    if cut is not None:  # the report is written, and says so too
+        tell(f"vest report: {cut}")
+        return 1
     return 0

@@ -337,7 +337,14 @@ def main(args: argparse.Namespace) -> int:
         assembled.close()
         if recorder is not None:
             recorder.close()
-            tell(f"recording: {args.record} (vest replay {args.record} --view)")
+            if recorder.stopped_why is None:
+                tell(f"recording: {args.record} (vest replay {args.record} --view)")
+            else:
+                tell(
+                    f"vest run: the recording {args.record} stopped before the session ended "
+                    f"({recorder.stopped_why}); it holds what came before"
+                )
         if view is not None:
             view.stop()
-    return 0 if timeline.write_error is None else 1  # the robot ran; its timeline was lost
+    recorded = recorder is None or recorder.stopped_why is None
+    return 0 if timeline.write_error is None and recorded else 1  # the robot ran; not its record

@@ -56,6 +56,8 @@ class SessionRecorder:
         self._broken = False
         self._connection: sqlite3.Connection | None = create(path)
         self._seq = 0  # the order of the session's events across tables
+        self.stopped_why: str | None = None
+        """Why the recording stopped before the session ended (a full disk), or None."""
         self._queue: queue.Queue[Row | None] = queue.Queue(maxsize=capacity)
         self._thread = threading.Thread(target=self._write, name="recorder", daemon=True)
         self._thread.start()
@@ -211,6 +213,7 @@ class SessionRecorder:
                 connection.commit()
             except sqlite3.Error as error:  # a full disk: the robot goes on, the record stops
                 log.error("recording %s stopped: %s", self.path, error)
+                self.stopped_why = str(error)
                 self._broken = True
                 return
 

@@ -112,6 +112,22 @@ class Recording:
         return int(self.meta["format"])
 
     @property
+    def cut_short(self) -> str | None:
+        """Why the recording is not whole, or None: a recording that was never finished
+        (the disk filled, or vest was killed) has no ``duration_s``; one that lost changes
+        on the way says how many."""
+        if "duration_s" not in self.meta:
+            return (
+                f"{self.path}: the recording was cut short at {self.duration_s:.2f} s (it was "
+                "never finished: the disk filled, or vest was stopped hard); what came after "
+                "is not in it"
+            )
+        dropped = self.meta.get("dropped", "0")
+        if dropped.isdigit() and int(dropped) > 0:
+            return f"{self.path}: the recording lost {dropped} changes (the disk fell behind)"
+        return None
+
+    @property
     def duration_s(self) -> float:
         """How long the session ran (the last thing recorded, if it was cut off)."""
         if "duration_s" in self.meta:

@@ -125,14 +125,6 @@ def _safety_rows(recording: Recording) -> str:
     )
 
 
-def _count(text: str | None) -> int:
-    """A count kept in the recording's meta (0 when absent or not a count)."""
-    try:
-        return max(0, int(text or 0))
-    except ValueError:
-        return 0
-
-
 def _started(epoch: str | None) -> str:
     """When the session was recorded, as a date a person reads (UTC)."""
     try:
@@ -194,13 +186,8 @@ def report_html(recording: Recording) -> str:
             if unheard
             else ""
         )
-        + (
-            f" The recording lost {lost} changes (the disk fell behind): this report may "
-            "miss some of what happened."
-            if (lost := _count(recording.meta.get("dropped"))) > 0
-            else ""
-        )
     )
+    cut = recording.cut_short
     plots = [
         plot(
             "Squeeze on the side pads",
@@ -239,6 +226,9 @@ def report_html(recording: Recording) -> str:
             f'<p class="meta">{when} &middot; {person} &middot; {end:.1f} s &middot; '
             f"{html.escape(profile)} &middot; robot {robot} &middot; {recorded}</p>",
             f"<p>{html.escape(summary)}</p>",
+            f'<p class="warning">{html.escape(cut)}: this report is of what it holds.</p>'
+            if cut
+            else "",
             "<h2>What the person did, and how the robot answered</h2>",
             _table(
                 ["when", "who", "did", "the robot", "answer after"],
