@@ -215,3 +215,17 @@ def test_a_recording_cut_short_says_where_in_replay_and_report_and_exits_1(
     assert main(["report", str(demo)]) == 1
     assert "cut short at 10.00 s" in capsys.readouterr().err
     assert "cut short at 10.00 s" in demo.with_suffix(".html").read_text()
+
+
+def test_a_recording_whose_meta_is_a_view_that_never_ends_is_refused(
+    tmp_path: Path, capsys
+) -> None:
+    hostile = tmp_path / "hostile.db"
+    with sqlite3.connect(hostile) as connection:
+        connection.executescript(
+            "CREATE VIEW meta AS WITH RECURSIVE n(i) AS (SELECT 1 UNION ALL SELECT i + 1 "
+            "FROM n) SELECT 'format' AS key, '1' AS value FROM n;"
+        )
+    for command in (["replay", str(hostile)], ["report", str(hostile)]):
+        assert main(command) == 1
+        assert "'meta' is not a table" in capsys.readouterr().err

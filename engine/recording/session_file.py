@@ -111,6 +111,11 @@ def _is_recording(path: Path) -> bool:
                 return False
         connection = sqlite3.connect(f"file:{path}?mode=ro", uri=True)
         try:
+            kind = connection.execute(
+                "SELECT type FROM sqlite_master WHERE name = 'meta'"
+            ).fetchone()
+            if kind != ("table",):
+                return False
             row = connection.execute("SELECT value FROM meta WHERE key = 'format'").fetchone()
         finally:
             connection.close()
@@ -136,6 +141,14 @@ def open_for_reading(path: Path) -> sqlite3.Connection:
     try:
         # one connection, used from the view's threads one query at a time (Recording locks)
         connection = sqlite3.connect(f"file:{path}?mode=ro", uri=True, check_same_thread=False)
+        kinds = dict(connection.execute("SELECT name, type FROM sqlite_master").fetchall())
+    except sqlite3.Error:
+        raise ConfigError(f"{path}: not a vest recording (vest run --record makes them)") from None
+    not_tables = sorted(name for name in (*TABLES, "events") if kinds.get(name, "table") != "table")
+    if not_tables:  # a view in a table's place could ask anything of the reader (a loop)
+        connection.close()
+        raise ConfigError(f"{path}: not a vest recording ({not_tables[0]!r} is not a table)")
+    try:
         row = connection.execute("SELECT value FROM meta WHERE key = 'format'").fetchone()
     except sqlite3.Error:
         raise ConfigError(f"{path}: not a vest recording (vest run --record makes them)") from None
@@ -146,11 +159,7 @@ def open_for_reading(path: Path) -> sqlite3.Connection:
             f"{path}: recorded in format {row[0]}, newer than this vest reads "
             f"({FORMAT_VERSION}); update vest"
         )
-    try:
-        tables = {name for (name,) in connection.execute("SELECT name FROM sqlite_master")}
-    except sqlite3.Error as error:
-        raise ConfigError(f"{path}: a damaged recording ({error})") from None
-    missing = sorted(set(TABLES) - tables)
+    missing = sorted(set(TABLES) - set(kinds))
     if missing:
         raise ConfigError(f"{path}: a damaged recording (no table {missing[0]!r})")
     return connection
