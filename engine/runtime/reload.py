@@ -33,6 +33,8 @@ from engine.session.stream import SessionStream
 _log = logging.getLogger("vest.reload")
 
 Stamp = tuple[int, int] | None
+STEADY_ATTEMPTS = 5
+"""Loads of a file being saved meanwhile, before the check after leaves it to the next."""
 
 
 def _stamp(path: Path) -> Stamp:
@@ -145,12 +147,26 @@ class TreeReloader:
             current = {file: _stamp(file) for file in watched}
             if current == watched:
                 continue
-            ready, used = self._prepare(tree)
+            ready, read = self._prepare_steady(tree, current)
             # a refused version is remembered (reported once, not at every check); its
             # files are watched too: the fix may be in a subtree the running one lacks
-            self._stamps[path] = {**current, **_stamps(used)} if ready.problem else _stamps(used)
+            self._stamps[path] = {**current, **read} if ready.problem else read
             prepared.append(ready)
         return prepared
+
+    def _prepare_steady(
+        self, tree: RunningTree, before: dict[Path, Stamp]
+    ) -> tuple[_Prepared, dict[Path, Stamp]]:
+        """Load the changed files until what was read did not change while it was read
+        (the files' stamps before and after a load agree), so a save that finished during
+        a read is loaded too; (the load, the stamps of the files it read)."""
+        for _ in range(STEADY_ATTEMPTS):
+            ready, used = self._prepare(tree)
+            after = _stamps(used)
+            if all(before.get(file, after[file]) == after[file] for file in used):
+                return ready, after
+            before = after  # changed while being read: read it again
+        return ready, dict.fromkeys(before)  # still being written: the next check reads it
 
     def _prepare(self, tree: RunningTree) -> tuple[_Prepared, list[Path]]:
         """Load and build the changed file, or say why the running tree is kept."""

@@ -170,3 +170,24 @@ def test_each_reload_and_each_refused_edit_is_told_on_the_session_stream(tmp_pat
     reloads = heard.of(TreeReloaded)
     assert [(r.tree, r.problem == "") for r in reloads] == [("greeter", True), ("greeter", False)]
     assert "unknown node type 'Chek'" in reloads[1].problem
+
+
+def test_a_save_that_finishes_while_the_file_is_read_is_loaded_too(tmp_path):
+    robot, tree_file, reports = start(tmp_path)
+    robot.scheduler.run(until_s=0.05)
+    loader = robot.behaviors.loader
+    read = loader.load_watching
+
+    def read_during_a_save(path):
+        loaded = read(path)  # the first half of a two-part save was read...
+        if read_during_a_save.saving:
+            read_during_a_save.saving = False
+            edit(tree_file, GREETER.replace("PHRASE", "Good morning"), 2)  # ...then it ended
+        return loaded
+
+    read_during_a_save.saving = True
+    loader.load_watching = read_during_a_save
+    edit(tree_file, GREETER.replace("PHRASE", "Good morning").replace("root:", "ro"), 1)
+    robot.scheduler.run(until_s=1.05)
+    assert said(robot)[-1] == "Good morning"
+    assert reports == [("greeter", None)]  # the half-saved file was never reported
