@@ -8,8 +8,12 @@ import threading
 from pathlib import Path
 from typing import Any
 
+from engine.files.problems import LoadError
+from engine.files.yaml_source import read_bytes
+
 log = logging.getLogger("engine.services.cloud_link")
 DONE_KEPT = 1000
+MAX_DONE_BYTES = 16 * 1024 * 1024
 
 
 class DoneCommands:
@@ -23,11 +27,15 @@ class DoneCommands:
         self._done: dict[str, dict[str, Any]] = {}
         self.damaged: Path | None = None
         self._lock = threading.Lock()
-        try:
-            text = path.read_text(encoding="utf-8")
-        except FileNotFoundError:
+        if not path.exists() and not path.is_symlink():
             return  # none yet
-        except (OSError, UnicodeDecodeError) as error:
+        try:  # the one safe reader: a FIFO here is refused, never waited on
+            raw = read_bytes(path, max_bytes=MAX_DONE_BYTES, kind="record", too_big_hint="")
+            text = raw.decode("utf-8")
+        except LoadError as error:
+            self._set_aside(f"cannot be read ({error.problems[0].message})")
+            return
+        except UnicodeDecodeError as error:
             self._set_aside(f"cannot be read ({error})")
             return
         try:

@@ -20,6 +20,9 @@ from engine.files.yaml_source import read_bytes
 Samples = npt.NDArray[np.float32]
 SPEECH_RATE_HZ = 16000
 MAX_WAV_S = 600.0
+MIN_WAV_RATE_HZ, MAX_WAV_RATE_HZ = 8000, 96000
+"""The sample rates vest reads (speech needs 16 kHz; 96 kHz is a studio's most)."""
+MAX_WAV_CHANNELS = 8
 """Longer recordings are refused: the robot hears utterances, not lectures."""
 
 
@@ -55,8 +58,13 @@ class Audio:
                 samples = np.convolve(samples, kernel, mode="same").astype(np.float32)
         count = round(len(samples) * rate_hz / self.rate_hz)
         at = np.linspace(0, len(samples) - 1, count, dtype=np.float64)
-        out = np.interp(at, np.arange(len(samples)), samples).astype(np.float32)
-        return Audio(out, rate_hz)
+        # linear interpolation by index: memory for the output only, not for a float64 copy
+        # of every input sample (np.interp needs one)
+        below = np.minimum(at.astype(np.int64), len(samples) - 1)
+        above = np.minimum(below + 1, len(samples) - 1)
+        weight = (at - below).astype(np.float32)
+        out = samples[below] * (1.0 - weight) + samples[above] * weight
+        return Audio(out.astype(np.float32), rate_hz)
 
     def scaled(self, volume: float) -> Audio:
         """Louder or softer by ``volume`` (0..1 of full scale), clipped."""
@@ -92,7 +100,7 @@ def write_wav(path: Path, audio: Audio) -> None:
     path.write_bytes(audio.wav_bytes())
 
 
-MAX_WAV_BYTES = 200 * 1024 * 1024
+MAX_WAV_BYTES = 128 * 1024 * 1024
 """The largest WAV file read (10 minutes of 48 kHz 16-bit stereo fit four times over)."""
 
 
@@ -111,27 +119,45 @@ def wav_from_bytes(data: bytes, name: str) -> Audio:
     to a pipe says "as long as possible") is read for what the data holds."""
     if not data:
         raise AudioFileError(f"{name}: not a WAV file (it is empty)")
+    dtypes: dict[int, str] = {1: "u1", 2: "<i2", 4: "<i4"}
+    chunks: list[npt.NDArray[np.float32]] = []
     try:
         with wave.open(io.BytesIO(data), "rb") as wav:
             channels, width, rate = wav.getnchannels(), wav.getsampwidth(), wav.getframerate()
-            if rate < 1000 or rate > 384000:
-                raise AudioFileError(f"{name}: sample rate {rate} Hz; use 8000 to 384000 Hz")
-            raw = wav.readframes(round(MAX_WAV_S * rate) + 1)
+            if not MIN_WAV_RATE_HZ <= rate <= MAX_WAV_RATE_HZ:
+                raise AudioFileError(
+                    f"{name}: sample rate {rate} Hz; use {MIN_WAV_RATE_HZ} to {MAX_WAV_RATE_HZ} Hz"
+                )
+            if width not in dtypes:
+                raise AudioFileError(f"{name}: {8 * width}-bit samples; use 8, 16 or 32-bit PCM")
+            if not 1 <= channels <= MAX_WAV_CHANNELS:
+                raise AudioFileError(f"{name}: {channels} channels; at most {MAX_WAV_CHANNELS}")
+            most = round(MAX_WAV_S * rate)
+            taken = 0
+            while taken <= most:  # a second at a time, mixed to mono: memory for the mono
+                raw = wav.readframes(rate)
+                frames = len(raw) // (width * channels)
+                if not frames:
+                    break
+                taken += frames
+                chunks.append(_mono(raw[: frames * width * channels], dtypes[width], channels))
     except (wave.Error, EOFError) as error:
         raise AudioFileError(f"{name}: not a WAV file ({error or 'cut short'})") from None
-    dtypes: dict[int, str] = {1: "u1", 2: "<i2", 4: "<i4"}
-    if width not in dtypes:
-        raise AudioFileError(f"{name}: {8 * width}-bit samples; use 8, 16 or 32-bit PCM")
-    frames = len(raw) // (width * channels)
-    if frames > MAX_WAV_S * rate:
+    if taken > most:
         raise AudioFileError(f"{name}: more than {MAX_WAV_S:.0f} s of audio")
-    usable = frames * width * channels
-    ints = np.frombuffer(raw[:usable], dtype=dtypes[width]).astype(np.float32)
+    samples = np.concatenate(chunks) if chunks else np.zeros(0, dtype=np.float32)
+    return Audio(samples, rate)
+
+
+def _mono(raw: bytes, dtype: str, channels: int) -> npt.NDArray[np.float32]:
+    """PCM frames as float32 samples, -1..1, the channels mixed."""
+    ints = np.frombuffer(raw, dtype=dtype).astype(np.float32)
+    width = np.dtype(dtype).itemsize
     scale = {1: 128.0, 2: 32768.0, 4: 2147483648.0}[width]
     samples = (ints - 128.0) / scale if width == 1 else ints / scale
     if channels > 1:
         samples = samples.reshape(-1, channels).mean(axis=1)
-    return Audio(samples.astype(np.float32), rate)
+    return samples.astype(np.float32)
 
 
 def with_noise(audio: Audio, snr_db: float, seed: int = 0) -> Audio:

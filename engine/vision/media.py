@@ -6,7 +6,7 @@ from pathlib import Path
 
 import cv2
 
-from engine.vision.preprocess import read_image
+from engine.vision.preprocess import MAX_FRAME_PX, read_image
 
 
 def check_media(path: Path, *, video: bool) -> str | None:
@@ -22,7 +22,13 @@ def check_media(path: Path, *, video: bool) -> str | None:
         return None
     capture = cv2.VideoCapture(str(path))
     try:
-        ok = capture.isOpened() and capture.read()[0]
+        if not capture.isOpened():
+            return f"{path}: not a video OpenCV can play"
+        width = int(capture.get(cv2.CAP_PROP_FRAME_WIDTH))
+        height = int(capture.get(cv2.CAP_PROP_FRAME_HEIGHT))
+        if not (0 < width <= MAX_FRAME_PX and 0 < height <= MAX_FRAME_PX):
+            return f"{path}: {width}x{height} px frames; at most {MAX_FRAME_PX}x{MAX_FRAME_PX}"
+        ok = capture.read()[0]
     finally:
         capture.release()
     return None if ok else f"{path}: not a video OpenCV can play"

@@ -24,6 +24,9 @@ import numpy as np
 import numpy.typing as npt
 
 from engine.errors import ConfigError
+from engine.files.problems import LoadError
+from engine.files.yaml_source import read_bytes
+from engine.vision.image_size import image_size
 
 Frame = npt.NDArray[np.uint8]
 """An image as OpenCV holds it: rows x columns (x 3 for BGR colour), uint8."""
@@ -31,6 +34,16 @@ Frame = npt.NDArray[np.uint8]
 SIDE_PX = 128
 LABELS = (0, 1, 2, 3, 4, 5)
 """What the network tells apart: how many fingers a hand shows."""
+
+
+MAX_SIDE_PX = 1024
+MAX_KERNEL_PX = 101
+"""The widest blur or threshold window (the paper's are 3 and 11 px)."""
+"""The largest window a model may read (the paper's is 128)."""
+MAX_SETTINGS_BYTES = 64 * 1024
+MAX_IMAGE_BYTES = 64 * 1024 * 1024
+MAX_FRAME_PX = 8192
+"""The widest or tallest frame or picture vest reads."""
 
 
 @dataclass(frozen=True)
@@ -52,18 +65,36 @@ class Preprocessing:
     threshold_c: float = 4.0
 
     def __post_init__(self) -> None:
-        if self.side_px < 8:
-            raise ValueError(f"side_px must be at least 8, got {self.side_px}")
+        """Every number within what a frame can use: a model's settings are a file a person
+        may have edited (``blur_px: 99999`` would make one frame take minutes)."""
+        for name in ("side_px", "blur_px", "block_px", "crop_x", "crop_y"):
+            value = getattr(self, name)
+            if value is not None and (isinstance(value, bool) or not isinstance(value, int)):
+                raise ValueError(f"{name} must be a whole number of px, got {value!r}")
+        for name in ("blur_sigma", "threshold_c"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, int | float):
+                raise ValueError(f"{name} must be a number, got {value!r}")
+        if not 8 <= self.side_px <= MAX_SIDE_PX:
+            raise ValueError(f"side_px must be 8..{MAX_SIDE_PX}, got {self.side_px}")
         for name in ("blur_px", "block_px"):
             value = getattr(self, name)
-            if value < 1 or value % 2 == 0:
-                raise ValueError(f"{name} must be a positive odd number of px, got {value}")
+            if not 1 <= value <= MAX_KERNEL_PX or value % 2 == 0:
+                raise ValueError(
+                    f"{name} must be a positive odd number of px, at most {MAX_KERNEL_PX}, "
+                    f"got {value}"
+                )
         if self.block_px < 3:
             raise ValueError(f"block_px must be at least 3, got {self.block_px}")
+        if not 0 <= self.blur_sigma <= 100 or not -255 <= self.threshold_c <= 255:
+            raise ValueError(
+                f"blur_sigma must be 0..100 and threshold_c -255..255, got "
+                f"{self.blur_sigma} and {self.threshold_c}"
+            )
         for name in ("crop_x", "crop_y"):
             value = getattr(self, name)
-            if value is not None and value < 0:
-                raise ValueError(f"{name} must be 0 or more px, got {value}")
+            if value is not None and not 0 <= value <= MAX_FRAME_PX:
+                raise ValueError(f"{name} must be 0..{MAX_FRAME_PX} px, got {value}")
 
     def with_crop(self, x: int | None, y: int | None) -> Preprocessing:
         return replace(self, crop_x=x, crop_y=y)
@@ -154,13 +185,23 @@ def network_input(frame: Frame, settings: Preprocessing) -> npt.NDArray[np.float
 
 
 def read_image(path: Path) -> Frame:
-    """An image file as a BGR frame; ValueError naming the file when it cannot be read."""
-    if not path.is_file():
-        raise ValueError(f"{path}: no such file")
+    """An image file (PNG, JPEG, BMP, GIF, WebP) as a BGR frame, read by the one safe
+    reader and measured from its header before it is decoded: ValueError naming the file
+    when it cannot be read, is no picture, or is larger than :data:`MAX_FRAME_PX` a side
+    (a small file can hold a huge picture)."""
     try:
-        data = np.fromfile(str(path), dtype=np.uint8)
-    except OSError as error:
-        raise ValueError(f"{path}: cannot be read ({error.strerror or error})") from None
+        raw = read_bytes(path, max_bytes=MAX_IMAGE_BYTES, kind="picture", too_big_hint="")
+    except LoadError as error:
+        raise ValueError(f"{path}: {error.problems[0].message}") from None
+    size = image_size(raw)
+    if size is None:
+        raise ValueError(f"{path}: not a picture vest reads (PNG, JPEG, BMP, GIF or WebP)")
+    width, height = size
+    if not (0 < width <= MAX_FRAME_PX and 0 < height <= MAX_FRAME_PX):
+        raise ValueError(
+            f"{path}: a {width}x{height} px picture; at most {MAX_FRAME_PX}x{MAX_FRAME_PX}"
+        )
+    data = np.frombuffer(raw, dtype=np.uint8)
     image = cv2.imdecode(data, cv2.IMREAD_COLOR) if data.size else None
     if image is None:
         raise ValueError(f"{path}: not an image OpenCV can read")
@@ -168,12 +209,21 @@ def read_image(path: Path) -> Frame:
 
 
 def load_settings(path: Path) -> dict[str, Any]:
-    """A model's JSON sidecar as a mapping; ConfigError naming the file when unreadable."""
+    """A model's JSON sidecar as a mapping, read by the one safe reader (a FIFO or a huge
+    file is refused, never waited on); ConfigError naming the file when unreadable."""
+    if not path.exists():
+        raise ConfigError(f"{path}: no such file (a model's settings sit beside it)")
     try:
-        data = json.loads(path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise ConfigError(f"{path}: no such file (a model's settings sit beside it)") from None
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as error:
+        raw = read_bytes(
+            path,
+            max_bytes=MAX_SETTINGS_BYTES,
+            kind="model settings file",
+            too_big_hint="a model's settings are a few lines of JSON",
+        )
+        data = json.loads(raw.decode("utf-8"))
+    except LoadError as error:
+        raise ConfigError(str(error.problems[0])) from None
+    except (UnicodeDecodeError, json.JSONDecodeError, RecursionError) as error:
         raise ConfigError(f"{path}: not readable JSON ({error})") from None
     if not isinstance(data, dict):
         raise ConfigError(f"{path}: must hold a JSON object")

@@ -68,9 +68,9 @@ def test_bad_pictures_are_named_and_the_others_still_counted(tmp_path: Path, cap
     assert main(args) == 1
     captured = capsys.readouterr()
     assert captured.out.startswith(f"{good}: 1 finger (")
-    assert "notes.png: not an image OpenCV can read" in captured.err
+    assert "notes.png: not a picture vest reads" in captured.err
     assert "tiny.png: a 50x50 image is smaller than the 128x128 window" in captured.err
-    assert "gone.png: no such file" in captured.err
+    assert "gone.png: file not found" in captured.err
     assert "Traceback" not in captured.err
 
 
