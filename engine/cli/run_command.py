@@ -21,6 +21,7 @@ on stderr, the run goes on, and it exits 1.
 from __future__ import annotations
 
 import argparse
+import math
 import re
 import sys
 from collections.abc import Callable
@@ -48,7 +49,7 @@ from engine.runtime.reload import TreeReloader
 from engine.runtime.robot import Behaviors
 from engine.runtime.robot_factory import build_robot
 from engine.scenario.player import ScenarioPlayer
-from engine.scenario.scenario_file import ScenarioEvent
+from engine.scenario.scenario_file import Scenario, ScenarioEvent
 from engine.services.cloud_link import CloudLink
 from engine.services.interfaces import Speech
 from engine.services.simulated import simulated_services
@@ -220,6 +221,11 @@ def _cloud_link(args: argparse.Namespace) -> CloudLink | None:
 
 def main(args: argparse.Namespace) -> int:
     # the same checks as `vest validate`: every problem of every file, before anything starts
+    if args.hardware == DEFAULT_HARDWARE and not DEFAULT_HARDWARE.exists():
+        raise ConfigError(
+            f"no robot config: {DEFAULT_HARDWARE} is not here; run from the project folder, "
+            "or give --hardware CONFIG"
+        )
     inputs = load_run_inputs(
         args.trees,
         dialogs=args.dialogs,
@@ -231,6 +237,9 @@ def main(args: argparse.Namespace) -> int:
     behaviors, config, scenario = inputs.behaviors, inputs.config, inputs.scenario
     if args.fast and not config.simulated:
         raise ConfigError(f"{args.hardware}: --fast needs a simulated vest (simulated: true)")
+    if args.buttons is not None and args.scenario is None and not args.fast:
+        # only buttons asked for: a session the therapist leads, until Ctrl-C
+        scenario = Scenario(duration_s=math.inf, events=(), path=Path("(the buttons alone)"))
     if args.person is not None and args.record is None:
         raise UsageError("--person names whose session is recorded: add --record FILE")
     if args.record is not None:
@@ -318,6 +327,13 @@ def main(args: argparse.Namespace) -> int:
             robot.scheduler.hooks.append(reloader)
             reloader.start()
         duration = args.duration if args.duration is not None else scenario.duration_s
+        if view is not None:  # a page goes with the run: say for how long
+            tell(
+                "the session runs until Ctrl-C"
+                if math.isinf(duration)
+                else f"the session lasts {duration:g} s (--duration S to change it), and "
+                "the page with it"
+            )
         # a signal that came during start-up stops the run before its first tick
         args.stop_signals.on_stop(robot.scheduler.stop)
         timeline.start()

@@ -32,10 +32,25 @@ from engine.runtime.robot import Behaviors, load_behaviors
 from engine.scenario.scenario_file import Scenario, ScenarioEvent, load_scenario
 from engine.values.params import did_you_mean
 
-DEFAULT_DIALOGS = Path("dialogs")
-DEFAULT_HARDWARE = Path("examples/robots/sim.yaml")
-DEFAULT_SCENARIO = Path("examples/scenarios/demo.yaml")
-DEFAULT_BUTTONS = Path("trees/buttons/session.yaml")
+PROJECT = Path(__file__).resolve().parents[2]
+"""The folder vest was installed from (a checkout): its defaults are found from anywhere."""
+
+
+def project_default(relative: str) -> Path:
+    """A default file or folder of the project: as named, where the command runs (the
+    project folder, or one laid out like it), else the one in the project vest runs from,
+    so ``vest validate`` and ``vest run`` find the simulated vest outside the project too."""
+    here = Path(relative)
+    if here.exists():
+        return here
+    there = PROJECT / relative
+    return there if there.exists() else here
+
+
+DEFAULT_DIALOGS = project_default("dialogs")
+DEFAULT_HARDWARE = project_default("examples/robots/sim.yaml")
+DEFAULT_SCENARIO = project_default("examples/scenarios/demo.yaml")
+DEFAULT_BUTTONS = project_default("trees/buttons/session.yaml")
 _DEVICE_OK = "/devices/*/ok"
 
 

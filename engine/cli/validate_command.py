@@ -18,6 +18,7 @@ from engine.cli.run_inputs import (
     DEFAULT_BUTTONS,
     DEFAULT_DIALOGS,
     DEFAULT_HARDWARE,
+    button_warnings,
     check_on_robot,
     check_presses,
     check_scenario_events,
@@ -136,6 +137,10 @@ class Validator:
         self.files = ParsedFiles()
         """Each file is parsed once, however many checks look at it."""
         self.buttons_file: Path | None = None
+        self.boards: list[ButtonBoard] = []
+        """The button files checked (their conditions are checked against the trees)."""
+        self.default_dialogs: Path | None = None
+        """The dialogs a tree with no dialogs folder of its own uses (as ``vest run``)."""
         """The buttons a scenario's presses are checked against (--buttons, else the
         default)."""
         self.trees: list[TreeDefinition] = []
@@ -144,7 +149,7 @@ class Validator:
     def dialogs_for(self, path: Path) -> DialogLibrary | None:
         """The dialogs a tree at ``path`` uses (none when there is no dialogs folder, as in
         ``vest run``), or None when they have problems of their own (told once)."""
-        folder = self.dialogs_dir or find_dialogs_folder(path)
+        folder = self.dialogs_dir or find_dialogs_folder(path) or self.default_dialogs
         return self.dialog_library(folder) if folder is not None else DialogLibrary()
 
     def dialog_library(self, folder: Path) -> DialogLibrary | None:
@@ -204,7 +209,11 @@ class Validator:
             elif kind == "robot config":
                 load_config(path, self.problems)
             elif kind == "buttons":
-                load_checked_buttons(path, self.loader_for(path), self.config, self.problems)
+                board = load_checked_buttons(
+                    path, self.loader_for(path), self.config, self.problems
+                )
+                if board is not None:
+                    self.boards.append(board)
             else:
                 where = document.mark if document is not None else Mark(str(path), 1, 1)
                 self.problems.add(
@@ -264,8 +273,16 @@ def main(args: argparse.Namespace) -> int:
     problems = Problems()
     hardware = args.hardware or (DEFAULT_HARDWARE if DEFAULT_HARDWARE.is_file() else None)
     config = load_config(hardware, problems) if hardware is not None else None
+    if hardware is None:  # say which checks were skipped, never a silent "ok"
+        tell(
+            f"note: no robot config here ({DEFAULT_HARDWARE} is missing): pads, joints, "
+            "devices and safety were not checked; give --hardware CONFIG"
+        )
     dialogs = dialogs_folder(args.dialogs) if args.dialogs is not None else None
     validator = Validator(default_registry(), config, dialogs, problems)
+    # as vest run: a dialogs folder named among the paths, else the one it would use
+    named = [p for p in args.paths if p.is_dir() and p.name == DEFAULT_DIALOGS.name]
+    validator.default_dialogs = named[0] if named else dialogs_folder(None)
     validator.buttons_file = args.buttons
     profile = resolve_profile(args.profile, args.paths)
     if profile is not None:
@@ -295,7 +312,12 @@ def main(args: argparse.Namespace) -> int:
         raise LoadError(list(dict.fromkeys(validator.problems.items)))
     if not files:
         raise LoadError([Problem(Mark(str(args.paths[0]), 1, 1), "no YAML files found")])
-    for warning in turn_warnings(run_together) + spoken_quote_warnings(run_together):
+    warnings = turn_warnings(run_together) + spoken_quote_warnings(run_together)
+    if run_together:  # as vest run warns: a button shown only while a missing tree runs
+        names = [tree.name for tree in run_together]
+        for board in validator.boards:
+            warnings += button_warnings(board, names)
+    for warning in dict.fromkeys(warnings):  # a file named twice is told once
         tell(warning)
     print(f"ok: {len(files)} file{'s' if len(files) != 1 else ''}")
     return 0
