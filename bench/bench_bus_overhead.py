@@ -129,7 +129,12 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument(
         "--strict", action="store_true", help="exit 1 when the median overhead misses the target"
     )
+    parser.add_argument(
+        "--quick", action="store_true", help="a short run that only shows it still works"
+    )
     args = parser.parse_args(argv)
+    if args.quick:
+        args.transactions, args.rounds = 400, 2
     if args.transactions < args.rounds or args.rounds < 1:
         parser.error("--transactions must be at least --rounds, and --rounds at least 1")
 

@@ -19,7 +19,7 @@ Both sides share the machine's cores: on 2 cores the load generator takes about 
 CPU as the service.
 
     .venv/bin/python bench/bench_cloud.py            # ~3 min
-    .venv/bin/python bench/bench_cloud.py --quick    # ~1 min: shorter phases
+    .venv/bin/python bench/bench_cloud.py --quick    # a short run that shows it still works
 """
 
 from __future__ import annotations
@@ -167,7 +167,7 @@ async def robot(
             status, body = await polls.request("GET", f"/api/v1/robot/commands/next?wait_s={wait}")
             if status == 200:
                 command = json.loads(body)
-                key = command["args"]["key"]
+                key = command["args"]["text"]
                 if key in sent_at:
                     results.latencies_ms.append((time.perf_counter() - sent_at.pop(key)) * 1000)
                 await polls.request(
@@ -219,7 +219,7 @@ async def operator(
             status, _ = await connection.request(
                 "POST",
                 f"/api/v1/robots/{robot_name}/commands",
-                {"type": "say", "args": {"key": key}},
+                {"type": "say", "args": {"text": key}},
             )
             if status != 201:
                 raise SystemExit(f"sending a command answered {status}")
@@ -392,7 +392,7 @@ async def on_postgresql(seconds: float) -> float:
 
 
 async def run(quick: bool, only: str | None) -> None:
-    seconds = 8.0 if quick else 20.0
+    seconds = 3.0 if quick else 20.0
     print(
         f"{ROBOTS} robots, {COMMANDS_PER_S:g} commands/s for {seconds:g} s per phase; "
         f"{os.cpu_count()} cores shared by the service and this load\n"
@@ -424,7 +424,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(
         description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
     )
-    parser.add_argument("--quick", action="store_true", help="8 s phases instead of 20 s")
+    parser.add_argument("--quick", action="store_true", help="3 s phases instead of 20 s")
     parser.add_argument("--only", choices=("sqlite", "postgresql"), help="one database")
     args = parser.parse_args()
     asyncio.run(run(args.quick, args.only))

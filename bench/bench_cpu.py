@@ -131,7 +131,12 @@ def main(argv: list[str] | None = None) -> int:
         default=2.0,
         help="seconds of the long run left out of the /proc reading (start-up; default 2)",
     )
+    parser.add_argument(
+        "--quick", action="store_true", help="a short run that only shows it still works"
+    )
     args = parser.parse_args(argv)
+    if args.quick:
+        args.seconds, args.repeat, args.skip = 3.0, 2, 1.0
     if args.seconds <= 1.0 or args.repeat < 2 or not 0 <= args.skip < args.seconds:
         parser.error("--seconds above 1, --repeat at least 2, --skip within 0..--seconds")
 

@@ -597,7 +597,12 @@ def main(argv: list[str] | None = None) -> int:
         "(a what-if: vest run does not do this)",
     )
     parser.add_argument("--strict", action="store_true", help="exit 1 when a target is missed")
+    parser.add_argument(
+        "--quick", action="store_true", help="a short run that only shows it still works"
+    )
     args = parser.parse_args(argv)
+    if args.quick:
+        args.events, args.reads = 2, 3
     if args.events < 1 or args.reads < 1:
         parser.error("--events and --reads must be at least 1")
 

@@ -40,6 +40,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # run from a check
 from engine.blackboard.board import Blackboard
 from engine.blackboard.catalogue import default_catalogue
 from engine.clock import RealClock, stopwatch
+from engine.hardware.config_file import load_robot_config
+from engine.hardware.touch_pads import name_scenario_pads
 from engine.runtime.reload import TreeReloader
 from engine.runtime.robot import Robot, load_behaviors
 from engine.runtime.scheduler import RunningTree
@@ -53,6 +55,7 @@ ROOT = Path(__file__).resolve().parents[1]
 TREES_DIR = ROOT / "trees"
 DIALOGS_DIR = ROOT / "dialogs"
 SCENARIO = ROOT / "examples" / "scenarios" / "demo.yaml"
+SIM_CONFIG = ROOT / "examples" / "robots" / "sim.yaml"
 
 
 class Row:
@@ -79,6 +82,10 @@ class EngineRun:
     def __init__(self) -> None:
         behaviors = load_behaviors([TREES_DIR], dialogs_dir=DIALOGS_DIR)
         self.scenario = load_scenario(SCENARIO)
+        # its touches name pads ("middle_back"): numbered as the simulated vest names them
+        problems = name_scenario_pads(self.scenario.events, load_robot_config(SIM_CONFIG))
+        if problems:
+            raise SystemExit(f"{SCENARIO}: {problems[0]}")
         self.clock = RealClock()
         blackboard = Blackboard(default_catalogue(), self.clock)
         blackboard.reset()
@@ -225,7 +232,12 @@ def main(argv: list[str] | None = None) -> int:
         help="real seconds of each baseline, split before and after the engine "
         "(default: --seconds)",
     )
+    parser.add_argument(
+        "--quick", action="store_true", help="a short run that only shows it still works"
+    )
     args = parser.parse_args(argv)
+    if args.quick:
+        args.seconds, args.baseline_seconds = 2.0, 1.0
     if args.seconds <= 0:
         parser.error("--seconds must be above 0")
     baseline_s = args.seconds if args.baseline_seconds is None else args.baseline_seconds

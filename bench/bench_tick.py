@@ -639,7 +639,12 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument(
         "--strict", action="store_true", help="exit 1 when a ratio is over the target"
     )
+    parser.add_argument(
+        "--quick", action="store_true", help="a short run that only shows it still works"
+    )
     args = parser.parse_args(argv)
+    if args.quick:
+        args.rounds, args.ticks = 2, 60
     if args.rounds < 1 or args.ticks < 1:
         parser.error("--rounds and --ticks must be at least 1")
 

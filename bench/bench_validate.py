@@ -102,5 +102,10 @@ if __name__ == "__main__":
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--nodes", type=int, default=10_000)
     parser.add_argument("--rounds", type=int, default=5)
+    parser.add_argument(
+        "--quick", action="store_true", help="a short run that only shows it still works"
+    )
     options = parser.parse_args()
+    if options.quick:
+        options.nodes, options.rounds = 500, 1
     run(options.nodes, options.rounds)

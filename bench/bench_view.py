@@ -82,7 +82,12 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seconds", type=float, default=20.0, help="each run's length")
     parser.add_argument("--rounds", type=int, default=2)
+    parser.add_argument(
+        "--quick", action="store_true", help="a short run that only shows it still works"
+    )
     args = parser.parse_args()
+    if args.quick:
+        args.seconds, args.rounds = 3.0, 1
     ways = ("plain", "record", "view")
     results: dict[str, list[dict[str, float]]] = {way: [] for way in ways}
     with tempfile.TemporaryDirectory() as folder:

@@ -72,7 +72,12 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--frames", type=int, default=400, help="frames timed")
     parser.add_argument("--accuracy", type=int, default=1200, help="frames per style")
+    parser.add_argument(
+        "--quick", action="store_true", help="a short run that only shows it still works"
+    )
     args = parser.parse_args()
+    if args.quick:
+        args.frames, args.accuracy = 20, 24
 
     model = HandModel.load(DEFAULT_MODEL, threads=1)
     settings = model.settings
