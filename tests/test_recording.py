@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import shutil
 import sqlite3
 from pathlib import Path
 
@@ -9,6 +10,7 @@ import pytest
 
 from engine.cli import main
 from engine.recording.replay import Recording
+from engine.recording.session_file import COLUMNS
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -229,3 +231,25 @@ def test_a_recording_whose_meta_is_a_view_that_never_ends_is_refused(
     for command in (["replay", str(hostile)], ["report", str(hostile)]):
         assert main(command) == 1
         assert "'meta' is not a table" in capsys.readouterr().err
+
+
+def test_a_value_of_another_kind_in_any_column_is_a_damaged_recording_never_a_traceback(
+    demo: Path, tmp_path: Path, capsys
+) -> None:
+    """Every column a reader uses, given text where a number is, a number where a word
+    is, bytes anywhere: replay and report name the recording as damaged."""
+    for table, columns in COLUMNS.items():
+        for column in columns:
+            for value in ("'x'", "X'00ff'", "1.5"):
+                copy = tmp_path / f"{table}.{column}.db"
+                shutil.copy(demo, copy)
+                with sqlite3.connect(copy) as connection:  # one row: keys stay unique
+                    connection.execute(
+                        f"UPDATE {table} SET {column} = {value} "
+                        f"WHERE rowid = (SELECT max(rowid) FROM {table})"
+                    )
+                for command in (["replay", str(copy), "--at", "3"], ["report", str(copy)]):
+                    code = main(command)
+                    err = capsys.readouterr().err
+                    assert code in (0, 1) and "Traceback" not in err, (table, column, value)
+                copy.unlink()

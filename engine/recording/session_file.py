@@ -162,4 +162,89 @@ def open_for_reading(path: Path) -> sqlite3.Connection:
     missing = sorted(set(TABLES) - set(kinds))
     if missing:
         raise ConfigError(f"{path}: a damaged recording (no table {missing[0]!r})")
+    _check_kinds_of_values(connection, path, set(kinds))
     return connection
+
+
+TEXT, NUMBER, WHOLE = ("text",), ("real", "integer"), ("integer",)
+COLUMNS: dict[str, dict[str, tuple[tuple[str, ...], bool]]] = {
+    "meta": {"key": (TEXT, False), "value": (TEXT, False)},
+    "trees": {
+        "tree": (TEXT, False),
+        "version": (WHOLE, False),
+        "at_s": (NUMBER, False),
+        "file": (TEXT, False),
+        "rate_hz": (NUMBER, False),
+        "dot": (TEXT, False),
+    },
+    "nodes": {
+        "tree": (TEXT, False),
+        "version": (WHOLE, False),
+        "node": (WHOLE, False),
+        "path": (TEXT, False),
+        "type": (TEXT, False),
+        "label": (TEXT, False),
+        "depth": (WHOLE, False),
+    },
+    "statuses": {
+        "at_s": (NUMBER, False),
+        "tree": (TEXT, False),
+        "version": (WHOLE, False),
+        "node": (WHOLE, False),
+        "status": (TEXT, False),
+        "feedback": (TEXT, False),
+    },
+    "blackboard": {"at_s": (NUMBER, False), "key": (TEXT, False), "value": (TEXT, False)},
+    "actions": {
+        "at_s": (NUMBER, False),
+        "tree": (TEXT, False),
+        "action": (TEXT, False),
+        "args": (TEXT, False),
+        "error": (TEXT, True),
+        "outcome": (TEXT, True),
+        "ended_s": (NUMBER, True),
+        "why": (TEXT, True),
+        "seq": (WHOLE, True),
+        "ended_seq": (WHOLE, True),
+    },
+    "world": {"at_s": (NUMBER, False), "kind": (TEXT, False), "description": (TEXT, False)},
+    "events": {
+        "at_s": (NUMBER, False),
+        "kind": (TEXT, False),
+        "tree": (TEXT, False),
+        "data": (TEXT, False),
+        "seq": (WHOLE, True),
+    },
+}
+"""What kind of value each column a reader uses holds (and whether it may be empty)."""
+MAX_DEPTH = 1000
+
+
+def _check_kinds_of_values(connection: sqlite3.Connection, path: Path, tables: set[str]) -> None:
+    """ConfigError naming the first column that holds another kind of value than vest
+    writes there (text where a time is, a picture's bytes where a name is): one query a
+    table, so no reader meets such a value later."""
+    for table, columns in COLUMNS.items():
+        if table not in tables:
+            continue  # format 1 has no events table
+        present = {row[1] for row in connection.execute(f"PRAGMA table_info({table})")}
+        for column, (kinds, empty) in columns.items():
+            if column not in present:
+                continue  # a column format 1 did not have
+            allowed = ", ".join(f"'{kind}'" for kind in (*kinds, *(("null",) if empty else ())))
+            try:
+                wrong = connection.execute(
+                    f"SELECT typeof({column}) FROM {table} "
+                    f"WHERE typeof({column}) NOT IN ({allowed}) LIMIT 1"
+                ).fetchone()
+            except sqlite3.Error as error:
+                raise ConfigError(f"{path}: a damaged recording ({error})") from None
+            if wrong is not None:
+                raise ConfigError(
+                    f"{path}: a damaged recording ({table}.{column} holds {wrong[0]})"
+                )
+    deep = connection.execute(
+        "SELECT depth FROM nodes WHERE depth < 0 OR depth > ? LIMIT 1", (MAX_DEPTH,)
+    ).fetchone()
+    if deep is not None:
+        raise ConfigError(f"{path}: a damaged recording (a node at depth {deep[0]})")
