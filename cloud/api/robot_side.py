@@ -34,9 +34,15 @@ async def next_command(
     with store.telemetry.polling(robot.id) as superseded:
         store.doorbell.ring(robot.id)  # an older long-poll of this robot wakes and ends
         while not (superseded() or store.closing.is_set() or await request.is_disconnected()):
-            if await run_in_threadpool(store.principals.authenticate, token) is None:
-                raise HTTPException(status.HTTP_401_UNAUTHORIZED, "this robot's token is revoked")
-            command = await run_in_threadpool(store.ledger.claim_next, robot.id)
+
+            def still_valid() -> None:  # asked only when there is a command to take
+                if store.principals.authenticate(token) is None:
+                    raise PermissionError("this robot's token is revoked")
+
+            try:
+                command = await run_in_threadpool(store.ledger.claim_next, robot.id, still_valid)
+            except PermissionError as error:
+                raise HTTPException(status.HTTP_401_UNAUTHORIZED, str(error)) from None
             if command is not None:
                 public = CommandPublic.of(command, robot.name)
                 return ClaimedCommand(**public.model_dump(), lease_s=store.ledger.lease_s)
@@ -82,8 +88,10 @@ def report_result(
 async def push_telemetry(body: TelemetryReport, store: StoreDep, robot: CurrentRobot) -> None:
     """Kept in memory (written in batches). 422 when the robot would hold more keys than
     the service keeps for one robot (its first push of a worker reads its stored keys)."""
+    if not store.telemetry.knows(robot.id):  # its stored keys, once a worker: the database
+        await run_in_threadpool(store.telemetry.learn, robot.id)
     try:
-        await run_in_threadpool(store.telemetry.put, robot.id, body.values)
+        store.telemetry.put(robot.id, body.values)
     except TelemetryFullError as error:
         problem = {"field": "values", "message": str(error)}
         raise HTTPException(422, [problem]) from None

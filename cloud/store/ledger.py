@@ -227,9 +227,13 @@ class CommandLedger:
 
         return self._transition(robot_id, command_id, cancel)
 
-    def claim_next(self, robot_id: int) -> Command | None:
+    def claim_next(
+        self, robot_id: int, before_taking: Callable[[], None] = lambda: None
+    ) -> Command | None:
         """The oldest QUEUED command of this robot, now IN_PROGRESS under a lease (one
-        another claim or a cancel took first is passed over)."""
+        another claim or a cancel took first is passed over). ``before_taking`` is called
+        when there is one to take, before it is taken: what it raises leaves it QUEUED (a
+        robot revoked meanwhile takes nothing)."""
         self._expire_due()
         for _ in range(CHANGE_ATTEMPTS):
             try:
@@ -247,6 +251,7 @@ class CommandLedger:
                     )
                     if row is None:
                         return None
+                    before_taking()
                     self._change(row, IN_PROGRESS)
                     row.lease_until_s = self.clock.now() + self.lease_s
                     row.deliveries += 1

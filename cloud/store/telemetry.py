@@ -65,12 +65,9 @@ class Telemetry:
         if not values:
             self.seen(robot_id)
             return
-        with self._lock:
-            known = self._keys.get(robot_id)
-        if known is None:
-            stored = set(self._stored(robot_id))
-            with self._lock:
-                known = self._keys.setdefault(robot_id, stored)
+        if not self.knows(robot_id):
+            self.learn(robot_id)
+        known = self._keys[robot_id]
         now = self.clock.now()
         with self._lock:
             new = [key for key in values if key not in known]
@@ -85,6 +82,17 @@ class Telemetry:
             for key, value in values.items():
                 latest[key] = unwritten[key] = {"value": value, "at_s": now}
             self._seen[robot_id] = self._unwritten_seen[robot_id] = now
+
+    def knows(self, robot_id: int) -> bool:
+        """Whether this worker knows the robot's telemetry keys (no database needed)."""
+        with self._lock:
+            return robot_id in self._keys
+
+    def learn(self, robot_id: int) -> None:
+        """Read the robot's stored telemetry keys (once a worker: the database)."""
+        stored = set(self._stored(robot_id))
+        with self._lock:
+            self._keys.setdefault(robot_id, stored)
 
     def seen(self, robot_id: int) -> None:
         """The robot called in now (a long-poll counts)."""
