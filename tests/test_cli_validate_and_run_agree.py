@@ -198,7 +198,8 @@ def test_validate_checks_the_trees_with_a_profile_given_by_name_or_path(
 def test_a_tree_answering_from_dialogs_that_are_not_there_is_refused_by_both(
     tmp_path, capsys, monkeypatch
 ):
-    monkeypatch.chdir(tmp_path)  # no dialogs/ here nor above the tree
+    monkeypatch.chdir(tmp_path)  # a dialogs/ here, without the dialog the tree answers from
+    (tmp_path / "dialogs").mkdir()
     trees = tmp_path / "trees"
     write(
         trees / "talk.yaml",

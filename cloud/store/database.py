@@ -93,7 +93,12 @@ class Database:
         if self.is_postgresql or not database or database == ":memory:":
             yield
             return
-        with open(f"{database}.migrate-lock", "a") as lock:
+        try:
+            lock = open(f"{database}.migrate-lock", "a")  # noqa: SIM115 (held while migrating)
+        except OSError:  # no such folder: opening the database says so, in its words
+            yield
+            return
+        with lock:
             fcntl.flock(lock, fcntl.LOCK_EX)
             try:
                 yield

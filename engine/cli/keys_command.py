@@ -7,7 +7,7 @@ import argparse
 import json
 from pathlib import Path
 
-from engine.cli.run_inputs import DEFAULT_HARDWARE
+from engine.cli.run_inputs import DEFAULT_HARDWARE, found
 from engine.hardware.config_file import load_robot_config
 from engine.hardware.vest_picture import vest_picture
 from engine.nodes.registry import default_registry
@@ -30,7 +30,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def main(args: argparse.Namespace) -> int:
-    hardware = args.hardware or (DEFAULT_HARDWARE if DEFAULT_HARDWARE.is_file() else None)
+    default = found(DEFAULT_HARDWARE)
+    hardware = args.hardware or (default if default.is_file() else None)
     picture = vest_picture(load_robot_config(hardware)) if hardware is not None else None
     if args.pads:
         if picture is None:

@@ -33,6 +33,7 @@ from engine.cli.run_inputs import (
     DEFAULT_BUTTONS,
     DEFAULT_HARDWARE,
     button_warnings,
+    found,
     load_run_inputs,
 )
 from engine.cli.timeline import Timeline
@@ -221,18 +222,21 @@ def _cloud_link(args: argparse.Namespace) -> CloudLink | None:
 
 def main(args: argparse.Namespace) -> int:
     # the same checks as `vest validate`: every problem of every file, before anything starts
-    if args.hardware == DEFAULT_HARDWARE and not DEFAULT_HARDWARE.exists():
-        raise ConfigError(
-            f"no robot config: {DEFAULT_HARDWARE} is not here; run from the project folder, "
-            "or give --hardware CONFIG"
-        )
+    if args.hardware == DEFAULT_HARDWARE:
+        args.hardware = found(DEFAULT_HARDWARE)
+        if not args.hardware.exists():
+            raise ConfigError(
+                f"no robot config: {DEFAULT_HARDWARE} is not here; run from the project "
+                "folder, or give --hardware CONFIG"
+            )
     inputs = load_run_inputs(
         args.trees,
         dialogs=args.dialogs,
         profile=args.profile,
         hardware=args.hardware,
         scenario=args.scenario,
-        buttons=args.buttons or (DEFAULT_BUTTONS if DEFAULT_BUTTONS.is_file() else None),
+        buttons=args.buttons
+        or (found(DEFAULT_BUTTONS) if found(DEFAULT_BUTTONS).is_file() else None),
     )
     behaviors, config, scenario = inputs.behaviors, inputs.config, inputs.scenario
     if args.fast and not config.simulated:

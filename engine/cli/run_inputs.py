@@ -36,21 +36,21 @@ PROJECT = Path(__file__).resolve().parents[2]
 """The folder vest was installed from (a checkout): its defaults are found from anywhere."""
 
 
-def project_default(relative: str) -> Path:
-    """A default file or folder of the project: as named, where the command runs (the
-    project folder, or one laid out like it), else the one in the project vest runs from,
-    so ``vest validate`` and ``vest run`` find the simulated vest outside the project too."""
-    here = Path(relative)
-    if here.exists():
-        return here
-    there = PROJECT / relative
-    return there if there.exists() else here
+def found(default: Path) -> Path:
+    """A default file or folder of the project, looked for now: as named, where the command
+    runs (the project folder, or one laid out like it), else the one in the project vest
+    runs from, so ``vest validate`` and ``vest run`` find the simulated vest from any
+    folder; as named when neither has it."""
+    if default.exists() or default.is_absolute():
+        return default
+    there = PROJECT / default
+    return there if there.exists() else default
 
 
-DEFAULT_DIALOGS = project_default("dialogs")
-DEFAULT_HARDWARE = project_default("examples/robots/sim.yaml")
-DEFAULT_SCENARIO = project_default("examples/scenarios/demo.yaml")
-DEFAULT_BUTTONS = project_default("trees/buttons/session.yaml")
+DEFAULT_DIALOGS = Path("dialogs")
+DEFAULT_HARDWARE = Path("examples/robots/sim.yaml")
+DEFAULT_SCENARIO = Path("examples/scenarios/demo.yaml")
+DEFAULT_BUTTONS = Path("trees/buttons/session.yaml")
 _DEVICE_OK = "/devices/*/ok"
 
 
@@ -86,7 +86,8 @@ def dialogs_folder(given: Path | None) -> Path | None:
     """The dialogs folder: the one given with ``--dialogs`` (ConfigError when it is not
     a folder), else ``dialogs/`` when there is one."""
     if given is None:
-        return DEFAULT_DIALOGS if DEFAULT_DIALOGS.is_dir() else None
+        folder = found(DEFAULT_DIALOGS)
+        return folder if folder.is_dir() else None
     if not given.is_dir():
         raise ConfigError(f"--dialogs {given}: no such folder")
     return given
@@ -389,5 +390,5 @@ def default_scenario(path: Path | None, *, simulated: bool) -> Scenario:
     if path is not None:
         return load_scenario(path)
     if simulated:
-        return load_scenario(DEFAULT_SCENARIO)
+        return load_scenario(found(DEFAULT_SCENARIO))
     return Scenario(duration_s=float("inf"), events=(), path=Path("(no scenario)"))

@@ -23,6 +23,7 @@ from engine.cli.run_inputs import (
     check_presses,
     check_scenario_events,
     dialogs_folder,
+    found,
     list_lengths,
     load_checked_buttons,
     load_config,
@@ -201,9 +202,8 @@ class Validator:
                 scenario = load_scenario(path)
                 if self.config is not None:
                     self.problems.extend(check_scenario_events(scenario.events, self.config))
-                buttons = self.buttons_file or (
-                    DEFAULT_BUTTONS if DEFAULT_BUTTONS.is_file() else None
-                )
+                default = found(DEFAULT_BUTTONS)
+                buttons = self.buttons_file or (default if default.is_file() else None)
                 board = self.buttons(buttons) if buttons is not None else None
                 self.problems.extend(check_presses(scenario.events, board, buttons))
             elif kind == "robot config":
@@ -271,7 +271,8 @@ class Validator:
 def main(args: argparse.Namespace) -> int:
     files = yaml_files(args.paths)
     problems = Problems()
-    hardware = args.hardware or (DEFAULT_HARDWARE if DEFAULT_HARDWARE.is_file() else None)
+    default = found(DEFAULT_HARDWARE)
+    hardware = args.hardware or (default if default.is_file() else None)
     config = load_config(hardware, problems) if hardware is not None else None
     if hardware is None:  # say which checks were skipped, never a silent "ok"
         tell(
