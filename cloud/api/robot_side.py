@@ -7,6 +7,8 @@ from typing import Annotated
 from fastapi import APIRouter, HTTPException, Query, Request, Response, status
 from starlette.concurrency import run_in_threadpool
 
+from sqlalchemy.orm import Session
+
 from cloud.api.deps import CurrentRobot, StoreDep
 from cloud.api.schemas import ClaimedCommand, CommandPublic, ResultReport, TelemetryReport
 from cloud.store.ledger import ConflictError
@@ -35,8 +37,8 @@ async def next_command(
         store.doorbell.ring(robot.id)  # an older long-poll of this robot wakes and ends
         while not (superseded() or store.closing.is_set() or await request.is_disconnected()):
 
-            def still_valid() -> None:  # asked only when there is a command to take
-                if store.principals.authenticate(token) is None:
+            def still_valid(session: Session) -> None:  # only when there is one to take
+                if store.principals.authenticate(token, session) is None:
                     raise PermissionError("this robot's token is revoked")
 
             try:

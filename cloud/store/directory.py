@@ -77,18 +77,23 @@ class Directory:
             )
             row.revoked = True
 
-    def authenticate(self, token: str) -> Principal | None:
-        """The operator or robot whose token this is, or None (unknown or revoked)."""
-        wanted = digest(token)
-        with self.db.transaction() as session:
-            operator = session.scalar(select(OperatorRow).where(OperatorRow.token_digest == wanted))
-            if operator is not None and same_digest(operator.token_digest, wanted):
-                return (
-                    None if operator.revoked else Principal("operator", operator.id, operator.name)
-                )
-            robot = session.scalar(select(RobotRow).where(RobotRow.token_digest == wanted))
-            if robot is not None and same_digest(robot.token_digest, wanted):
-                return None if robot.revoked else Principal("robot", robot.id, robot.name)
+    def authenticate(self, token: str, session: Session | None = None) -> Principal | None:
+        """The operator or robot whose token this is, or None (unknown or revoked). Asked
+        inside another transaction, pass its ``session``: the lookup then takes no second
+        connection from the pool (a claim waiting on a second one could starve it)."""
+        if session is not None:
+            return self._holder(session, digest(token))
+        with self.db.transaction() as own:
+            return self._holder(own, digest(token))
+
+    @staticmethod
+    def _holder(session: Session, wanted: str) -> Principal | None:
+        operator = session.scalar(select(OperatorRow).where(OperatorRow.token_digest == wanted))
+        if operator is not None and same_digest(operator.token_digest, wanted):
+            return None if operator.revoked else Principal("operator", operator.id, operator.name)
+        robot = session.scalar(select(RobotRow).where(RobotRow.token_digest == wanted))
+        if robot is not None and same_digest(robot.token_digest, wanted):
+            return None if robot.revoked else Principal("robot", robot.id, robot.name)
         return None
 
     def robots_of(self, operator_id: int) -> list[RobotRow]:

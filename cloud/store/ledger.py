@@ -228,12 +228,13 @@ class CommandLedger:
         return self._transition(robot_id, command_id, cancel)
 
     def claim_next(
-        self, robot_id: int, before_taking: Callable[[], None] = lambda: None
+        self, robot_id: int, before_taking: Callable[[Session], None] = lambda session: None
     ) -> Command | None:
         """The oldest QUEUED command of this robot, now IN_PROGRESS under a lease (one
         another claim or a cancel took first is passed over). ``before_taking`` is called
-        when there is one to take, before it is taken: what it raises leaves it QUEUED (a
-        robot revoked meanwhile takes nothing)."""
+        when there is one to take, before it is taken, with the claim's session (to read
+        on it, never on a second connection): what it raises leaves it QUEUED (a robot
+        revoked meanwhile takes nothing)."""
         self._expire_due()
         for _ in range(CHANGE_ATTEMPTS):
             try:
@@ -251,7 +252,7 @@ class CommandLedger:
                     )
                     if row is None:
                         return None
-                    before_taking()
+                    before_taking(session)
                     self._change(row, IN_PROGRESS)
                     row.lease_until_s = self.clock.now() + self.lease_s
                     row.deliveries += 1

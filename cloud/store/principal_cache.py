@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import threading
 
+from sqlalchemy.orm import Session
+
 from cloud.store.directory import Directory, Principal
 from cloud.store.tokens import digest
 from engine.clock import Clock
@@ -32,14 +34,15 @@ class PrincipalCache:
             known = self._known.get(digest(token))
         return known[0] if known is not None and self.clock.now() < known[1] else None
 
-    def authenticate(self, token: str) -> Principal | None:
-        """The operator or robot whose token this is, or None (unknown or revoked)."""
+    def authenticate(self, token: str, session: Session | None = None) -> Principal | None:
+        """The operator or robot whose token this is, or None (unknown or revoked); looked
+        up on ``session`` when one is given (see `Directory.authenticate`)."""
         remembered = self.remembered(token)
         if remembered is not None:
             return remembered
         key = digest(token)
         now = self.clock.now()
-        principal = self.directory.authenticate(token)
+        principal = self.directory.authenticate(token, session)
         with self._lock:
             if principal is None:
                 self._known.pop(key, None)

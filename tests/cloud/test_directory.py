@@ -3,10 +3,12 @@
 from __future__ import annotations
 
 import pytest
-from sqlalchemy import select
+from sqlalchemy import event, select
+from sqlalchemy.orm import Session
 
 from cloud.store.database import Database
 from cloud.store.directory import Directory
+from cloud.store.ledger import CommandLedger
 from cloud.store.principal_cache import PrincipalCache
 from cloud.store.tables import OperatorRow, RobotRow
 from engine.clock import VirtualClock
@@ -77,3 +79,36 @@ def test_a_token_revoked_elsewhere_stops_working_within_the_cache_time(
     clock.advance(0.2)
     assert principals.authenticate(token) is None
     assert principals.authenticate("a guess") is None
+
+
+def test_a_claim_asks_after_its_robots_token_on_its_own_connection(
+    directory: Directory, clock: VirtualClock
+) -> None:
+    """Many long-polls claiming at once, each waiting on a second connection to check its
+    token, would hold the whole pool and starve each other: the check reads on the claim's."""
+    directory.add_operator("ana")
+    token = directory.add_robot("hbs2", operator="ana")
+    principals = PrincipalCache(directory, clock, ttl_s=0.0)  # never trusted from memory
+    ledger = CommandLedger(directory.db, clock)
+    robot = principals.authenticate(token)
+    assert robot is not None
+    ledger.submit(robot.id, "say", {"text": "hello"})
+    held = [0]
+    most = [0]
+
+    def taken(*_: object) -> None:
+        held[0] += 1
+        most[0] = max(most[0], held[0])
+
+    def given_back(*_: object) -> None:
+        held[0] -= 1
+
+    event.listen(directory.db.engine, "checkout", taken)
+    event.listen(directory.db.engine, "checkin", given_back)
+    checked: list[bool] = []
+
+    def still_valid(session: Session) -> None:
+        checked.append(principals.authenticate(token, session) is not None)
+
+    assert ledger.claim_next(robot.id, still_valid) is not None
+    assert checked == [True] and most[0] == 1
