@@ -110,6 +110,14 @@ MAX_VALUE_BYTES = 1024
 
 
 _NUMBERS = (int, float)  # bool is an int
+_LARGEST_INT = 2**63  # a reading as a database stores it; 20 characters of JSON at most
+
+
+def _small_number(value: Any) -> bool:
+    """A finite float (24 characters of JSON at most) or an int within 64 bits."""
+    if isinstance(value, float):
+        return math.isfinite(value)
+    return isinstance(value, int) and -_LARGEST_INT <= value < _LARGEST_INT
 
 
 def small_values(values: dict[str, Any]) -> dict[str, Any]:
@@ -119,8 +127,11 @@ def small_values(values: dict[str, Any]) -> dict[str, Any]:
     for key, value in values.items():
         valid_text(key)
         if isinstance(value, _NUMBERS):
-            if isinstance(value, float) and not math.isfinite(value):
-                raise ValueError(f"numbers must be finite, got {value} for {key!r}")
+            if not _small_number(value):
+                raise ValueError(
+                    f"the value of {key!r} must be a finite number within 64 bits, "
+                    f"got {str(value)[:24]}"
+                )
             continue
         checked_json(value, 1)
         if value is None or (isinstance(value, str) and len(value) <= MAX_VALUE_BYTES // 6):
@@ -128,9 +139,9 @@ def small_values(values: dict[str, Any]) -> dict[str, Any]:
         if (
             isinstance(value, list)
             and len(value) <= 32
-            and all(isinstance(item, _NUMBERS) for item in value)
+            and all(_small_number(item) for item in value)
         ):
-            continue  # a sensor's list of readings: far below the bound
+            continue  # a sensor's list of readings: at most 32 x 25 bytes, below the bound
         size = len(json.dumps(value, separators=(",", ":")))
         if size > MAX_VALUE_BYTES:
             raise ValueError(

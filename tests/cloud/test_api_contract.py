@@ -472,5 +472,15 @@ def test_a_robot_s_telemetry_is_bounded_however_often_it_pushes(service: Service
     assert "may hold 500" in more.json()["detail"][0]["message"]
     big = requests.post(push, json={"values": {"/sensors/k1": "x" * 2000}}, headers=service.robot)
     assert big.status_code == 422 and "at most 1024" in big.text
+    huge = 10**4000  # one number, 4 KB of JSON
+    for value in (huge, [10**1000] * 32, -(2**63) - 1):
+        body = json.dumps({"values": {"/sensors/k1": value}})
+        as_json = {**service.robot, "Content-Type": "application/json"}
+        answer = requests.post(push, data=body, headers=as_json)
+        assert answer.status_code == 422
+        assert "within 64 bits" in answer.text or "at most 1024" in answer.text
+    edge = {"/sensors/k1": 2**63 - 1, "/sensors/k2": [-(2**63)] * 32}
+    assert requests.post(push, json={"values": edge}, headers=service.robot).status_code == 204
     seen = requests.get(f"{service.url}/robots/hbs2/telemetry", headers=service.operator)
     assert len(seen.json()) == 500 and seen.json()["/sensors/k7"]["value"] == 8
+    assert seen.json()["/sensors/k1"]["value"] == 2**63 - 1
