@@ -3,7 +3,7 @@
 Robots push every second; writing each push at once would make the database the
 bottleneck (200 robots: 200 transactions a second). The latest values are kept in memory
 and written in one batch by ``flush()`` (the service calls it every ``flush_s``, and when it
-stops): one row per robot that pushed, holding all its keys. Reads merge memory over the
+stops): one row per robot that pushed, its stored keys merged with the new ones. Reads merge memory over the
 database, so this worker always answers with the newest it has heard; another worker
 sharing a PostgreSQL database sees it after the next flush (robots push every key every
 second, so a worker's batch is never more than a push behind).
@@ -16,8 +16,9 @@ from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from typing import Any
 
-from sqlalchemy import bindparam, update
+from sqlalchemy import bindparam, select, update
 from sqlalchemy.dialects import postgresql, sqlite
+from sqlalchemy.orm import Session
 
 from cloud.store.database import Database
 from cloud.store.tables import Table, TelemetryRow
@@ -156,25 +157,18 @@ class Telemetry:
 
     def flush(self) -> int:
         """Write what came in since the last flush, in one transaction: each robot that
-        pushed gets its row rewritten with every key this worker holds for it. Returns how
-        many new values went in."""
+        pushed gets its stored readings merged with the new ones (the newer reading of a key
+        wins; keys another worker or an earlier run stored stay). Returns how many new values
+        went in."""
         with self._lock:
             values, self._unwritten = self._unwritten, {}
             seen, self._unwritten_seen = self._unwritten_seen, {}
-            rows = [
-                {
-                    "robot_id": robot_id,
-                    "readings": dict(self._latest[robot_id]),
-                    "at_s": max(r["at_s"] for r in self._latest[robot_id].values()),
-                }
-                for robot_id in values
-            ]
-        if not rows and not seen:
+        if not values and not seen:
             return 0
         try:
             with self.db.transaction() as session:
-                if rows:
-                    session.execute(self._upsert(), rows)
+                if values:
+                    session.execute(self._upsert(), self._merged(session, values))
                 if seen:
                     session.connection().execute(
                         _SEEN, [{"robot": robot, "at": at_s} for robot, at_s in seen.items()]
@@ -183,6 +177,27 @@ class Telemetry:
             self._unwrite(values, seen)  # kept for the next flush
             raise
         return sum(len(readings) for readings in values.values())
+
+    def _merged(
+        self, session: Session, values: dict[int, dict[str, Reading]]
+    ) -> list[dict[str, Any]]:
+        """A row for each robot in ``values``: what is stored, updated with ``values`` (on
+        PostgreSQL the stored rows are locked: two workers flushing at once both count)."""
+        query = select(TelemetryRow.robot_id, TelemetryRow.readings).where(
+            TelemetryRow.robot_id.in_(values)
+        )
+        if self.db.is_postgresql:
+            query = query.with_for_update()
+        stored = {robot_id: dict(readings) for robot_id, readings in session.execute(query)}
+        rows = []
+        for robot_id, readings in values.items():
+            merged = stored.get(robot_id, {})
+            for key, reading in readings.items():
+                if key not in merged or merged[key]["at_s"] <= reading["at_s"]:
+                    merged[key] = reading
+            at_s = max(reading["at_s"] for reading in merged.values())
+            rows.append({"robot_id": robot_id, "readings": merged, "at_s": at_s})
+        return rows
 
     def _unwrite(self, values: dict[int, dict[str, Reading]], seen: dict[int, float]) -> None:
         with self._lock:

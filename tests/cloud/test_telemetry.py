@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+import pytest
+
 from cloud.store.database import Database
 from cloud.store.directory import Directory
-from cloud.store.telemetry import Telemetry
+from cloud.store.telemetry import MAX_KEYS, Telemetry, TelemetryFullError
 from engine.clock import VirtualClock
 
 
@@ -34,6 +36,36 @@ def test_pushes_are_read_at_once_and_written_in_one_batch(
         "/sensors/force/left_n": {"value": 4.5, "at_s": 1001.0},
     }
     assert telemetry.flush() == 0  # nothing new
+
+
+def test_keys_stored_before_a_restart_or_by_another_worker_stay_and_count(
+    db: Database, directory: Directory, clock: VirtualClock
+) -> None:
+    directory.add_operator("ana")
+    hbs2 = robot_id(directory)
+    before_restart = Telemetry(db, clock)
+    before_restart.put(hbs2, {"/a": 1, "/b": 2, "/c": 3})
+    before_restart.flush()
+    clock.advance(1.0)
+    one, two = Telemetry(db, clock), Telemetry(db, clock)  # the service again, two workers
+    one.put(hbs2, {"/d": 4, "/a": 10})
+    two.put(hbs2, {"/e": 5})
+    clock.advance(1.0)
+    two.put(hbs2, {"/a": 11})  # newer than what the first worker holds
+    two.flush()
+    one.flush()  # an older reading of /a, written after
+    stored = Telemetry(db, clock).latest(hbs2)
+    assert {key: reading["value"] for key, reading in stored.items()} == {
+        "/a": 11,
+        "/b": 2,
+        "/c": 3,
+        "/d": 4,
+        "/e": 5,
+    }
+    counted = Telemetry(db, clock)
+    counted.put(hbs2, {f"/new{i}": i for i in range(MAX_KEYS - 5)})  # exactly full
+    with pytest.raises(TelemetryFullError, match="holds 500 keys"):
+        counted.put(hbs2, {"/one_more": 0})
 
 
 def test_last_seen_moves_forward_only_whichever_worker_writes_last(
