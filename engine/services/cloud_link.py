@@ -211,6 +211,7 @@ class CloudLink:
                 continue
             if answer.status_code == 204:
                 self.reachable, delay_s = True, FIRST_BACKOFF_S
+                self._replies_bad = False  # the next streak of bad replies is logged again
                 continue
             if answer.status_code != 200:
                 log.warning(
@@ -228,12 +229,9 @@ class CloudLink:
     def _command_in(self, answer: requests.Response) -> dict[str, Any] | None:
         """The command a 200 reply carries, or None for a reply that is not one (counted in
         ``bad_replies``, logged once per streak): a captive portal's page, a proxy's."""
-        try:
-            command = answer.json()
-        except ValueError:
-            command = None
+        command = json_object(answer)
         if (
-            isinstance(command, dict)
+            command is not None
             and isinstance(command.get("id"), str)
             and isinstance(command.get("type"), str)
             and isinstance(command.get("args", {}), dict)
@@ -328,11 +326,9 @@ class CloudLink:
             except requests.RequestException as error:
                 self._unreachable(error)
                 continue
-            try:
-                state = answer.json().get("state") if answer.status_code == 200 else None
-            except ValueError:  # not JSON (a proxy's page): asked again at the next turn
-                state = None
-            if state == "CANCELED":
+            # a reply that is not the command (a proxy's page): asked again at the next turn
+            reply = json_object(answer) if answer.status_code == 200 else None
+            if reply is not None and reply.get("state") == "CANCELED":
                 self._cancel(command_id)
 
     def _cancel(self, command_id: str) -> None:
@@ -407,3 +403,13 @@ class CloudLink:
         if self.reachable:
             log.warning("the cloud cannot be reached (%s); the robot goes on and retries", error)
         self.reachable = False
+
+
+def json_object(answer: requests.Response) -> dict[str, Any] | None:
+    """The JSON object ``answer`` carries; None for anything else (not JSON, nested too
+    deep to read, a list or a number): a peer's reply never ends the thread reading it."""
+    try:
+        body = answer.json()
+    except (ValueError, RecursionError):
+        return None
+    return body if isinstance(body, dict) else None

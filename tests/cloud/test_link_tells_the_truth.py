@@ -146,19 +146,24 @@ def test_any_damaged_record_of_finished_commands_is_set_aside(tmp_path: Path, da
 
 
 class CaptivePortal(http.server.BaseHTTPRequestHandler):
-    """Answers the robot's first polls with a portal's page (200, HTML), then one command,
-    then nothing more; takes any report."""
+    """Answers the robot's first polls with a portal's page (200, HTML) and JSON nested too
+    deep to read, then one command, nothing, the portal again, then nothing more; answers
+    the robot's progress with a JSON list (not the command); takes any report."""
 
     polls = 0
+    progress = 0
     reports: list[dict[str, Any]] = []
+    PORTAL = b"<html><body>Welcome! Log in to the clinic wifi</body></html>"
 
     def do_GET(self) -> None:
         CaptivePortal.polls += 1
-        if CaptivePortal.polls <= 2:
-            self._send(200, b"<html><body>Welcome! Log in to the clinic wifi</body></html>")
+        if CaptivePortal.polls in (1, 5):
+            self._send(200, self.PORTAL)
+        elif CaptivePortal.polls == 2:
+            self._send(200, b"[" * 100_000 + b"]" * 100_000, "application/json")
         elif CaptivePortal.polls == 3:
             command = {"id": "c-1", "type": "say", "args": {"text": "through the portal"}}
-            self._send(200, json.dumps({**command, "lease_s": 30}).encode(), "application/json")
+            self._send(200, json.dumps({**command, "lease_s": 0.3}).encode(), "application/json")
         else:
             self._send(204, b"")
 
@@ -167,6 +172,10 @@ class CaptivePortal(http.server.BaseHTTPRequestHandler):
         body = self.rfile.read(length)
         if self.path.endswith("/result"):
             CaptivePortal.reports.append(json.loads(body))
+        if self.path.endswith("/progress"):
+            CaptivePortal.progress += 1
+            self._send(200, b"[]", "application/json")
+            return
         self._send(200, b"{}", "application/json")
 
     def _send(self, code: int, body: bytes, kind: str = "text/html") -> None:
@@ -203,7 +212,9 @@ def test_a_reply_that_is_not_a_command_is_retried_and_the_robot_keeps_taking_com
     said = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
     assert any(line.get("args", {}).get("text") == "through the portal" for line in said)
     assert CaptivePortal.reports == [{"status": "SUCCEEDED", "result": None}]
-    assert caplog.text.count("is not a command") == 1  # once for the streak of two
+    assert CaptivePortal.progress >= 1  # its odd answers did not stop the robot reporting
+    assert CaptivePortal.polls > 5  # nor polling
+    assert caplog.text.count("is not a command") == 2  # once a streak
 
 
 def test_a_robot_revoked_while_its_long_poll_waits_is_answered_401_and_takes_nothing(
