@@ -16,7 +16,7 @@ from pathlib import Path
 from typing import Any
 
 from engine.errors import ConfigError
-from engine.recording.session_file import open_for_reading
+from engine.recording.session_file import open_for_reading, whole_number
 
 STATUS_MARKS = {"SUCCESS": "ok", "FAILURE": "no", "RUNNING": "..", "INVALID": "  "}
 """How a status reads in the terminal: success, failure, running, not ticked."""
@@ -122,8 +122,10 @@ class Recording:
                 "never finished: the disk filled, or vest was stopped hard); what came after "
                 "is not in it"
             )
-        dropped = self.meta.get("dropped", "0")
-        if dropped.isdigit() and int(dropped) > 0:
+        dropped = whole_number(self.meta.get("dropped", "0"))
+        if dropped is None:
+            raise ConfigError(f"{self.path}: a damaged recording (its count of lost changes)")
+        if dropped > 0:
             return f"{self.path}: the recording lost {dropped} changes (the disk fell behind)"
         return None
 
@@ -142,7 +144,10 @@ class Recording:
             self._rows(f"SELECT max(at_s) FROM {table}")[0][0]
             for table in ("statuses", "blackboard", "actions")
         ]
-        return max((t for t in last if t is not None), default=0.0)
+        end_s = max((float(t) for t in last if t is not None), default=0.0)
+        if not math.isfinite(end_s) or end_s < 0:
+            raise ConfigError(f"{self.path}: a damaged recording (a change at {end_s} s)")
+        return end_s
 
     def _read_trees(self) -> list[RecordedTree]:
         nodes: dict[tuple[str, int], list[RecordedNode]] = {}

@@ -152,9 +152,10 @@ def open_for_reading(path: Path) -> sqlite3.Connection:
         row = connection.execute("SELECT value FROM meta WHERE key = 'format'").fetchone()
     except sqlite3.Error:
         raise ConfigError(f"{path}: not a vest recording (vest run --record makes them)") from None
-    if row is None or not str(row[0]).isdigit():
+    version = whole_number(row[0]) if row is not None else None
+    if version is None:
         raise ConfigError(f"{path}: not a vest recording (it has no format number)")
-    if int(row[0]) > FORMAT_VERSION:
+    if version > FORMAT_VERSION:
         raise ConfigError(
             f"{path}: recorded in format {row[0]}, newer than this vest reads "
             f"({FORMAT_VERSION}); update vest"
@@ -164,6 +165,16 @@ def open_for_reading(path: Path) -> sqlite3.Connection:
         raise ConfigError(f"{path}: a damaged recording (no table {missing[0]!r})")
     _check_kinds_of_values(connection, path, set(kinds))
     return connection
+
+
+def whole_number(value: object) -> int | None:
+    """``value`` (a meta value: text) as a count or a format number, or None when it is
+    not one: ASCII digits only, at most 18 of them (a damaged file may hold '²' or 5,000
+    nines, which ``int`` refuses or takes long over)."""
+    text = str(value)
+    if not (0 < len(text) <= 18 and text.isascii() and text.isdigit()):
+        return None
+    return int(text)
 
 
 TEXT, NUMBER, WHOLE = ("text",), ("real", "integer"), ("integer",)
