@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import shutil
 import sqlite3
 from pathlib import Path
@@ -117,6 +118,10 @@ def test_recording_over_a_file_that_is_not_a_recording_is_refused(
     assert main(["run", "--fast", "--speech", "text", "--record", str(precious)]) == 1
     assert "holds something else, which a new recording would replace" in (capsys.readouterr().err)
     assert precious.read_text() == "name: hug\n"
+    fifo = tmp_path / "fifo.db"
+    os.mkfifo(fifo)  # nobody writes it: reading it to see what it holds would wait for ever
+    assert main(["run", "--fast", "--speech", "text", "--record", str(fifo)]) == 1
+    assert "fifo.db: holds something else" in capsys.readouterr().err
 
 
 def test_recording_again_under_the_name_of_an_earlier_session_keeps_that_session(

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import pytest
@@ -87,6 +88,10 @@ def test_a_report_that_cannot_be_written_is_said_in_one_line(
     path = record(tmp_path, "examples/scenarios/unplug_touch.yaml", capsys, monkeypatch)
     assert main(["report", str(path), "-o", str(tmp_path / "no" / "r.html")]) == 1
     assert "r.html: cannot write the report" in capsys.readouterr().err
+    fifo = tmp_path / "fifo.html"
+    os.mkfifo(fifo)  # nobody reads it: writing would wait for ever
+    assert main(["report", str(path), "-o", str(fifo)]) == 1
+    assert "fifo.html: cannot write the report (is not a regular file" in capsys.readouterr().err
 
 
 @pytest.mark.parametrize("name", ["gone.db"])

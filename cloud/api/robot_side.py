@@ -5,9 +5,8 @@ from __future__ import annotations
 from typing import Annotated
 
 from fastapi import APIRouter, HTTPException, Query, Request, Response, status
-from starlette.concurrency import run_in_threadpool
-
 from sqlalchemy.orm import Session
+from starlette.concurrency import run_in_threadpool
 
 from cloud.api.deps import CurrentRobot, StoreDep
 from cloud.api.schemas import ClaimedCommand, CommandPublic, ResultReport, TelemetryReport

@@ -3,10 +3,10 @@
 Robots push every second; writing each push at once would make the database the
 bottleneck (200 robots: 200 transactions a second). The latest values are kept in memory
 and written in one batch by ``flush()`` (the service calls it every ``flush_s``, and when it
-stops): one row per robot that pushed, its stored keys merged with the new ones. Reads merge memory over the
-database, so this worker always answers with the newest it has heard; another worker
-sharing a PostgreSQL database sees it after the next flush (robots push every key every
-second, so a worker's batch is never more than a push behind).
+stops): one row per robot that pushed, its stored keys merged with the new ones. Reads
+merge memory over the database, so this worker always answers with the newest it has
+heard; another worker sharing a PostgreSQL database sees it after the next flush (robots
+push every key every second, so a worker's batch is never more than a push behind).
 """
 
 from __future__ import annotations

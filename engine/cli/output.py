@@ -10,8 +10,10 @@ drive the terminal.
 
 from __future__ import annotations
 
+import errno
 import math
 import os
+import stat
 import sys
 import unicodedata
 from pathlib import Path
@@ -127,3 +129,28 @@ def writable_folder(folder: Path) -> None:
         probe.unlink()
     except OSError as error:
         raise ConfigError(f"{folder}: cannot write there ({error.strerror or error})") from None
+
+
+def write_file(path: Path, data: bytes, named_by: str, what: str) -> None:
+    """``data`` (``what``: "the report") into the regular file ``path`` (made, or
+    replaced); ConfigError naming it (``named_by``: as the person did, ``-o r.html``) when
+    it cannot be written, or is a folder, a FIFO or a device: opened without blocking, so a
+    FIFO with no reader refuses at once instead of hanging the command."""
+    flags = os.O_WRONLY | os.O_CREAT | os.O_NONBLOCK | os.O_CLOEXEC
+    try:
+        descriptor = os.open(path, flags, 0o644)
+    except OSError as error:
+        why = "is not a regular file (a FIFO)" if error.errno == errno.ENXIO else reason(error)
+        raise ConfigError(f"{named_by}: cannot write {what} ({why})") from None
+    try:
+        if not stat.S_ISREG(os.fstat(descriptor).st_mode):
+            raise ConfigError(f"{named_by}: cannot write {what} (it is not a regular file)")
+        os.set_blocking(descriptor, True)
+        os.ftruncate(descriptor, 0)
+        view = memoryview(data)
+        while view:
+            view = view[os.write(descriptor, view) :]
+    except OSError as error:
+        raise ConfigError(f"{named_by}: cannot write {what} ({reason(error)})") from None
+    finally:
+        os.close(descriptor)

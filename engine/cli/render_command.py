@@ -10,8 +10,8 @@ import shutil
 import sys
 from pathlib import Path
 
+from engine.cli.output import write_file
 from engine.dialogs.library import DialogLibrary, find_dialogs_folder
-from engine.errors import ConfigError
 from engine.loader.tree_drawing import ascii_tree, dot_source
 from engine.loader.tree_file import TreeLoader
 from engine.nodes.registry import default_registry
@@ -52,7 +52,7 @@ def main(args: argparse.Namespace) -> int:
     if args.format in ("ascii", "dot"):
         text = ascii_tree(definition) if args.format == "ascii" else dot_source(definition)
         if args.output:
-            _write(args.output, text.encode("utf-8"))
+            write_file(args.output, text.encode("utf-8"), f"-o {args.output}", "the drawing")
         else:
             sys.stdout.write(text)
         return 0
@@ -80,14 +80,7 @@ def _graphviz(source: str, fmt: str, output: Path | None) -> int:
         print(f"vest render: dot failed: {result.stderr.decode(errors='replace')}", file=sys.stderr)
         return 3
     if output:
-        _write(output, result.stdout)
+        write_file(output, result.stdout, f"-o {output}", "the drawing")
     else:
         sys.stdout.buffer.write(result.stdout)
     return 0
-
-
-def _write(path: Path, data: bytes) -> None:
-    try:
-        path.write_bytes(data)
-    except OSError as error:
-        raise ConfigError(f"-o {path}: {error.strerror or error}") from None

@@ -9,8 +9,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from engine.cli.output import tell
-from engine.errors import ConfigError
+from engine.cli.output import tell, write_file
 from engine.recording.replay import Recording
 from engine.recording.report import report_html
 
@@ -38,12 +37,7 @@ def main(args: argparse.Namespace) -> int:
     finally:
         recording.close()
     output = args.output or args.recording.with_suffix(".html")
-    try:
-        output.write_text(page, encoding="utf-8")
-    except OSError as error:
-        raise ConfigError(
-            f"{output}: cannot write the report ({error.strerror or error})"
-        ) from None
+    write_file(output, page.encode("utf-8"), f"{output}", "the report")
     print(f"report: {output}")
     if cut is not None:  # the report is written, and says so too
         tell(f"vest report: {cut}")

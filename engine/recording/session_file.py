@@ -105,6 +105,8 @@ def create(path: Path) -> sqlite3.Connection:
 
 
 def _is_recording(path: Path) -> bool:
+    if not path.is_file():  # a FIFO would block the open until a writer came
+        return False
     try:
         with open(path, "rb") as file:
             if file.read(16) != b"SQLite format 3\x00":
