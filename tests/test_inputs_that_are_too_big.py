@@ -117,8 +117,13 @@ def test_a_model_s_settings_with_numbers_past_any_frame_are_refused(
         Preprocessing.from_json({field: value}, "model.json")
 
 
-def test_settings_that_are_json_nested_past_reading_are_named(tmp_path: Path) -> None:
-    deep = tmp_path / "model.json"
-    deep.write_text("[" * 20_000 + "]" * 20_000)
-    with pytest.raises(ConfigError, match="not readable JSON"):
-        load_settings(deep)
+@pytest.mark.parametrize(
+    "text",
+    ["[" * 20_000 + "]" * 20_000, '{"blur_px": ' + "9" * 5000 + "}"],
+    ids=["nested past reading", "a 5,000-digit number"],
+)
+def test_settings_that_python_cannot_read_as_json_are_named(tmp_path: Path, text: str) -> None:
+    settings = tmp_path / "model.json"
+    settings.write_text(text)
+    with pytest.raises(ConfigError, match=r"model\.json: not readable JSON"):
+        load_settings(settings)

@@ -113,9 +113,12 @@ class HandModel:
         if (
             not isinstance(labels, list)
             or not labels
-            or not all(isinstance(label, int) and not isinstance(label, bool) for label in labels)
+            or not all(
+                isinstance(label, int) and not isinstance(label, bool) and 0 <= label <= 10
+                for label in labels
+            )
         ):
-            raise ConfigError(f"{sidecar}: 'labels' must be a list of finger counts")
+            raise ConfigError(f"{sidecar}: 'labels' must be a list of finger counts (0 to 10)")
         settings = Preprocessing.from_json(data.get("preprocessing", {}), str(sidecar))
         options = ort.SessionOptions()
         options.intra_op_num_threads = max(1, threads)

@@ -223,7 +223,7 @@ def load_settings(path: Path) -> dict[str, Any]:
         data = json.loads(raw.decode("utf-8"))
     except LoadError as error:
         raise ConfigError(str(error.problems[0])) from None
-    except (UnicodeDecodeError, json.JSONDecodeError, RecursionError) as error:
+    except (ValueError, RecursionError) as error:  # bad UTF-8, bad JSON, a 5,000-digit number
         raise ConfigError(f"{path}: not readable JSON ({error})") from None
     if not isinstance(data, dict):
         raise ConfigError(f"{path}: must hold a JSON object")

@@ -6,6 +6,7 @@ from __future__ import annotations
 import json
 import shutil
 from pathlib import Path
+from typing import Any
 
 import onnxruntime as ort
 import pytest
@@ -76,3 +77,13 @@ def test_asking_only_for_a_provider_this_build_lacks_is_refused() -> None:
         pytest.skip("this onnxruntime has TensorRT")
     with pytest.raises(ConfigError, match="none of the providers TensorrtExecutionProvider"):
         choose_providers(["TensorrtExecutionProvider"])
+
+
+@pytest.mark.parametrize("labels", [[-7, 1, 2, 3, 4, 5], [0, 1, 2, 3, 4, 10**30], [0, 1.5]])
+def test_labels_that_are_not_finger_counts_are_refused(tmp_path: Path, labels: list[Any]) -> None:
+    path = copy_of_the_shipped_model(tmp_path)
+    sidecar = json.loads(path.with_suffix(".json").read_text())
+    sidecar["labels"] = labels
+    path.with_suffix(".json").write_text(json.dumps(sidecar))
+    with pytest.raises(ConfigError, match=r"must be a list of finger counts \(0 to 10\)"):
+        HandModel.load(path)
