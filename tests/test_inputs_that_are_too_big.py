@@ -57,6 +57,17 @@ def test_the_header_gives_each_format_s_size() -> None:
     assert image_size(b"\x89PNG\r\n\x1a\n") is None  # cut short
 
 
+def test_an_os2_bitmap_is_measured_by_its_own_header_and_read(tmp_path: Path) -> None:
+    """OS/2's BMP header keeps the size in two 16-bit numbers, not two 32-bit ones."""
+    width, height = 100, 60
+    pixels = b"\x80" * ((width * 3 + 3) // 4 * 4 * height)
+    core = struct.pack("<IHHHH", 12, width, height, 1, 24)
+    picture = tmp_path / "os2.bmp"
+    picture.write_bytes(b"BM" + struct.pack("<IHHI", 26 + len(pixels), 0, 0, 26) + core + pixels)
+    assert image_size(picture.read_bytes()) == (100, 60)
+    assert read_image(picture).shape == (60, 100, 3)
+
+
 def wav(path: Path, rate: int, seconds: float, channels: int = 1) -> Path:
     frames = int(rate * seconds)
     samples = (np.sin(np.arange(frames * channels) / 20.0) * 8000).astype("<i2")

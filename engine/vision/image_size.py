@@ -20,7 +20,11 @@ def image_size(data: bytes) -> tuple[int, int] | None:
         if data[:2] == b"\xff\xd8":
             return _jpeg_size(data)
         if data[:2] == b"BM":
-            width, height = struct.unpack("<ii", data[18:26])
+            (header_size,) = struct.unpack("<I", data[14:18])
+            if header_size == 12:  # OS/2's BITMAPCOREHEADER: 16-bit sizes
+                width, height = struct.unpack("<HH", data[18:22])
+            else:
+                width, height = struct.unpack("<ii", data[18:26])
             return abs(int(width)), abs(int(height))
         if data[:6] in (b"GIF87a", b"GIF89a"):
             width, height = struct.unpack("<HH", data[6:10])
