@@ -211,7 +211,12 @@ def _cloud_link(args: argparse.Namespace) -> CloudLink | None:
     if args.fast:
         raise UsageError("--cloud runs in real time: leave out --fast")
     try:
-        token = read_text(args.token_file, max_bytes=4096).strip()
+        token = read_text(
+            args.token_file,
+            max_bytes=4096,
+            kind="token file",
+            too_big_hint="it holds one line: the token `vest cloud add-robot` gave",
+        ).strip()
     except LoadError as error:
         raise ConfigError(f"--token-file {error.problems[0]}") from None
     if not token or any(c.isspace() for c in token):

@@ -208,18 +208,17 @@ def resolved(path: Path) -> Path:
 
 
 class _NotRegular(Exception):  # noqa: N818 - a refusal, reported as a problem
-    def __init__(self, what: str, hint: str | None) -> None:
+    def __init__(self, what: str) -> None:
         super().__init__(what)
         self.what = what
-        self.hint = hint
 
 
 _KINDS = (
-    (stat.S_ISDIR, "is a folder, not a file", None),
-    (stat.S_ISFIFO, "is not a regular file (a FIFO)", "name a .yaml file"),
-    (stat.S_ISCHR, "is not a regular file (a character device)", "name a .yaml file"),
-    (stat.S_ISBLK, "is not a regular file (a block device)", "name a .yaml file"),
-    (stat.S_ISSOCK, "is not a regular file (a socket)", "name a .yaml file"),
+    (stat.S_ISDIR, "is a folder, not a file"),
+    (stat.S_ISFIFO, "is not a regular file (a FIFO)"),
+    (stat.S_ISCHR, "is not a regular file (a character device)"),
+    (stat.S_ISBLK, "is not a regular file (a block device)"),
+    (stat.S_ISSOCK, "is not a regular file (a socket)"),
 )
 
 
@@ -234,11 +233,9 @@ def _read_at_most(path: Path, max_bytes: int) -> bytes:
     try:
         mode = os.fstat(fd).st_mode
         if not stat.S_ISREG(mode):
-            what, hint = next(
-                ((w, h) for test, w, h in _KINDS if test(mode)),
-                ("is not a regular file", "name a .yaml file"),
+            raise _NotRegular(
+                next((what for test, what in _KINDS if test(mode)), "is not a regular file")
             )
-            raise _NotRegular(what, hint)
         chunks: list[bytes] = []
         left = max_bytes + 1
         while left > 0:
@@ -270,7 +267,9 @@ def read_bytes(
     try:
         data = _read_at_most(path, max_bytes)
     except _NotRegular as refused:
-        raise LoadError([Problem(start, refused.what, refused.hint)]) from None
+        hint = "name a .yaml file" if kind == "vest YAML file" else f"name a {kind}"
+        folder = refused.what.startswith("is a folder")
+        raise LoadError([Problem(start, refused.what, None if folder else hint)]) from None
     except FileNotFoundError:
         raise LoadError([Problem(start, "file not found", "check the path")]) from None
     except PermissionError:
@@ -297,10 +296,17 @@ def read_bytes(
     return data
 
 
-def read_text(path: Path, shown: str | None = None, *, max_bytes: int = MAX_FILE_BYTES) -> str:
+def read_text(
+    path: Path,
+    shown: str | None = None,
+    *,
+    max_bytes: int = MAX_FILE_BYTES,
+    kind: str = "vest YAML file",
+    too_big_hint: str = "split it into subtrees",
+) -> str:
     """The file's text (see :func:`read_bytes`), or a LoadError, also when it is not UTF-8."""
     name = (shown or str(path)).replace("\0", "\\0")
-    data = read_bytes(path, shown, max_bytes=max_bytes)
+    data = read_bytes(path, shown, max_bytes=max_bytes, kind=kind, too_big_hint=too_big_hint)
     try:
         return data.decode("utf-8")
     except UnicodeDecodeError as error:

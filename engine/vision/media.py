@@ -12,8 +12,10 @@ from engine.vision.preprocess import MAX_FRAME_PX, read_image
 def check_media(path: Path, *, video: bool) -> str | None:
     """Why ``path`` cannot be shown to the camera (a picture, or a video when ``video``),
     or None when it can: the file is there and OpenCV reads a frame of it."""
-    if not path.is_file():
+    if not path.exists():
         return f"{path}: no such file"
+    if not path.is_file():  # a folder, a FIFO (OpenCV would wait on it), a device
+        return f"{path}: is not a regular file; name a {'video' if video else 'picture'} file"
     if not video:
         try:
             read_image(path)

@@ -64,6 +64,8 @@ def test_vest_run_carries_out_a_say_from_the_cloud_and_reports_it(
         (["--cloud", "http://x"], "go together"),
         (["--cloud", "ftp://x", "--token-file", "t"], "http:// or https://"),
         (["--cloud", "http://x", "--token-file", "/no/such/token"], "file not found"),
+        (["--cloud", "http://x", "--token-file", "/dev/zero"], "(name a token file)"),
+        (["--cloud", "http://x", "--token-file", "/etc"], "/etc:1:1: is a folder, not a file"),
     ],
 )
 def test_wrong_cloud_options_are_named(

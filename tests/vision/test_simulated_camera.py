@@ -3,6 +3,7 @@ a video) becomes frames; it can be unplugged; bad show_hand events are named."""
 
 from __future__ import annotations
 
+import os
 import textwrap
 from pathlib import Path
 
@@ -125,6 +126,20 @@ def test_a_missing_picture_and_a_file_that_is_no_video_are_named_before_the_run(
     assert len(found) == 2
     assert "scene.yaml:3:" in found[0] and "gone.png: no such file" in found[0]
     assert "scene.yaml:4:" in found[1] and "notes.avi: not a video OpenCV can play" in found[1]
+
+
+def test_a_fifo_or_a_folder_shown_to_the_camera_is_named_and_never_waited_on(
+    tmp_path: Path,
+) -> None:
+    os.mkfifo(tmp_path / "pipe.avi")
+    (tmp_path / "pictures").mkdir()
+    found = problems(
+        tmp_path,
+        "  - {at: 1.0, show_hand: {video: pipe.avi}}\n"
+        "  - {at: 2.0, show_hand: {image: pictures}}\n",
+    )
+    assert "pipe.avi: is not a regular file; name a video file" in found[0]
+    assert "pictures: is not a regular file; name a picture file" in found[1]
 
 
 def test_a_hand_held_up_while_another_is_lowered_stays(tmp_path: Path) -> None:
