@@ -73,10 +73,17 @@ class Database:
             if self.is_postgresql:  # released when the transaction ends
                 connection.execute(text(f"SELECT pg_advisory_xact_lock({MIGRATION_LOCK})"))
             config = alembic_config(connection)
-            current = MigrationContext.configure(connection).get_current_revision()
+            heads = MigrationContext.configure(connection).get_current_heads()
             known = {
                 script.revision for script in ScriptDirectory.from_config(config).walk_revisions()
             }
+            if len(heads) > 1:  # vest's migrations are one line: never two at once
+                raise ConfigError(
+                    f"--db {shown_url(str(self.engine.url))}: its schema is recorded as at "
+                    f"{len(heads)} revisions at once ({', '.join(map(repr, heads))}), which "
+                    "no vest makes: it was changed by another program; restore a backup"
+                )
+            current = heads[0] if heads else None
             if current is not None and current not in known:
                 raise ConfigError(
                     f"--db {shown_url(str(self.engine.url))}: its schema (revision "

@@ -92,6 +92,20 @@ def test_a_database_a_newer_vest_upgraded_is_named_in_one_line(
     assert "Traceback" not in err
 
 
+def test_a_database_recorded_at_two_revisions_at_once_is_named_in_one_line(
+    db_url: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    Database(db_url).close()
+    engine = sa.create_engine(engine_url(db_url))
+    with engine.begin() as connection:
+        connection.execute(sa.text("INSERT INTO alembic_version VALUES ('0001_other')"))
+    engine.dispose()
+    assert main(["cloud", "add-operator", "ana", "--db", db_url]) == 1
+    err = capsys.readouterr().err
+    assert "its schema is recorded as at 2 revisions at once" in err
+    assert "Traceback" not in err
+
+
 def test_commands_opening_a_new_sqlite_database_at_once_all_succeed(tmp_path: Path) -> None:
     opener = "from cloud.store.database import Database; import sys; Database(sys.argv[1]).close()"
     for round_ in range(4):
