@@ -56,6 +56,9 @@ TELEMETRY_PREFIXES = (SENSORS_PREFIX, DEVICES_PREFIX)
 PROGRESS_EVERY_S = 2.0
 """How often the robot tells the service it is still at a command (at most a third of
 the lease): an operator's cancel stops the robot within this."""
+PROGRESS_AT_MOST_EVERY_S = 0.1
+"""However short a lease the service gives, the robot says it is still at a command at most
+ten times a second (a lease of 1 ms would otherwise be a storm of requests)."""
 
 
 def _positive(value: Any, default: float) -> float:
@@ -299,7 +302,7 @@ class CloudLink:
         """Until the command being carried out is reported (or BUSY_AT_MOST_S passed: a
         robot without the iot_command tree must not stop taking commands for good)."""
         deadline_s = self.clock.now() + BUSY_AT_MOST_S
-        extend_every_s = min(self._lease_s / 3, PROGRESS_EVERY_S)
+        extend_every_s = max(min(self._lease_s / 3, PROGRESS_EVERY_S), PROGRESS_AT_MOST_EVERY_S)
         extend_at_s = self.clock.now() + extend_every_s
         while not self._idle.is_set() and not self._stop.is_set():
             now_s = self.clock.now()

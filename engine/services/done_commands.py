@@ -30,7 +30,9 @@ class DoneCommands:
         if not path.exists() and not path.is_symlink():
             return  # none yet
         try:  # the one safe reader: a FIFO here is refused, never waited on
-            raw = read_bytes(path, max_bytes=MAX_DONE_BYTES, kind="record of finished commands", too_big_hint="")
+            raw = read_bytes(
+                path, max_bytes=MAX_DONE_BYTES, kind="record of finished commands", too_big_hint=""
+            )
             text = raw.decode("utf-8")
         except LoadError as error:
             self._set_aside(f"cannot be read ({error.problems[0].message})")

@@ -147,8 +147,9 @@ def test_any_damaged_record_of_finished_commands_is_set_aside(tmp_path: Path, da
 
 class CaptivePortal(http.server.BaseHTTPRequestHandler):
     """Answers the robot's first polls with a portal's page (200, HTML) and JSON nested too
-    deep to read, then one command, nothing, the portal again, then nothing more; answers
-    the robot's progress with a JSON list (not the command); takes any report."""
+    deep to read, then one command (with a 1 ms lease), nothing, the portal again, then
+    nothing more; answers the robot's progress with a JSON list (not the command); takes
+    any report."""
 
     polls = 0
     progress = 0
@@ -163,7 +164,8 @@ class CaptivePortal(http.server.BaseHTTPRequestHandler):
             self._send(200, b"[" * 100_000 + b"]" * 100_000, "application/json")
         elif CaptivePortal.polls == 3:
             command = {"id": "c-1", "type": "say", "args": {"text": "through the portal"}}
-            self._send(200, json.dumps({**command, "lease_s": 0.3}).encode(), "application/json")
+            lease = {"lease_s": 0.001}  # a service set up wrong: the robot must not storm it
+            self._send(200, json.dumps({**command, **lease}).encode(), "application/json")
         else:
             self._send(204, b"")
 
@@ -212,7 +214,9 @@ def test_a_reply_that_is_not_a_command_is_retried_and_the_robot_keeps_taking_com
     said = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
     assert any(line.get("args", {}).get("text") == "through the portal" for line in said)
     assert CaptivePortal.reports == [{"status": "SUCCEEDED", "result": None}]
-    assert CaptivePortal.progress >= 1  # its odd answers did not stop the robot reporting
+    # its odd answers did not stop the robot reporting, at most ten times a second (a say
+    # of three words takes about a second; at a third of the lease it would be thousands)
+    assert 1 <= CaptivePortal.progress <= 30
     assert CaptivePortal.polls > 5  # nor polling
     assert caplog.text.count("is not a command") == 2  # once a streak
 
