@@ -119,8 +119,8 @@ class Recording:
         if "duration_s" not in self.meta:
             return (
                 f"{self.path}: the recording was cut short at {self.duration_s:.2f} s (it was "
-                "never finished: the disk filled, or vest was stopped hard); what came after "
-                "is not in it"
+                "never finished: the disk filled, or vest was stopped hard, or it is still "
+                "being recorded); what came after is not in it"
             )
         dropped = whole_number(self.meta.get("dropped", "0"))
         if dropped is None:
