@@ -33,6 +33,22 @@ def test_outside_the_project_validate_and_run_find_the_simulated_vest_and_the_di
     assert "buttons        lights the face green" in ran.stdout
 
 
+def test_a_project_of_its_own_gets_our_buttons_only_with_our_demo_that_presses_them(
+    tmp_path: Path, capsys, monkeypatch
+) -> None:
+    (tmp_path / "trees").mkdir()  # a therapist's project: one tree, no button board
+    shutil.copy(ROOT / "trees" / "hug.yaml", tmp_path / "trees")
+    (tmp_path / "pat.yaml").write_text(
+        "duration_s: 5\nevents:\n  - {at: 1.0, touch: {pad: chest, seconds: 1}}\n"
+    )
+    monkeypatch.chdir(tmp_path)
+    run = ["run", "--fast", "--speech", "text", "--duration", "9", "--trees", "trees"]
+    assert main([*run, "--scenario", "pat.yaml"]) == 0
+    assert "buttons" not in capsys.readouterr().out  # our 'Well done' never joins it
+    assert main(run) == 0  # our demo scenario, which presses our button: lent together
+    assert "presses the button 'Well done'" in capsys.readouterr().out
+
+
 def test_validate_says_which_checks_it_skipped_without_a_robot_config(
     tmp_path: Path, capsys, monkeypatch
 ) -> None:

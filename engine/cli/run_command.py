@@ -30,9 +30,9 @@ from pathlib import Path
 from engine.buttons.wizard import Wizard
 from engine.cli.output import shown, tell
 from engine.cli.run_inputs import (
-    DEFAULT_BUTTONS,
     DEFAULT_HARDWARE,
     button_warnings,
+    default_buttons,
     found,
     load_run_inputs,
 )
@@ -240,8 +240,7 @@ def main(args: argparse.Namespace) -> int:
         profile=args.profile,
         hardware=args.hardware,
         scenario=args.scenario,
-        buttons=args.buttons
-        or (found(DEFAULT_BUTTONS) if found(DEFAULT_BUTTONS).is_file() else None),
+        buttons=args.buttons or default_buttons(with_our_scenario=args.scenario is None),
     )
     behaviors, config, scenario = inputs.behaviors, inputs.config, inputs.scenario
     if args.fast and not config.simulated:

@@ -54,6 +54,20 @@ DEFAULT_BUTTONS = Path("trees/buttons/session.yaml")
 _DEVICE_OK = "/devices/*/ok"
 
 
+def default_buttons(*, with_our_scenario: bool = False) -> Path | None:
+    """The button board a session gets when none is named: ``trees/buttons/session.yaml``
+    where the command runs. The project vest runs from lends its board to a folder that is
+    no project, or along with its demo scenario (``with_our_scenario``, which presses it); a
+    project with trees/ of its own and no board otherwise has none (ours would act on a
+    robot its author set up)."""
+    if DEFAULT_BUTTONS.is_file():
+        return DEFAULT_BUTTONS
+    if Path("trees").is_dir() and not with_our_scenario:
+        return None
+    there = found(DEFAULT_BUTTONS)
+    return there if there.is_file() else None
+
+
 def resolve_profile(value: str | Path | None, trees: Sequence[Path]) -> Path | None:
     """A profile given by file or by name: ``child`` is ``profiles/child.yaml`` in the
     folder of the trees (or a folder above it, for a subtree in ``parts/``).

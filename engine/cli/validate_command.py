@@ -22,6 +22,7 @@ from engine.cli.run_inputs import (
     check_on_robot,
     check_presses,
     check_scenario_events,
+    default_buttons,
     dialogs_folder,
     found,
     list_lengths,
@@ -202,8 +203,7 @@ class Validator:
                 scenario = load_scenario(path)
                 if self.config is not None:
                     self.problems.extend(check_scenario_events(scenario.events, self.config))
-                default = found(DEFAULT_BUTTONS)
-                buttons = self.buttons_file or (default if default.is_file() else None)
+                buttons = self.buttons_file or default_buttons()
                 board = self.buttons(buttons) if buttons is not None else None
                 self.problems.extend(check_presses(scenario.events, board, buttons))
             elif kind == "robot config":
