@@ -14,6 +14,8 @@ from engine.files.yaml_source import read_bytes
 log = logging.getLogger("engine.services.cloud_link")
 DONE_KEPT = 1000
 MAX_DONE_BYTES = 16 * 1024 * 1024
+REPORTED = ("SUCCEEDED", "FAILED")
+"""What a robot reports of a command it finished."""
 
 
 class DoneCommands:
@@ -45,7 +47,10 @@ class DoneCommands:
         except (ValueError, RecursionError) as error:  # not JSON; nested beyond reading
             self._set_aside(f"is not JSON ({error})")
             return
-        if not isinstance(loaded, dict) or not all(isinstance(v, dict) for v in loaded.values()):
+        if not isinstance(loaded, dict) or not all(
+            isinstance(report, dict) and report.get("status") in REPORTED
+            for report in loaded.values()
+        ):  # a report the service would refuse, on every delivery again
             self._set_aside("does not hold finished commands by id")
             return
         self._done = {str(k): v for k, v in loaded.items()}

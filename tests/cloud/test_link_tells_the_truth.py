@@ -135,7 +135,14 @@ def test_telemetry_is_what_the_scheduler_committed_and_its_failures_are_counted(
 
 @pytest.mark.parametrize(
     "damaged",
-    ["[" * 100_000 + "]" * 100_000, "", "[1, 2]", '{"cmd-1": "done"}', "\x00\xff"],
+    [
+        "[" * 100_000 + "]" * 100_000,
+        "",
+        "[1, 2]",
+        '{"cmd-1": "done"}',
+        '{"cmd-1": {"status": "X"}}',
+        "\x00\xff",
+    ],
 )
 def test_any_damaged_record_of_finished_commands_is_set_aside(tmp_path: Path, damaged: str) -> None:
     path = tmp_path / "robot.token.done.json"
