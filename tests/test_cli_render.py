@@ -74,7 +74,8 @@ def test_rendering_a_broken_tree_lists_its_problems(tmp_path, capsys):
 def test_an_output_file_that_cannot_be_written_is_named_with_the_reason(capsys, monkeypatch):
     monkeypatch.chdir(ROOT)
     assert main(["render", "trees/hug.yaml", "-o", "/nonexistent/hug.txt"]) == 1
-    assert "-o /nonexistent/hug.txt: No such file or directory" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert "-o /nonexistent/hug.txt: cannot write the drawing (No such file or directory)" in err
 
 
 def test_a_drawing_speaks_plainly_frames_subtrees_and_has_a_legend(capsys, monkeypatch):
