@@ -75,7 +75,8 @@ COMPOSITES = (
                 "succeed_when",
                 Choice(("all", "one")),
                 "all",
-                "all: succeed when every child succeeded; one: when the first one did",
+                "all: succeed when every child succeeded; one: as soon as one did (the "
+                "children after it are not ticked, those still running are halted)",
             ),
             Param(
                 "synchronise",

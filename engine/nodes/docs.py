@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from typing import Any
 
+from engine.nodes.bt_cpp_counterparts import comparison_markdown
 from engine.nodes.registry import NodeRegistry
 from engine.nodes.spec import KINDS
 from engine.values.params import REQUIRED, Param
@@ -59,6 +60,7 @@ def nodes_markdown(registry: NodeRegistry) -> str:
                 lines += [f"Reads: {reads}. Writes: {writes}.", ""]
             if node_type.source != "vest":
                 lines += [f"From: {node_type.source}", ""]
+    lines += comparison_markdown()
     return "\n".join(lines).rstrip() + "\n"
 
 

@@ -23,9 +23,11 @@ class Parallel(py_trees.composites.Composite):
 
     ``succeed_when="all"``: SUCCESS when every child succeeded; FAILURE when every child
     has finished and at least one failed (the feedback names them); RUNNING before.
-    ``succeed_when="one"``: SUCCESS as soon as one child succeeds (the others are halted);
-    FAILURE when every child failed. ``synchronise``: a child that succeeded is not
-    ticked again in this round (with ``False`` it is, so a condition can change its mind).
+    ``succeed_when="one"``: SUCCESS as soon as one child succeeds: the children after it
+    are not ticked in that tick, those still running are halted (as BehaviorTree.CPP's
+    Parallel with success_count 1); FAILURE when every child failed. ``synchronise``: a
+    child that succeeded is not ticked again in this round (with ``False`` it is, so a
+    condition can change its mind).
     """
 
     def __init__(
@@ -57,6 +59,8 @@ class Parallel(py_trees.composites.Composite):
             if child.status == Status.SUCCESS and self.synchronise:
                 continue
             yield from child.tick()
+            if self.succeed_when == "one" and child.status == Status.SUCCESS:
+                break  # decided: the children after it are not started only to be halted
         new_status = self._outcome()
         self.current_child = self.children[-1]
         if new_status != Status.RUNNING:

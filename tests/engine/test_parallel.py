@@ -64,3 +64,22 @@ def test_a_new_round_starts_every_child_afresh() -> None:
 
 def test_no_children_is_success() -> None:
     assert tick(Parallel("empty", [])) == Status.SUCCESS
+
+
+class Counted(StatusQueue):
+    """A child that also counts its ticks."""
+
+    ticks = 0
+
+    def update(self) -> Status:
+        self.ticks += 1
+        return super().update()
+
+
+def test_succeed_when_one_starts_no_child_after_the_one_that_succeeded() -> None:
+    # the robot must not start saying something only to be cut short in the same tick
+    late = Counted(name="late", queue=[Status.RUNNING], eventually=Status.RUNNING)
+    both = Parallel("both", [child("fast", Status.SUCCESS), late], succeed_when="one")
+    assert tick(both) == Status.SUCCESS
+    assert late.ticks == 0
+    assert late.status == Status.INVALID
