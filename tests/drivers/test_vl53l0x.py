@@ -114,8 +114,8 @@ def test_no_chip_raises_device_error_naming_chip_and_address(clock, bus):
 def test_init_sets_2v8_io_signal_rate_limit_and_sequence(clock, bus, chip):
     VL53L0X(bus, clock=clock, signal_rate_limit_mcps=0.5)
     assert chip.peek(0x89) & 0x01  # 2V8 I/O
-    assert chip.peek(0x60) & 0x12 == 0x12  # MSRC and pre-range limit checks off
-    assert (chip.peek(0x44) << 8) | chip.peek(0x45) == 64  # 0.5 MCPS in Q9.7
+    assert chip.peek(0x60) == 0x00  # MSRC_CONFIG_CONTROL as ST's tuning table leaves it
+    assert (chip.peek(0x44) << 8) | chip.peek(0x45) == 64  # 0.5 MCPS in Q9.7, after the table
     assert chip.peek(0x0A) == 0x04  # interrupt on new sample ready
     assert chip.peek(0x01) == 0xE8  # DSS, pre-range, final range
 
