@@ -6,73 +6,61 @@ be moved to its own address before the next one is switched on:
 :meth:`VL53L0X.set_address`; a TCA9548A multiplexer (:mod:`engine.drivers.tca9548a`)
 is the other way, each sensor keeping 0x29 on its own channel.
 
-The initialisation follows the order of ST's API as Pololu's library distils it, keeping
-the steps that matter for single-shot ranging:
+The bring-up is ST's (``VL53L0X_DataInit``, ``StaticInit`` and ``PerformRefCalibration``
+of its API), in the order Pololu's library distils it:
 
 * I/O in 2V8 mode (bit 0 of VHV_CONFIG_PAD_SCL_SDA__EXTSUP_HV) and I2C standard mode;
 * read the "stop variable" from the private register page (it is written back before each
   single-shot measurement, as ST's code does);
 * disable the MSRC and pre-range signal-rate limit checks and set the final-range signal
-  rate limit (0.25 MCPS, Q9.7 fixed point);
+  rate limit (0.25 MCPS by default, Q9.7 fixed point); the tuning table below writes both
+  registers again, as in ST's API, and a limit other than its 0.25 MCPS is set once more;
+* the reference SPADs: their count, kind and map of working SPADs read from the chip's
+  NVM through ST's handshake (:mod:`engine.drivers.vl53l0x_spads`), then enabled;
+* ST's default tuning table (:mod:`engine.drivers.vl53l0x_tuning`);
 * interrupt on "new sample ready", active low, cleared;
-* sequence steps DSS, pre-range and final range (0xE8), then the VHV and phase
-  reference calibrations.
+* the timing budget read back with the tuning's sequence steps and applied again to the
+  sequence DSS, pre-range and final range (0xE8), so the final range gets the time TCC and
+  MSRC no longer take (:mod:`engine.drivers.vl53l0x_timing`);
+* the VHV and phase reference calibrations.
 
-Simplified, compared with ST's full sequence: the reference-SPAD selection (read from the
-chip's NVM and written to GLOBAL_CONFIG_SPAD_ENABLES_REF_*), the ~80-register default
-tuning table and the timing-budget recomputation are not done. The chip then ranges with
-its power-on SPAD map and tuning and its default ~33 ms timing budget; readings are
-usable for presence and tracking at arm's length but can be less accurate or shorter-ranged
-than with the full ST sequence. Port those steps if millimetre accuracy ever matters.
+``tests/drivers/test_vl53l0x_bring_up.py`` holds these register writes against those of
+Adafruit's CircuitPython driver on the simulated chip. Not done: ST's reference SPAD
+management (a calibration on a target, for a chip whose NVM is invalid: such a chip is
+refused), offset and cross-talk calibration, and continuous ranging.
 """
 
 from __future__ import annotations
 
+import contextlib
 import threading
-from collections.abc import Callable
+from collections.abc import Callable, Iterable, Iterator
 
 from engine.clock import Clock
+from engine.drivers import vl53l0x_registers as reg
 from engine.drivers.bus_protocols import I2CBus
 from engine.drivers.device_errors import ImplausibleReadingError, device_error, i2c_place
+from engine.drivers.vl53l0x_spads import (
+    NVM_GOOD_SPAD_MAP,
+    NVM_SPAD_INFO,
+    SPAD_MAP_BYTES,
+    ReferenceSpads,
+    from_nvm_words,
+    select_reference_spads,
+)
+from engine.drivers.vl53l0x_timing import (
+    TimingRegisters,
+    final_range_timeout_for,
+    timing_budget_us,
+)
+from engine.drivers.vl53l0x_tuning import DEFAULT_TUNING, TUNING_SIGNAL_RATE_LIMIT
 from engine.errors import DeviceError
 
 CHIP = "VL53L0X"
 DEFAULT_ADDRESS = 0x29
-
-# -- register map (ST API names) ------------------------------------------------------------
-SYSRANGE_START = 0x00
-SYSRANGE_START_SINGLESHOT = 0x01  # bit 0: start; clears itself once ranging has begun
-SYSTEM_SEQUENCE_CONFIG = 0x01
-SYSTEM_INTERRUPT_CONFIG_GPIO = 0x0A
-INTERRUPT_NEW_SAMPLE_READY = 0x04
-SYSTEM_INTERRUPT_CLEAR = 0x0B
-RESULT_INTERRUPT_STATUS = 0x13
-RESULT_INTERRUPT_MASK = 0x07
-RESULT_RANGE_STATUS = 0x14
-RESULT_RANGE_MM_OFFSET = 10  # range in mm, big-endian 16-bit, at RESULT_RANGE_STATUS + 10
-RESULT_BLOCK_LENGTH = 12
-FINAL_RANGE_CONFIG_MIN_COUNT_RATE_RTN_LIMIT = 0x44  # 16-bit, Q9.7 MCPS
-MSRC_CONFIG_CONTROL = 0x60
-MSRC_DISABLE_SIGNAL_RATE_CHECKS = 0x12  # bit 1 MSRC, bit 4 pre-range
-GPIO_HV_MUX_ACTIVE_HIGH = 0x84
-GPIO_HV_MUX_POLARITY_HIGH = 0x10
-I2C_STANDARD_MODE = 0x88
-VHV_CONFIG_PAD_SCL_SDA_EXTSUP_HV = 0x89
-VHV_CONFIG_2V8 = 0x01
-I2C_SLAVE_DEVICE_ADDRESS = 0x8A
-IDENTIFICATION_MODEL_ID = 0xC0
-IDENTITY = (0xEE, 0xAA, 0x10)  # registers 0xC0, 0xC1, 0xC2 (model, ?, revision)
-
-# The private page that holds the stop variable (register 0x91 with 0xFF = 0x01).
-POWER_MANAGEMENT = 0x80
-PAGE_SELECT = 0xFF
-STOP_VARIABLE = 0x91
-
-SEQUENCE_ALL = 0xFF
-SEQUENCE_DSS_PRE_FINAL = 0xE8  # DSS, pre-range and final range; no TCC, no MSRC
-SEQUENCE_VHV_CALIBRATION = 0x01
-SEQUENCE_PHASE_CALIBRATION = 0x02
-VHV_CALIBRATION_START = 0x40
+# What the chip kind probes with (engine.hardware.chips.vl53l0x):
+IDENTIFICATION_MODEL_ID = reg.IDENTIFICATION_MODEL_ID  # the first identity register
+IDENTITY = reg.IDENTITY  # 0xC0..0xC2
 
 # Bits 6:3 of RESULT_RANGE_STATUS: the device's range status; 11 means a valid range.
 DEVICE_RANGE_STATUS_VALID = 11
@@ -122,10 +110,11 @@ def check_address(address: int) -> int:
 
 
 class VL53L0X:
-    """One VL53L0X, checked and initialised on construction; single-shot ranging.
+    """One VL53L0X, checked and brought up as ST does on construction; single-shot ranging.
 
-    ``timeout_s`` bounds one measurement (start to result, on ``clock``); a chip that does
-    not finish in time raises :class:`DeviceError`. Thread-safe: one measurement at a time.
+    ``timeout_s`` bounds one measurement (start to result, on ``clock``), and each wait of
+    the bring-up; a chip that does not finish in time raises :class:`DeviceError`, as does
+    one whose NVM holds unusable reference SPAD data. Thread-safe: one measurement at a time.
     """
 
     def __init__(
@@ -147,12 +136,18 @@ class VL53L0X:
         self._lock = threading.Lock()
         self._check_identity()
         self._stop_variable = 0
+        self._timing_budget_us = 0
         self._init(signal_rate_limit_to_register(signal_rate_limit_mcps), io_2v8)
 
     @property
     def address(self) -> int:
         """The 7-bit I2C address the chip answers on now."""
         return self._address
+
+    @property
+    def timing_budget_s(self) -> float:
+        """How long one measurement takes by the chip's timing registers, in seconds."""
+        return self._timing_budget_us / 1e6
 
     def __repr__(self) -> str:
         return f"VL53L0X(address=0x{self._address:02X})"
@@ -164,9 +159,19 @@ class VL53L0X:
     def _write(self, register: int, value: int) -> None:
         self._bus.write_byte_data(self._address, register, value & 0xFF)
 
+    def _write_all(self, writes: Iterable[tuple[int, int]]) -> None:
+        for register, value in writes:
+            self._write(register, value)
+
     def _write_u16(self, register: int, value: int) -> None:
         # 16-bit registers are big-endian: most significant byte at the lower address.
         self._bus.write_i2c_block_data(self._address, register, [value >> 8, value & 0xFF])
+
+    def _read_block(self, register: int, length: int) -> bytes:
+        return bytes(self._bus.read_i2c_block_data(self._address, register, length))
+
+    def _read_u16(self, register: int) -> int:
+        return int.from_bytes(self._read_block(register, 2), "big")
 
     def _where(self) -> str:
         return f"{CHIP} at 0x{self._address:02X}"
@@ -174,13 +179,13 @@ class VL53L0X:
     def _check_identity(self) -> None:
         try:
             identity = tuple(
-                self._bus.read_i2c_block_data(self._address, IDENTIFICATION_MODEL_ID, 3)
+                self._bus.read_i2c_block_data(self._address, reg.IDENTIFICATION_MODEL_ID, 3)
             )
         except OSError as err:
             raise device_error(
                 f"{self._where()} did not answer: {err.strerror or err}", err
             ) from err
-        if identity != IDENTITY:
+        if identity != reg.IDENTITY:
             found = " ".join(f"0x{b:02X}" for b in identity)
             raise DeviceError(
                 f"{self._where()}: identity registers 0xC0..0xC2 read {found}, "
@@ -190,55 +195,136 @@ class VL53L0X:
     # -- initialisation --------------------------------------------------------------------
     def _init(self, signal_rate_limit: int, io_2v8: bool) -> None:
         if io_2v8:
-            pad = self._read(VHV_CONFIG_PAD_SCL_SDA_EXTSUP_HV)
-            self._write(VHV_CONFIG_PAD_SCL_SDA_EXTSUP_HV, pad | VHV_CONFIG_2V8)
-        self._write(I2C_STANDARD_MODE, 0x00)
+            pad = self._read(reg.VHV_CONFIG_PAD_SCL_SDA_EXTSUP_HV)
+            self._write(reg.VHV_CONFIG_PAD_SCL_SDA_EXTSUP_HV, pad | reg.VHV_CONFIG_2V8)
+        self._write(reg.I2C_STANDARD_MODE, 0x00)
         self._stop_variable = self._read_stop_variable()
-        msrc = self._read(MSRC_CONFIG_CONTROL)
-        self._write(MSRC_CONFIG_CONTROL, msrc | MSRC_DISABLE_SIGNAL_RATE_CHECKS)
-        self._write_u16(FINAL_RANGE_CONFIG_MIN_COUNT_RATE_RTN_LIMIT, signal_rate_limit)
-        self._write(SYSTEM_SEQUENCE_CONFIG, SEQUENCE_ALL)
-        # (reference SPADs and the default tuning table would go here: see module docstring)
-        self._write(SYSTEM_INTERRUPT_CONFIG_GPIO, INTERRUPT_NEW_SAMPLE_READY)
-        mux = self._read(GPIO_HV_MUX_ACTIVE_HIGH)
-        self._write(GPIO_HV_MUX_ACTIVE_HIGH, mux & ~GPIO_HV_MUX_POLARITY_HIGH)
-        self._write(SYSTEM_INTERRUPT_CLEAR, 0x01)
-        self._write(SYSTEM_SEQUENCE_CONFIG, SEQUENCE_DSS_PRE_FINAL)
-        self._write(SYSTEM_SEQUENCE_CONFIG, SEQUENCE_VHV_CALIBRATION)
-        self._single_reference_calibration(VHV_CALIBRATION_START, "VHV calibration")
-        self._write(SYSTEM_SEQUENCE_CONFIG, SEQUENCE_PHASE_CALIBRATION)
+        msrc = self._read(reg.MSRC_CONFIG_CONTROL)
+        self._write(reg.MSRC_CONFIG_CONTROL, msrc | reg.MSRC_DISABLE_SIGNAL_RATE_CHECKS)
+        self._write_u16(reg.FINAL_RANGE_CONFIG_MIN_COUNT_RATE_RTN_LIMIT, signal_rate_limit)
+        self._write(reg.SYSTEM_SEQUENCE_CONFIG, reg.SEQUENCE_ALL)
+        self._set_reference_spads(self._read_reference_spads())
+        with self._off_main_page():
+            self._write_all(DEFAULT_TUNING)
+        if signal_rate_limit != TUNING_SIGNAL_RATE_LIMIT:  # the table set its own
+            self._write_u16(reg.FINAL_RANGE_CONFIG_MIN_COUNT_RATE_RTN_LIMIT, signal_rate_limit)
+        self._write(reg.SYSTEM_INTERRUPT_CONFIG_GPIO, reg.INTERRUPT_NEW_SAMPLE_READY)
+        mux = self._read(reg.GPIO_HV_MUX_ACTIVE_HIGH)
+        self._write(reg.GPIO_HV_MUX_ACTIVE_HIGH, mux & ~reg.GPIO_HV_MUX_POLARITY_HIGH)
+        self._write(reg.SYSTEM_INTERRUPT_CLEAR, 0x01)
+        budget_us = timing_budget_us(self._timing_registers())  # with the tuning's steps
+        self._write(reg.SYSTEM_SEQUENCE_CONFIG, reg.SEQUENCE_DSS_PRE_FINAL)
+        self._set_timing_budget_us(budget_us)
+        self._write(reg.SYSTEM_SEQUENCE_CONFIG, reg.SEQUENCE_VHV_CALIBRATION)
+        self._single_reference_calibration(reg.VHV_CALIBRATION_START, "VHV calibration")
+        self._write(reg.SYSTEM_SEQUENCE_CONFIG, reg.SEQUENCE_PHASE_CALIBRATION)
         self._single_reference_calibration(0x00, "phase calibration")
-        self._write(SYSTEM_SEQUENCE_CONFIG, SEQUENCE_DSS_PRE_FINAL)
+        self._write(reg.SYSTEM_SEQUENCE_CONFIG, reg.SEQUENCE_DSS_PRE_FINAL)
 
-    def _enter_private_page(self) -> None:
-        self._write(POWER_MANAGEMENT, 0x01)
-        self._write(PAGE_SELECT, 0x01)
-        self._write(0x00, 0x00)
-
-    def _leave_private_page(self) -> None:
-        self._write(0x00, 0x01)
-        self._write(PAGE_SELECT, 0x00)
-        self._write(POWER_MANAGEMENT, 0x00)
+    @contextlib.contextmanager
+    def _off_main_page(self) -> Iterator[None]:
+        """Writes that select another register page; after a failure among them, a try to
+        select page 0 again, so that a retry finds the identity registers where they are."""
+        try:
+            yield
+        except Exception:
+            with contextlib.suppress(OSError):
+                self._write_all(((reg.PAGE_SELECT, 0x01), *reg.LEAVE_PRIVATE_PAGE))
+            raise
 
     def _read_stop_variable(self) -> int:
-        self._enter_private_page()
-        value = self._read(STOP_VARIABLE)
-        self._leave_private_page()
+        with self._off_main_page():
+            self._write_all(reg.ENTER_PRIVATE_PAGE)
+            value = self._read(reg.STOP_VARIABLE)
+            self._write_all(reg.LEAVE_PRIVATE_PAGE)
         return value
 
+    def _read_reference_spads(self) -> ReferenceSpads:
+        """The reference SPAD data from NVM (ST's ``VL53L0X_get_info_from_device``)."""
+        with self._off_main_page():
+            self._write_all((*reg.ENTER_PRIVATE_PAGE, (reg.PAGE_SELECT, reg.NVM_ENABLE_PAGE)))
+            self._write(reg.NVM_CONTROL, self._read(reg.NVM_CONTROL) | reg.NVM_ENABLE)
+            self._write_all(
+                (
+                    (reg.PAGE_SELECT, reg.NVM_PAGE),
+                    (reg.NVM_POWER, 0x01),
+                    (reg.POWER_MANAGEMENT, 0x01),
+                )
+            )
+            words = [self._read_nvm_word(word) for word in (NVM_SPAD_INFO, *NVM_GOOD_SPAD_MAP)]
+            self._write_all(((reg.NVM_POWER, 0x00), (reg.PAGE_SELECT, reg.NVM_ENABLE_PAGE)))
+            self._write(reg.NVM_CONTROL, self._read(reg.NVM_CONTROL) & ~reg.NVM_ENABLE)
+            self._write_all(((reg.PAGE_SELECT, 0x01), *reg.LEAVE_PRIVATE_PAGE))
+        return from_nvm_words(*words)
+
+    def _read_nvm_word(self, word: int) -> int:
+        """One 32-bit NVM word: its address, the read strobe, the wait, the data."""
+        self._write(reg.NVM_ADDRESS, word)
+        self._write(reg.NVM_CONTROL, 0x00)
+        deadline = self._clock.now() + self.timeout_s
+        self._wait_for(lambda: self._read(reg.NVM_CONTROL) != 0, deadline, f"NVM read 0x{word:02X}")
+        self._write(reg.NVM_CONTROL, 0x01)
+        return int.from_bytes(self._read_block(reg.NVM_DATA, 4), "big")
+
+    def _set_reference_spads(self, spads: ReferenceSpads) -> None:
+        """Enable the reference SPADs the NVM names (ST's ``VL53L0X_set_reference_spads``)."""
+        try:
+            enables = select_reference_spads(spads)
+        except ValueError as err:
+            raise DeviceError(f"{self._where()}: {err}") from err
+        with self._off_main_page():
+            self._write_all(
+                (
+                    (reg.PAGE_SELECT, 0x01),
+                    (reg.DYNAMIC_SPAD_REF_EN_START_OFFSET, 0x00),
+                    (reg.DYNAMIC_SPAD_NUM_REQUESTED_REF_SPAD, reg.DYNAMIC_SPADS_REQUESTED),
+                    (reg.PAGE_SELECT, 0x00),
+                )
+            )
+        self._write(reg.GLOBAL_CONFIG_REF_EN_START_SELECT, reg.REF_EN_START_SELECT)
+        self._bus.write_i2c_block_data(
+            self._address, reg.GLOBAL_CONFIG_SPAD_ENABLES_REF_0, [*enables]
+        )
+        held = self._read_block(reg.GLOBAL_CONFIG_SPAD_ENABLES_REF_0, SPAD_MAP_BYTES)
+        if held != enables:
+            raise DeviceError(
+                f"{self._where()}: reference SPAD enables read back {held.hex(' ')}, "
+                f"written {enables.hex(' ')}"
+            )
+
+    def _timing_registers(self) -> TimingRegisters:
+        return TimingRegisters(
+            sequence_config=self._read(reg.SYSTEM_SEQUENCE_CONFIG),
+            pre_range_vcsel_period=self._read(reg.PRE_RANGE_CONFIG_VCSEL_PERIOD),
+            msrc_timeout=self._read(reg.MSRC_CONFIG_TIMEOUT_MACROP),
+            pre_range_timeout=self._read_u16(reg.PRE_RANGE_CONFIG_TIMEOUT_MACROP_HI),
+            final_range_vcsel_period=self._read(reg.FINAL_RANGE_CONFIG_VCSEL_PERIOD),
+            final_range_timeout=self._read_u16(reg.FINAL_RANGE_CONFIG_TIMEOUT_MACROP_HI),
+        )
+
+    def _set_timing_budget_us(self, budget_us: int) -> None:
+        """Give the final range what the budget leaves (ST's ``set_measurement_timing_
+        budget_micro_seconds``); DeviceError when the registers leave it nothing."""
+        try:
+            encoded = final_range_timeout_for(self._timing_registers(), budget_us)
+        except ValueError as err:
+            raise DeviceError(f"{self._where()}: {err}") from err
+        self._write_u16(reg.FINAL_RANGE_CONFIG_TIMEOUT_MACROP_HI, encoded)
+        self._timing_budget_us = budget_us
+
     def _single_reference_calibration(self, start_bits: int, what: str) -> None:
-        self._write(SYSRANGE_START, SYSRANGE_START_SINGLESHOT | start_bits)
+        self._write(reg.SYSRANGE_START, reg.SYSRANGE_START_SINGLESHOT | start_bits)
         deadline = self._clock.now() + self.timeout_s
         self._wait_for(self._interrupt_raised, deadline, what)
-        self._write(SYSTEM_INTERRUPT_CLEAR, 0x01)
-        self._write(SYSRANGE_START, 0x00)
+        self._write(reg.SYSTEM_INTERRUPT_CLEAR, 0x01)
+        self._write(reg.SYSRANGE_START, 0x00)
 
     # -- ranging ---------------------------------------------------------------------------
     def _interrupt_raised(self) -> bool:
-        return self._read(RESULT_INTERRUPT_STATUS) & RESULT_INTERRUPT_MASK != 0
+        return self._read(reg.RESULT_INTERRUPT_STATUS) & reg.RESULT_INTERRUPT_MASK != 0
 
     def _start_bit_clear(self) -> bool:
-        return self._read(SYSRANGE_START) & SYSRANGE_START_SINGLESHOT == 0
+        return self._read(reg.SYSRANGE_START) & reg.SYSRANGE_START_SINGLESHOT == 0
 
     def _wait_for(self, condition: Callable[[], bool], deadline_s: float, what: str) -> None:
         """Poll ``condition`` through the clock until true; DeviceError after the deadline."""
@@ -258,19 +344,19 @@ class VL53L0X:
         beyond the chip's ~2 m, or a range field above 8191.
         """
         with self._lock:
-            self._enter_private_page()
-            self._write(STOP_VARIABLE, self._stop_variable)
-            self._leave_private_page()
-            self._write(SYSTEM_INTERRUPT_CLEAR, 0x01)  # a stale result must not pass for ours
-            self._write(SYSRANGE_START, SYSRANGE_START_SINGLESHOT)
+            with self._off_main_page():
+                self._write_all((*reg.ENTER_PRIVATE_PAGE, (reg.STOP_VARIABLE, self._stop_variable)))
+                self._write_all(reg.LEAVE_PRIVATE_PAGE)
+            self._write(reg.SYSTEM_INTERRUPT_CLEAR, 0x01)  # a stale result must not pass for ours
+            self._write(reg.SYSRANGE_START, reg.SYSRANGE_START_SINGLESHOT)
             deadline = self._clock.now() + self.timeout_s
             self._wait_for(self._start_bit_clear, deadline, "start of ranging")
             self._wait_for(self._interrupt_raised, deadline, "ranging")
             result = self._bus.read_i2c_block_data(
-                self._address, RESULT_RANGE_STATUS, RESULT_BLOCK_LENGTH
+                self._address, reg.RESULT_RANGE_STATUS, reg.RESULT_BLOCK_LENGTH
             )
-            self._write(SYSTEM_INTERRUPT_CLEAR, 0x01)
-        offset = RESULT_RANGE_MM_OFFSET
+            self._write(reg.SYSTEM_INTERRUPT_CLEAR, 0x01)
+        offset = reg.RESULT_RANGE_MM_OFFSET
         range_mm = (result[offset] << 8) | result[offset + 1]
         distance_mm = decode_range(result[0], range_mm)
         if range_mm > RANGE_CODE_MAX or (distance_mm is not None and distance_mm > MAX_RANGE_MM):
@@ -289,10 +375,10 @@ class VL53L0X:
         """Move the chip to ``new_address`` (kept until power-off or XSHUT low)."""
         check_address(new_address)
         with self._lock:
-            self._write(I2C_SLAVE_DEVICE_ADDRESS, new_address & 0x7F)
+            self._write(reg.I2C_SLAVE_DEVICE_ADDRESS, new_address & 0x7F)
             old, self._address = self._address, new_address
             try:
-                self._read(IDENTIFICATION_MODEL_ID)
+                self._read(reg.IDENTIFICATION_MODEL_ID)
             except OSError as err:
                 raise device_error(
                     f"{CHIP} moved from 0x{old:02X} but does not answer at "

@@ -114,10 +114,30 @@ def test_no_chip_raises_device_error_naming_chip_and_address(clock, bus):
 def test_init_sets_2v8_io_signal_rate_limit_and_sequence(clock, bus, chip):
     VL53L0X(bus, clock=clock, signal_rate_limit_mcps=0.5)
     assert chip.peek(0x89) & 0x01  # 2V8 I/O
-    assert chip.peek(0x60) & 0x12 == 0x12  # MSRC and pre-range limit checks off
-    assert (chip.peek(0x44) << 8) | chip.peek(0x45) == 64  # 0.5 MCPS in Q9.7
+    assert chip.peek(0x60) == 0x00  # MSRC_CONFIG_CONTROL as ST's tuning table leaves it
+    assert (chip.peek(0x44) << 8) | chip.peek(0x45) == 64  # 0.5 MCPS in Q9.7, after the table
     assert chip.peek(0x0A) == 0x04  # interrupt on new sample ready
     assert chip.peek(0x01) == 0xE8  # DSS, pre-range, final range
+
+
+def test_the_nvm_answers_sts_handshake_only_once_switched_on(clock, bus, chip):
+    def strobe(word: int) -> int:
+        bus.write_byte_data(0x29, 0xFF, 0x07)
+        bus.write_byte_data(0x29, 0x94, word)  # which NVM word
+        bus.write_byte_data(0x29, 0x83, 0x00)  # the read strobe
+        return bus.read_byte_data(0x29, 0x83)  # non-zero: read done
+
+    assert strobe(0x6B) == 0  # NVM access not enabled: the strobe never completes
+    bus.write_byte_data(0x29, 0xFF, 0x06)
+    bus.write_byte_data(0x29, 0x83, 0x04)  # page 6: enable NVM access
+    bus.write_byte_data(0x29, 0xFF, 0x07)
+    bus.write_byte_data(0x29, 0x81, 0x01)  # page 7: NVM on
+    assert strobe(0x6B) != 0
+    assert bus.read_i2c_block_data(0x29, 0x90, 4) == [0x00, 0x00, 0x85, 0x00]  # 5, aperture
+    strobe(0x24)
+    assert bus.read_i2c_block_data(0x29, 0x90, 4) == [0xFF, 0xDF, 0xFF, 0xFF]  # SPAD 13 bad
+    bus.write_byte_data(0x29, 0xFF, 0x00)
+    assert bus.read_i2c_block_data(0x29, 0xB0, 6) == [0xFF, 0xDF, 0xFF, 0xFF, 0xFF, 0x3F]
 
 
 def test_each_measurement_writes_back_the_stop_variable(clock, bus, chip):

@@ -4,7 +4,18 @@ What it models, as the chip behaves on the wire:
 
 * identity registers 0xC0..0xC2 = 0xEE 0xAA 0x10; an 8-bit register pointer that
   auto-increments, so 16-bit registers read big-endian in one transfer;
-* the private register page (0xFF = 0x01) with the stop variable at 0x91;
+* register pages selected by 0xFF: page 0 is the documented map, page 1 the private page
+  with the stop variable at 0x91, pages 6 and 7 the NVM access of ST's API; every page
+  keeps what is written to it, so ST's default tuning table lands where the chip keeps it;
+* the factory NVM (ST's "get info from device" handshake): with bit 2 of register 0x83 set
+  on page 6 and register 0x81 = 0x01 on page 7, writing the NVM word address to 0x94 and
+  0x00 to 0x83 (the read strobe) loads that 32-bit word big-endian into 0x90..0x93, and
+  0x83 then reads non-zero; without those two enables the strobe never completes (0x83
+  reads 0, as a chip whose NVM is not switched on). Word 0x6B holds the reference SPAD
+  count (bits 14:8) and type (bit 15, aperture), words 0x24 and 0x25 the 6-byte map of
+  good reference SPADs;
+* the reference SPAD enables GLOBAL_CONFIG_SPAD_ENABLES_REF_0..5 (0xB0..0xB5) boot
+  holding that good-SPAD map (Pololu's observation, which Adafruit's driver relies on);
 * single-shot ranging: writing bit 0 of SYSRANGE_START starts it (the bit reads back 0
   once ranging has begun, here at once); RESULT_INTERRUPT_STATUS reads 0 for the timing
   budget (~33 ms by default) and then "new sample ready" (0x04) until SYSTEM_INTERRUPT_CLEAR
@@ -17,10 +28,13 @@ What it models, as the chip behaves on the wire:
   forgets its address and every register; high boots it at 0x29, NACKing for tBOOT.
 
 Simplified: the distance is sampled when ranging starts; there is no noise, no signal rate,
-no SPAD or tuning effect (the chip ranges the same with or without the full ST init);
-back-to-back and timed continuous modes are not modelled; a calibration's duration is a
-stand-in (ST does not publish it). The "no target" status is MSRC no-target (4); a real
-chip may report another failure code, which the driver treats alike.
+no SPAD or tuning effect (the chip ranges the same with or without the full ST init, and
+takes ``timing_budget_s`` whatever its timing registers say); an NVM read completes at
+once; back-to-back and timed continuous modes are not modelled; a calibration's duration is
+a stand-in (ST does not publish it). The "no target" status is MSRC no-target (4); a real
+chip may report another failure code, which the driver treats alike. ST documents none of
+the NVM registers: their behaviour here is what ST's API and Adafruit's driver expect of
+them.
 
 Two chips cannot share an address on a :class:`SimI2CBus`, so a collision that real
 hardware would turn into garbled answers raises ``ValueError`` here (a wiring mistake in
@@ -43,8 +57,24 @@ RESULT_INTERRUPT_STATUS = 0x13
 RESULT_RANGE_STATUS = 0x14
 RESULT_RANGE_MM = RESULT_RANGE_STATUS + 10  # 0x1E..0x1F, big-endian
 I2C_SLAVE_DEVICE_ADDRESS = 0x8A
+GLOBAL_CONFIG_SPAD_ENABLES_REF_0 = 0xB0  # six bytes, 0xB0..0xB5
 PAGE_SELECT = 0xFF
+PRIVATE_PAGE = 0x01
 STOP_VARIABLE = 0x91  # on the private page
+NVM_ENABLE_PAGE = 0x06  # bit 2 of NVM_CONTROL there switches NVM access on
+NVM_PAGE = 0x07
+NVM_CONTROL = 0x83  # page 6: enable bit; page 7: read strobe (0x00 starts, non-zero done)
+NVM_ENABLE = 0x04
+NVM_POWER = 0x81  # page 7: 0x01 while NVM is read
+NVM_DATA = 0x90  # page 7: the word read, big-endian, 0x90..0x93
+NVM_ADDRESS = 0x94  # page 7: which NVM word the strobe reads
+NVM_SPAD_INFO = 0x6B  # bits 14:8 reference SPAD count, bit 15 aperture type
+NVM_GOOD_SPAD_MAP = (0x24, 0x25)  # bytes 0..3, then 4..5 in the high half
+NVM_READ_DONE = 0x01
+
+# A plausible factory calibration: 5 aperture SPADs; reference SPAD 13 is bad.
+DEFAULT_SPAD_COUNT = 5
+DEFAULT_GOOD_SPAD_MAP = bytes([0xFF, 0xDF, 0xFF, 0xFF, 0xFF, 0x3F])
 
 INTERRUPT_NEW_SAMPLE_READY = 0x04
 DEVICE_STATUS_RANGE_VALID = 11
@@ -69,11 +99,21 @@ _POWER_ON_PRIVATE = {STOP_VARIABLE: 0x3C}  # a plausible stop variable; any valu
 _READ_ONLY = {0xC0, 0xC1, 0xC2, RESULT_INTERRUPT_STATUS, *range(0x14, 0x20)}
 
 
+def _factory_nvm(spad_count: int, spad_aperture: bool, good_spad_map: bytes) -> dict[int, int]:
+    """The NVM words ST's API reads, by word address (32-bit values)."""
+    spad_info = spad_count | (0x80 if spad_aperture else 0x00)
+    head = int.from_bytes(good_spad_map[:4], "big")
+    tail = int.from_bytes(good_spad_map[4:], "big") << 16
+    return {NVM_SPAD_INFO: spad_info << 8, NVM_GOOD_SPAD_MAP[0]: head, NVM_GOOD_SPAD_MAP[1]: tail}
+
+
 class SimVL53L0X(SimI2CDevice):
     """A VL53L0X soldered onto ``bus``, looking at whatever is ``distance_mm`` away.
 
     With ``xshut_high`` (the board's pull-up) it is powered and on the bus at once;
-    otherwise it waits in hardware standby for :meth:`set_xshut`.
+    otherwise it waits in hardware standby for :meth:`set_xshut`. ``spad_count``,
+    ``spad_aperture`` and ``good_spad_map`` are its factory calibration in NVM (the
+    reference SPADs to enable, their type, and which of the 48 reference SPADs work).
     """
 
     def __init__(
@@ -85,12 +125,21 @@ class SimVL53L0X(SimI2CDevice):
         timing_budget_s: float = 0.033,
         max_range_mm: float = 1200.0,
         xshut_high: bool = True,
+        spad_count: int = DEFAULT_SPAD_COUNT,
+        spad_aperture: bool = True,
+        good_spad_map: bytes = DEFAULT_GOOD_SPAD_MAP,
     ) -> None:
         super().__init__(address)
+        if not 0 <= spad_count <= 0x7F:
+            raise ValueError(f"a VL53L0X NVM holds a SPAD count of 0..127, got {spad_count}")
+        if len(good_spad_map) != 6:
+            raise ValueError(f"the good reference SPAD map is 6 bytes, got {len(good_spad_map)}")
         self._clock = clock
         self._bus = bus
         self.timing_budget_s = timing_budget_s
         self.max_range_mm = max_range_mm
+        self._nvm = _factory_nvm(spad_count, spad_aperture, good_spad_map)
+        self._good_spad_map = bytes(good_spad_map)
         self._distance_mm: float | None = None
         self._attached = False
         self._xshut_high = False
@@ -136,21 +185,28 @@ class SimVL53L0X(SimI2CDevice):
         """Whether XSHUT is high (the chip is out of hardware standby)."""
         return self._xshut_high
 
-    def peek(self, register: int, *, private_page: bool = False) -> int:
-        """A register's content as the chip holds it (for tests; no side effects)."""
+    def peek(self, register: int, *, private_page: bool = False, page: int = 0) -> int:
+        """A register's content as the chip holds it on ``page`` (the private page: 1).
+
+        For tests; no side effects on the chip.
+        """
         self._update()
-        if register == RESULT_INTERRUPT_STATUS and not private_page:
+        page = PRIVATE_PAGE if private_page else page
+        if register == RESULT_INTERRUPT_STATUS and page == 0:
             return self._interrupt_status
-        return (self._private if private_page else self._registers)[register]
+        return self._bank(page)[register]
 
     # -- power and wiring ---------------------------------------------------------------------
     def _power_on_reset(self) -> None:
         self._registers = bytearray(256)
         for register, value in _POWER_ON_REGISTERS.items():
             self._registers[register] = value
-        self._private = bytearray(256)
+        spads = GLOBAL_CONFIG_SPAD_ENABLES_REF_0
+        self._registers[spads : spads + 6] = self._good_spad_map  # loaded from NVM at boot
+        private = bytearray(256)
         for register, value in _POWER_ON_PRIVATE.items():
-            self._private[register] = value
+            private[register] = value
+        self._pages = {0: self._registers, PRIVATE_PAGE: private}
         self._page = 0
         self._pointer = 0
         self._interrupt_status = 0
@@ -208,12 +264,16 @@ class SimVL53L0X(SimI2CDevice):
             self._write_register(self._pointer, value)
             self._pointer = (self._pointer + 1) & 0xFF
 
+    def _bank(self, page: int) -> bytearray:
+        """The registers of ``page`` (a page never written reads 0)."""
+        return self._pages.setdefault(page, bytearray(256))
+
     def _write_register(self, register: int, value: int) -> None:
         if register == PAGE_SELECT:
-            self._page = value & 0x01
+            self._page = value
             return
         if self._page:
-            self._private[register] = value
+            self._write_paged(register, value)
             return
         if register in _READ_ONLY:
             return
@@ -229,6 +289,21 @@ class SimVL53L0X(SimI2CDevice):
             self._move_to(value & 0x7F)
         else:
             self._registers[register] = value
+
+    def _write_paged(self, register: int, value: int) -> None:
+        bank = self._bank(self._page)
+        bank[register] = value
+        if self._page == NVM_PAGE and register == NVM_CONTROL and value == 0x00:
+            self._strobe_nvm(bank)
+
+    def _strobe_nvm(self, bank: bytearray) -> None:
+        """The NVM read strobe: the word at NVM_ADDRESS into NVM_DATA, if NVM is on."""
+        enabled = self._bank(NVM_ENABLE_PAGE)[NVM_CONTROL] & NVM_ENABLE
+        if not enabled or not bank[NVM_POWER] & 0x01:
+            return  # the strobe never completes: NVM_CONTROL keeps reading 0
+        word = self._nvm.get(bank[NVM_ADDRESS], 0)
+        bank[NVM_DATA : NVM_DATA + 4] = word.to_bytes(4, "big")
+        bank[NVM_CONTROL] = NVM_READ_DONE
 
     def _move_to(self, new_address: int) -> None:
         if not 0x03 <= new_address <= 0x77:
@@ -249,8 +324,10 @@ class SimVL53L0X(SimI2CDevice):
         self._update()
         out = bytearray()
         for _ in range(length):
-            if self._page:
-                out.append(self._private[self._pointer])
+            if self._pointer == PAGE_SELECT:
+                out.append(self._page)
+            elif self._page:
+                out.append(self._bank(self._page)[self._pointer])
             elif self._pointer == RESULT_INTERRUPT_STATUS:
                 out.append(self._interrupt_status)
             else:
