@@ -2,12 +2,14 @@
 
   vest gesture IMAGE... [--model FILE] [--json] [--crop X,Y,W]
       how many fingers each picture shows (the paper's crop: the centred 128 x 128 px
-      window, or the window W px wide at X,Y, scaled to 128)
+      window, or the window W px wide at X,Y, scaled to 128; a smaller picture is scaled
+      up to fill the window, and said so)
   vest gesture record DATA --label N [--frames K] [--camera DEV]   K frames from the camera
   vest gesture record DATA [--camera DEV]      a frame each time you type its label + Enter
   vest gesture record DATA --label N --from FOLDER       pictures you already have
   vest gesture generate DATA --count N [--seed S] [--style studio|variant]
-  vest gesture train DATA -o MODEL.onnx [--epochs E] [--split session|file]
+  vest gesture train DATA... -o MODEL.onnx [--epochs E] [--split session|file]
+      [--held-out SHARE] [--preprocess gray|edges] [--init MODEL.onnx]
   vest gesture eval DATA --model MODEL.onnx [--json]
 
 DATA is a folder with 0/ .. 5/ (pictures showing that many fingers) and none/ (no hand).
@@ -20,6 +22,7 @@ import argparse
 import json
 import sys
 from collections.abc import Sequence
+from dataclasses import replace
 from pathlib import Path
 
 from engine.cli.output import writable_folder
@@ -29,6 +32,8 @@ HELP = "count fingers in pictures; record, generate, train and check a hand mode
 ACTIONS = ("classify", "record", "generate", "train", "eval")
 STYLE_NAMES = ("studio", "wallpaper", "varied", "variant")
 """The hand generator's styles (engine/vision/synthetic_hands.py; not imported here)."""
+PREPROCESS_MODES = ("gray", "edges")
+"""How a picture becomes the network's input (engine/vision/preprocess.py's MODES)."""
 
 
 def with_action(argv: Sequence[str]) -> list[str]:
@@ -84,6 +89,11 @@ def _share(text: str) -> float:
     return value
 
 
+def _held_out(text: str) -> float:
+    """A share to hold out: 0 (none) or between 0 and 1."""
+    return 0.0 if text.strip() in ("0", "0.0") else _share(text)
+
+
 def _label(text: str) -> str:
     from engine.vision.dataset import FOLDERS
 
@@ -134,12 +144,21 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     generate.add_argument("--style", choices=STYLE_NAMES, default="studio")
 
     train = actions.add_parser("train", help="train the table-2 network (needs .[train])")
-    train.add_argument("data", type=Path, metavar="DATA")
+    train.add_argument("data", type=Path, nargs="+", metavar="DATA")
     train.add_argument("-o", "--output", type=Path, required=True, metavar="MODEL.onnx")
     train.add_argument("--epochs", type=_positive, default=16)
     train.add_argument("--batch", type=_positive, default=64)
     train.add_argument("--seed", type=_seed, default=1)
-    train.add_argument("--held-out", type=_share, default=0.15, help="share held out (0..1)")
+    train.add_argument(
+        "--held-out", type=_held_out, default=0.15, help="share held out (0: none; below 1)"
+    )
+    train.add_argument(
+        "--preprocess",
+        choices=PREPROCESS_MODES,
+        default=None,
+        help="gray (the shipped model's) or edges (the paper's); default: the --init "
+        "model's, else gray",
+    )
     train.add_argument("--split", choices=("session", "file"), default="session")
     train.add_argument("--threads", type=_positive, default=2, help="CPU threads")
     train.add_argument(
@@ -182,7 +201,7 @@ def main(args: argparse.Namespace) -> int:
 def _classify(args: argparse.Namespace) -> int:
     from engine.cli.output import shown, tell
     from engine.vision.classifier import DEFAULT_MODEL, HandModel
-    from engine.vision.preprocess import read_image, scaled_window
+    from engine.vision.preprocess import fills_window, read_image, scaled_window
 
     model = HandModel.load(args.model or DEFAULT_MODEL)
     side = model.settings.side_px
@@ -192,21 +211,24 @@ def _classify(args: argparse.Namespace) -> int:
             image = read_image(path)
             if args.crop is not None:
                 image = scaled_window(image, *args.crop, side_px=side)
+            scaled = not fills_window(image, model.settings)
             reading = model.read(image)
         except ValueError as error:
             text = str(error)
             tell(text if str(path) in text else f"{path}: {text}")
             failed += 1
             continue
+        size = f"{image.shape[1]}x{image.shape[0]}"
         if args.json:
-            print(json.dumps({"file": str(path), **reading.to_json()}))
+            print(json.dumps({"file": str(path), **reading.to_json(), "scaled_up": scaled}))
         else:
             said = (
                 "not sure"
                 if reading.fingers is None
                 else f"{reading.fingers} finger" + ("" if reading.fingers == 1 else "s")
             )
-            print(f"{shown(str(path))}: {said} ({reading.confidence:.0%})")
+            note = f" (a {size} px picture, scaled up to the {side} px window)" if scaled else ""
+            print(f"{shown(str(path))}: {said} ({reading.confidence:.0%}){note}")
     return 1 if failed else 0
 
 
@@ -228,6 +250,8 @@ def _train(args: argparse.Namespace) -> int:
         raise DeviceError(
             None, "training needs PyTorch: pip install -e '.[train]' (see docs/vision.md)"
         ) from None
+    from engine.vision.classifier import HandModel
+    from engine.vision.preprocess import Preprocessing
     from engine.vision.training import TrainingSettings, train
 
     if args.output.suffix != ".onnx":
@@ -235,7 +259,13 @@ def _train(args: argparse.Namespace) -> int:
     writable_folder(args.output.parent)  # before the training, not after it
     if args.matrix is not None:
         writable_folder(args.matrix.parent)
+    pre = Preprocessing(mode="gray")
+    if args.init is not None:  # a lab's retraining reads pictures as the model it starts from
+        pre = HandModel.load(args.init).settings
+    if args.preprocess is not None:
+        pre = replace(pre, mode=args.preprocess)
     settings = TrainingSettings(
+        preprocessing=pre,
         epochs=args.epochs,
         batch=args.batch,
         seed=args.seed,
@@ -246,13 +276,16 @@ def _train(args: argparse.Namespace) -> int:
         start_from=args.init,
     )
     result = train(args.data, args.output, settings, lambda line: print(line, flush=True))
+    sidecar = args.output.with_suffix(".json")
+    if not result.held_out:
+        print(f"model: {args.output} (settings in {sidecar}); nothing held out: measure it with")
+        print(f"  vest gesture eval PICTURES --model {args.output}")
+        return 0
     print(result.evaluation.table())
     print(f"held out: {result.evaluation.summary()}")
     matrix = args.matrix or args.output.with_suffix(".matrix.png")
     result.evaluation.write_png(matrix, f"{args.output.name}: held out ({result.split})")
-    print(
-        f"model: {args.output} (settings in {args.output.with_suffix('.json')}); matrix: {matrix}"
-    )
+    print(f"model: {args.output} (settings in {sidecar}); matrix: {matrix}")
     return 0
 
 

@@ -8,8 +8,8 @@
 A picture's session is its file name up to the last ``-`` (``record`` names files
 ``<session>-<n>.png``): frames of one session look alike, so the held-out pictures are
 whole sessions, never random frames of a session the network trained on. Pictures may
-be any size at least the window's; training shifts, turns, flips and relights them
-(:func:`augment`) before the shared preprocessing.
+be any size (one smaller than the window is scaled up to fill it); training shifts, turns,
+flips and relights them (:func:`augment`) before the shared preprocessing.
 """
 
 from __future__ import annotations
@@ -27,10 +27,10 @@ from engine.vision.preprocess import (
     LABELS,
     Frame,
     Preprocessing,
-    as_input,
     crop,
-    edges,
+    filling,
     read_image,
+    window_input,
 )
 from engine.vision.synthetic_hands import NO_HAND
 
@@ -108,13 +108,13 @@ def split(
 def load_pictures(pictures: Sequence[Picture], settings: Preprocessing) -> list[Frame]:
     """The pictures' images, each cut to its centred window and a margin of up to
     :data:`MARGIN_PX` around it (all that training's shifts and turns look at: a lab's
-    thousands of 640 x 360 frames then fit in memory); ConfigError naming the first that
-    cannot be read or is smaller than the window."""
+    thousands of 640 x 360 frames then fit in memory; a picture smaller than the window is
+    scaled up to fill it first); ConfigError naming the first that cannot be read."""
     images = []
     side = settings.side_px
     for picture in pictures:
         try:
-            image = read_image(picture.path)
+            image = filling(read_image(picture.path), settings)  # a small one: scaled up
             x, y = settings.window(image.shape[0], image.shape[1])
         except ValueError as error:
             raise ConfigError(
@@ -129,30 +129,38 @@ def load_pictures(pictures: Sequence[Picture], settings: Preprocessing) -> list[
 
 
 def augment(image: Frame, rng: np.random.Generator, settings: Preprocessing) -> Frame:
-    """A window-sized picture made from ``image`` the way a camera might have seen it:
-    the window shifted (up to 8 px), turned (up to 10 degrees), scaled (0.9..1.1),
-    mirrored half the time, relit and noised."""
+    """A window-sized picture made from ``image`` the way another camera, room or child
+    might have shown it: the window shifted (up to 10 px), turned (up to 20 degrees),
+    scaled (0.8..1.15), mirrored half the time; each colour channel gained on its own
+    (0.6..1.4: skin tones, white balance), brightened or darkened, gamma-curved
+    (0.7..1.4), sometimes blurred (out of focus), and noised."""
     height, width = image.shape[:2]
     x, y = settings.window(height, width)
     side = settings.side_px
-    centre = (x + side / 2 + rng.uniform(-8, 8), y + side / 2 + rng.uniform(-8, 8))
-    angle, scale = rng.uniform(-10, 10), rng.uniform(0.9, 1.1)
+    centre = (x + side / 2 + rng.uniform(-10, 10), y + side / 2 + rng.uniform(-10, 10))
+    angle, scale = rng.uniform(-20, 20), rng.uniform(0.8, 1.15)
     matrix = cv2.getRotationMatrix2D(centre, angle, scale)
     matrix[:, 2] += np.array([side / 2 - centre[0], side / 2 - centre[1]])
-    window = cv2.warpAffine(image, matrix, (side, side), borderMode=cv2.BORDER_REFLECT)
+    window = cv2.warpAffine(image, matrix, (side, side), borderMode=cv2.BORDER_REPLICATE)
     if rng.random() < 0.5:
         window = window[:, ::-1]
-    relit = window.astype(np.float32) * rng.uniform(0.7, 1.3) + rng.uniform(-25, 25)
-    relit += rng.normal(0.0, rng.uniform(0.0, 6.0), relit.shape).astype(np.float32)
-    return np.asarray(np.clip(relit, 0, 255), dtype=np.uint8)
+    relit = window.astype(np.float32)
+    if relit.ndim == 3:
+        relit *= rng.uniform(0.6, 1.4, size=relit.shape[2]).astype(np.float32)
+    relit += rng.uniform(-30, 30)
+    if rng.random() < 0.3:
+        relit = np.asarray(cv2.GaussianBlur(relit, (5, 5), rng.uniform(0.1, 1.5)), np.float32)
+    relit += np.asarray(rng.normal(0.0, rng.uniform(0.0, 8.0), size=relit.shape), np.float32)
+    curved = 255.0 * (np.clip(relit, 0, 255) / 255.0) ** rng.uniform(0.7, 1.4)
+    return np.asarray(np.clip(curved, 0, 255), dtype=np.uint8)
 
 
 def network_inputs(windows: Sequence[Frame], settings: Preprocessing) -> npt.NDArray[np.float32]:
-    """The edge images of window-sized pictures as a batch (N, 1, side, side) of 0/1
-    (:func:`~engine.vision.preprocess.as_input`)."""
+    """Window-sized pictures as the network reads them, a batch (N, 1, side, side)
+    (:func:`~engine.vision.preprocess.window_input`)."""
     batch = np.empty((len(windows), 1, settings.side_px, settings.side_px), dtype=np.float32)
     for index, window in enumerate(windows):
-        batch[index, 0] = as_input(edges(window, settings))
+        batch[index, 0] = window_input(window, settings)
     return batch
 
 

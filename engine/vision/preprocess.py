@@ -1,7 +1,15 @@
-"""The paper's preprocessing (section 4.4), written once for training, inference and the
-simulated camera: a frame is cropped to a square window without scaling (128 x 128 px),
-turned grayscale, blurred (Gaussian, 3 x 3, sigma 7) and thresholded adaptively (Gaussian
-weights over an 11 x 11 window) into a binary edge image the network reads as 0.0 / 1.0.
+"""How a frame becomes the network's input, written once for training, inference and the
+simulated camera. A frame is cropped to a square window without scaling (128 x 128 px; a
+picture smaller than the window is first scaled up to fill it), turned grayscale, then
+read one of two ways (``mode``):
+
+- ``gray`` (the shipped model's): the grayscale window normalised to mean 0 and standard
+  deviation 1, so a hand reads the same in a dim room and a bright one. It counts real
+  photographs of hands (docs/vision-model-card.md).
+- ``edges`` (the paper's, section 4.4): blurred (Gaussian, 3 x 3, sigma 7) and thresholded
+  adaptively (Gaussian weights over an 11 x 11 window) into a binary edge image the network
+  reads as 0.0 / 1.0. Kept for models trained that way; on photographs it loses the hand in
+  the texture of skin and light (the model card has both figures).
 
 The settings travel beside a model (``model.json`` next to ``model.onnx``), so a model
 retrained with other settings carries its own. What the paper leaves open and we chose:
@@ -36,6 +44,9 @@ LABELS = (0, 1, 2, 3, 4, 5)
 """What the network tells apart: how many fingers a hand shows."""
 
 
+MODES = ("gray", "edges")
+"""How a window is read: normalised grayscale, or the paper's binary edges."""
+
 MAX_SIDE_PX = 1024
 MAX_KERNEL_PX = 101
 """The widest blur or threshold window (the paper's are 3 and 11 px)."""
@@ -51,10 +62,11 @@ class Preprocessing:
     """How a frame becomes the network's input.
 
     ``crop_x``/``crop_y``: the window's top-left corner in px, or None to centre it;
-    ``side_px``: the window's side (the network's input, 128); ``blur_px``/``blur_sigma``:
-    the Gaussian blur's kernel side (odd) and sigma; ``block_px``: the adaptive threshold's
-    window side (odd); ``threshold_c``: subtracted from the weighted local mean (grey
-    levels)."""
+    ``side_px``: the window's side (the network's input, 128); ``mode``: "gray" or "edges"
+    (see the module); for edges, ``blur_px``/``blur_sigma``: the Gaussian blur's kernel
+    side (odd) and sigma; ``block_px``: the adaptive threshold's window side (odd);
+    ``threshold_c``: subtracted from the weighted local mean (grey levels). A model's
+    settings without a mode are the paper's (edges): models made before there was a choice."""
 
     crop_x: int | None = None
     crop_y: int | None = None
@@ -63,10 +75,13 @@ class Preprocessing:
     blur_sigma: float = 7.0
     block_px: int = 11
     threshold_c: float = 4.0
+    mode: str = "edges"
 
     def __post_init__(self) -> None:
         """Every number within what a frame can use: a model's settings are a file a person
         may have edited (``blur_px: 99999`` would make one frame take minutes)."""
+        if self.mode not in MODES:
+            raise ValueError(f"mode must be one of {', '.join(MODES)}, got {self.mode!r}")
         for name in ("side_px", "blur_px", "block_px", "crop_x", "crop_y"):
             value = getattr(self, name)
             if value is not None and (isinstance(value, bool) or not isinstance(value, int)):
@@ -134,8 +149,29 @@ class Preprocessing:
             raise ConfigError(f"{where}: {error}") from None
 
 
+def fills_window(frame: Frame, settings: Preprocessing) -> bool:
+    """Whether ``frame`` is at least the window's size both ways (else :func:`crop` scales
+    it up first: a 100 x 100 photograph for a 128 x 128 window)."""
+    return bool(min(frame.shape[0], frame.shape[1]) >= settings.side_px)
+
+
+def filling(frame: Frame, settings: Preprocessing) -> Frame:
+    """``frame`` as it is when it fills the window; else scaled up, keeping its shape,
+    until its shorter side is the window's."""
+    if fills_window(frame, settings):
+        return frame
+    factor = settings.side_px / min(frame.shape[0], frame.shape[1])
+    size = (
+        max(settings.side_px, round(frame.shape[1] * factor)),
+        max(settings.side_px, round(frame.shape[0] * factor)),
+    )
+    return np.asarray(cv2.resize(frame, size, interpolation=cv2.INTER_LINEAR), dtype=np.uint8)
+
+
 def crop(frame: Frame, settings: Preprocessing) -> Frame:
-    """The square window of ``frame`` (no scaling), as a copy."""
+    """The square window of ``frame`` (no scaling, unless the frame is smaller than the
+    window: :func:`filling`), as a copy."""
+    frame = filling(frame, settings)
     x, y = settings.window(frame.shape[0], frame.shape[1])
     side = settings.side_px
     return frame[y : y + side, x : x + side].copy()
@@ -178,10 +214,27 @@ def as_input(binary: Frame) -> npt.NDArray[np.float32]:
     return result
 
 
+def normalised_gray(window: Frame) -> npt.NDArray[np.float32]:
+    """The window in grayscale with mean 0 and standard deviation 1 (a flat window: 0)."""
+    gray = cv2.cvtColor(window, cv2.COLOR_BGR2GRAY) if window.ndim == 3 else window
+    values = gray.astype(np.float32)
+    spread = float(values.std())
+    result: npt.NDArray[np.float32] = (values - float(values.mean())) / max(spread, 1.0)
+    return result
+
+
+def window_input(window: Frame, settings: Preprocessing) -> npt.NDArray[np.float32]:
+    """A window-sized picture as the network reads it, (side, side) float32, by the
+    settings' ``mode``."""
+    if settings.mode == "gray":
+        return normalised_gray(window)
+    return as_input(edges(window, settings))
+
+
 def network_input(frame: Frame, settings: Preprocessing) -> npt.NDArray[np.float32]:
-    """What the network reads for ``frame``: the edge image of its window as float32
-    1.0 (edge) / 0.0, shape (1, side, side)."""
-    return as_input(edges(crop(frame, settings), settings))[np.newaxis]
+    """What the network reads for ``frame``: its window (:func:`crop`) read by the
+    settings' mode, shape (1, side, side)."""
+    return window_input(crop(frame, settings), settings)[np.newaxis]
 
 
 def read_image(path: Path) -> Frame:

@@ -58,7 +58,7 @@ class TrainingSettings:
     seed: int = 1
     threads: int = 2
     min_confidence: float = 0.6
-    preprocessing: Preprocessing = field(default_factory=Preprocessing)
+    preprocessing: Preprocessing = field(default_factory=lambda: Preprocessing(mode="gray"))
     start_from: Path | None = None
     """A model whose weights training starts from (else He initialisation)."""
 
@@ -73,10 +73,12 @@ class TrainingResult:
 
 
 def learning_rate_factor(step: int, steps_per_epoch: int, settings: TrainingSettings) -> float:
-    """The share of the learning rate at ``step``: rising from 0.1 to 1 over the warm-up,
-    then halved at 60 % and again at 85 % of the epochs."""
-    if step < settings.warmup_steps:
-        return 0.1 + 0.9 * step / settings.warmup_steps
+    """The share of the learning rate at ``step``: rising from 0.1 to 1 over the warm-up
+    (at most a fifth of the run: a short fine-tuning run is not all warm-up), then halved
+    at 60 % and again at 85 % of the epochs."""
+    warmup = min(settings.warmup_steps, steps_per_epoch * settings.epochs // 5)
+    if step < warmup:
+        return 0.1 + 0.9 * step / warmup
     epoch = step / steps_per_epoch
     factor = 1.0
     for share in (0.6, 0.85):
@@ -95,21 +97,27 @@ def soft_targets(labels: npt.NDArray[np.int64]) -> npt.NDArray[np.float32]:
 
 
 def train(
-    data: Path,
+    data: Path | Sequence[Path],
     out: Path,
     settings: TrainingSettings,
     progress: Callable[[str], None] = lambda line: None,
 ) -> TrainingResult:
-    """Train on the pictures in ``data`` and write ``out`` (.onnx) and its .json; ConfigError
-    when the data is not a labelled folder."""
+    """Train on the pictures in ``data`` (one labelled folder, or several: real photographs
+    and drawn ones, say) and write ``out`` (.onnx) and its .json; ConfigError when a folder
+    is not a labelled one. With ``held_out`` 0 nothing is held out (the model is measured
+    elsewhere: ``vest gesture eval``) and the evaluation is empty."""
     import torch
 
     from engine.vision.hand_network import HandNetwork, export_onnx, load_onnx_weights
 
-    pictures = find_pictures(data)
-    train_set, test_set, how = split(
-        pictures, settings.held_out, settings.seed, by=settings.split_by
-    )
+    folders = [data] if isinstance(data, Path) else list(data)
+    pictures = [picture for folder in folders for picture in find_pictures(folder)]
+    if settings.held_out > 0:
+        train_set, test_set, how = split(
+            pictures, settings.held_out, settings.seed, by=settings.split_by
+        )
+    else:
+        train_set, test_set, how = list(pictures), [], "none held out"
     progress(
         f"{len(pictures)} pictures: training on {len(train_set)}, "
         f"holding out {len(test_set)} ({how})"
@@ -158,19 +166,24 @@ def train(
         )
 
     export_onnx(network, out)
-    write_sidecar(out, settings, data, how, len(train_set), len(test_set))
+    write_sidecar(out, settings, folders, how, len(train_set), len(test_set))
     evaluation = evaluate_pictures(
         HandModel.load(out, min_confidence=settings.min_confidence), test_set
     )
     sidecar = out.with_suffix(".json")
     document = json.loads(sidecar.read_text(encoding="utf-8"))
-    document["training"]["held_out_evaluation"] = evaluation.to_json()
+    document["training"]["held_out_evaluation"] = evaluation.to_json() if test_set else None
     sidecar.write_text(json.dumps(document, indent=2) + "\n", encoding="utf-8")
     return TrainingResult(out, evaluation, how, len(train_set), len(test_set))
 
 
 def write_sidecar(
-    out: Path, settings: TrainingSettings, data: Path, how: str, trained: int, held: int
+    out: Path,
+    settings: TrainingSettings,
+    data: Sequence[Path],
+    how: str,
+    trained: int,
+    held: int,
 ) -> None:
     """The model's settings beside it: what the robot needs, and how it was made."""
     import torch
@@ -180,7 +193,7 @@ def write_sidecar(
         "labels": list(LABELS),
         "preprocessing": settings.preprocessing.to_json(),
         "training": {
-            "data": data.name,
+            "data": [folder.name for folder in data],
             "pictures": trained,
             "held_out": held,
             "split": how,

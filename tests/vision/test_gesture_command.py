@@ -12,6 +12,8 @@ import pytest
 from engine.cli import main
 from engine.vision.synthetic_hands import render_frame
 
+REAL_HANDS = Path(__file__).resolve().parents[2] / "examples" / "hands-real"
+
 
 def exit_code(args: list[str]) -> int | str | None:
     """What `vest` exits with (argparse exits on its own for a wrong command line)."""
@@ -38,9 +40,12 @@ def test_pictures_are_counted_one_json_line_each(tmp_path: Path, capsys) -> None
 
 def test_a_picture_reads_as_words_without_json(tmp_path: Path, capsys) -> None:
     two = picture(tmp_path, "two.png", 2, seed=13)
+    assert main(["gesture", str(two), "--json"]) == 0
+    said = json.loads(capsys.readouterr().out)
     assert main(["gesture", str(two)]) == 0
-    out = capsys.readouterr().out
-    assert out.startswith(f"{two}: 2 fingers (") and out.rstrip().endswith("%)")
+    count = said["fingers"]
+    words = "not sure" if count is None else f"{count} finger" + ("" if count == 1 else "s")
+    assert capsys.readouterr().out == f"{two}: {words} ({said['confidence']:.0%})\n"
 
 
 def test_a_window_elsewhere_is_given_with_crop(tmp_path: Path, capsys) -> None:
@@ -56,22 +61,24 @@ def test_a_window_elsewhere_is_given_with_crop(tmp_path: Path, capsys) -> None:
 def test_bad_pictures_are_named_and_the_others_still_counted(tmp_path: Path, capsys) -> None:
     good = picture(tmp_path, "good.png", 1, seed=15)
     (tmp_path / "notes.png").write_text("not a picture")
-    tiny = tmp_path / "tiny.png"
-    cv2.imwrite(str(tiny), np.zeros((50, 50, 3), np.uint8))
-    args = [
-        "gesture",
-        str(tmp_path / "notes.png"),
-        str(good),
-        str(tiny),
-        str(tmp_path / "gone.png"),
-    ]
+    args = ["gesture", str(tmp_path / "notes.png"), str(good), str(tmp_path / "gone.png")]
     assert main(args) == 1
     captured = capsys.readouterr()
     assert captured.out.startswith(f"{good}: 1 finger (")
     assert "notes.png: not a picture vest reads" in captured.err
-    assert "tiny.png: a 50x50 image is smaller than the 128x128 window" in captured.err
     assert "gone.png: file not found" in captured.err
     assert "Traceback" not in captured.err
+
+
+def test_a_photograph_smaller_than_the_window_is_scaled_up_and_said_so(capsys) -> None:
+    """The real photographs beside the project are 100 x 100 px, the window 128."""
+    photo = next((REAL_HANDS / "held-out" / "3").glob("*.jpg"))
+    assert main(["gesture", str(photo)]) == 0
+    said = capsys.readouterr().out
+    assert said.startswith(f"{photo}: 3 fingers (")
+    assert said.endswith("(a 100x100 px picture, scaled up to the 128 px window)\n")
+    assert main(["gesture", str(photo), "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["scaled_up"] is True
 
 
 @pytest.mark.parametrize(
@@ -106,6 +113,28 @@ def test_a_lab_generates_trains_and_checks_its_own_model(tmp_path: Path, capsys)
     report = json.loads(capsys.readouterr().out)
     assert sum(map(sum, report["matrix"])) == 36
     assert report["columns"][-1] == "not sure"
+
+
+def test_a_model_learns_from_photographs_and_drawn_hands_together(tmp_path: Path, capsys) -> None:
+    """Several folders at once, nothing held out (measured elsewhere), the preprocessing
+    chosen: what scripts/train-hand-model's last stage does, in miniature."""
+    pytest.importorskip("torch", reason="training needs the train extra")
+    drawn, model = tmp_path / "drawn", tmp_path / "mixed.onnx"
+    assert main(["gesture", "generate", str(drawn), "--count", "12", "--seed", "5"]) == 0
+    photos = tmp_path / "photos"
+    for count in ("2", "5"):
+        (photos / count).mkdir(parents=True)
+        for photo in sorted((REAL_HANDS / "train" / count).glob("*.jpg"))[:3]:
+            (photos / count / photo.name).write_bytes(photo.read_bytes())
+    args = ["gesture", "train", str(photos), str(drawn), "-o", str(model), "--epochs", "1"]
+    assert main([*args, "--held-out", "0", "--preprocess", "edges", "--threads", "1"]) == 0
+    out = capsys.readouterr().out
+    assert "18 pictures: training on 18, holding out 0 (none held out)" in out
+    assert "nothing held out: measure it with" in out
+    sidecar = json.loads(model.with_suffix(".json").read_text())
+    assert sidecar["preprocessing"]["mode"] == "edges"
+    assert sidecar["training"]["data"] == ["photos", "drawn"]
+    assert sidecar["training"]["held_out_evaluation"] is None
 
 
 def test_training_on_a_folder_that_is_not_labelled_is_refused(tmp_path: Path, capsys) -> None:

@@ -16,7 +16,12 @@ torch = pytest.importorskip(
 from engine.vision.classifier import HandModel  # noqa: E402
 from engine.vision.hand_network import HandNetwork, WithSoftmax, export_onnx, parameter_count  # noqa: E402
 from engine.vision.synthetic_hands import write_dataset  # noqa: E402
-from engine.vision.training import TrainingSettings, soft_targets, train  # noqa: E402
+from engine.vision.training import (  # noqa: E402
+    TrainingSettings,
+    learning_rate_factor,
+    soft_targets,
+    train,
+)
 
 
 def test_the_network_is_table_2_with_its_1_64_million_parameters() -> None:
@@ -72,3 +77,14 @@ def test_a_short_training_run_writes_a_model_and_its_settings(tmp_path: Path) ->
     assert sidecar["training"]["epochs"] == 2
     assert sidecar["training"]["held_out_evaluation"]["matrix"] == result.evaluation.matrix.tolist()
     assert HandModel.load(out).read(np.zeros((360, 640, 3), np.uint8)).confidence > 0
+
+
+def test_a_short_fine_tuning_run_is_not_all_warm_up() -> None:
+    """300 warm-up steps in a run of 10 epochs of 30 steps would leave no step at the full
+    rate: the warm-up is at most a fifth of the run."""
+    short = TrainingSettings(epochs=10, warmup_steps=300)
+    assert learning_rate_factor(0, 30, short) == 0.1
+    assert learning_rate_factor(60, 30, short) == 1.0  # a fifth of 300 steps: warm
+    assert learning_rate_factor(200, 30, short) == 0.5  # past 60 % of the epochs
+    long = TrainingSettings(epochs=16, warmup_steps=300)
+    assert learning_rate_factor(150, 500, long) == 0.1 + 0.9 * 150 / 300

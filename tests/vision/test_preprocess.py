@@ -1,5 +1,6 @@
-"""The paper's preprocessing, shared by training, the robot and the simulated camera:
-crop without scaling, grayscale, blur, adaptive threshold, edges read as 1."""
+"""The preprocessing, shared by training, the robot and the simulated camera: a window
+cut without scaling (a smaller picture scaled up to fill it), then the paper's grayscale,
+blur, adaptive threshold and edges read as 1, or normalised grayscale."""
 
 from __future__ import annotations
 
@@ -115,3 +116,30 @@ def test_a_file_that_is_not_a_picture_is_named(tmp_path: Path) -> None:
         read_image(text)
     with pytest.raises(ValueError, match=r"missing\.png: file not found"):
         read_image(tmp_path / "missing.png")
+
+
+def test_gray_reads_the_window_normalised_whatever_the_light() -> None:
+    rng = np.random.default_rng(3)
+    scene = rng.integers(0, 200, size=(128, 128, 3)).astype(np.float32)
+    dim, bright = (scene * 0.4).astype(np.uint8), np.clip(scene * 1.2 + 20, 0, 255).astype(np.uint8)
+    gray = Preprocessing(mode="gray")
+    read_dim, read_bright = network_input(dim, gray), network_input(bright, gray)
+    assert read_dim.shape == (1, 128, 128)
+    assert abs(float(read_dim.mean())) < 1e-4 and abs(float(read_dim.std()) - 1.0) < 1e-3
+    np.testing.assert_allclose(read_dim, read_bright, atol=0.1)  # the same scene, relit
+    flat = np.full((128, 128, 3), 90, np.uint8)
+    assert not network_input(flat, gray).any()  # nothing to see: zeros, never a division by 0
+
+
+def test_settings_without_a_mode_are_the_papers_and_an_unknown_mode_is_named() -> None:
+    assert Preprocessing.from_json({"blur_px": 3}, "old.json").mode == "edges"
+    with pytest.raises(ConfigError, match=r"old\.json: mode must be one of gray, edges"):
+        Preprocessing.from_json({"mode": "color"}, "old.json")
+
+
+def test_a_picture_smaller_than_the_window_is_scaled_up_to_fill_it() -> None:
+    photo = np.zeros((100, 80, 3), np.uint8)
+    photo[:, :40] = 200  # the left half bright
+    window = crop(photo, Preprocessing())
+    assert window.shape == (128, 128, 3)  # 80 wide became 128; 100 high became 160, cut
+    assert window[:, :60].min() == 200 and window[:, 68:].max() == 0

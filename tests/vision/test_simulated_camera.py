@@ -67,6 +67,23 @@ def test_a_picture_is_placed_in_the_frame_unscaled(tmp_path: Path) -> None:
     assert (frame[WINDOW][:, :, 2] == 200).all() and (frame[WINDOW][:, :, 0] == 0).all()
 
 
+def test_a_photograph_smaller_than_the_window_is_held_up_close_to_fill_it(
+    tmp_path: Path,
+) -> None:
+    """A 100 x 100 px photograph of a hand would sit in the window with the room around it;
+    held up close, it fills the window, as `vest gesture` reads such a picture."""
+    photo = np.zeros((100, 100, 3), np.uint8)
+    photo[:, :, 1] = 180  # green
+    cv2.imwrite(str(tmp_path / "hand.png"), photo)
+    camera, player, clock = camera_on(tmp_path, "  - {at: 1.0, show_hand: {image: hand.png}}\n")
+    room = camera.read()
+    at(player, clock, 1.0)
+    frame = camera.read()
+    assert (frame[WINDOW][:, :, 1] == 180).all() and (frame[WINDOW][:, :, 0] == 0).all()
+    outside = (slice(0, 100), slice(0, 200))
+    assert np.array_equal(frame[outside], room[outside])  # the room around it is still there
+
+
 def test_a_video_plays_on_the_robot_s_clock_from_when_it_is_shown(tmp_path: Path) -> None:
     video = tmp_path / "clip.avi"
     writer = cv2.VideoWriter(str(video), cv2.VideoWriter.fourcc(*"MJPG"), 10.0, (640, 360))
