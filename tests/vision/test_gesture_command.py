@@ -50,11 +50,11 @@ def test_a_picture_reads_as_words_without_json(tmp_path: Path, capsys) -> None:
 
 def test_a_window_elsewhere_is_given_with_crop(tmp_path: Path, capsys) -> None:
     frame = np.full((400, 400, 3), 90, np.uint8)
-    hand = render_frame(4, np.random.default_rng(14))[116:244, 256:384]  # the hand's window
-    frame[10:138, 20:148] = hand
+    photo = REAL_HANDS / "held-out" / "4" / "p005-IMG_1162.jpg"  # 100 x 100 px, four fingers
+    frame[10:110, 20:120] = cv2.imread(str(photo))
     path = tmp_path / "corner.png"
     cv2.imwrite(str(path), frame)
-    assert main(["gesture", str(path), "--crop", "20,10,128", "--json"]) == 0
+    assert main(["gesture", str(path), "--crop", "20,10,100", "--json"]) == 0
     assert json.loads(capsys.readouterr().out)["fingers"] == 4
 
 
