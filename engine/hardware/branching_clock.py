@@ -59,10 +59,6 @@ class BranchingClock:
         """Waits on the robot's time (a waiting thread is never inside a branch)."""
         return self.base.wait(event, timeout_s)
 
-    @property
-    def in_branch(self) -> bool:
-        return self._offset() is not None
-
     @contextlib.contextmanager
     def branch(self) -> Iterator[None]:
         """Run the body on its own time line starting now; nested branches share the outer one."""

@@ -39,11 +39,6 @@ class DeviceHealth:
         return self._bus_ok and self._driver_ok
 
     @property
-    def bus_ok(self) -> bool:
-        """The bus manager has the device online."""
-        return self._bus_ok
-
-    @property
     def driver_ok(self) -> bool:
         """The driver's last answers made sense."""
         return self._driver_ok

@@ -216,14 +216,6 @@ class SafetyEnvelope:
         scale = limit / max(rgb)
         return "#" + "".join(f"{round(part * scale * 255):02X}" for part in rgb)
 
-    def moves_always_refused(self, joint: str, angle_deg: float) -> str | None:
-        """Why a move of ``joint`` to ``angle_deg`` can never be made (for validate)."""
-        limits = self.config.joint_limits.get(joint)
-        if limits is not None and not limits[0] <= angle_deg <= limits[1]:
-            verdict = self.refusal(joint, angle_deg)
-            return None if verdict is None else f"safety: {verdict.why}"
-        return None
-
     def tell(self, action: SafetyKind, joint: str, verdict: Verdict) -> None:
         """Publish what the envelope did to a move of ``joint``."""
         if self.stream is not None:

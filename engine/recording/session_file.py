@@ -1,4 +1,4 @@
-"""The session recording file: one SQLite database (docs/recordings.md describes it).
+"""The session recording file: one SQLite database (docs/view-and-recordings.md describes it).
 
 Times are seconds since the session started (its first tick's clock time). Tables:
 

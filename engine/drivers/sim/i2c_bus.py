@@ -140,10 +140,6 @@ class SimI2CBus(I2CBus):
         with self._lock:
             return self._active_fault(address)
 
-    def clear_faults(self) -> None:
-        with self._lock:
-            self._faults.clear()
-
     def _active_fault(self, key: int | None) -> str | None:
         fault = self._faults.get(key)
         if fault is None:
