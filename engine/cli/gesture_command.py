@@ -91,7 +91,11 @@ def _share(text: str) -> float:
 
 def _held_out(text: str) -> float:
     """A share to hold out: 0 (none) or between 0 and 1."""
-    return 0.0 if text.strip() in ("0", "0.0") else _share(text)
+    try:
+        nothing = float(text) == 0.0
+    except ValueError:
+        nothing = False
+    return 0.0 if nothing else _share(text)
 
 
 def _label(text: str) -> str:
@@ -156,8 +160,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--preprocess",
         choices=PREPROCESS_MODES,
         default=None,
-        help="gray (the shipped model's) or edges (the paper's); default: the --init "
-        "model's, else gray",
+        help="edges (the paper's and the shipped model's) or gray; default: the --init "
+        "model's, else edges",
     )
     train.add_argument("--split", choices=("session", "file"), default="session")
     train.add_argument("--threads", type=_positive, default=2, help="CPU threads")
@@ -250,19 +254,35 @@ def _train(args: argparse.Namespace) -> int:
         raise DeviceError(
             None, "training needs PyTorch: pip install -e '.[train]' (see docs/vision.md)"
         ) from None
+    from engine.files.yaml_source import resolved
     from engine.vision.classifier import HandModel
     from engine.vision.preprocess import Preprocessing
     from engine.vision.training import TrainingSettings, train
 
     if args.output.suffix != ".onnx":
         raise ConfigError(f"{args.output}: the model's file name must end in .onnx")
-    writable_folder(args.output.parent)  # before the training, not after it
-    if args.matrix is not None:
-        writable_folder(args.matrix.parent)
-    pre = Preprocessing(mode="gray")
+    matrix = args.matrix or args.output.with_suffix(".matrix.png")
+    for path in (args.output, args.output.with_suffix(".json"), matrix):
+        writable_folder(path.parent)  # before the training, not after it
+        if path.exists() and not path.is_file():  # a folder, a FIFO: found out after hours
+            raise ConfigError(f"{path}: not a file the training can write; name another")
+    seen: set[Path] = set()
+    twice = None
+    for folder in args.data:
+        twice = twice or (folder if resolved(folder) in seen else None)
+        seen.add(resolved(folder))
+    if twice is not None:  # its pictures would count twice, and be trained and tested on
+        raise ConfigError(f"{twice}: named twice; name each folder of pictures once")
+    pre = Preprocessing()
     if args.init is not None:  # a lab's retraining reads pictures as the model it starts from
         pre = HandModel.load(args.init).settings
     if args.preprocess is not None:
+        if args.init is not None and args.preprocess != pre.mode:
+            print(
+                f"note: {args.init} reads pictures as {pre.mode}; training it on "
+                f"{args.preprocess} starts from weights made for another input",
+                file=sys.stderr,
+            )
         pre = replace(pre, mode=args.preprocess)
     settings = TrainingSettings(
         preprocessing=pre,
@@ -283,7 +303,6 @@ def _train(args: argparse.Namespace) -> int:
         return 0
     print(result.evaluation.table())
     print(f"held out: {result.evaluation.summary()}")
-    matrix = args.matrix or args.output.with_suffix(".matrix.png")
     result.evaluation.write_png(matrix, f"{args.output.name}: held out ({result.split})")
     print(f"model: {args.output} (settings in {sidecar}); matrix: {matrix}")
     return 0

@@ -25,7 +25,7 @@ from engine.clock import EpochClock
 from engine.drivers.camera import CameraError, OpenCvCamera
 from engine.errors import ConfigError
 from engine.vision.dataset import FOLDERS, IMAGE_SUFFIXES
-from engine.vision.preprocess import SIDE_PX, Frame, read_image
+from engine.vision.preprocess import Frame, read_image
 from engine.vision.synthetic_hands import NO_HAND
 
 SESSION = re.compile(r"[A-Za-z0-9_.]+")
@@ -64,11 +64,6 @@ class Recorder:
         self.saved = 0
 
     def save(self, frame: Frame, label: str) -> Path:
-        if frame.shape[0] < SIDE_PX or frame.shape[1] < SIDE_PX:
-            raise ConfigError(
-                f"a {frame.shape[1]}x{frame.shape[0]} picture is smaller than the "
-                f"{SIDE_PX}x{SIDE_PX} window"
-            )
         folder = self.data / label
         writable_folder(folder)
         number = len(list(folder.glob(f"{self.session}-*.png")))

@@ -51,6 +51,7 @@ from engine.drivers.vl53l0x_spads import (
 from engine.drivers.vl53l0x_timing import (
     TimingRegisters,
     final_range_timeout_for,
+    implausible,
     timing_budget_us,
 )
 from engine.drivers.vl53l0x_tuning import DEFAULT_TUNING, TUNING_SIGNAL_RATE_LIMIT
@@ -293,7 +294,9 @@ class VL53L0X:
             )
 
     def _timing_registers(self) -> TimingRegisters:
-        return TimingRegisters(
+        """The registers the timing budget depends on; DeviceError naming the register when
+        one reads what no working chip holds (a garbled read never becomes a budget)."""
+        timing = TimingRegisters(
             sequence_config=self._read(reg.SYSTEM_SEQUENCE_CONFIG),
             pre_range_vcsel_period=self._read(reg.PRE_RANGE_CONFIG_VCSEL_PERIOD),
             msrc_timeout=self._read(reg.MSRC_CONFIG_TIMEOUT_MACROP),
@@ -301,6 +304,10 @@ class VL53L0X:
             final_range_vcsel_period=self._read(reg.FINAL_RANGE_CONFIG_VCSEL_PERIOD),
             final_range_timeout=self._read_u16(reg.FINAL_RANGE_CONFIG_TIMEOUT_MACROP_HI),
         )
+        why = implausible(timing)
+        if why is not None:
+            raise DeviceError(f"{self._where()}: {why}, which no working VL53L0X holds")
+        return timing
 
     def _set_timing_budget_us(self, budget_us: int) -> None:
         """Give the final range what the budget leaves (ST's ``set_measurement_timing_

@@ -59,6 +59,32 @@ class TimingRegisters:
         return bool(self.sequence_config & 0x80)
 
 
+PRE_RANGE_VCSEL_REGISTERS = range(5, 9)
+"""Pre-range VCSEL periods the chip supports, 12..18 PLL clocks, as register values."""
+FINAL_RANGE_VCSEL_REGISTERS = range(3, 7)
+"""Final-range VCSEL periods the chip supports, 8..14 PLL clocks, as register values."""
+MAX_TIMEOUT_EXPONENT = 15
+"""The largest exponent (MSB) of an encoded timeout a chip ever holds (255 << 15 macro
+periods is minutes: far past any budget)."""
+
+
+def implausible(timing: TimingRegisters) -> str | None:
+    """Why these register values cannot be a working chip's (a garbled read), or None."""
+    if timing.pre_range_vcsel_period not in PRE_RANGE_VCSEL_REGISTERS:
+        return f"pre-range VCSEL period register 0x50 reads {timing.pre_range_vcsel_period:#04x}"
+    if timing.final_range_vcsel_period not in FINAL_RANGE_VCSEL_REGISTERS:
+        return (
+            f"final-range VCSEL period register 0x70 reads {timing.final_range_vcsel_period:#04x}"
+        )
+    for name, register, encoded in (
+        ("pre-range", 0x51, timing.pre_range_timeout),
+        ("final-range", 0x71, timing.final_range_timeout),
+    ):
+        if encoded >> 8 > MAX_TIMEOUT_EXPONENT:
+            return f"{name} timeout register {register:#04x} reads {encoded:#06x}"
+    return None
+
+
 def vcsel_period_pclks(register: int) -> int:
     """The VCSEL period in PLL clocks from its register value (``(reg + 1) * 2``)."""
     return ((register + 1) & 0xFF) << 1

@@ -28,6 +28,11 @@ def _default(param: Param[Any]) -> str:
     return f"`{param.default}`"
 
 
+def _cell(text: str) -> str:
+    """``text`` for a Markdown table cell: a ``|`` in it (``all | one``) would end the cell."""
+    return text.replace("|", "\\|")
+
+
 def nodes_markdown(registry: NodeRegistry) -> str:
     """A Markdown page describing every node type, grouped by kind."""
     lines = [
@@ -50,8 +55,8 @@ def nodes_markdown(registry: NodeRegistry) -> str:
                 lines += ["| parameter | type | default | meaning |", "|---|---|---|---|"]
                 for param in node_type.params:
                     lines.append(
-                        f"| `{param.name}` | {param.type.describe()} | "
-                        f"{_default(param)} | {param.doc} |"
+                        f"| `{param.name}` | {_cell(param.type.describe())} | "
+                        f"{_cell(_default(param))} | {_cell(param.doc)} |"
                     )
                 lines.append("")
             if node_type.fixed_reads or node_type.fixed_writes:

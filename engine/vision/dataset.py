@@ -29,6 +29,7 @@ from engine.vision.preprocess import (
     Preprocessing,
     crop,
     filling,
+    fills_window,
     read_image,
     window_input,
 )
@@ -114,7 +115,10 @@ def load_pictures(pictures: Sequence[Picture], settings: Preprocessing) -> list[
     side = settings.side_px
     for picture in pictures:
         try:
-            image = filling(read_image(picture.path), settings)  # a small one: scaled up
+            image = read_image(picture.path)
+            if not fills_window(image, settings):  # a small one: its window, scaled up
+                images.append(filling(image, settings))
+                continue
             x, y = settings.window(image.shape[0], image.shape[1])
         except ValueError as error:
             raise ConfigError(
@@ -135,8 +139,9 @@ def augment(image: Frame, rng: np.random.Generator, settings: Preprocessing) -> 
     (0.6..1.4: skin tones, white balance), brightened or darkened, gamma-curved
     (0.7..1.4), sometimes blurred (out of focus), and noised."""
     height, width = image.shape[:2]
-    x, y = settings.window(height, width)
     side = settings.side_px
+    # a window-sized picture (a small one, scaled up when loaded) is its own window
+    x, y = (0, 0) if (height, width) == (side, side) else settings.window(height, width)
     centre = (x + side / 2 + rng.uniform(-10, 10), y + side / 2 + rng.uniform(-10, 10))
     angle, scale = rng.uniform(-20, 20), rng.uniform(0.8, 1.15)
     matrix = cv2.getRotationMatrix2D(centre, angle, scale)

@@ -1,15 +1,15 @@
 """How a frame becomes the network's input, written once for training, inference and the
 simulated camera. A frame is cropped to a square window without scaling (128 x 128 px; a
-picture smaller than the window is first scaled up to fill it), turned grayscale, then
-read one of two ways (``mode``):
+picture smaller than the window: its centred square, scaled up to fill it), turned
+grayscale, then read one of two ways (``mode``):
 
-- ``gray`` (the shipped model's): the grayscale window normalised to mean 0 and standard
-  deviation 1, so a hand reads the same in a dim room and a bright one. It counts real
-  photographs of hands (docs/vision-model-card.md).
-- ``edges`` (the paper's, section 4.4): blurred (Gaussian, 3 x 3, sigma 7) and thresholded
-  adaptively (Gaussian weights over an 11 x 11 window) into a binary edge image the network
-  reads as 0.0 / 1.0. Kept for models trained that way; on photographs it loses the hand in
-  the texture of skin and light (the model card has both figures).
+- ``edges`` (the paper's, section 4.4, and the shipped model's): blurred (Gaussian,
+  3 x 3, sigma 7) and thresholded adaptively (Gaussian weights over an 11 x 11 window) into
+  a binary edge image the network reads as 0.0 / 1.0.
+- ``gray``: the grayscale window normalised to mean 0 and standard deviation 1, so a hand
+  reads the same in a dim room and a bright one. On the photographs of real hands it
+  counts less well than edges (docs/vision-model-card.md has both figures); a choice for a
+  lab whose light or camera makes edges noisy.
 
 The settings travel beside a model (``model.json`` next to ``model.onnx``), so a model
 retrained with other settings carries its own. What the paper leaves open and we chose:
@@ -156,22 +156,25 @@ def fills_window(frame: Frame, settings: Preprocessing) -> bool:
 
 
 def filling(frame: Frame, settings: Preprocessing) -> Frame:
-    """``frame`` as it is when it fills the window; else scaled up, keeping its shape,
-    until its shorter side is the window's."""
+    """``frame`` as it is when it fills the window; else the window from it: its centred
+    square (its shorter side wide), scaled up to the window's side. A picture smaller than
+    the window is no camera frame, so a configured crop position does not apply to it; it
+    is cut before it is scaled (an 8192 x 1 px picture costs no more than a square one)."""
     if fills_window(frame, settings):
         return frame
-    factor = settings.side_px / min(frame.shape[0], frame.shape[1])
-    size = (
-        max(settings.side_px, round(frame.shape[1] * factor)),
-        max(settings.side_px, round(frame.shape[0] * factor)),
-    )
-    return np.asarray(cv2.resize(frame, size, interpolation=cv2.INTER_LINEAR), dtype=np.uint8)
+    height, width = frame.shape[:2]
+    side = min(height, width)
+    top, left = (height - side) // 2, (width - side) // 2
+    square = frame[top : top + side, left : left + side]
+    size = (settings.side_px, settings.side_px)
+    return np.asarray(cv2.resize(square, size, interpolation=cv2.INTER_LINEAR), dtype=np.uint8)
 
 
 def crop(frame: Frame, settings: Preprocessing) -> Frame:
-    """The square window of ``frame`` (no scaling, unless the frame is smaller than the
-    window: :func:`filling`), as a copy."""
-    frame = filling(frame, settings)
+    """The square window of ``frame`` (no scaling), as a copy; a frame smaller than the
+    window is :func:`filling`'s window."""
+    if not fills_window(frame, settings):
+        return filling(frame, settings)
     x, y = settings.window(frame.shape[0], frame.shape[1])
     side = settings.side_px
     return frame[y : y + side, x : x + side].copy()

@@ -58,7 +58,7 @@ class TrainingSettings:
     seed: int = 1
     threads: int = 2
     min_confidence: float = 0.6
-    preprocessing: Preprocessing = field(default_factory=lambda: Preprocessing(mode="gray"))
+    preprocessing: Preprocessing = field(default_factory=Preprocessing)
     start_from: Path | None = None
     """A model whose weights training starts from (else He initialisation)."""
 
@@ -112,6 +112,11 @@ def train(
 
     folders = [data] if isinstance(data, Path) else list(data)
     pictures = [picture for folder in folders for picture in find_pictures(folder)]
+    if all(picture.label == NONE_INDEX for picture in pictures):
+        raise ConfigError(
+            f"{', '.join(map(str, folders))}: no pictures of a hand (0/ .. 5/ are empty); "
+            "a model learns to count from them"
+        )
     if settings.held_out > 0:
         train_set, test_set, how = split(
             pictures, settings.held_out, settings.seed, by=settings.split_by

@@ -208,3 +208,31 @@ def test_garbage_never_becomes_a_valid_distance_past_two_metres(
     assert readings.refused
     assert all(mm is None or 0 <= mm <= 2000 for mm in readings.believed)
     assert any("VL53L0X at I2C 0x29: range with a valid status" in str(r) for r in readings.refused)
+
+
+class GarbledAt(SimVL53L0X):
+    """A VL53L0X whose bus garbles one register of page 0: it always reads 0xFF."""
+
+    def __init__(self, clock: VirtualClock, bus: SimI2CBus, register: int) -> None:
+        super().__init__(clock, bus)
+        self.garbled = register
+
+    def read(self, length: int) -> bytes:
+        if self._pointer == self.garbled and not self._page:
+            self._pointer = (self._pointer + length) & 0xFF
+            return b"\xff" * length
+        return super().read(length)
+
+
+@pytest.mark.parametrize(
+    ("register", "named"),
+    [(0x50, "register 0x50"), (0x70, "register 0x70"), (0x71, "register 0x71")],
+)
+def test_a_garbled_timing_register_is_a_device_error_never_a_budget(
+    clock: VirtualClock, bus: SimI2CBus, register: int, named: str
+) -> None:
+    """One byte read as 0xFF during bring-up: a VCSEL period no chip has (it divided by
+    zero), or a timeout of 10^74 s (it became the budget)."""
+    GarbledAt(clock, bus, register)
+    with pytest.raises(DeviceError, match=rf"VL53L0X at 0x29: .*{named} reads 0xff"):
+        VL53L0X(bus, clock=clock)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import os
 from pathlib import Path
 
 import cv2
@@ -127,7 +128,7 @@ def test_a_model_learns_from_photographs_and_drawn_hands_together(tmp_path: Path
         for photo in sorted((REAL_HANDS / "train" / count).glob("*.jpg"))[:3]:
             (photos / count / photo.name).write_bytes(photo.read_bytes())
     args = ["gesture", "train", str(photos), str(drawn), "-o", str(model), "--epochs", "1"]
-    assert main([*args, "--held-out", "0", "--preprocess", "edges", "--threads", "1"]) == 0
+    assert main([*args, "--held-out", "0.00", "--preprocess", "edges", "--threads", "1"]) == 0
     out = capsys.readouterr().out
     assert "18 pictures: training on 18, holding out 0 (none held out)" in out
     assert "nothing held out: measure it with" in out
@@ -203,6 +204,48 @@ def test_generating_or_training_into_a_place_that_cannot_be_written_is_said_firs
     assert main(["gesture", "train", str(data), "-o", str(blocked / "m.onnx")]) == 1
     err = capsys.readouterr().err
     assert "cannot write there" in err and "epoch" not in err
+
+
+@pytest.mark.parametrize("blocker", ["m.json", "m.matrix.png", "m.onnx"])
+def test_a_model_s_files_that_could_not_be_written_are_named_before_the_training(
+    tmp_path: Path, capsys, blocker: str
+) -> None:
+    """Found out after an hour of training, a folder or a FIFO where the model's settings go
+    lost the run (a traceback, or a wait for ever)."""
+    data = tmp_path / "data"
+    assert main(["gesture", "generate", str(data), "--count", "6"]) == 0
+    out = tmp_path / "out"
+    out.mkdir()
+    if blocker == "m.json":
+        os.mkfifo(out / blocker)
+    else:
+        (out / blocker).mkdir()
+    assert main(["gesture", "train", str(data), "-o", str(out / "m.onnx")]) == 1
+    captured = capsys.readouterr()
+    assert f"{blocker}: not a file the training can write" in captured.err
+    assert "epoch" not in captured.out
+
+
+def test_training_refuses_a_folder_named_twice_and_pictures_with_no_hand(
+    tmp_path: Path, capsys
+) -> None:
+    data = tmp_path / "data"
+    assert main(["gesture", "generate", str(data), "--count", "6"]) == 0
+    model = str(tmp_path / "m.onnx")
+    assert main(["gesture", "train", str(data), f"{data}/", "-o", model]) == 1
+    assert "named twice; name each folder of pictures once" in capsys.readouterr().err
+    empty_rooms = tmp_path / "rooms" / "none"
+    empty_rooms.mkdir(parents=True)
+    picture(empty_rooms, "room.png", None, seed=8)
+    assert main(["gesture", "train", str(empty_rooms.parent), "-o", model]) == 1
+    assert "no pictures of a hand (0/ .. 5/ are empty)" in capsys.readouterr().err
+
+
+def test_record_takes_photographs_smaller_than_the_window(tmp_path: Path, capsys) -> None:
+    data = tmp_path / "data"
+    photos = REAL_HANDS / "train" / "3"
+    assert main(["gesture", "record", str(data), "--label", "3", "--from", str(photos)]) == 0
+    assert len(list((data / "3").iterdir())) == len(list(photos.iterdir()))
 
 
 @pytest.mark.parametrize(

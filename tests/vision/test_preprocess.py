@@ -141,5 +141,14 @@ def test_a_picture_smaller_than_the_window_is_scaled_up_to_fill_it() -> None:
     photo = np.zeros((100, 80, 3), np.uint8)
     photo[:, :40] = 200  # the left half bright
     window = crop(photo, Preprocessing())
-    assert window.shape == (128, 128, 3)  # 80 wide became 128; 100 high became 160, cut
+    assert window.shape == (128, 128, 3)  # its centred 80 x 80 square, scaled to 128
     assert window[:, :60].min() == 200 and window[:, 68:].max() == 0
+    placed = Preprocessing(crop_x=300, crop_y=100)  # a camera's window: not for a photograph
+    assert np.array_equal(crop(photo, placed), window)
+
+
+def test_a_picture_of_absurd_shape_is_cut_before_it_is_scaled() -> None:
+    """An 8192 x 1 px strip would become 1,048,576 x 128 px if scaled whole."""
+    strip = np.full((1, 8192, 3), 77, np.uint8)
+    assert crop(strip, Preprocessing()).shape == (128, 128, 3)
+    assert network_input(strip, Preprocessing()).shape == (1, 128, 128)

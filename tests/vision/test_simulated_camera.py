@@ -18,6 +18,7 @@ from engine.files.problems import LoadError
 from engine.scenario.player import ScenarioPlayer
 from engine.scenario.scenario_file import load_scenario
 from engine.scenario.world import World
+from engine.vision.preprocess import Preprocessing, crop
 
 WINDOW = (slice(116, 244), slice(256, 384))  # the centred 128 x 128 window of 640 x 360
 
@@ -82,6 +83,17 @@ def test_a_photograph_smaller_than_the_window_is_held_up_close_to_fill_it(
     assert (frame[WINDOW][:, :, 1] == 180).all() and (frame[WINDOW][:, :, 0] == 0).all()
     outside = (slice(0, 100), slice(0, 200))
     assert np.array_equal(frame[outside], room[outside])  # the room around it is still there
+
+
+def test_the_camera_holds_up_a_small_picture_as_vest_gesture_reads_it(tmp_path: Path) -> None:
+    """A narrow photograph (60 x 100 px): the camera shows the window `vest gesture` reads,
+    so a scenario and the command count the same picture alike."""
+    rng = np.random.default_rng(4)
+    photo = rng.integers(0, 255, size=(100, 60, 3)).astype(np.uint8)
+    cv2.imwrite(str(tmp_path / "narrow.png"), photo)
+    camera, player, clock = camera_on(tmp_path, "  - {at: 1.0, show_hand: {image: narrow.png}}\n")
+    at(player, clock, 1.0)
+    assert np.array_equal(camera.read()[WINDOW], crop(photo, Preprocessing()))
 
 
 def test_a_video_plays_on_the_robot_s_clock_from_when_it_is_shown(tmp_path: Path) -> None:

@@ -18,7 +18,14 @@ import numpy as np
 from engine.clock import Clock
 from engine.drivers.camera import CameraError
 from engine.scenario.world import ShownHand, World
-from engine.vision.preprocess import SIDE_PX, Frame, read_image
+from engine.vision.preprocess import (
+    SIDE_PX,
+    Frame,
+    Preprocessing,
+    filling,
+    fills_window,
+    read_image,
+)
 from engine.vision.shown_hand import render_shown_hand
 from engine.vision.synthetic_hands import render_frame
 
@@ -112,13 +119,12 @@ class SimulatedCamera:
     def _fit(self, image: Frame) -> Frame:
         """A picture placed in the camera's frame as it is (no scaling): centred on the
         room, or its centre cut out when it is larger. A picture smaller than the crop
-        window (a 100 x 100 px photograph of a hand) is held up close: scaled to fill the
-        window, where the window is."""
-        if min(image.shape[:2]) < SIDE_PX:
+        window (a 100 x 100 px photograph of a hand) is held up close: its centred square
+        scaled to fill the window, where the window is (as `vest gesture` reads it)."""
+        if not fills_window(image, Preprocessing()):
             frame = self._room.copy()
             x, y = self.window or ((self.width - SIDE_PX) // 2, (self.height - SIDE_PX) // 2)
-            close = cv2.resize(image, (SIDE_PX, SIDE_PX), interpolation=cv2.INTER_LINEAR)
-            frame[y : y + SIDE_PX, x : x + SIDE_PX] = close
+            frame[y : y + SIDE_PX, x : x + SIDE_PX] = filling(image, Preprocessing())
             return frame
         frame = self._room.copy()
         height, width = image.shape[:2]
