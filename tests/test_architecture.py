@@ -5,10 +5,13 @@ from __future__ import annotations
 
 import ast
 import re
+import subprocess
+import sys
 from collections import defaultdict
 from pathlib import Path
 
-ENGINE = Path(__file__).resolve().parents[1] / "engine"
+ROOT = Path(__file__).resolve().parents[1]
+ENGINE = ROOT / "engine"
 MAX_LINES = 420  # "about 400": a module one reads in one sitting
 
 
@@ -138,3 +141,18 @@ def test_every_sensor_key_name_is_written_once_in_the_catalogue() -> None:
             ):
                 written.append(f"{path.relative_to(ENGINE.parent)}:{node.lineno}")
     assert written == []
+
+
+def test_the_cloud_service_loads_no_robot_code() -> None:
+    """A cloud host runs the service alone: importing it loads no behavior trees, no
+    speech, no vision; what both sides share (the commands, the clock) imports none."""
+    program = (
+        "import sys, cloud.app, cloud.server;"
+        "robot = ('py_trees', 'engine.nodes', 'engine.speech', 'engine.vision', 'cv2',"
+        " 'onnxruntime', 'faster_whisper', 'engine.drivers', 'engine.hardware');"
+        "print(sorted(m for m in sys.modules if m.startswith(robot)))"
+    )
+    loaded = subprocess.run(
+        [sys.executable, "-c", program], capture_output=True, text=True, check=True, cwd=ROOT
+    )
+    assert loaded.stdout.strip() == "[]"

@@ -8,7 +8,7 @@ from cloud.api.deps import CurrentOperator, StoreDep
 from cloud.api.robots import granted
 from cloud.api.schemas import CommandCreate, CommandPublic
 from cloud.store.ledger import ConflictError
-from engine.nodes.remote import command_problem
+from engine.remote_commands import command_problem
 
 router = APIRouter(prefix="/robots/{robot}/commands", tags=["operator"])
 

@@ -10,7 +10,7 @@ from cloud.api.deps import CurrentOperator, StoreDep
 from cloud.api.schemas import RobotPublic
 from cloud.services import CloudStore
 from cloud.store.tables import RobotRow
-from engine.nodes.remote import command_catalogue
+from engine.remote_commands import command_catalogue
 
 router = APIRouter(prefix="/robots", tags=["operator"])
 ONLINE_WITHIN_S = 15.0

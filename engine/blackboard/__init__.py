@@ -1,11 +1,7 @@
-"""The shared blackboard: a catalogue of known keys, events, and staged writes.
+"""The shared blackboard: a catalogue of known keys (``catalogue``), events (``events``),
+and the board with its staged writes (``board``).
 
 Producers in other threads *stage* writes; the scheduler commits them between ticks so
-every tree in one tick sees one consistent snapshot.
+every tree in one tick sees one consistent snapshot. Import from the modules: the key
+catalogue loads no py_trees (the cloud service reads it without the robot's code).
 """
-
-from engine.blackboard.board import Blackboard
-from engine.blackboard.catalogue import KeyCatalogue, KeySpec, default_catalogue
-from engine.blackboard.events import Event, EventLog
-
-__all__ = ["Blackboard", "Event", "EventLog", "KeyCatalogue", "KeySpec", "default_catalogue"]

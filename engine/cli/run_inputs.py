@@ -27,7 +27,7 @@ from engine.loader.tree_checks import variable_problems
 from engine.loader.tree_definition import TreeDefinition
 from engine.loader.tree_file import TreeLoader
 from engine.nodes.registry import NodeRegistry, default_registry
-from engine.nodes.remote import COMMAND_TYPES
+from engine.remote_commands import COMMAND_TYPES
 from engine.runtime.robot import Behaviors, load_behaviors
 from engine.scenario.scenario_file import Scenario, ScenarioEvent, load_scenario
 from engine.values.params import did_you_mean

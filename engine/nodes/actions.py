@@ -12,10 +12,10 @@ from typing import Any, ClassVar
 from py_trees.common import Status
 
 from engine.blackboard.catalogue import RANGE_CENTER_MM, RANGE_LEFT_MM, RANGE_RIGHT_MM
-from engine.colors import NAMED_COLORS, parse_color
 from engine.errors import ServiceError
 from engine.nodes.base import Leaf, ServiceAction
 from engine.nodes.event_reader import EQUALS, ONE_OF, EventReader, check_choice, wanted
+from engine.remote_commands import LED_ARGS, MOVE_ARGS, SAY_ARGS
 from engine.services.interfaces import ON_REQUEST_SENSORS
 from engine.services.jobs import ImmediateJob, Job
 from engine.values.params import (
@@ -29,35 +29,8 @@ from engine.values.params import (
     Number,
     Param,
     ParamIssue,
-    ParamProblem,
-    ParamType,
     Text,
-    did_you_mean,
 )
-from engine.values.templates import Template
-
-MAX_SAID_CHARS = 1000
-"""The longest phrase one Say speaks (about a minute of speech)."""
-
-
-class Color(ParamType[str]):
-    """A color name (pink, blue, ...) or #RRGGBB."""
-
-    name = "color"
-
-    def json_schema(self) -> dict[str, Any]:
-        return {"anyOf": [{"enum": list(NAMED_COLORS)}, {"type": "string", "pattern": "^#"}]}
-
-    def convert(self, value: Any, ctx: CheckContext) -> str:
-        try:
-            parse_color(str(value))
-        except ValueError:
-            nearest = did_you_mean(str(value), list(NAMED_COLORS))
-            known = "colors: " + ", ".join(NAMED_COLORS) + ", or #RRGGBB"
-            raise ParamProblem(
-                f"unknown color {value!r}", f"{nearest} {known}" if nearest else known
-            ) from None
-        return str(value)
 
 
 class Say(ServiceAction):
@@ -68,12 +41,7 @@ class Say(ServiceAction):
     a field has no value yet.
     """
 
-    text = Param(
-        "text",
-        Template(max_chars=MAX_SAID_CHARS),
-        doc="what to say; {key} fields are filled from the blackboard",
-    )
-    volume = Param("volume", Number(0.0, 1.0), None, "0..1; empty: the robot's default volume")
+    text, volume = SAY_ARGS  # an operator's say command takes the same (remote_commands)
 
     def start(self) -> Job:
         try:
@@ -90,13 +58,7 @@ class SetLed(ServiceAction):
     ``seconds``); FAILURE when the LED service failed.
     """
 
-    color = Param("color", Color(), doc="a color name (pink, blue, off, ...) or #RRGGBB")
-    seconds = Param(
-        "seconds",
-        SECONDS,
-        None,
-        "how long to keep it lit; empty: until the next color",
-    )
+    color, seconds = LED_ARGS
 
     def start(self) -> Job:
         return self.ctx.actions.set_led(self.color, seconds=self.seconds)
@@ -109,14 +71,7 @@ class MoveServo(ServiceAction):
     (unknown joint, beyond the joint's limits) or failed.
     """
 
-    joint = Param("joint", Text(), doc="joint name from the robot config, e.g. neck")
-    angle_deg = Param("angle_deg", Number(-180.0, 180.0, "deg"), doc="target angle in degrees")
-    speed_dps = Param(
-        "speed_dps",
-        SPEED_DPS,
-        None,
-        "degrees per second; empty: the joint's own maximum",
-    )
+    joint, angle_deg, speed_dps = MOVE_ARGS
 
     def start(self) -> Job:
         return self.ctx.actions.move_servo(self.joint, self.angle_deg, speed_dps=self.speed_dps)

@@ -1,12 +1,7 @@
 """CarryOut: do what a remote operator asked (the iot_command behavior).
 
-A command is ``{"id": ..., "type": ..., "args": {...}}``. Types:
-
-- ``say``: ``{text, volume?}``
-- ``led``: ``{color, seconds?}``
-- ``move``: ``{joint, angle_deg, speed_dps?}``
-- ``read``: ``{sensor}``: temperature or ultrasound (read on request), or touch, force,
-  range, gesture (the latest values on the blackboard)
+A command is ``{"id": ..., "type": ..., "args": {...}}``; its types and arguments, and
+their checks, are in :mod:`engine.remote_commands` (shared with the cloud service).
 """
 
 from __future__ import annotations
@@ -16,73 +11,19 @@ from typing import Any, ClassVar
 
 from py_trees.common import Status
 
-from engine.blackboard.catalogue import (
-    FORCE_LEFT_N,
-    FORCE_RIGHT_N,
-    GESTURE_LAST,
-    IOT_CANCELED,
-    RANGE_CENTER_MM,
-    RANGE_LEFT_MM,
-    RANGE_RIGHT_MM,
-    TOUCH_ANY,
-    TOUCH_PADS,
-    default_catalogue,
-)
+from engine.blackboard.catalogue import IOT_CANCELED
 from engine.blackboard.events import EventLog
-from engine.errors import ServiceError
-from engine.nodes.actions import MoveServo, Say, SetLed
-from engine.nodes.base import Leaf, ServiceAction, declared_params
+from engine.nodes.base import ServiceAction
 from engine.nodes.event_reader import EventReader
+from engine.remote_commands import (
+    COMMAND_TYPES,
+    POLLED_READINGS,
+    READABLE_SENSORS,
+    CommandError,
+    checked_args,
+)
 from engine.services.jobs import ImmediateJob, Job
-from engine.values.params import SECONDS, CheckContext, Key, Param, ParamProblem, did_you_mean
-from engine.values.templates import Template
-
-POLLED_READINGS: dict[str, tuple[str, ...]] = {
-    "touch": (TOUCH_PADS, TOUCH_ANY),
-    "force": (FORCE_LEFT_N, FORCE_RIGHT_N),
-    "range": (RANGE_LEFT_MM, RANGE_CENTER_MM, RANGE_RIGHT_MM),
-    "gesture": (GESTURE_LAST,),
-}
-COMMAND_TYPES = ("say", "led", "move", "read")
-
-
-class CommandError(ServiceError):
-    """A remote command is malformed; the message says what to send instead."""
-
-
-ACTION_NODES: dict[str, type[Leaf]] = {"say": Say, "led": SetLed, "move": MoveServo}
-"""The node whose declaration checks each acting command's arguments: one set of rules
-for a tree's parameters and an operator's arguments."""
-
-
-def checked_args(command_type: str, args: Mapping[str, Any], ctx: CheckContext) -> dict[str, Any]:
-    """``args`` converted by the parameters ``ACTION_NODES[command_type]`` declares.
-
-    Raises CommandError naming the argument, the value and what is expected: unknown
-    names, missing required ones, wrong types, NaN, inf, numbers past their bounds, text
-    past its length. Text is taken as written (an operator's braces are no template).
-    """
-    declared = {param.name: param for param in declared_params(ACTION_NODES[command_type])}
-    for name in args:
-        if name not in declared:
-            hint = did_you_mean(str(name), list(declared)) or "arguments: " + ", ".join(declared)
-            raise CommandError(f"unknown argument {name!r} for {command_type} ({hint})")
-    values: dict[str, Any] = {}
-    for name, param in declared.items():
-        raw = args.get(name)
-        if raw is None:
-            if param.required:
-                raise CommandError(f"{command_type} needs {name!r}: {param.doc}")
-            values[name] = param.default
-            continue
-        if isinstance(param.type, Template) and isinstance(raw, str):
-            raw = raw.replace("{", "{{").replace("}", "}}")
-        try:
-            values[name] = param.type.convert(raw, ctx)
-        except ParamProblem as problem:
-            hint = f" ({problem.hint})" if problem.hint else ""
-            raise CommandError(f"{name!r} {problem.message}{hint}") from None
-    return values
+from engine.values.params import SECONDS, CheckContext, Key, Param
 
 
 class CarryOut(ServiceAction):
@@ -92,7 +33,7 @@ class CarryOut(ServiceAction):
     ``save_result_as``; FAILURE when the command is malformed, the service failed, the
     command took longer than ``timeout_s`` or the operator canceled it meanwhile (its
     action is cut short), with ``{"error": why}`` saved there instead.
-    Arguments are checked by the declarations of Say, SetLed and MoveServo. The result
+    Arguments are checked as Say, SetLed and MoveServo check their parameters. The result
     saved always belongs to this command (it is cleared when the command starts).
     """
 
@@ -207,53 +148,6 @@ class CarryOut(ServiceAction):
         if status == Status.FAILURE and self.save_result_as:
             self.write(self.save_result_as, {"error": self.feedback_message})
         return status
-
-
-READABLE_SENSORS = ("temperature", "ultrasound", *POLLED_READINGS)
-
-
-def command_problem(kind: str, args: Mapping[str, Any]) -> str | None:
-    """What is wrong with a command's arguments, checked as the robot will check them
-    (the service answers 422 at once instead of the robot FAILED later); None when they
-    are fine, or when ``kind`` is not built in (the robot decides). What only the robot
-    knows (its joints and their limits) is checked there."""
-    try:
-        if kind in ACTION_NODES:
-            checked_args(kind, args, CheckContext(default_catalogue()))
-        elif kind == "read":
-            sensor = args.get("sensor")
-            if sensor not in READABLE_SENSORS or set(args) - {"sensor"}:
-                return f"read takes 'sensor', one of {', '.join(READABLE_SENSORS)}"
-    except CommandError as error:
-        return str(error)
-    return None
-
-
-def command_catalogue() -> dict[str, list[dict[str, Any]]]:
-    """Each command type's arguments as an operator's page builds its form from them:
-    ``{type: [{"name", "doc", "required", "schema"}]}`` (schema: JSON Schema of a value).
-    The same declarations check the arguments when the robot carries a command out."""
-    catalogue = {
-        kind: [
-            {
-                "name": param.name,
-                "doc": param.doc,
-                "required": param.required,
-                "schema": param.type.json_schema(),
-            }
-            for param in declared_params(node)
-        ]
-        for kind, node in ACTION_NODES.items()
-    }
-    catalogue["read"] = [
-        {
-            "name": "sensor",
-            "doc": "which sensor to read",
-            "required": True,
-            "schema": {"enum": list(READABLE_SENSORS)},
-        }
-    ]
-    return catalogue
 
 
 def _shown(value: Any) -> str:

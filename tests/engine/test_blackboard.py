@@ -1,6 +1,7 @@
 """The blackboard: staged writes appear only at commit; events are handled once each."""
 
-from engine.blackboard import Blackboard, default_catalogue
+from engine.blackboard.board import Blackboard
+from engine.blackboard.catalogue import default_catalogue
 from engine.clock import VirtualClock
 
 

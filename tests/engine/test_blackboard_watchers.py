@@ -4,7 +4,8 @@ import logging
 
 import pytest
 
-from engine.blackboard import Blackboard, default_catalogue
+from engine.blackboard.board import Blackboard
+from engine.blackboard.catalogue import default_catalogue
 from engine.clock import VirtualClock
 
 

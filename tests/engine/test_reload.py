@@ -3,7 +3,8 @@
 import os
 import textwrap
 
-from engine.blackboard import Blackboard, default_catalogue
+from engine.blackboard.board import Blackboard
+from engine.blackboard.catalogue import default_catalogue
 from engine.clock import VirtualClock
 from engine.runtime.reload import TreeReloader
 from engine.runtime.robot import Robot, load_behaviors

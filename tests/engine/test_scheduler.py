@@ -8,7 +8,8 @@ from pathlib import Path
 import pytest
 from py_trees.common import Status
 
-from engine.blackboard import Blackboard, default_catalogue
+from engine.blackboard.board import Blackboard
+from engine.blackboard.catalogue import default_catalogue
 from engine.clock import VirtualClock
 from engine.errors import ConfigError
 from engine.nodes import Condition, Param, Text, builtin_registry

@@ -254,7 +254,7 @@ def test_a_profile_that_is_not_a_mapping_is_named(tmp_path: Path, text: str) -> 
 
 
 def test_two_dialog_files_with_one_name_are_reported_with_both_files(tmp_path):
-    from engine.blackboard import default_catalogue
+    from engine.blackboard.catalogue import default_catalogue
     from engine.dialogs import DialogLibrary
     from engine.files.problems import LoadError
 

@@ -5,7 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from engine.blackboard import Blackboard, default_catalogue
+from engine.blackboard.board import Blackboard
+from engine.blackboard.catalogue import default_catalogue
 from engine.clock import VirtualClock
 from engine.drivers.camera import CameraError
 from engine.hardware.device_health import DeviceHealth
