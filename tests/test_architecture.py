@@ -144,10 +144,12 @@ def test_every_sensor_key_name_is_written_once_in_the_catalogue() -> None:
 
 
 def test_the_cloud_service_loads_no_robot_code() -> None:
-    """A cloud host runs the service alone: importing it loads no behavior trees, no
-    speech, no vision; what both sides share (the commands, the clock) imports none."""
+    """A cloud host runs the service alone: importing it, or `vest cloud`'s command line,
+    loads no behavior trees, no speech, no vision; what both sides share (the commands, the
+    clock) imports none."""
     program = (
-        "import sys, cloud.app, cloud.server;"
+        "import sys, cloud.app, cloud.server; from engine.cli import build_parser;"
+        "build_parser('cloud').parse_args(['cloud', 'add-operator', 'ana']);"
         "robot = ('py_trees', 'engine.nodes', 'engine.speech', 'engine.vision', 'cv2',"
         " 'onnxruntime', 'faster_whisper', 'engine.drivers', 'engine.hardware');"
         "print(sorted(m for m in sys.modules if m.startswith(robot)))"

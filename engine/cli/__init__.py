@@ -12,6 +12,7 @@ from __future__ import annotations
 # Only light imports here: SIGINT and SIGTERM are handled before the commands (and the
 # engine they import) are loaded, which takes a second or more on a small board.
 import argparse
+import importlib
 import logging
 import sys
 from collections.abc import Sequence
@@ -32,24 +33,31 @@ output could not be written; 2 wrong command line; 3 something needed is missing
 machine"""
 
 
-def build_parser() -> argparse.ArgumentParser:
-    from engine.cli import (
-        cloud_command,
-        devices_command,
-        dialogs_command,
-        gesture_command,
-        hear_command,
-        keys_command,
-        nodes_command,
-        render_command,
-        replay_command,
-        report_command,
-        run_command,
-        say_command,
-        schema_command,
-        validate_command,
-    )
+COMMANDS: tuple[tuple[str, str], ...] = (
+    ("run", "run the behaviors (default: the demo scenario on the simulated vest)"),
+    ("validate", "check trees, profiles, dialogs and scenarios"),
+    ("render", "draw a tree as ascii, dot, svg or png"),
+    ("nodes", "list node types and their parameters"),
+    ("keys", "list the blackboard keys"),
+    ("devices", "probe the robot's devices and read each once"),
+    ("schema", "print a JSON Schema of tree files (for editors)"),
+    ("hear", "run the robot's hearing on WAV files (or the microphone) and show the answers"),
+    ("say", "speak a text with the robot's voice (or write it to a WAV file)"),
+    ("dialogs", "check that each dialog phrase is recognized, and as its own rule"),
+    ("cloud", "run the cloud service; add operators and robots, grant, revoke"),
+    ("gesture", "count fingers in pictures; record, generate, train and check a hand model"),
+    ("replay", "show a recorded session at a moment (trees' statuses, the blackboard)"),
+    ("report", "write a recorded session as a report for the therapist (HTML)"),
+)
+"""Each command and what it does, in the order ``vest --help`` lists them; the command's
+own module, ``engine.cli.<name>_command``, is loaded only when it runs (a cloud host has no
+behavior-tree, speech or vision packages: ``vest cloud`` runs without them)."""
 
+
+def build_parser(chosen: str | None) -> argparse.ArgumentParser:
+    """The command line, with the arguments of ``chosen`` (the others are listed, and
+    loaded only when asked for). ModuleNotFoundError when ``chosen`` needs packages this
+    machine does not have."""
     parser = argparse.ArgumentParser(
         prog="vest",
         description="Behavior-tree social interaction engine for robots wearing a sensor vest.",
@@ -57,25 +65,14 @@ def build_parser() -> argparse.ArgumentParser:
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     commands = parser.add_subparsers(dest="command", metavar="COMMAND")
-    for module in (
-        run_command,
-        validate_command,
-        render_command,
-        nodes_command,
-        keys_command,
-        devices_command,
-        schema_command,
-        hear_command,
-        say_command,
-        dialogs_command,
-        cloud_command,
-        gesture_command,
-        replay_command,
-        report_command,
-    ):
+    for name, summary in COMMANDS:
+        if name != chosen:
+            commands.add_parser(name, help=summary, add_help=False)
+            continue
+        module = importlib.import_module(f"engine.cli.{name}_command")
         sub = commands.add_parser(
-            module.NAME,
-            help=module.HELP,
+            name,
+            help=summary,
             description=module.__doc__,
             epilog=EPILOG,
             formatter_class=argparse.RawDescriptionHelpFormatter,
@@ -112,8 +109,18 @@ def _handled(argv: Sequence[str] | None, signals: StopSignals, out: WatchedOutpu
     try:
         from engine.cli.gesture_command import with_action
 
-        parser = build_parser()
-        args = parser.parse_args(with_action(sys.argv[1:] if argv is None else argv))
+        words = with_action(sys.argv[1:] if argv is None else argv)
+        chosen = next((word for word in words if not word.startswith("-")), None)
+        try:
+            parser = build_parser(chosen)
+        except ModuleNotFoundError as missing:  # a cloud host without the robot's packages
+            tell(
+                f"vest {chosen}: needs {missing.name}, which is not installed here; "
+                "pip install 'vest-engine[robot]' (docs/cloud.md: a cloud host needs only "
+                "'vest-engine[cloud]')"
+            )
+            return EXIT_MISSING
+        args = parser.parse_args(words)
         if args.command is None:
             parser.print_help()
             sys.stdout.flush()

@@ -19,9 +19,6 @@ from engine.errors import UsageError
 if TYPE_CHECKING:
     from cloud.settings import Settings
 
-NAME = "cloud"
-HELP = "run the cloud service; add operators and robots, grant, revoke"
-
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     from cloud.settings import DEFAULT_DB

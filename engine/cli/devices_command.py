@@ -19,9 +19,6 @@ from engine.hardware.device_report import describe_devices, format_rows
 from engine.hardware.sim_vest import build_sim_vest
 from engine.scenario.world import World
 
-NAME = "devices"
-HELP = "probe the robot's devices and read each once"
-
 # the MCP9808's first conversion takes 250 ms; a simulated vest is given that long first
 SIMULATED_WARM_UP_S = 0.3
 

@@ -28,9 +28,6 @@ from engine.speech.vad import SileroVad
 from engine.speech.voice_models import load_voice
 from engine.speech.voices import NeuralVoice, Voice
 
-NAME = "dialogs"
-HELP = "check that each dialog phrase is recognized, and as its own rule"
-
 
 @dataclass(frozen=True)
 class Variant:

@@ -27,8 +27,6 @@ from pathlib import Path
 
 from engine.cli.output import writable_folder
 
-NAME = "gesture"
-HELP = "count fingers in pictures; record, generate, train and check a hand model"
 ACTIONS = ("classify", "record", "generate", "train", "eval")
 STYLE_NAMES = ("studio", "wallpaper", "varied", "variant")
 """The hand generator's styles (engine/vision/synthetic_hands.py; not imported here)."""
@@ -39,7 +37,7 @@ PREPROCESS_MODES = ("gray", "edges")
 def with_action(argv: Sequence[str]) -> list[str]:
     """``vest gesture IMAGE...`` is ``vest gesture classify IMAGE...``."""
     words = list(argv)
-    if len(words) >= 2 and words[0] == NAME and words[1] not in (*ACTIONS, "-h", "--help"):
+    if len(words) >= 2 and words[0] == "gesture" and words[1] not in (*ACTIONS, "-h", "--help"):
         words.insert(1, "classify")
     return words
 
@@ -148,7 +146,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     generate.add_argument("--style", choices=STYLE_NAMES, default="studio")
 
     train = actions.add_parser("train", help="train the table-2 network (needs .[train])")
-    train.add_argument("data", type=Path, nargs="+", metavar="DATA")
+    train.add_argument(
+        "data",
+        type=Path,
+        nargs="+",
+        metavar="DATA",
+        help="folders of pictures; the held-out test comes from the first only",
+    )
     train.add_argument("-o", "--output", type=Path, required=True, metavar="MODEL.onnx")
     train.add_argument("--epochs", type=_positive, default=16)
     train.add_argument("--batch", type=_positive, default=64)
@@ -300,6 +304,12 @@ def _train(args: argparse.Namespace) -> int:
     if not result.held_out:
         print(f"model: {args.output} (settings in {sidecar}); nothing held out: measure it with")
         print(f"  vest gesture eval PICTURES --model {args.output}")
+        return 0
+    if not result.evaluation.hands:  # 0.0 % of nothing would read as a model that fails
+        print(
+            f"model: {args.output} (settings in {sidecar}); the held-out pictures show no "
+            "hand: hold out more (--held-out), or measure it with vest gesture eval"
+        )
         return 0
     print(result.evaluation.table())
     print(f"held out: {result.evaluation.summary()}")

@@ -26,9 +26,6 @@ from engine.speech.audio import read_wav
 from engine.speech.hearing import Hearing, conversation
 from engine.speech.recognizer import WhisperRecognizer
 
-NAME = "hear"
-HELP = "run the robot's hearing on WAV files (or the microphone) and show the answers"
-
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("files", type=Path, nargs="*", metavar="FILE.wav", help="recordings")

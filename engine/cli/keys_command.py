@@ -12,9 +12,6 @@ from engine.hardware.config_file import load_robot_config
 from engine.hardware.vest_picture import vest_picture
 from engine.nodes.registry import default_registry
 
-NAME = "keys"
-HELP = "list the blackboard keys"
-
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--format", choices=("text", "json"), default="text")

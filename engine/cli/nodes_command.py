@@ -11,9 +11,6 @@ import json
 from engine.nodes.docs import nodes_json, nodes_markdown
 from engine.nodes.registry import default_registry
 
-NAME = "nodes"
-HELP = "list node types and their parameters"
-
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(

@@ -16,9 +16,6 @@ from engine.loader.tree_drawing import ascii_tree, dot_source
 from engine.loader.tree_file import TreeLoader
 from engine.nodes.registry import default_registry
 
-NAME = "render"
-HELP = "draw a tree as ascii, dot, svg or png"
-
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("tree", type=Path, metavar="TREE.yaml")

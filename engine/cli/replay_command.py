@@ -20,9 +20,6 @@ from engine.errors import UsageError
 from engine.recording.replay import Recording, moment
 from engine.view.replay_source import ReplaySource
 
-NAME = "replay"
-HELP = "show a recorded session at a moment (trees' statuses, the blackboard)"
-
 
 def _seconds(text: str) -> float:
     try:

@@ -13,9 +13,6 @@ from engine.cli.output import tell, write_file
 from engine.recording.replay import Recording
 from engine.recording.report import report_html
 
-NAME = "report"
-HELP = "write a recorded session as a report for the therapist (HTML)"
-
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("recording", type=Path, metavar="FILE", help="made by vest run --record")

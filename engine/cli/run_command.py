@@ -61,9 +61,6 @@ from engine.speech.robot_speech import RobotSpeech, audio_folder, build_speech, 
 from engine.view.hub import ViewHub
 from engine.view.server import LiveSource, ViewServer
 
-NAME = "run"
-HELP = "run the behaviors (default: the demo scenario on the simulated vest)"
-
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(

@@ -22,8 +22,6 @@ from engine.speech.speaker import Speaker
 from engine.speech.voice_models import load_voice
 from engine.speech.voices import EspeakVoice, sentences
 
-NAME = "say"
-HELP = "speak a text with the robot's voice (or write it to a WAV file)"
 MAX_TEXT_CHARS = 5000
 
 

@@ -13,9 +13,6 @@ import json
 from engine.nodes.registry import default_registry
 from engine.nodes.schema import tree_schema
 
-NAME = "schema"
-HELP = "print a JSON Schema of tree files (for editors)"
-
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """No options."""

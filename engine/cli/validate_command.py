@@ -46,9 +46,6 @@ from engine.runtime.robot import declared_beside, tree_files
 from engine.scenario.scenario_file import load_scenario
 from engine.values.params import did_you_mean
 
-NAME = "validate"
-HELP = "check trees, profiles, dialogs and scenarios"
-
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("paths", nargs="+", type=Path, metavar="PATH", help="YAML files or folders")

@@ -102,25 +102,32 @@ def train(
     settings: TrainingSettings,
     progress: Callable[[str], None] = lambda line: None,
 ) -> TrainingResult:
-    """Train on the pictures in ``data`` (one labelled folder, or several: real photographs
-    and drawn ones, say) and write ``out`` (.onnx) and its .json; ConfigError when a folder
-    is not a labelled one. With ``held_out`` 0 nothing is held out (the model is measured
-    elsewhere: ``vest gesture eval``) and the evaluation is empty."""
+    """Train on the pictures in ``data`` (one labelled folder, or several: a lab's own, then
+    photographs and drawn ones, say) and write ``out`` (.onnx) and its .json; ConfigError
+    when a folder is not a labelled one. The held-out pictures come from the first folder
+    only: the others are trained on whole (a model started from may have seen them, and a
+    test on them would say more than it knows). With ``held_out`` 0 nothing is held out
+    (the model is measured elsewhere: ``vest gesture eval``) and the evaluation is empty."""
     import torch
 
     from engine.vision.hand_network import HandNetwork, export_onnx, load_onnx_weights
 
     folders = [data] if isinstance(data, Path) else list(data)
-    pictures = [picture for folder in folders for picture in find_pictures(folder)]
+    own = find_pictures(folders[0])
+    others = [picture for folder in folders[1:] for picture in find_pictures(folder)]
+    pictures = own + others
     if all(picture.label == NONE_INDEX for picture in pictures):
         raise ConfigError(
             f"{', '.join(map(str, folders))}: no pictures of a hand (0/ .. 5/ are empty); "
             "a model learns to count from them"
         )
-    if settings.held_out > 0:
-        train_set, test_set, how = split(
-            pictures, settings.held_out, settings.seed, by=settings.split_by
+    if settings.held_out > 0:  # only the first folder's: the others may be what a model
+        train_set, test_set, how = split(  # it starts from already saw
+            own, settings.held_out, settings.seed, by=settings.split_by
         )
+        train_set += others
+        if others:
+            how += f", of {folders[0].name} only"
     else:
         train_set, test_set, how = list(pictures), [], "none held out"
     progress(

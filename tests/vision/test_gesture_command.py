@@ -137,6 +137,13 @@ def test_a_model_learns_from_photographs_and_drawn_hands_together(tmp_path: Path
     assert sidecar["training"]["data"] == ["photos", "drawn"]
     assert sidecar["training"]["held_out_evaluation"] is None
 
+    # a lab's own pictures first: its test comes from them alone, never from pictures the
+    # model it starts from may have seen
+    args = ["gesture", "train", str(photos), str(drawn), "-o", str(model), "--epochs", "1"]
+    assert main([*args, "--held-out", "0.5", "--split", "file", "--threads", "1"]) == 0
+    out = capsys.readouterr().out
+    assert "holding out 3 (by picture, of photos only)" in out
+
 
 def test_training_on_a_folder_that_is_not_labelled_is_refused(tmp_path: Path, capsys) -> None:
     pytest.importorskip("torch", reason="training needs the train extra")

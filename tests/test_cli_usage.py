@@ -1,0 +1,37 @@
+"""The command line loads a command's module only when that command runs: a machine
+without the robot's packages (a cloud host) is told what to install, never a traceback."""
+
+from __future__ import annotations
+
+import importlib
+from types import ModuleType
+
+import pytest
+
+from engine.cli import COMMANDS, main
+
+
+def test_a_command_whose_packages_are_missing_says_what_to_install(
+    capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    real = importlib.import_module
+
+    def without_yaml(name: str, package: str | None = None) -> ModuleType:
+        if name == "engine.cli.run_command":  # as on a host with only vest-engine[cloud]
+            raise ModuleNotFoundError("No module named 'yaml'", name="yaml")
+        return real(name, package)
+
+    monkeypatch.setattr(importlib, "import_module", without_yaml)
+    assert main(["run", "--fast"]) == 3
+    err = capsys.readouterr().err
+    assert "vest run: needs yaml, which is not installed here" in err
+    assert "pip install 'vest-engine[robot]'" in err and "Traceback" not in err
+
+
+def test_every_command_is_listed_with_what_it_does(capsys: pytest.CaptureFixture[str]) -> None:
+    with pytest.raises(SystemExit):
+        main(["--help"])
+    listed = capsys.readouterr().out
+    for name, summary in COMMANDS:
+        assert name in listed and summary.split()[0] in listed
+        assert importlib.import_module(f"engine.cli.{name}_command").main  # each one exists
