@@ -20,7 +20,7 @@ from cloud.api.page import add_page
 from cloud.api.schemas import ERRORS
 from cloud.services import CloudStore
 from cloud.settings import Settings
-from cloud.store.writer import TelemetryWriter
+from cloud.store.writer import Upkeep
 from engine.clock import Clock, EpochClock
 
 API = "/api/v1"
@@ -33,7 +33,7 @@ def create_app(
     settings: Settings, *, clock: Clock | None = None, store: CloudStore | None = None
 ) -> FastAPI:
     """The FastAPI app; ``store`` is opened from ``settings`` unless given (and then closed
-    with the app). While the app runs, telemetry is written every ``settings.flush_s``."""
+    with the app). While the app runs, its upkeep runs every ``settings.flush_s``."""
     owned = store is None
     store = store or CloudStore.open(settings, clock or EpochClock())
 
@@ -41,11 +41,11 @@ def create_app(
     async def lifespan(app: FastAPI) -> AsyncIterator[None]:
         # endpoints run in threads; a long-poll holds one while it waits
         anyio.to_thread.current_default_thread_limiter().total_tokens = settings.threads
-        writer = TelemetryWriter(store.telemetry, store.clock, settings.flush_s)
+        upkeep = Upkeep(store.telemetry, store.ledger, store.clock, settings.flush_s)
         try:
             yield
         finally:
-            writer.close()
+            upkeep.close()
             if owned:
                 store.close()
 

@@ -8,7 +8,7 @@ from typing import Annotated, Any, Literal
 
 from pydantic import AfterValidator, BaseModel, ConfigDict, Field, StringConstraints
 
-from cloud.store.ledger import Command
+from cloud.store.ledger import Command, CommandState
 
 MAX_DEPTH = 16
 
@@ -68,7 +68,7 @@ class CommandPublic(BaseModel):
     robot: str
     type: str
     args: dict[str, Any]
-    state: str
+    state: CommandState
     version: int
     result: Any = None
     created_s: float

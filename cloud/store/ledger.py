@@ -18,6 +18,7 @@ import uuid
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
+from enum import StrEnum
 from typing import Any, Protocol
 
 from sqlalchemy import select
@@ -30,8 +31,22 @@ from cloud.store.tables import CommandRow
 from engine.clock import Clock
 from engine.errors import VestError
 
-QUEUED, IN_PROGRESS = "QUEUED", "IN_PROGRESS"
-SUCCEEDED, FAILED, TIMED_OUT, CANCELED = "SUCCEEDED", "FAILED", "TIMED_OUT", "CANCELED"
+
+class CommandState(StrEnum):
+    """Where a command is: QUEUED (waiting for its robot), IN_PROGRESS (claimed, under a
+    lease), then one of its ends. Stored as its name."""
+
+    QUEUED = "QUEUED"
+    IN_PROGRESS = "IN_PROGRESS"
+    SUCCEEDED = "SUCCEEDED"
+    FAILED = "FAILED"
+    TIMED_OUT = "TIMED_OUT"
+    CANCELED = "CANCELED"
+
+
+QUEUED, IN_PROGRESS = CommandState.QUEUED, CommandState.IN_PROGRESS
+SUCCEEDED, FAILED = CommandState.SUCCEEDED, CommandState.FAILED
+TIMED_OUT, CANCELED = CommandState.TIMED_OUT, CommandState.CANCELED
 FINISHED = frozenset({SUCCEEDED, FAILED, TIMED_OUT, CANCELED})
 REPORTS = (SUCCEEDED, FAILED)
 DEFAULT_LEASE_S = 30.0
@@ -64,7 +79,7 @@ class Command:
     robot_id: int
     type: str
     args: dict[str, Any]
-    state: str
+    state: CommandState
     version: int
     result: Any
     idempotency_key: str | None
@@ -74,13 +89,23 @@ class Command:
     deliveries: int
 
     @classmethod
-    def of(cls, row: CommandRow) -> Command:
+    def of(cls, row: CommandRow, now_s: float | None = None) -> Command:
+        """The command as ``row`` holds it; with ``now_s``, as it stands then (a read
+        never writes: a timeout or a lease that ran out since the last upkeep shows as
+        TIMED_OUT or QUEUED, as the upkeep will store it)."""
+        state = CommandState(row.state)
+        lease_until_s = row.lease_until_s
+        if now_s is not None and state in (QUEUED, IN_PROGRESS):
+            if row.timeout_at_s <= now_s:
+                state = TIMED_OUT
+            elif state == IN_PROGRESS and lease_until_s is not None and lease_until_s <= now_s:
+                state = QUEUED
         return cls(
             row.id,
             row.robot_id,
             row.type,
             dict(row.args),
-            row.state,
+            state,
             row.version,
             row.result,
             row.idempotency_key,
@@ -169,17 +194,17 @@ class CommandLedger:
         return Command.of(row), True
 
     def get(self, robot_id: int, command_id: str) -> Command | None:
-        """The command, only if it is this robot's."""
-        self._expire_due()
+        """The command as it stands now, only if it is this robot's (reads write nothing)."""
         if not _is_command_id(command_id):
             return None
+        now_s = self.clock.now()
         with self.db.transaction() as session:
             row = session.get(CommandRow, command_id)
-            return Command.of(row) if row is not None and row.robot_id == robot_id else None
+            return Command.of(row, now_s) if row is not None and row.robot_id == robot_id else None
 
     def recent(self, robot_id: int, limit: int = 50) -> list[Command]:
-        """This robot's commands, newest first."""
-        self._expire_due()
+        """This robot's commands as they stand now, newest first (reads write nothing)."""
+        now_s = self.clock.now()
         with self.db.transaction() as session:
             rows = session.scalars(
                 select(CommandRow)
@@ -187,7 +212,7 @@ class CommandLedger:
                 .order_by(CommandRow.created_s.desc(), CommandRow.id)
                 .limit(limit)
             )
-            return [Command.of(row) for row in rows]
+            return [Command.of(row, now_s) for row in rows]
 
     def _transition(
         self, robot_id: int, command_id: str, change: Callable[[CommandRow], bool]
@@ -235,7 +260,7 @@ class CommandLedger:
         when there is one to take, before it is taken, with the claim's session (to read
         on it, never on a second connection): what it raises leaves it QUEUED (a robot
         revoked meanwhile takes nothing)."""
-        self._expire_due()
+        self.expire_due()
         for _ in range(CHANGE_ATTEMPTS):
             try:
                 with self._changing() as (session, changed):
@@ -268,7 +293,7 @@ class CommandLedger:
         (one that ran out meanwhile and is QUEUED again is taken back). A finished command is
         answered as it is (CANCELED: the operator no longer wants it). None when the command
         is not this robot's."""
-        self._expire_due()
+        self.expire_due()
 
         def extend(row: CommandRow) -> bool:
             if row.state == QUEUED:
@@ -300,7 +325,9 @@ class CommandLedger:
 
         return self._transition(robot_id, command_id, finish)
 
-    def _expire_due(self) -> None:
+    def expire_due(self) -> None:
+        """:meth:`expire`, at most every :data:`EXPIRE_EVERY_S` (the service's upkeep and
+        every change call it)."""
         if self.clock.now() - self._expired_at_s >= EXPIRE_EVERY_S:
             self.expire()
 

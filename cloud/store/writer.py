@@ -1,4 +1,5 @@
-"""Writing the telemetry kept in memory to the database, every ``flush_s``, in a thread."""
+"""The service's upkeep, every ``flush_s``, in a thread: the telemetry kept in memory is
+written, and commands whose lease or timeout ran out are stored so (reads never write)."""
 
 from __future__ import annotations
 
@@ -7,21 +8,27 @@ import threading
 
 from sqlalchemy.exc import SQLAlchemyError
 
+from cloud.store.ledger import CommandLedger
 from cloud.store.telemetry import Telemetry
 from engine.clock import Clock
 
 log = logging.getLogger(__name__)
 
 
-class TelemetryWriter:
-    """Flushes ``telemetry`` every ``flush_s`` until closed, and once more then."""
+class Upkeep:
+    """Every ``flush_s`` until closed (and once more then): flushes ``telemetry`` and lets
+    ``ledger`` expire what ran out (an operator's page hears of a command that timed out
+    though nobody wrote to it)."""
 
-    def __init__(self, telemetry: Telemetry, clock: Clock, flush_s: float) -> None:
+    def __init__(
+        self, telemetry: Telemetry, ledger: CommandLedger, clock: Clock, flush_s: float
+    ) -> None:
         self.telemetry = telemetry
+        self.ledger = ledger
         self.clock = clock
         self.flush_s = flush_s
         self._stop = clock.event()
-        self._thread = threading.Thread(target=self._run, name="telemetry-writer", daemon=True)
+        self._thread = threading.Thread(target=self._run, name="cloud-upkeep", daemon=True)
         self._thread.start()
 
     def close(self) -> None:
@@ -38,3 +45,7 @@ class TelemetryWriter:
             self.telemetry.flush()
         except SQLAlchemyError as error:  # kept in memory; the next flush tries again
             log.warning("could not write telemetry (%s); trying again", error)
+        try:
+            self.ledger.expire_due()
+        except SQLAlchemyError as error:  # what ran out still reads so; stored next time
+            log.warning("could not store expired commands (%s); trying again", error)

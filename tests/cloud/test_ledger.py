@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import pytest
+from sqlalchemy import select
 
 from cloud.store.database import Database
 from cloud.store.directory import Directory
@@ -16,6 +17,7 @@ from cloud.store.ledger import (
     CommandLedger,
     ConflictError,
 )
+from cloud.store.tables import CommandRow
 from engine.clock import VirtualClock
 
 
@@ -178,3 +180,33 @@ def test_nothing_is_lost_when_the_service_restarts(
     reopened = CommandLedger(Database(url), clock)  # a new process on the same file
     states = {c.id: c.state for c in reopened.recent(one)}
     assert states == {done.id: SUCCEEDED, running.id: IN_PROGRESS, waiting.id: QUEUED}
+
+
+def test_reading_a_command_writes_nothing_yet_says_how_it_stands_now(
+    ledger: CommandLedger, robots: tuple[int, int], clock: VirtualClock
+) -> None:
+    """An operator's GET shows a command whose lease or timeout ran out as the upkeep will
+    store it; only the upkeep (or a change) stores it."""
+    one, _ = robots
+    leased, _ = ledger.submit(one, "say", {"text": "leased"}, timeout_s=100.0)
+    ledger.claim_next(one)
+    forgotten, _ = ledger.submit(one, "say", {"text": "forgotten"}, timeout_s=10.0)
+    clock.advance(31.0)  # past the lease of the first, the timeout of the second
+
+    def stored() -> dict[str, tuple[str, int]]:
+        with ledger.db.transaction() as session:
+            return {row.id: (row.state, row.version) for row in session.scalars(select(CommandRow))}
+
+    before = stored()
+    assert ledger.get(one, leased.id).state == QUEUED  # type: ignore[union-attr]
+    assert {c.id: c.state for c in ledger.recent(one)} == {
+        leased.id: QUEUED,
+        forgotten.id: TIMED_OUT,
+    }
+    assert stored() == before  # the reads wrote nothing
+    assert before[leased.id][0] == IN_PROGRESS and before[forgotten.id][0] == QUEUED
+    ledger.expire_due()  # what the service's upkeep does every second
+    assert {key: state for key, (state, _) in stored().items()} == {
+        leased.id: QUEUED,
+        forgotten.id: TIMED_OUT,
+    }
