@@ -1,10 +1,12 @@
-"""The engine's view of py_trees' blackboard: staged writes committed between ticks.
+"""The robot's blackboard: staged writes committed between ticks.
 
-py_trees keeps one process-wide blackboard; :class:`Blackboard` owns how the engine writes
-to it. Threads that produce data (pollers, the speech recognizer, the IoT client) call
-:meth:`Blackboard.stage` or :meth:`Blackboard.stage_event`; the scheduler calls
-:meth:`Blackboard.commit` between ticks, so a tick never sees half an update. Tree nodes
-read through py_trees blackboard clients and write during their tick with :meth:`set`.
+Each robot owns its :class:`Blackboard` and the keys in it (py_trees' own blackboard is one
+dictionary for the whole process: two robots, or two test harnesses, in one process would
+see each other's keys; vest's nodes do not use it). Threads that produce data (pollers,
+the speech recognizer, the IoT client) call :meth:`Blackboard.stage` or
+:meth:`Blackboard.stage_event`; the scheduler calls :meth:`Blackboard.commit` between
+ticks, so a tick never sees half an update. Tree nodes read with :meth:`get` and write
+during their tick with :meth:`set`.
 """
 
 from __future__ import annotations
@@ -14,13 +16,10 @@ import threading
 from collections.abc import Callable
 from typing import Any
 
-import py_trees
-
 from engine.blackboard.catalogue import KeyCatalogue
 from engine.blackboard.events import EventLog
 from engine.clock import Clock
 
-_STORAGE = py_trees.blackboard.Blackboard.storage
 _log = logging.getLogger(__name__)
 
 Watcher = Callable[[str, Any], None]
@@ -38,6 +37,8 @@ class Blackboard:
         self._pending: list[tuple[str, Any, bool]] = []
         self._lock = threading.Lock()
         self._updated_s: dict[str, float] = {}
+        self._values: dict[str, Any] = {}
+        """Every committed key's value: this robot's alone."""
         self.watchers: list[Watcher] = []
         """Called as (key, value) for every committed write (debug views, the timeline).
 
@@ -105,10 +106,10 @@ class Blackboard:
         self._append_event(key, value)
 
     def get(self, key: str, default: Any = None) -> Any:
-        return _STORAGE.get(key, default)
+        return self._values.get(key, default)
 
     def event_log(self, key: str) -> EventLog:
-        log = _STORAGE.get(key)
+        log = self._values.get(key)
         return log if isinstance(log, EventLog) else EventLog()
 
     def updated_s(self, key: str) -> float | None:
@@ -117,20 +118,20 @@ class Blackboard:
 
     def snapshot(self) -> dict[str, Any]:
         """A copy of every key and value, for debug views and recordings."""
-        return dict(_STORAGE)
+        return dict(self._values)
 
     def reset(self) -> None:
-        """Forget every key, pending write and blackboard client (a fresh robot)."""
+        """Forget every key and pending write (a fresh robot)."""
         with self._lock:
             self._pending.clear()
         self._updated_s.clear()
-        py_trees.blackboard.Blackboard.clear()
+        self._values.clear()
 
     def _write(self, key: str, value: Any) -> None:
-        _STORAGE[key] = value
+        self._values[key] = value
         self._updated_s[key] = self.clock.now()
 
     def _append_event(self, key: str, value: Any) -> None:
         now = self.clock.now()
-        _STORAGE[key] = self.event_log(key).appended(value, now)
+        self._values[key] = self.event_log(key).appended(value, now)
         self._updated_s[key] = now

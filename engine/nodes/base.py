@@ -33,7 +33,7 @@ from types import SimpleNamespace
 from typing import Any, ClassVar
 
 import py_trees
-from py_trees.common import Access, Status
+from py_trees.common import Status
 
 from engine.nodes.context import TreeContext
 from engine.nodes.spec import NodeType
@@ -77,13 +77,8 @@ class Leaf(py_trees.behaviour.Behaviour):
         super().__init__(name)
         self.args = args
         self.ctx = ctx
-        read_keys, write_keys = leaf_type(type(self)).keys(vars(args))
+        _, write_keys = leaf_type(type(self)).keys(vars(args))
         self.write_keys = frozenset(write_keys)
-        self.blackboard = self.attach_blackboard_client(name=name)
-        for key in dict.fromkeys(read_keys):
-            self.blackboard.register_key(key, access=Access.READ)
-        for key in dict.fromkeys(write_keys):
-            self.blackboard.register_key(key, access=Access.WRITE)
 
     @classmethod
     def check_params(cls, args: Mapping[str, Any], ctx: CheckContext) -> list[ParamIssue]:
@@ -92,11 +87,9 @@ class Leaf(py_trees.behaviour.Behaviour):
 
     # -- helpers for subclasses ---------------------------------------------------------
     def read(self, key: str, default: Any = None) -> Any:
-        """The committed value of ``key``, or ``default`` when it has none yet."""
-        try:
-            return self.blackboard.get(key)
-        except KeyError:
-            return default
+        """The committed value of ``key`` on this robot's blackboard, or ``default`` when
+        it has none yet."""
+        return self.ctx.blackboard.get(key, default)
 
     def write(self, key: str, value: Any) -> None:
         """Write one of this tree's variables (``/vars/...``) now: only a key the node

@@ -5,7 +5,7 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping
 from typing import Any, ClassVar
 
-from py_trees.common import Access, Status
+from py_trees.common import Status
 
 from engine.dialogs.model import Dialog, FollowUp
 from engine.errors import ServiceError
@@ -51,17 +51,6 @@ class Reply(Leaf):
         self.phase = "idle"
         self.follow_up: FollowUp | None = None
         self.follow_up_until_s = 0.0
-        for key in dict.fromkeys(self._answer_keys()):  # whatever an answer may fill in
-            self.blackboard.register_key(key, access=Access.READ)
-
-    def _answer_keys(self) -> list[str]:
-        """Every blackboard key the dialog's answers and fallback name (none when the dialog
-        is not loaded: initialise() reports that)."""
-        dialogs = self.ctx.dialogs
-        dialog = dialogs.get(self.args.dialog) if dialogs is not None else None
-        if dialog is None:
-            return []
-        return [key for template in dialog.templates() for key in template.keys]
 
     def dialog(self) -> Dialog:
         dialogs = self.ctx.dialogs

@@ -10,6 +10,6 @@
         assert robot.said == ["I love hugs!"]
 """
 
-from engine.testing.harness import HarnessReplacedError, TreeHarness
+from engine.testing.harness import TreeHarness
 
-__all__ = ["HarnessReplacedError", "TreeHarness"]
+__all__ = ["TreeHarness"]

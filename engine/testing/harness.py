@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any, ClassVar
+from typing import Any
 
 from py_trees.common import Status
 
@@ -12,7 +12,6 @@ from engine.blackboard.catalogue import KeyCatalogue, default_catalogue
 from engine.blackboard.events import EventLog
 from engine.clock import VirtualClock
 from engine.dialogs.library import DialogLibrary, find_dialogs_folder
-from engine.errors import VestError
 from engine.loader.substitution import load_profile
 from engine.loader.tree_definition import TreeDefinition
 from engine.loader.tree_file import TreeLoader
@@ -25,26 +24,15 @@ from engine.services.simulated import simulated_services
 from engine.services.staged_readings import with_staged_readings
 
 
-class HarnessReplacedError(VestError, RuntimeError):
-    """A TreeHarness was used after a newer one took over py_trees' blackboard."""
-
-
 class TreeHarness:
     """One tree, a fresh blackboard, a virtual clock, recording services and a world.
 
     ``world`` answers on-request sensor reads (``world.temperature_c = 22.2``);
     ``services`` are the simulated services (``services.speech.fail_next = "why"``).
 
-    **One harness at a time.** py_trees keeps one blackboard per process, and every
-    harness uses it: creating a harness empties it, so a second harness resets the first
-    one's keys and the two would read each other's writes. Use one harness per test (or
-    finish with one before creating the next); an older harness raises
-    :class:`HarnessReplacedError` on its next ``tick``, ``advance`` or ``set``. To compare
-    two robots (say, two profiles), run one, note what it did, then create the other.
+    Each harness is a robot of its own, with its own blackboard: two harnesses (say, two
+    profiles) run side by side and never see each other's keys.
     """
-
-    _newest: ClassVar[int] = 0
-    """The number of the harness that owns py_trees' blackboard now (the latest created)."""
 
     def __init__(
         self,
@@ -56,9 +44,7 @@ class TreeHarness:
         services: Services | None = None,
         keep_node_errors: bool = False,
     ) -> None:
-        TreeHarness._newest += 1
         self.keep_node_errors = keep_node_errors
-        self._number = TreeHarness._newest
         self.definition = definition
         self.clock = clock or VirtualClock()
         self.blackboard = Blackboard(catalogue or default_catalogue(), self.clock)
@@ -123,17 +109,8 @@ class TreeHarness:
         )
 
     # -- the world ------------------------------------------------------------------------
-    def _check_current(self) -> None:
-        if self._number != TreeHarness._newest:
-            raise HarnessReplacedError(
-                f"this TreeHarness ({self.definition.name}) is used after another TreeHarness "
-                "was created: py_trees' blackboard is process-wide, and the newer harness "
-                "reset it; use one harness at a time"
-            )
-
     def set(self, key: str, value: Any) -> None:
         """Write ``key`` (an event key gets one new event), seen from the next tick on."""
-        self._check_current()
         if self._is_event(key):
             self.blackboard.stage_event(key, value)
         else:
@@ -162,7 +139,6 @@ class TreeHarness:
 
     def tick(self, n: int = 1) -> Status:
         """Tick ``n`` times, one tree period apart (as the scheduler would); the last status."""
-        self._check_current()
         for _ in range(n):
             self.blackboard.commit()
             self.tree.tick()
