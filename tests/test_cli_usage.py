@@ -4,6 +4,8 @@ without the robot's packages (a cloud host) is told what to install, never a tra
 from __future__ import annotations
 
 import importlib
+import subprocess
+import sys
 from types import ModuleType
 
 import pytest
@@ -35,3 +37,16 @@ def test_every_command_is_listed_with_what_it_does(capsys: pytest.CaptureFixture
     for name, summary in COMMANDS:
         assert name in listed and summary.split()[0] in listed
         assert importlib.import_module(f"engine.cli.{name}_command").main  # each one exists
+
+
+def test_the_cloud_on_a_robot_without_its_packages_says_what_to_install(tmp_path) -> None:
+    """`vest cloud` on a machine set up with `scripts/setup robot` (no SQLAlchemy)."""
+    program = (
+        "import sys; sys.modules['sqlalchemy'] = None;"  # as if it were not installed
+        "from engine.cli import main;"
+        f"raise SystemExit(main(['cloud', 'add-operator', 'ana', '--db', 'sqlite:///{tmp_path}/c.db']))"
+    )
+    done = subprocess.run([sys.executable, "-c", program], capture_output=True, text=True)
+    assert done.returncode == 3, done.stderr
+    assert "vest cloud: needs sqlalchemy, which is not installed here" in done.stderr
+    assert "pip install 'vest-engine[cloud]'" in done.stderr and "Traceback" not in done.stderr

