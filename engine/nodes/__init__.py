@@ -5,6 +5,7 @@ from py_trees.common import Status
 from engine.nodes.base import Condition, Leaf, ServiceAction
 from engine.nodes.registry import NodeRegistry, builtin_registry, default_registry
 from engine.nodes.spec import NodeType
+from engine.remote_commands import Color
 from engine.values.params import (
     AnyValue,
     Boolean,
@@ -23,6 +24,7 @@ __all__ = [
     "AnyValue",
     "Boolean",
     "Choice",
+    "Color",
     "Condition",
     "Integer",
     "Key",

@@ -13,8 +13,7 @@ from __future__ import annotations
 from types import SimpleNamespace
 from typing import ClassVar
 
-from engine.nodes import Condition, Integer, Leaf, NodeRegistry, Number, Param, Status
-from engine.nodes.actions import Color
+from engine.nodes import Color, Condition, Integer, Leaf, NodeRegistry, Number, Param, Status
 from engine.nodes.context import TreeContext
 from engine.services import Job
 
