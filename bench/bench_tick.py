@@ -355,7 +355,8 @@ class Side:
     ticks: int = 0
 
     def enter(self) -> None:
-        """Put this side's blackboard contents in py_trees' (process-wide) storage."""
+        """Put this side's blackboard contents in py_trees' (process-wide) storage (the
+        bare py_trees side reads it; the engine's side reads its own Blackboard)."""
         _STORAGE.clear()
         _STORAGE.update(self.saved)
 

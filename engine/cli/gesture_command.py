@@ -236,6 +236,11 @@ def _classify(args: argparse.Namespace) -> int:
                 else f"{reading.fingers} finger" + ("" if reading.fingers == 1 else "s")
             )
             note = f" (a {size} px picture, scaled up to the {side} px window)" if scaled else ""
+            if reading.fingers is None and not scaled and args.crop is None:
+                note = (
+                    f" (the centred {side} px window of a {size} px picture; "
+                    "--crop X,Y,W looks where the hand is)"
+                )
             print(f"{shown(str(path))}: {said} ({reading.confidence:.0%}){note}")
     return 1 if failed else 0
 

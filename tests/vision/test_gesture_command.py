@@ -82,6 +82,19 @@ def test_a_photograph_smaller_than_the_window_is_scaled_up_and_said_so(capsys) -
     assert json.loads(capsys.readouterr().out)["scaled_up"] is True
 
 
+def test_a_big_picture_it_is_not_sure_of_hints_at_crop(tmp_path: Path, capsys) -> None:
+    """A 1000 x 1000 px photograph: the centred 128 px window shows a patch of palm."""
+    photo = cv2.imread(str(REAL_HANDS / "held-out" / "3" / "p005-IMG_1161.jpg"))
+    big = tmp_path / "big.png"
+    cv2.imwrite(str(big), cv2.resize(photo, (1000, 1000)))
+    assert main(["gesture", str(big)]) == 0
+    said = capsys.readouterr().out
+    assert said.startswith(f"{big}: not sure (")
+    assert "(the centred 128 px window of a 1000x1000 px picture; --crop X,Y,W" in said
+    assert main(["gesture", str(big), "--crop", "0,0,1000"]) == 0
+    assert capsys.readouterr().out.startswith(f"{big}: 3 fingers (")
+
+
 @pytest.mark.parametrize(
     ("args", "message"),
     [
