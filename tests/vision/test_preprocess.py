@@ -152,3 +152,11 @@ def test_a_picture_of_absurd_shape_is_cut_before_it_is_scaled() -> None:
     strip = np.full((1, 8192, 3), 77, np.uint8)
     assert crop(strip, Preprocessing()).shape == (128, 128, 3)
     assert network_input(strip, Preprocessing()).shape == (1, 128, 128)
+
+
+def test_the_command_line_offers_every_preprocessing_mode_and_no_other() -> None:
+    """`vest gesture train --preprocess` lists the modes without loading OpenCV."""
+    from engine.cli.gesture_command import PREPROCESS_MODES
+    from engine.vision.preprocess import MODES
+
+    assert sorted(PREPROCESS_MODES) == sorted(MODES)
