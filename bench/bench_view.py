@@ -46,9 +46,11 @@ def read_changes(address: str, counted: list[int], stop: threading.Event) -> Non
 
 
 def run(way: str, seconds: float, folder: Path) -> dict[str, float]:
+    """One run of ``way``; a recording goes to a new file in ``folder`` (vest never
+    replaces an earlier session)."""
     args = [*VEST, "run", "--speech", "text", "--duration", str(seconds)]
     if way == "record":
-        args += ["--record", str(folder / "bench.db")]
+        args += ["--record", str(folder / f"bench-{len(list(folder.iterdir()))}.db")]
     if way == "view":
         args += ["--view", "--view-port", "0"]
     process = subprocess.Popen(

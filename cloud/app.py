@@ -6,7 +6,6 @@ import logging
 from collections.abc import AsyncIterator
 from contextlib import asynccontextmanager
 
-import anyio.to_thread
 from fastapi import FastAPI, Request, Response
 from fastapi.exception_handlers import http_exception_handler
 from fastapi.exceptions import RequestValidationError
@@ -39,8 +38,6 @@ def create_app(
 
     @asynccontextmanager
     async def lifespan(app: FastAPI) -> AsyncIterator[None]:
-        # endpoints run in threads; a long-poll holds one while it waits
-        anyio.to_thread.current_default_thread_limiter().total_tokens = settings.threads
         upkeep = Upkeep(store.telemetry, store.ledger, store.clock, settings.flush_s)
         try:
             yield

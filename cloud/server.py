@@ -1,25 +1,22 @@
 """Running the service: one process, or several sharing a port.
 
-Stopping the service ends the operators' live streams and waiting long-polls at once
-(they reconnect to the next service) instead of holding the shutdown up. Several workers
-each bind the port with SO_REUSEPORT and the kernel spreads connections among them
-(uvicorn's own --workers hands its workers a socket on which Nagle's algorithm stays on:
-every request took ~45 ms more).
+Stopping a one-process service ends the operators' live streams and waiting long-polls at
+once (they reconnect to the next service) instead of holding the shutdown up. Several
+workers run under uvicorn's supervisor on one socket made here (uvicorn's own socket keeps
+Nagle's algorithm on: every request took ~45 ms more).
 """
 
 from __future__ import annotations
 
 import gc
 import logging
-import multiprocessing
-import signal
+import os
 import socket
 import sys
-from multiprocessing.connection import wait
-from types import FrameType
 
 import uvicorn
 from fastapi import FastAPI
+from uvicorn.supervisors import Multiprocess
 
 from cloud.services import CloudStore
 from cloud.settings import Settings
@@ -92,45 +89,36 @@ def serve(settings: Settings, host: str, port: int, *, shared: bool = False) -> 
 
 
 def serve_workers(settings: Settings, host: str, port: int, workers: int) -> None:
-    """Run ``workers`` service processes on one port until SIGTERM or Ctrl-C; a worker that
-    dies is started again."""
-    listening_socket(host, port, shared=True, listen=False).close()  # named now if taken
+    """Run ``workers`` service processes on one port until SIGTERM or Ctrl-C.
+
+    uvicorn's own supervisor (``Multiprocess``) starts them, checks they answer, and starts
+    another when one dies; each worker reads its settings from the environment
+    (:meth:`Settings.environment`) and serves on the socket made here (made as TCP, so
+    Nagle's algorithm is off). Stopping gives requests in flight ``GRACE_S`` to finish; a
+    long-poll still waiting then ends and its robot asks the next service."""
+    sock = listening_socket(host, port, shared=True)
+    os.environ.update(settings.environment())
     _say_where(host, port, workers)
-    context = multiprocessing.get_context("spawn")
-    stopping = False
+    config = uvicorn.Config(
+        "cloud.server:app_from_environment",
+        factory=True,
+        workers=workers,
+        timeout_graceful_shutdown=GRACE_S,
+        log_level="info",
+    )
+    Multiprocess(config, sockets=[sock]).run()
 
-    def start() -> multiprocessing.process.BaseProcess:
-        process = context.Process(
-            target=_worker, args=(settings.to_json(), host, port), name="vest-cloud-worker"
-        )
-        process.start()
-        return process
 
-    def stop(signum: int, _frame: FrameType | None) -> None:
-        nonlocal stopping
-        stopping = True
-        for process in running:
-            if process.pid is not None and process.is_alive():
-                process.terminate()  # SIGTERM: each worker ends its requests and stops
+def app_from_environment() -> FastAPI:
+    """A worker's app: the settings its supervisor put in the environment."""
+    from cloud.app import create_app
 
-    running = [start() for _ in range(workers)]
-    signal.signal(signal.SIGTERM, stop)
-    signal.signal(signal.SIGINT, stop)
-    while running:
-        wait([process.sentinel for process in running])
-        for process in [p for p in running if not p.is_alive()]:
-            running.remove(process)
-            if not stopping:
-                log.error("a worker ended (exit code %s); starting another", process.exitcode)
-                running.append(start())
+    app = create_app(Settings())
+    tune_garbage_collector()
+    return app
 
 
 def _say_where(host: str, port: int, workers: int) -> None:
     shown = f"[{host}]" if ":" in host else host
     processes = "1 process" if workers == 1 else f"{workers} processes"
     print(f"vest cloud: operators open http://{shown}:{port}/ ({processes})", file=sys.stderr)
-
-
-def _worker(settings_json: str, host: str, port: int) -> None:
-    logging.basicConfig(level=logging.INFO, format="%(levelname)s:     %(message)s")
-    serve(Settings.from_json(settings_json), host, port, shared=True)

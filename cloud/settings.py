@@ -1,55 +1,64 @@
-"""The service's settings, checked when it starts."""
+"""The service's settings, checked when it starts.
+
+Given on the command line (``vest cloud serve --db ... --lease-s ...``) or, for a service
+run by a process manager or in a container, from the environment: ``VEST_CLOUD_DB_URL``,
+``VEST_CLOUD_LEASE_S`` and so on (pydantic-settings reads them; a value given in code wins
+over the environment). Worker processes receive their settings through the same variables.
+"""
 
 from __future__ import annotations
 
-import json
-from dataclasses import asdict, dataclass
+from typing import Any
+
+from pydantic import Field, ValidationError
+from pydantic_settings import BaseSettings, SettingsConfigDict
 
 from engine.errors import ConfigError
 
 DEFAULT_DB = "sqlite:///vest-cloud.db"
+DAY_S = 86400.0
+ENV_PREFIX = "VEST_CLOUD_"
 
 
-@dataclass(frozen=True)
-class Settings:
+def _seconds(default: float) -> Any:
+    """A time above 0 and at most a day."""
+    return Field(default, gt=0, le=DAY_S, allow_inf_nan=False)
+
+
+class Settings(BaseSettings):
     """``db_url``: SQLite file or PostgreSQL URL; ``lease_s``: how long a robot has to
-    report a claimed command; ``max_wait_s``: the longest long-poll; ``recheck_s``: how
+    report a claimed command; ``default_timeout_s``: how long a command waits to be taken
+    unless its operator says; ``max_wait_s``: the longest long-poll; ``recheck_s``: how
     often a long-poll looks at the ledger again; ``max_body_bytes``: larger bodies get 413;
-    ``flush_s``: how often telemetry held in memory is written; ``threads``: requests
-    worked on at once (each waiting long-poll holds one); ``token_cache_s``: how long a
-    token found valid is trusted before it is looked up again (a revoked token stops
-    working within it). Times in seconds."""
+    ``flush_s``: how often telemetry held in memory is written; ``token_cache_s``: how long
+    a token found valid is trusted before it is looked up again (a revoked token stops
+    working within it). Times in seconds; a value out of range is a ConfigError naming it."""
+
+    model_config = SettingsConfigDict(env_prefix=ENV_PREFIX, frozen=True, extra="forbid")
 
     db_url: str = DEFAULT_DB
-    lease_s: float = 30.0
-    default_timeout_s: float = 300.0
-    max_wait_s: float = 30.0
-    recheck_s: float = 5.0
-    max_body_bytes: int = 64 * 1024
-    flush_s: float = 1.0
-    threads: int = 1000
-    token_cache_s: float = 5.0
+    lease_s: float = _seconds(30.0)
+    default_timeout_s: float = _seconds(300.0)
+    max_wait_s: float = _seconds(30.0)
+    recheck_s: float = _seconds(5.0)
+    max_body_bytes: int = Field(64 * 1024, ge=1024, le=16 * 1024 * 1024)
+    flush_s: float = _seconds(1.0)
+    token_cache_s: float = Field(5.0, ge=0, le=60, allow_inf_nan=False)
 
-    def __post_init__(self) -> None:
-        for name in ("lease_s", "default_timeout_s", "max_wait_s", "recheck_s", "flush_s"):
-            value = getattr(self, name)
-            if not 0 < value <= 86400:
-                raise ConfigError(
-                    f"{name} must be above 0 and at most a day (86400 s), got {value}"
-                )
-        if not 1024 <= self.max_body_bytes <= 16 * 1024 * 1024:
-            raise ConfigError(
-                f"setting max_body_bytes must be 1 KiB..16 MiB, got {self.max_body_bytes}"
-            )
-        if not 0 <= self.token_cache_s <= 60:
-            raise ConfigError(f"token_cache_s must be 0..60 s, got {self.token_cache_s}")
-        if not 4 <= self.threads <= 10000:
-            raise ConfigError(f"setting threads must be 4..10000, got {self.threads}")
+    def __init__(self, **values: Any) -> None:
+        try:
+            super().__init__(**values)
+        except ValidationError as error:
+            raise ConfigError("; ".join(_problem(item) for item in error.errors())) from None
 
-    def to_json(self) -> str:
-        """For handing to worker processes (``from_json`` reads it back, checked again)."""
-        return json.dumps(asdict(self))
+    def environment(self) -> dict[str, str]:
+        """These settings as the environment variables that give them (for workers)."""
+        return {
+            ENV_PREFIX + name.upper(): str(value) for name, value in self.model_dump().items()
+        }
 
-    @classmethod
-    def from_json(cls, text: str) -> Settings:
-        return cls(**json.loads(text))
+
+def _problem(item: Any) -> str:
+    """One setting's problem in a line: its name, what it must be, what it was."""
+    name = ".".join(str(part) for part in item["loc"]) or "settings"
+    return f"{name}: {item['msg'][0].lower()}{item['msg'][1:]} (got {item['input']!r})"

@@ -8,6 +8,8 @@ All times are in seconds.
 
 from __future__ import annotations
 
+import asyncio
+import contextlib
 import threading
 import time
 from typing import Protocol
@@ -39,6 +41,11 @@ class Clock(Protocol):
         Returns True when the event is set (at once if it already is): each worker waits
         for its own event, so stopping one never cuts short another's sleep.
         """
+        ...
+
+    async def wait_async(self, event: asyncio.Event, timeout_s: float) -> bool:
+        """On an event loop: until ``event`` is set or ``timeout_s`` of this clock's time has
+        passed, holding no thread (a web service's long-polls and streams). True when set."""
         ...
 
 
@@ -94,6 +101,11 @@ class RealClock:
                 event._condition.wait(left)
         return True
 
+    async def wait_async(self, event: asyncio.Event, timeout_s: float) -> bool:
+        with contextlib.suppress(TimeoutError):
+            await asyncio.wait_for(event.wait(), max(timeout_s, 0.0))
+        return event.is_set()
+
 
 class EpochClock(RealClock):
     """Seconds since the Unix epoch (UTC): for times that are stored and shown as dates
@@ -119,6 +131,7 @@ class VirtualClock:
         self._lock = threading.Condition()
         self._waiting = 0
         self._entered = 0
+        self._async_waits: list[_AsyncWait] = []
 
     def now(self) -> float:
         return self._now
@@ -129,6 +142,7 @@ class VirtualClock:
             raise ValueError(f"a clock cannot go backwards: advance({seconds})")
         with self._lock:
             self._now += seconds
+            self._wake_async_waits()
             self._lock.notify_all()
 
     def sleep(self, seconds: float) -> None:
@@ -141,6 +155,7 @@ class VirtualClock:
             return True
         with self._lock:
             self._now = max(self._now, deadline_s)
+            self._wake_async_waits()
             self._lock.notify_all()
         return False
 
@@ -164,6 +179,37 @@ class VirtualClock:
                 self._waiting -= 1
             return event.is_set()
 
+    async def wait_async(self, event: asyncio.Event, timeout_s: float) -> bool:
+        """Until ``event`` is set or another thread advances the clock by ``timeout_s``;
+        counted as a waiter by :meth:`until_waiting`, as a thread in :meth:`wait` is."""
+        wait = _AsyncWait(asyncio.get_running_loop())
+        with self._lock:
+            wait.deadline_s = self._now + max(timeout_s, 0.0)
+            if event.is_set() or self._now >= wait.deadline_s:
+                return event.is_set()
+            self._async_waits.append(wait)
+            self._waiting += 1
+            self._entered += 1
+            self._lock.notify_all()
+        woken = asyncio.ensure_future(event.wait())
+        timed_out = asyncio.ensure_future(wait.timed_out.wait())
+        try:
+            await asyncio.wait((woken, timed_out), return_when=asyncio.FIRST_COMPLETED)
+        finally:
+            woken.cancel()
+            timed_out.cancel()
+            with self._lock:
+                self._async_waits.remove(wait)
+                self._waiting -= 1
+        return event.is_set()
+
+    def _wake_async_waits(self) -> None:
+        """(Holding the lock.) Ends the async waits whose time has come, on their loops."""
+        for wait in self._async_waits:
+            if self._now >= wait.deadline_s:
+                with contextlib.suppress(RuntimeError):  # its loop has closed
+                    wait.loop.call_soon_threadsafe(wait.timed_out.set)
+
     def until_waiting(self, threads: int = 1, *, entered: int = 0, limit_s: float = 10.0) -> bool:
         """Block until ``threads`` threads are inside :meth:`wait`, and waits have been
         entered ``entered`` times in all (a test's hand-off point: advance the clock only
@@ -174,6 +220,15 @@ class VirtualClock:
             return self._lock.wait_for(
                 lambda: self._waiting >= threads and self._entered >= entered, timeout=limit_s
             )
+
+
+class _AsyncWait:
+    """One coroutine waiting on a :class:`VirtualClock`: its loop and its deadline."""
+
+    def __init__(self, loop: asyncio.AbstractEventLoop) -> None:
+        self.loop = loop
+        self.deadline_s = 0.0
+        self.timed_out = asyncio.Event()
 
 
 def stopwatch() -> float:

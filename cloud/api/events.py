@@ -76,9 +76,9 @@ class OperatorView:
                 events.append(_event("telemetry", {"robot": row.name, "values": fresh}))
         return events
 
-    def wait(self, timeout_s: float) -> bool:
-        """Until a command of one of the robots changes, or ``timeout_s``."""
-        return self.store.doorbell.wait(self.robot_ids, timeout_s)
+    async def wait(self, timeout_s: float) -> bool:
+        """Until a command of one of the robots changes, or ``timeout_s`` (no thread held)."""
+        return await self.store.doorbell.wait(self.robot_ids, timeout_s)
 
 
 @router.get("/events")
@@ -108,7 +108,7 @@ async def _stream(request: Request, store: CloudStore, view: OperatorView) -> As
         elif store.clock.now() - quiet_since_s >= KEEPALIVE_S:
             quiet_since_s = store.clock.now()
             yield ": still here\n\n"
-        await run_in_threadpool(view.wait, TELEMETRY_EVERY_S)
+        await view.wait(TELEMETRY_EVERY_S)
 
 
 def _event(name: str, data: Any) -> str:

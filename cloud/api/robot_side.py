@@ -50,9 +50,7 @@ async def next_command(
             left_s = deadline_s - store.clock.now()
             if left_s <= 0:
                 break
-            await run_in_threadpool(
-                store.doorbell.wait, robot.id, min(left_s, store.settings.recheck_s)
-            )
+            await store.doorbell.wait(robot.id, min(left_s, store.settings.recheck_s))
     return Response(status_code=status.HTTP_204_NO_CONTENT)
 
 

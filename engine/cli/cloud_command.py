@@ -6,6 +6,8 @@
   vest cloud grant OPERATOR ROBOT
   vest cloud revoke operator|robot NAME
 Every one takes --db URL: a SQLite file (default sqlite:///vest-cloud.db) or postgresql://...
+A setting not given on the command line is read from the environment when it is there
+(``VEST_CLOUD_DB_URL``, ``VEST_CLOUD_LEASE_S``, ...: docs/cloud.md lists them).
 """
 
 from __future__ import annotations
@@ -27,7 +29,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
     def action(name: str, help: str) -> argparse.ArgumentParser:
         sub = actions.add_parser(name, help=help, description=help)
-        sub.add_argument("--db", default=DEFAULT_DB, metavar="URL", help=f"default {DEFAULT_DB}")
+        sub.add_argument(
+            "--db", metavar="URL", help=f"default $VEST_CLOUD_DB_URL, else {DEFAULT_DB}"
+        )
         return sub
 
     serve = action("serve", "run the service (HTTP, /api/v1)")
@@ -42,15 +46,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     serve.add_argument(
         "--lease-s",
         type=float,
-        default=30.0,
         help="seconds a robot has to report a command it took before it is delivered again "
-        "(default 30)",
+        "(default $VEST_CLOUD_LEASE_S, else 30)",
     )
     serve.add_argument(
         "--timeout-s",
         type=float,
-        default=300.0,
-        help="seconds a command may wait and run, unless it says otherwise (default 300)",
+        help="seconds a command may wait and run, unless it says otherwise "
+        "(default $VEST_CLOUD_DEFAULT_TIMEOUT_S, else 300)",
     )
     action("add-operator", "add an operator; prints its token").add_argument("name")
     robot = action("add-robot", "add a robot, granted to an operator; prints its token")
@@ -68,10 +71,10 @@ def main(args: argparse.Namespace) -> int:
     from cloud.services import CloudStore
     from cloud.settings import Settings
 
+    given = {"db_url": args.db}
     if args.action == "serve":
-        settings = Settings(db_url=args.db, lease_s=args.lease_s, default_timeout_s=args.timeout_s)
-    else:
-        settings = Settings(db_url=args.db)
+        given |= {"lease_s": args.lease_s, "default_timeout_s": args.timeout_s}
+    settings = Settings(**{name: value for name, value in given.items() if value is not None})
     if args.action == "serve":
         return _serve(settings, args.host, args.port, args.workers)
     store = CloudStore.open(settings, EpochClock())

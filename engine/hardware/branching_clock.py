@@ -16,6 +16,7 @@ branch's time.
 
 from __future__ import annotations
 
+import asyncio
 import contextlib
 import threading
 from collections.abc import Iterator
@@ -58,6 +59,9 @@ class BranchingClock:
     def wait(self, event: ClockEvent, timeout_s: float) -> bool:
         """Waits on the robot's time (a waiting thread is never inside a branch)."""
         return self.base.wait(event, timeout_s)
+
+    async def wait_async(self, event: asyncio.Event, timeout_s: float) -> bool:
+        return await self.base.wait_async(event, timeout_s)
 
     @contextlib.contextmanager
     def branch(self) -> Iterator[None]:

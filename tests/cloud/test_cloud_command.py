@@ -64,7 +64,7 @@ def test_a_database_that_cannot_be_opened_is_named(capsys: pytest.CaptureFixture
         (["--workers", "2"], 2, "needs a PostgreSQL --db"),
         (["--port", "0"], 2, "--port 0: use 1..65535"),
         (["--workers", "0"], 2, "--workers 0: use 1..64"),
-        (["--lease-s", "nan"], 1, "lease_s must be above 0"),
+        (["--lease-s", "nan"], 1, "lease_s: input should be a finite number"),
         (["--db", "nonsense"], 1, "use sqlite:///FILE or postgresql://"),
         (["--db", "postgresql://ana:secret@127.0.0.1:1/vest"], 1, "ana:***@"),
     ],

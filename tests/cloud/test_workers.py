@@ -3,6 +3,7 @@ robot's long-poll in another, through LISTEN/NOTIFY."""
 
 from __future__ import annotations
 
+import asyncio
 import threading
 
 import pytest
@@ -32,7 +33,9 @@ def test_a_command_queued_in_one_worker_wakes_the_long_poll_in_another(
     assert robot is not None
     assert second.listener is not None and second.listener.wait_listening(10.0)
     woken: list[bool] = []
-    waiter = threading.Thread(target=lambda: woken.append(second.doorbell.wait(robot.id, 30.0)))
+    waiter = threading.Thread(
+        target=lambda: woken.append(asyncio.run(second.doorbell.wait(robot.id, 30.0)))
+    )
     waiter.start()
     assert isinstance(second.clock, VirtualClock) and second.clock.until_waiting(1)
     first.ledger.submit(robot.id, "say", {"text": "hi"})  # notifies every worker
