@@ -14,13 +14,14 @@ from sqlalchemy.exc import SQLAlchemyError
 from starlette.exceptions import HTTPException as StarletteHTTPException
 
 from cloud.api import commands, events, robot_side, robots
-from cloud.api.body_limit import BodyLimit
 from cloud.api.page import add_page
 from cloud.api.schemas import ERRORS
 from cloud.services import CloudStore
 from cloud.settings import Settings
 from cloud.store.writer import Upkeep
 from engine.clock import Clock, EpochClock
+from engine.web.body_limit import BodyLimit
+from engine.web.guard import SecurityHeaders
 
 API = "/api/v1"
 
@@ -53,6 +54,7 @@ def create_app(
     add_page(app)
 
     app.add_middleware(BodyLimit, max_bytes=settings.max_body_bytes)
+    app.add_middleware(SecurityHeaders)
 
     @app.exception_handler(RequestValidationError)
     async def bad_body(request: Request, error: RequestValidationError) -> JSONResponse:

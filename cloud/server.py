@@ -20,11 +20,9 @@ from uvicorn.supervisors import Multiprocess
 
 from cloud.services import CloudStore
 from cloud.settings import Settings
-from engine.errors import ConfigError
+from engine.web.serving import GRACE_S, listening_socket
 
 log = logging.getLogger(__name__)
-GRACE_S = 3
-"""How long requests in flight get to finish when the service stops."""
 
 
 class CloudServer(uvicorn.Server):
@@ -55,30 +53,9 @@ def tune_garbage_collector() -> None:
     gc.set_threshold(20_000, 50, 1_000)
 
 
-def listening_socket(host: str, port: int, *, shared: bool, listen: bool = True) -> socket.socket:
-    """A TCP socket bound to ``host``:``port`` (``shared``: other workers may bind it too).
-    A ConfigError names the address when it cannot be had (in use, not this machine's)."""
-    try:
-        family = socket.getaddrinfo(host, port, type=socket.SOCK_STREAM)[0][0]
-        # IPPROTO_TCP named: asyncio turns Nagle off only on sockets that say they are TCP
-        # (else each response's second write waits ~40 ms for a delayed ACK)
-        sock = socket.socket(family, socket.SOCK_STREAM, socket.IPPROTO_TCP)
-        sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
-        if shared:
-            sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEPORT, 1)
-        sock.bind((host, port))
-        if listen:
-            sock.listen(2048)
-        return sock
-    except OSError as error:
-        raise ConfigError(
-            f"--host {host} --port {port}: cannot listen there ({error.strerror or error})"
-        ) from None
-
-
 def serve(settings: Settings, host: str, port: int, *, shared: bool = False) -> None:
     """Run one service process until SIGTERM or Ctrl-C."""
-    sock = listening_socket(host, port, shared=shared)
+    sock = listening_socket(host, port, shared=shared, named=f"--host {host} --port {port}")
     from cloud.app import create_app
 
     if not shared:
@@ -96,7 +73,7 @@ def serve_workers(settings: Settings, host: str, port: int, workers: int) -> Non
     (:meth:`Settings.environment`) and serves on the socket made here (made as TCP, so
     Nagle's algorithm is off). Stopping gives requests in flight ``GRACE_S`` to finish; a
     long-poll still waiting then ends and its robot asks the next service."""
-    sock = listening_socket(host, port, shared=True)
+    sock = listening_socket(host, port, shared=True, named=f"--host {host} --port {port}")
     os.environ.update(settings.environment())
     _say_where(host, port, workers)
     config = uvicorn.Config(

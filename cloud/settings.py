@@ -53,9 +53,7 @@ class Settings(BaseSettings):
 
     def environment(self) -> dict[str, str]:
         """These settings as the environment variables that give them (for workers)."""
-        return {
-            ENV_PREFIX + name.upper(): str(value) for name, value in self.model_dump().items()
-        }
+        return {ENV_PREFIX + name.upper(): str(value) for name, value in self.model_dump().items()}
 
 
 def _problem(item: Any) -> str:

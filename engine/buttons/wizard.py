@@ -23,7 +23,6 @@ changes (:meth:`subscribe`).
 
 from __future__ import annotations
 
-import contextlib
 import dataclasses
 import queue
 import threading
@@ -34,6 +33,7 @@ from engine.loader.tree_definition import TreeDefinition
 from engine.runtime.robot import Robot
 from engine.runtime.scheduler import RunningTree
 from engine.session.events import BehaviorsPaused, ButtonPressed
+from engine.web.mailbox import Mailbox
 
 PAGE_QUEUE = 16
 """State updates a page may fall behind by before it is sent only the newest."""
@@ -55,7 +55,7 @@ class Wizard:
         self.presses = 0
         self._pressed: queue.SimpleQueue[tuple[int, str]] = queue.SimpleQueue()
         self._lock = threading.Lock()
-        self._pages: list[queue.Queue[dict[str, Any]]] = []
+        self._pages: list[Mailbox[dict[str, Any]]] = []
         self._state: dict[str, Any] = self._current_state()
 
     # -- from any thread ----------------------------------------------------------------------
@@ -77,14 +77,16 @@ class Wizard:
         with self._lock:
             return dict(self._state)
 
-    def subscribe(self) -> queue.Queue[dict[str, Any]]:
-        page: queue.Queue[dict[str, Any]] = queue.Queue(PAGE_QUEUE)
+    def subscribe(self) -> Mailbox[dict[str, Any]]:
+        """A page's mailbox: the state now, then each new one (a page that falls behind
+        gets only the newest)."""
+        page: Mailbox[dict[str, Any]] = Mailbox(self.robot.clock, PAGE_QUEUE)
         with self._lock:
             self._pages.append(page)
-            page.put(dict(self._state))
+            page.give(dict(self._state))
         return page
 
-    def unsubscribe(self, page: queue.Queue[dict[str, Any]]) -> None:
+    def unsubscribe(self, page: Mailbox[dict[str, Any]]) -> None:
         with self._lock:
             if page in self._pages:
                 self._pages.remove(page)
@@ -93,7 +95,7 @@ class Wizard:
         """Tell every page the session ended."""
         with self._lock:
             for page in self._pages:
-                _offer(page, {"ended": True})
+                page.give({"ended": True})
 
     # -- a scenario's presses ---------------------------------------------------------------
     def world_changed(self, world: Any, what: str) -> None:
@@ -197,15 +199,4 @@ class Wizard:
                 return
             self._state = state
             for page in self._pages:
-                _offer(page, dict(state))
-
-
-def _offer(page: queue.Queue[dict[str, Any]], state: dict[str, Any]) -> None:
-    """Give a page the newest state; a page that fell behind loses the older ones."""
-    while True:
-        try:
-            page.put_nowait(state)
-            return
-        except queue.Full:
-            with contextlib.suppress(queue.Empty):
-                page.get_nowait()
+                page.give(dict(state))

@@ -7,7 +7,8 @@ import secrets
 
 from engine.buttons.wizard import Wizard
 from engine.cli.output import tell
-from engine.view.server import ViewServer, ViewSource, is_loopback
+from engine.view.server import ViewServer, ViewSource
+from engine.web.guard import is_loopback
 
 DEFAULT_PORT = 8765
 

@@ -5,15 +5,13 @@ A reader of the session stream: the scheduler's thread tells the hub each event 
 version, a node's status after a tick, a blackboard change, and everything told in words:
 actions and how they ended, turns, safety, presses, what was heard; every second the tick
 and bus statistics come from its hook). The hub keeps the present state for a page that
-connects, and puts each change on every connected page's bounded queue. A page that
-cannot keep up loses changes (its queue overflows, and it is told to fetch the state
+connects, and gives each change to every connected page's bounded mailbox. A page that
+cannot keep up loses changes (its mailbox overflows, and it is told to fetch the state
 again), never a tick: nothing here waits for a browser.
 """
 
 from __future__ import annotations
 
-import contextlib
-import queue
 import threading
 from collections import deque
 from collections.abc import Callable
@@ -25,6 +23,7 @@ from engine.drivers.device_stats import DeviceStats
 from engine.runtime.scheduler import RunningTree
 from engine.session.events import KeyChanged, NodeStatus, SessionEvent, TreeStarted
 from engine.session.sentences import event_line, tone
+from engine.web.mailbox import Mailbox
 
 Change = dict[str, Any]
 QUEUE_CHANGES = 5000
@@ -48,25 +47,6 @@ def happened(event: SessionEvent, start_s: float) -> Change | None:
     }
 
 
-class Subscription:
-    """One connected page: its queue of changes, and whether it overflowed."""
-
-    def __init__(self, capacity: int) -> None:
-        self.changes: queue.Queue[Change | None] = queue.Queue(maxsize=capacity)
-        self.overflowed = False
-
-    def offer(self, change: Change) -> None:
-        try:
-            self.changes.put_nowait(change)
-        except queue.Full:
-            self.overflowed = True
-
-    def close(self) -> None:
-        """Wake the page's sender so it ends (after what is queued)."""
-        with contextlib.suppress(queue.Full):  # a full queue wakes its sender anyway
-            self.changes.put_nowait(None)
-
-
 class ViewHub:
     """The live state of one robot, and the pages watching it: a session reader
     (``on_event``). Times are clock seconds minus ``start_s`` (the session's start, as in
@@ -84,7 +64,7 @@ class ViewHub:
         self.device_stats = device_stats
         self.capacity = capacity
         self._lock = threading.Lock()
-        self._pages: list[Subscription] = []
+        self._pages: list[Mailbox[Change]] = []
         self._trees: dict[str, Change] = {}
         self._dots: dict[tuple[str, int], str] = {}
         self._statuses: dict[str, dict[int, Change]] = {}
@@ -169,16 +149,17 @@ class ViewHub:
         with self._lock:
             pages = list(self._pages)
         for page in pages:
-            page.offer(change)
+            page.give(change)
 
-    # -- the pages' threads -----------------------------------------------------------------
-    def subscribe(self) -> Subscription:
-        page = Subscription(self.capacity)
+    # -- the pages' streams -----------------------------------------------------------------
+    def subscribe(self) -> Mailbox[Change]:
+        """A new page's mailbox: every change from now on (the state: :meth:`snapshot`)."""
+        page: Mailbox[Change] = Mailbox(self.clock, self.capacity)
         with self._lock:
             self._pages.append(page)
         return page
 
-    def unsubscribe(self, page: Subscription) -> None:
+    def unsubscribe(self, page: Mailbox[Change]) -> None:
         with self._lock:
             if page in self._pages:
                 self._pages.remove(page)

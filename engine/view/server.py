@@ -1,6 +1,7 @@
 """The view's web server: one page (engine/view/web/) for the live robot and for replays.
 
-Plain HTTP from the standard library, a thread per connection, beside the robot:
+A Starlette app on the one web stack (:mod:`engine.web`), run by uvicorn in a thread
+beside the robot:
 
 - ``GET /`` the page, ``/view.js``, ``/view.css``;
 - ``GET /api/info`` live or replay (with the recording's length and its moments);
@@ -21,45 +22,44 @@ carry ``?token=...`` (the address ``vest run --view`` prints has it).
 
 from __future__ import annotations
 
-import contextlib
-import hmac
-import ipaddress
 import json
 import logging
 import math
-import queue
 import re
 import shutil
-import socket
 import subprocess
 import threading
-from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
+from collections.abc import AsyncIterator
 from pathlib import Path
 from typing import Any, Protocol
-from urllib.parse import parse_qs, unquote, urlparse
+from urllib.parse import urlparse
+
+from starlette.applications import Starlette
+from starlette.middleware import Middleware
+from starlette.requests import Request
+from starlette.responses import FileResponse, JSONResponse, PlainTextResponse, Response
+from starlette.routing import Route
 
 from engine.buttons.wizard import Wizard
-from engine.errors import ConfigError, DeviceError
+from engine.errors import ConfigError
 from engine.view.hub import Change, ViewHub
+from engine.web.body_limit import BodyLimit
+from engine.web.guard import LoopbackOrToken, SecurityHeaders, check_listening
+from engine.web.serving import ServerThread, address_of, listening_socket
+from engine.web.sse import CONNECTED, KEEPALIVE, KEEPALIVE_S, event_stream, frame
 
 log = logging.getLogger(__name__)
 WEB = Path(__file__).resolve().parent / "web"
 STATIC = {
-    "/": ("index.html", "text/html; charset=utf-8"),
-    "/view.js": ("view.js", "text/javascript; charset=utf-8"),
-    "/view.css": ("view.css", "text/css; charset=utf-8"),
-    "/buttons": ("buttons.html", "text/html; charset=utf-8"),
-    "/buttons.js": ("buttons.js", "text/javascript; charset=utf-8"),
-    "/buttons.css": ("buttons.css", "text/css; charset=utf-8"),
+    "/": "index.html",
+    "/view.js": "view.js",
+    "/view.css": "view.css",
+    "/buttons": "buttons.html",
+    "/buttons.js": "buttons.js",
+    "/buttons.css": "buttons.css",
 }
 MAX_PRESS_BYTES = 1024
-POST_READ_TIMEOUT_S = 5.0
-KEEPALIVE_S = 15.0
-"""A stream with nothing to say writes a comment this often: a page that left is noticed."""
 DOT_TIMEOUT_S = 20.0
-CSP = "default-src 'self'; img-src 'self' data:; style-src 'self' 'unsafe-inline'"
-"""Only the page's own files run: a drawing cannot carry a script or a javascript: link."""
-LOOPBACK_NAMES = ("127.0.0.1", "localhost", "[::1]")
 
 
 class ViewSource(Protocol):
@@ -93,18 +93,10 @@ class LiveSource:
         return []  # the live page keeps each node's changes as they come
 
 
-def is_loopback(host: str) -> bool:
-    if host == "localhost":
-        return True
-    try:
-        return ipaddress.ip_address(host).is_loopback
-    except ValueError:
-        return False
-
-
 class ViewServer:
     """Serves ``source`` (and the therapist's buttons, when given a ``wizard``) on
-    ``host``:``port`` (0: any free port) in a thread of its own."""
+    ``host``:``port`` (0: any free port) in a thread of its own; a ConfigError when it
+    cannot listen there or would listen beyond loopback without a token."""
 
     def __init__(
         self,
@@ -115,25 +107,20 @@ class ViewServer:
         token: str | None,
         wizard: Wizard | None = None,
     ) -> None:
-        if not is_loopback(host) and not token:
-            raise ConfigError(f"the view on {host} needs a token (only loopback goes without)")
+        check_listening(host, token, "the view")
         self.source = source
         self.token = token
         self.wizard = wizard
         self._svg: dict[tuple[str, int], bytes] = {}
         self._svg_lock = threading.Lock()
-        handler = _handler_for(self)
         try:
-            self._server = ThreadingHTTPServer((host, port), handler)
-        except OSError as error:
-            raise DeviceError(
-                error.errno,
-                f"the view cannot listen on {host}:{port} ({error.strerror}); "
-                "choose another with --view-port (0: any free one)",
-            ) from None
-        self._server.daemon_threads = True
-        self.host, self.port = host, int(self._server.server_address[1])
-        self._thread = threading.Thread(target=self._server.serve_forever, name="view", daemon=True)
+            sock = listening_socket(host, port, named=f"the view on {host}:{port}")
+        except ConfigError as error:
+            hint = "choose another with --view-port (0: any free one)"
+            raise ConfigError(f"{error}; {hint}") from None
+        self.host = host
+        self._server = ServerThread.of(self.app(), sock, "view")
+        self.port = self._server.port
 
     @property
     def url(self) -> str:
@@ -142,30 +129,47 @@ class ViewServer:
 
     def page_url(self, page: str) -> str:
         """The address of ``page`` (``/``, ``/buttons``), with the token when one is needed."""
-        host = socket.gethostname() if self.host in ("0.0.0.0", "::") else self.host
-        shown = f"[{host}]" if ":" in host else host
         query = f"?token={self.token}" if self.token else ""
-        return f"http://{shown}:{self.port}{page}{query}"
+        return address_of(self.host, self.port, page) + query
 
     def start(self) -> None:
-        self._thread.start()
+        self._server.start()
 
     def stop(self) -> None:
+        """Tells every page the session ended (their streams end), then stops serving."""
         if isinstance(self.source, LiveSource):
             self.source.hub.close()
         if self.wizard is not None:
             self.wizard.close()
-        self._server.shutdown()
-        self._server.server_close()
+        self._server.stop()
 
-    def host_allowed(self, host_header: str) -> bool:
-        """On loopback, only a page opened as 127.0.0.1 or localhost may ask (a web page
-        elsewhere cannot make the browser read the robot through a name of its own)."""
-        if not is_loopback(self.host):
-            return True  # the token guards it
-        name = host_header.rsplit(":", 1)[0] if not host_header.endswith("]") else host_header
-        return name in LOOPBACK_NAMES
+    def app(self) -> Starlette:
+        """The Starlette app: the routes above, behind the loopback-or-token rule."""
+        routes = [Route(path, self._file) for path in STATIC]
+        routes += [
+            Route("/api/info", self._info),
+            Route("/api/snapshot", self._snapshot),
+            Route("/api/svg/{rest:path}", self._drawing),
+            Route("/api/node", self._node),
+        ]
+        if isinstance(self.source, LiveSource):
+            routes.append(Route("/api/events", self._events))
+        if self.wizard is not None:
+            routes += [
+                Route("/api/buttons", self._buttons),
+                Route("/api/buttons/events", self._button_events),
+                Route("/api/press", self._press, methods=["POST"]),
+            ]
+        return Starlette(
+            routes=routes,
+            middleware=[
+                Middleware(SecurityHeaders),
+                Middleware(LoopbackOrToken, host=self.host, token=self.token, open_paths=STATIC),
+                Middleware(BodyLimit, max_bytes=MAX_PRESS_BYTES),
+            ],
+        )
 
+    # -- the drawings --------------------------------------------------------------------
     def svg(self, tree: str, version: int) -> bytes | None:
         """The tree drawn by Graphviz (cached); None when unknown or Graphviz is missing."""
         key = (tree, version)
@@ -189,180 +193,103 @@ class ViewServer:
             self._svg[key] = done.stdout
         return done.stdout
 
+    # -- the endpoints (plain functions run in uvicorn's threads; streams on its loop) ---
+    def _file(self, request: Request) -> Response:
+        return FileResponse(WEB / STATIC[request.url.path])
 
-def _handler_for(view: ViewServer) -> type[BaseHTTPRequestHandler]:
-    class Handler(BaseHTTPRequestHandler):
-        server_version = "vest-view"
+    def _info(self, request: Request) -> Response:
+        return JSONResponse(self.source.info())
 
-        def log_message(self, format: str, *args: Any) -> None:
-            log.debug("view: " + format, *args)
+    def _snapshot(self, request: Request) -> Response:
+        at = _number(request.query_params.get("at", "0"))
+        if at is None:
+            return PlainTextResponse("at is a number of seconds\n", status_code=400)
+        return JSONResponse(self.source.snapshot(at))
 
-        def _allowed(self, path: str, query: dict[str, str]) -> bool:
-            """The Host header names this server, and the token is given when needed."""
-            if not view.host_allowed(self.headers.get("Host", "")):
-                self._send(403, b"not this host: open the address vest printed\n", "text/plain")
-                return False
-            given = query.get("token", "").encode("utf-8", "replace")
-            if (
-                view.token
-                and path not in STATIC  # the page itself holds no data; it asks with the token
-                and not hmac.compare_digest(given, view.token.encode())
-            ):
-                self._send(403, b"a token is needed: use the address vest printed\n", "text/plain")
-                return False
-            return True
+    def _drawing(self, request: Request) -> Response:
+        tree, _, version = request.path_params["rest"].rpartition("/")
+        number = _count(version)
+        drawn = self.svg(tree, number) if number is not None else None
+        if drawn is None:
+            return PlainTextResponse("no drawing of that tree (or no Graphviz)\n", 404)
+        return Response(drawn, media_type="image/svg+xml")
 
-        def do_GET(self) -> None:
-            url = urlparse(self.path)
-            query = {key: values[-1] for key, values in parse_qs(url.query).items()}
-            if not self._allowed(url.path, query):
-                return
-            with contextlib.suppress(BrokenPipeError, ConnectionResetError):  # the page left
-                self._route(url.path, query)
+    def _node(self, request: Request) -> Response:
+        query = request.query_params
+        version, node = _count(query.get("version", "")), _count(query.get("node", ""))
+        if version is None or node is None:
+            return PlainTextResponse("version and node are numbers\n", status_code=400)
+        changes = self.source.node_changes(query.get("tree", ""), version, node)
+        return JSONResponse([{"at": at, "status": s, "feedback": f} for at, s, f in changes])
 
-        def do_POST(self) -> None:
-            with contextlib.suppress(BrokenPipeError, ConnectionResetError, TimeoutError):
-                self._post()
+    async def _events(self, request: Request) -> Response:
+        assert isinstance(self.source, LiveSource)
+        return event_stream(_changes(self.source.hub))
 
-        def _post(self) -> None:
-            url = urlparse(self.path)
-            query = {key: values[-1] for key, values in parse_qs(url.query).items()}
-            if not self._allowed(url.path, query):
-                return
-            if url.path != "/api/press" or view.wizard is None:
-                self._send(404, b"not found\n", "text/plain")
-                return
-            origin = self.headers.get("Origin")
-            if origin is not None and urlparse(origin).netloc != self.headers.get("Host"):
-                self._send(403, b"presses come from the buttons page only\n", "text/plain")
-                return
-            kind = self.headers.get("Content-Type", "").split(";")[0].strip()
-            length = _count(self.headers.get("Content-Length", ""))
-            if kind != "application/json" or length is None or length > MAX_PRESS_BYTES:
-                self._send(400, b'send JSON: {"button": N}\n', "text/plain")
-                return
-            self.connection.settimeout(POST_READ_TIMEOUT_S)  # a body promised but not sent
-            body = self.rfile.read(length)
-            try:
-                number = json.loads(body).get("button") if len(body) == length else None
-            except (ValueError, AttributeError, RecursionError):
-                number = None
-            if isinstance(number, bool) or not isinstance(number, int):
-                self._send(400, b'send JSON: {"button": N}\n', "text/plain")
-                return
-            if view.wizard.board.button(number) is None:
-                self._send(404, b"no such button\n", "text/plain")
-                return
-            if number not in view.wizard.state()["shown"]:
-                self._send(409, b"that button is not shown now\n", "text/plain")
-                return
-            button = view.wizard.press(number)
-            assert button is not None
-            self._send(202, json.dumps({"pressed": button.label}).encode(), "application/json")
+    def _buttons(self, request: Request) -> Response:
+        assert self.wizard is not None
+        buttons = [button.to_json() for button in self.wizard.board.buttons]
+        return JSONResponse({"buttons": buttons, "state": self.wizard.state()})
 
-        def _route(self, path: str, query: dict[str, str]) -> None:
-            if path in STATIC:
-                name, kind = STATIC[path]
-                self._send(200, (WEB / name).read_bytes(), kind)
-            elif path == "/api/info":
-                self._json(view.source.info())
-            elif path == "/api/snapshot":
-                at = _number(query.get("at", "0"))
-                if at is None:
-                    self._send(400, b"at is a number of seconds\n", "text/plain")
+    async def _button_events(self, request: Request) -> Response:
+        assert self.wizard is not None
+        return event_stream(_button_states(self.wizard))
+
+    async def _press(self, request: Request) -> Response:
+        wizard = self.wizard
+        assert wizard is not None
+        origin = request.headers.get("origin")
+        if origin is not None and urlparse(origin).netloc != request.headers.get("host"):
+            return PlainTextResponse("presses come from the buttons page only\n", 403)
+        kind = request.headers.get("content-type", "").split(";")[0].strip()
+        if kind != "application/json":
+            return PlainTextResponse('send JSON: {"button": N}\n', status_code=400)
+        try:
+            number = json.loads(await request.body()).get("button")
+        except (ValueError, AttributeError, RecursionError):
+            number = None
+        if isinstance(number, bool) or not isinstance(number, int):
+            return PlainTextResponse('send JSON: {"button": N}\n', status_code=400)
+        if wizard.board.button(number) is None:
+            return PlainTextResponse("no such button\n", status_code=404)
+        if number not in wizard.state()["shown"]:
+            return PlainTextResponse("that button is not shown now\n", status_code=409)
+        button = wizard.press(number)
+        assert button is not None
+        return JSONResponse({"pressed": button.label}, status_code=202)
+
+
+async def _changes(hub: ViewHub) -> AsyncIterator[str]:
+    """The live changes, as they come; a page that fell behind is told to start over."""
+    page = hub.subscribe()
+    try:
+        yield CONNECTED
+        while (taken := await page.take(KEEPALIVE_S)) is not None:
+            if not taken.items:
+                yield KEEPALIVE
+                continue
+            changes = taken.items
+            if taken.overflowed:  # behind: fetch the state again (and hear of the end)
+                changes = [{"kind": "resync"}] + [c for c in changes if c.get("kind") == "end"]
+            yield "".join(frame(change) for change in changes)
+    finally:
+        hub.unsubscribe(page)
+
+
+async def _button_states(wizard: Wizard) -> AsyncIterator[str]:
+    """The buttons shown, whenever they change, until the session ends."""
+    page = wizard.subscribe()
+    try:
+        yield CONNECTED
+        while (taken := await page.take(KEEPALIVE_S)) is not None:
+            if not taken.items:
+                yield KEEPALIVE
+            for state in taken.items:
+                yield frame(state)
+                if state.get("ended"):
                     return
-                self._json(view.source.snapshot(at))
-            elif path.startswith("/api/svg/"):
-                self._svg(path.removeprefix("/api/svg/"))
-            elif path == "/api/node":
-                self._node(query)
-            elif path == "/api/events" and isinstance(view.source, LiveSource):
-                self._events(view.source.hub)
-            elif path == "/api/buttons" and view.wizard is not None:
-                board = view.wizard.board
-                buttons = [button.to_json() for button in board.buttons]
-                self._json({"buttons": buttons, "state": view.wizard.state()})
-            elif path == "/api/buttons/events" and view.wizard is not None:
-                with contextlib.suppress(BrokenPipeError, ConnectionResetError):
-                    self._button_events(view.wizard)
-            else:
-                self._send(404, b"not found\n", "text/plain")
-
-        def _svg(self, rest: str) -> None:
-            tree, _, version = rest.rpartition("/")
-            number = _count(version)
-            drawn = view.svg(unquote(tree), number) if number is not None else None
-            if drawn is None:
-                self._send(404, b"no drawing of that tree (or no Graphviz)\n", "text/plain")
-            else:
-                self._send(200, drawn, "image/svg+xml")
-
-        def _node(self, query: dict[str, str]) -> None:
-            version, node = _count(query.get("version", "")), _count(query.get("node", ""))
-            if version is None or node is None:
-                self._send(400, b"version and node are numbers\n", "text/plain")
-                return
-            changes = view.source.node_changes(query.get("tree", ""), version, node)
-            self._json([{"at": at, "status": s, "feedback": f} for at, s, f in changes])
-
-        def _events(self, hub: ViewHub) -> None:
-            page = hub.subscribe()
-            try:
-                self._stream_start()
-                while True:
-                    change = page.changes.get()
-                    if change is None:
-                        break
-                    if page.overflowed and change.get("kind") != "end":  # behind: start over
-                        page.overflowed = False
-                        while not page.changes.empty():
-                            page.changes.get_nowait()
-                        change = {"kind": "resync"}
-                    self.wfile.write(b"data: " + json.dumps(change).encode() + b"\n\n")
-                    self.wfile.flush()
-            finally:
-                hub.unsubscribe(page)
-
-        def _button_events(self, wizard: Wizard) -> None:
-            page = wizard.subscribe()
-            try:
-                self._stream_start()
-                while True:
-                    try:
-                        state = page.get(timeout=KEEPALIVE_S)
-                    except queue.Empty:
-                        self.wfile.write(b": still here\n\n")  # raises once the page left
-                        self.wfile.flush()
-                        continue
-                    self.wfile.write(b"data: " + json.dumps(state).encode() + b"\n\n")
-                    self.wfile.flush()
-                    if state.get("ended"):
-                        break
-            finally:
-                wizard.unsubscribe(page)
-
-        def _stream_start(self) -> None:
-            self.send_response(200)
-            self.send_header("Content-Type", "text/event-stream")
-            self.send_header("Cache-Control", "no-store")
-            self.end_headers()
-            self.wfile.write(b": connected\n\n")
-            self.wfile.flush()
-
-        def _json(self, value: Any) -> None:
-            self._send(200, json.dumps(value).encode(), "application/json")
-
-        def _send(self, status: int, body: bytes, kind: str) -> None:
-            self.send_response(status)
-            self.send_header("Content-Type", kind)
-            self.send_header("Content-Length", str(len(body)))
-            self.send_header("Cache-Control", "no-store")
-            self.send_header("Content-Security-Policy", CSP)
-            self.send_header("X-Content-Type-Options", "nosniff")
-            self.end_headers()
-            self.wfile.write(body)
-
-    return Handler
+    finally:
+        wizard.unsubscribe(page)
 
 
 def _number(text: str) -> float | None:

@@ -21,7 +21,7 @@ import pytest
 import uvicorn
 
 from cloud.app import create_app
-from cloud.server import listening_socket, server_for
+from cloud.server import server_for
 from cloud.services import CloudStore
 from cloud.settings import Settings
 from cloud.store.database import Database
@@ -29,6 +29,7 @@ from cloud.store.directory import Directory
 from cloud.store.ledger import CommandLedger
 from cloud.throwaway_postgres import PostgresCluster
 from engine.clock import Clock, EpochClock, VirtualClock
+from engine.web.serving import listening_socket
 
 
 @pytest.fixture(scope="session")

@@ -1,4 +1,4 @@
-"""Refusing bodies over the service's limit with 413, declared or streamed.
+"""Refusing request bodies over a limit with 413, declared or streamed.
 
 A body whose Content-Length is over the limit is refused before it is read; a chunked body
 (no length) is counted as it arrives and refused as soon as it passes the limit, so a
@@ -8,7 +8,8 @@ from __future__ import annotations
 
 from typing import Any
 
-from fastapi import HTTPException, status
+from starlette import status
+from starlette.exceptions import HTTPException
 from starlette.responses import JSONResponse
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
