@@ -235,8 +235,8 @@ def build_rig(profile: Path) -> Rig:
     if hardware.startup_problems:
         assembled.close()
         raise SystemExit(f"the simulated vest did not start: {hardware.startup_problems}")
-    robot.scheduler.hooks.append(TreeReloader(behaviors.loader, robot.trees, clock))
-    robot.scheduler.hooks.append(instruments.step_hook)
+    robot.scheduler.add_hook(TreeReloader(behaviors.loader, robot.trees, clock))
+    robot.scheduler.add_hook(instruments.step_hook)
     for poller in hardware.pollers:
         instruments.watch_poller(poller)
     for tree in robot.trees:

@@ -91,7 +91,7 @@ class EngineRun:
         blackboard.reset()
         self.world = World()
         senses = BlackboardSenses(blackboard, self.world)
-        self.world.listeners.append(senses)
+        self.world.add_listener(senses)
         senses.start()
         services = simulated_services(self.clock, readers=senses.readers(), realistic=True)
         self.node_errors: list[str] = []
@@ -117,8 +117,8 @@ class EngineRun:
     def run(self, seconds: float) -> None:
         start_s = self.clock.now()
         scheduler = self.robot.scheduler
-        scheduler.hooks.append(ScenarioPlayer(self.scenario, self.world, start_s=start_s))
-        scheduler.hooks.append(TreeReloader(self.behaviors.loader, self.robot.trees, self.clock))
+        scheduler.add_hook(ScenarioPlayer(self.scenario, self.world, start_s=start_s))
+        scheduler.add_hook(TreeReloader(self.behaviors.loader, self.robot.trees, self.clock))
         scheduler.run(until_s=start_s + seconds)
         for tree, row in zip(self.robot.trees, self.rows, strict=True):
             row.stats = tree.stats

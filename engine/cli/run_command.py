@@ -24,10 +24,8 @@ import argparse
 import math
 import re
 import sys
-from collections.abc import Callable
 from pathlib import Path
 
-from engine.buttons.wizard import Wizard
 from engine.cli.output import shown, tell
 from engine.cli.run_inputs import (
     DEFAULT_HARDWARE,
@@ -38,28 +36,21 @@ from engine.cli.run_inputs import (
 )
 from engine.cli.timeline import Timeline
 from engine.cli.validate_command import turn_warnings
-from engine.cli.view_options import add_view_arguments, start_view
+from engine.cli.view_options import add_view_arguments, tell_view, view_plan
 from engine.clock import Clock, EpochClock, RealClock, VirtualClock
+from engine.composition.session_root import SessionPlan, build_session
 from engine.errors import ConfigError, UsageError
 from engine.files.problems import LoadError
 from engine.files.yaml_source import read_text
 from engine.loader.tree_checks import spoken_quote_warnings
-from engine.recording.recorder import SessionRecorder
 from engine.recording.session_file import check_new
-from engine.runtime.reload import TreeReloader
 from engine.runtime.robot import Behaviors
-from engine.runtime.robot_factory import build_robot
-from engine.scenario.player import ScenarioPlayer
-from engine.scenario.scenario_file import Scenario, ScenarioEvent
+from engine.scenario.scenario_file import Scenario
 from engine.services.cloud_link import CloudLink
 from engine.services.interfaces import Speech
 from engine.services.simulated import simulated_services
-from engine.session.events import WorldEvent
 from engine.session.sentences import TOLD_KINDS
-from engine.session.stream import SessionStream
 from engine.speech.robot_speech import RobotSpeech, audio_folder, build_speech, speech_settings
-from engine.view.hub import ViewHub
-from engine.view.server import LiveSource, ViewServer
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -165,17 +156,6 @@ def _profile_name(behaviors: Behaviors) -> str:
     return "" if profile is None else str(profile.path or profile.name)
 
 
-def _world_events(session: SessionStream) -> Callable[[float, ScenarioEvent], None]:
-    """What a scenario makes happen, published as the world's events; a scenario's press
-    is the therapist's, published by the buttons when they carry it out."""
-
-    def publish(at_s: float, event: ScenarioEvent) -> None:
-        if event.kind != "press":
-            session.publish(WorldEvent(at_s, event.kind, event.describe(), event.value))
-
-    return publish
-
-
 def _pseudonym(text: str) -> str:
     """A pseudonym: 1..40 letters, digits, '-', '_' or '.', starting with a letter or digit."""
     if not re.fullmatch(r"[A-Za-z0-9][A-Za-z0-9._-]{0,39}", text):
@@ -268,26 +248,34 @@ def main(args: argparse.Namespace) -> int:
         for event in scenario.events:
             if event.kind == "hear" and event.value["wav"] is None:
                 speech.prepare(event.value["text"])
-    assembled = build_robot(
-        behaviors,
-        config,
-        clock=clock,
-        speech=speech,
-        iot=link if link is not None else simulated.iot,
-        fallback=simulated,
+    paged = args.view or (args.buttons is not None and not args.fast)  # a page when asked
+    running = build_session(
+        SessionPlan(
+            behaviors,
+            config,
+            scenario,
+            clock,
+            speech,
+            iot=simulated.iot,
+            fallback=simulated,
+            link=link,
+            buttons=inputs.buttons,
+            view=view_plan(args) if paged else None,
+            record=args.record,
+            facts={
+                "robot_config": str(args.hardware),
+                "profile": _profile_name(behaviors),
+                "scenario": str(scenario.path),
+                "started": f"{EpochClock().now():.3f}",
+                "person": args.person or "",
+            },
+            reload=not args.fast,
+        )
     )
+    assembled = running.assembled
     robot, session = assembled.robot, assembled.robot.session
-    wizard = None
-    if inputs.buttons is not None:  # priority 100: ticks before the behaviors
-        wizard = Wizard(inputs.buttons, robot)
-        robot.scheduler.hooks.append(wizard)
-        assembled.world.listeners.append(wizard)
-    reloader: TreeReloader | None = None
-    recorder: SessionRecorder | None = None
-    view: ViewServer | None = None
     try:
-        start_s = clock.now()  # after start-up, which takes simulated time too
-        timeline = Timeline(sys.stdout, start_s=start_s, as_json=args.json)
+        timeline = Timeline(sys.stdout, start_s=running.start_s, as_json=args.json)
         warnings = turn_warnings(behaviors.trees) + spoken_quote_warnings(behaviors.trees)
         if inputs.buttons is not None and args.buttons is not None:  # the default: no noise
             warnings += button_warnings(inputs.buttons, [t.name for t in behaviors.trees])
@@ -302,37 +290,9 @@ def main(args: argparse.Namespace) -> int:
                 tell(f"warning: speech {part}: {shown(why)}")
         session.subscribe(timeline, TOLD_KINDS)  # every reader reads the one session stream
         timeline.on_closed = robot.scheduler.stop
-        if args.view or (args.buttons is not None and not args.fast):  # a page when asked
-            hub = ViewHub(clock, device_stats=assembled.hardware.stats)
-            hub.begin(start_s, robot.trees)
-            session.subscribe(hub)
-            robot.scheduler.hooks.append(hub.stats_hook)
-            view = start_view(LiveSource(hub), args, wizard=wizard)
-        if args.record is not None:
-            recorder = SessionRecorder(args.record, clock)
-            recorder.describe(
-                robot_config=str(args.hardware),
-                profile=_profile_name(behaviors),
-                scenario=str(scenario.path),
-                started=f"{EpochClock().now():.3f}",
-                person=args.person or "",
-            )
-            recorder.begin(start_s)
-            session.subscribe(recorder)
-        # the world moves first, then the pollers read it, then the trees tick
-        robot.scheduler.hooks.insert(
-            0,
-            ScenarioPlayer(
-                scenario, assembled.world, start_s=start_s, on_event=_world_events(session)
-            ),
-        )
-        if not args.fast:  # reload work runs beside the scheduler, swaps between ticks
-            behaving = [tree for tree in robot.trees if wizard is None or tree is not wizard.tree]
-            reloader = TreeReloader(behaviors.loader, behaving, clock, session=session)
-            robot.scheduler.hooks.append(reloader)
-            reloader.start()
         duration = args.duration if args.duration is not None else scenario.duration_s
-        if view is not None:  # a page goes with the run: say for how long
+        if running.view is not None:  # a page goes with the run: say where and for how long
+            tell_view(running.view)
             tell(
                 "the session runs until Ctrl-C"
                 if math.isinf(duration)
@@ -342,22 +302,12 @@ def main(args: argparse.Namespace) -> int:
         # a signal that came during start-up stops the run before its first tick
         args.stop_signals.on_stop(robot.scheduler.stop)
         timeline.start()
-        first_tick_s = clock.now()
-        robot.begin_session(start_s)  # every reader hears of every tree
-        assembled.start(origin_s=first_tick_s)  # readings staged just before each tick
-        if link is not None:
-            link.bind(assembled.blackboard, session)
-            link.start()
-        robot.scheduler.run(until_s=start_s + duration, start_s=first_tick_s)
+        running.run(until_s=running.start_s + duration)
         timeline.summary(robot.trees)
     finally:
-        if link is not None:
-            link.stop()
-        if reloader is not None:
-            reloader.stop()
-        assembled.close()
+        running.close()
+        recorder = running.recorder
         if recorder is not None:
-            recorder.close()
             if recorder.stopped_why is None:
                 tell(f"recording: {args.record} (vest replay {args.record} --view)")
             else:
@@ -365,7 +315,5 @@ def main(args: argparse.Namespace) -> int:
                     f"vest run: the recording {args.record} stopped before the session ended "
                     f"({recorder.stopped_why}); it holds what came before"
                 )
-        if view is not None:
-            view.stop()
-    recorded = recorder is None or recorder.stopped_why is None
+    recorded = running.recorder is None or running.recorder.stopped_why is None
     return 0 if timeline.write_error is None and recorded else 1  # the robot ran; not its record

@@ -7,6 +7,7 @@ import secrets
 
 from engine.buttons.wizard import Wizard
 from engine.cli.output import tell
+from engine.composition.session_root import ViewPlan
 from engine.view.server import ViewServer, ViewSource
 from engine.web.guard import is_loopback
 
@@ -36,17 +37,26 @@ def add_view_arguments(parser: argparse.ArgumentParser) -> None:
     )
 
 
+def view_plan(args: argparse.Namespace) -> ViewPlan:
+    """Where the options put the view, with a new token beyond loopback."""
+    token = None if is_loopback(args.view_host) else secrets.token_urlsafe(18)
+    return ViewPlan(args.view_host, args.view_port, token)
+
+
+def tell_view(server: ViewServer) -> None:
+    """The page's address on stderr (and the buttons' when it has them)."""
+    tell(f"view: {server.url}")
+    if server.wizard is not None:
+        tell(f"buttons: {server.page_url('/buttons')}")
+
+
 def start_view(
     source: ViewSource, args: argparse.Namespace, *, wizard: Wizard | None = None
 ) -> ViewServer:
     """Serve ``source`` (and the buttons of ``wizard``) as the options say and tell the
     addresses on stderr; DeviceError when the port is taken."""
-    token = None if is_loopback(args.view_host) else secrets.token_urlsafe(18)
-    server = ViewServer(
-        source, host=args.view_host, port=args.view_port, token=token, wizard=wizard
-    )
+    plan = view_plan(args)
+    server = ViewServer(source, host=plan.host, port=plan.port, token=plan.token, wizard=wizard)
     server.start()
-    tell(f"view: {server.url}")
-    if wizard is not None:
-        tell(f"buttons: {server.page_url('/buttons')}")
+    tell_view(server)
     return server

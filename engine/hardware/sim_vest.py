@@ -332,7 +332,7 @@ def build_sim_vest(config: RobotConfig, world: World, clock: Clock) -> SimVest:
     Close it (:meth:`SimVest.close`) after the hardware built on it.
     """
     vest = SimVest(config, world, clock)
-    world.listeners.append(vest)
+    world.add_listener(vest)
     vest.start()
     return vest
 

@@ -69,7 +69,7 @@ def rerun(recording: Recording, behaviors: Behaviors) -> list[RecordedAction]:
     board.reset()
     services = simulated_services(clock, realistic=True, readers=_readers(recording, clock))
     robot = Robot(behaviors, clock=clock, services=services, blackboard=board)
-    robot.scheduler.hooks.append(_Inputs(_sensed(recording), board))
+    robot.scheduler.add_hook(_Inputs(_sensed(recording), board))
     robot.scheduler.run(until_s=recording.duration_s, start_s=0.0)
     return [
         RecordedAction(record.t, record.tree, record.action, record.args, record.error)

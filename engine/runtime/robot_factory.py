@@ -8,14 +8,14 @@ has a camera. Every speech, LED and servo call passes through the config's safet
 whose watcher stops the arms between ticks when a person is too close or presses too hard.
 The caller hands in the speech (the assembled
 :class:`~engine.speech.robot_speech.RobotSpeech`, or any Speech service, e.g. a recording
-fake, with heard text then staged as text) and the cloud's service. The caller adds its
-own hooks (a scenario player goes first: the world moves, then the pollers read it, then
-the trees tick) and runs it.
+fake, with heard text then staged as text) and the cloud's service. What it opens is on
+the robot's :class:`~engine.runtime.lifecycle.Lifecycle`; the composition root
+(:mod:`engine.composition.session_root`) adds every other part of a run around it.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from engine.blackboard.board import Blackboard
 from engine.clock import Clock
@@ -29,6 +29,7 @@ from engine.hardware.safety_envelope import (
     with_envelope,
 )
 from engine.hardware.sim_vest import SimVest, UnwiredSenses, build_sim_vest
+from engine.runtime.lifecycle import Lifecycle
 from engine.runtime.robot import Behaviors, Robot
 from engine.scenario.world import World
 from engine.services.interfaces import IotResults, Services, Speech
@@ -49,26 +50,35 @@ class AssembledRobot:
     vest: SimVest | None
     speech: RobotSpeech | None = None
     vision: RobotVision | None = None
+    lifecycle: Lifecycle = field(default_factory=Lifecycle)
+    first_tick_s: float = 0.0
+    """When the trees first tick (clock seconds): the pollers are phased on it."""
+    _runners: bool = False
+
+    def add_runners(self) -> None:
+        """Put the poller threads (real time) and the camera's worker on the lifecycle, to
+        start with it (once)."""
+        if self._runners:
+            return
+        self._runners = True
+        hardware, vision = self.hardware, self.vision
+        self.lifecycle.add(
+            "pollers", start=lambda: hardware.start(origin_s=self.first_tick_s), stop=hardware.stop
+        )
+        if vision is not None and hardware.threaded:
+            self.lifecycle.add("camera's worker", start=vision.start, stop=vision.close)
 
     def start(self, origin_s: float) -> None:
-        """Start the poller threads (real time), phased on the trees' first deadline (s),
-        and the vision worker."""
-        self.hardware.start(origin_s=origin_s)
-        if self.vision is not None and self.hardware.threaded:
-            self.vision.start()
+        """Start the pollers, phased on the trees' first deadline ``origin_s`` (s), and the
+        vision worker (for a robot run without the composition root: tests, benchmarks)."""
+        self.first_tick_s = origin_s
+        self.add_runners()
+        self.lifecycle.start()
 
     def close(self) -> None:
-        """Stop the pollers, bus workers and the vision worker, close the buses, the camera
-        and the simulated vest."""
-        try:
-            if self.speech is not None:
-                self.speech.close()
-            if self.vision is not None:
-                self.vision.close()
-            self.hardware.close()
-        finally:
-            if self.vest is not None:
-                self.vest.close()
+        """Stop the speech, the vision worker, the pollers and bus workers, close the buses,
+        the camera and the simulated vest (in that order: the reverse of their opening)."""
+        self.lifecycle.stop()
 
 
 def build_robot(
@@ -88,17 +98,26 @@ def build_robot(
     happens is published on ``session`` (a new stream when not given: ``robot.session``).
     """
     session = session or SessionStream(clock)
+    lifecycle = Lifecycle()
     blackboard = Blackboard(behaviors.loader.catalogue, clock)
     blackboard.reset()
     world = World()
     vest = build_sim_vest(config, world, clock) if config.simulated else None
+    if vest is not None:
+        lifecycle.add("simulated vest", stop=vest.close)
     robot_speech = speech if isinstance(speech, RobotSpeech) else None
     if robot_speech is not None:
+        lifecycle.add("speech", stop=robot_speech.close)
         robot_speech.hears_into(blackboard)
-        world.listeners.append(robot_speech)
+        world.add_listener(robot_speech)
     heard_as_text = robot_speech is None or robot_speech.listener is None
-    world.listeners.append(UnwiredSenses(blackboard, hear=heard_as_text))  # the cloud: no device
-    hardware = build_hardware(config, clock, blackboard, vest=vest)
+    world.add_listener(UnwiredSenses(blackboard, hear=heard_as_text))  # the cloud: no device
+    try:
+        hardware = build_hardware(config, clock, blackboard, vest=vest)
+    except BaseException:
+        lifecycle.stop()
+        raise
+    lifecycle.add("hardware", stop=hardware.close)
     try:
         service = robot_speech.speaker if robot_speech is not None else speech
         services = hardware.services(speech=service, iot=iot, fallback=fallback)  # type: ignore[arg-type]
@@ -108,18 +127,24 @@ def build_robot(
             behaviors, clock=clock, services=services, blackboard=blackboard, session=session
         )
     except BaseException:
-        hardware.close()
-        if vest is not None:
-            vest.close()
+        lifecycle.stop()
         raise
-    robot.scheduler.hooks.extend(hardware.hooks)
+    for hook in hardware.hooks:
+        robot.scheduler.add_hook(hook)
     assert isinstance(services.servos, EnvelopedServos)
-    robot.scheduler.hooks.append(EnvelopeWatcher(services.servos, envelope))
+    robot.scheduler.add_hook(EnvelopeWatcher(services.servos, envelope))
     if robot_speech is not None:  # the microphone hears the room the world just changed
-        robot.scheduler.hooks.append(robot_speech)
+        robot.scheduler.add_hook(robot_speech)
     vision = None
     if config.camera is not None:  # the camera sees the world just changed, as the chips do
-        vision = build_vision(config.camera, world, clock, blackboard)
+        try:
+            vision = build_vision(config.camera, world, clock, blackboard)
+        except BaseException:
+            lifecycle.stop()
+            raise
+        lifecycle.add("camera", stop=vision.close)
         if vision.watcher is not None and not hardware.threaded:
-            robot.scheduler.hooks.append(vision.watcher)
-    return AssembledRobot(robot, clock, blackboard, world, hardware, vest, robot_speech, vision)
+            robot.scheduler.add_hook(vision.watcher)
+    return AssembledRobot(
+        robot, clock, blackboard, world, hardware, vest, robot_speech, vision, lifecycle
+    )

@@ -162,6 +162,14 @@ class Scheduler:
         self._stop = clock.event()
         self.hook_errors = 0
 
+    def add_hook(self, hook: Hook, *, first: bool = False) -> None:
+        """Run ``hook`` before each step's ticks, after those added before it (``first``:
+        before all of them: the scenario, which moves the world the others read)."""
+        if first:
+            self.hooks.insert(0, hook)
+        else:
+            self.hooks.append(hook)
+
     def add(self, tree: RunningTree) -> RunningTree:
         """Schedule ``tree``; trees added before the run share one origin for their deadlines.
 

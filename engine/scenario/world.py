@@ -50,6 +50,10 @@ class World:
     hand: ShownHand | None = None
     listeners: list[WorldListener] = field(default_factory=list)
 
+    def add_listener(self, listener: WorldListener) -> None:
+        """``listener`` hears every change and event from now on, after those added before."""
+        self.listeners.append(listener)
+
     def changed(self, what: str) -> None:
         for listener in self.listeners:
             listener.world_changed(self, what)

@@ -9,7 +9,7 @@ False); the rest of the robot is not held up by its eyes.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from engine.blackboard.board import Blackboard
 from engine.clock import Clock
@@ -32,6 +32,7 @@ class RobotVision:
     health: DeviceHealth
     watcher: HandWatcher | None
     problem: str | None = None
+    _closed: bool = field(default=False, init=False)
 
     def start(self) -> None:
         """On a real clock: start the worker thread."""
@@ -39,6 +40,10 @@ class RobotVision:
             self.watcher.start()
 
     def close(self) -> None:
+        """Stop the worker and close the camera (once; again does nothing)."""
+        if self._closed:
+            return
+        self._closed = True
         if self.watcher is not None:
             self.watcher.stop()
         else:
@@ -73,7 +78,7 @@ def open_camera(
             window=window,
             name=CAMERA_NAME,
         )
-        world.listeners.append(camera)
+        world.add_listener(camera)
         return camera
     return OpenCvCamera(config.device, width=config.width, height=config.height, fps=config.fps)
 

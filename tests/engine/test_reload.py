@@ -44,7 +44,7 @@ def start(tmp_path):
         check_every_s=1.0,
         on_reload=lambda name, error: reports.append((name, error)),
     )
-    robot.scheduler.hooks.append(reloader)
+    robot.scheduler.add_hook(reloader)
     board.set("/sensors/touch/any", True)
     return robot, tree_file, reports
 
@@ -162,7 +162,7 @@ def test_each_reload_and_each_refused_edit_is_told_on_the_session_stream(tmp_pat
     heard = EventCollector()
     robot.session.subscribe(heard, ("reload",))
     reloader = TreeReloader(robot.behaviors.loader, robot.trees, robot.clock, session=robot.session)
-    robot.scheduler.hooks.append(reloader)
+    robot.scheduler.add_hook(reloader)
     robot.scheduler.run(until_s=0.05, halt_at_end=False)
     edit(tree_file, GREETER.replace("PHRASE", "Good morning"), 1)
     robot.scheduler.run(until_s=1.05, halt_at_end=False)

@@ -113,7 +113,7 @@ def test_an_exception_in_a_leaf_makes_it_fail_is_reported_with_its_path_and_tick
 def test_stop_ends_the_run_after_the_current_tick(tmp_path):
     write(tmp_path, "t.yaml", "rate_hz: 10\nroot:\n  Wait: {seconds: 100}\n")
     robot, _ = make_robot(tmp_path)
-    robot.scheduler.hooks.append(lambda now: robot.scheduler.stop() if now >= 0.3 else None)
+    robot.scheduler.add_hook(lambda now: robot.scheduler.stop() if now >= 0.3 else None)
     robot.scheduler.run()
     assert robot.trees[0].stats.ticks == 4  # 0.0, 0.1, 0.2, 0.3
 
@@ -140,7 +140,7 @@ def test_stopping_the_run_cancels_what_a_tree_was_still_doing(tmp_path):
 def test_time_spent_in_hooks_counts_as_lateness(tmp_path):
     write(tmp_path, "t.yaml", "rate_hz: 10\nroot:\n  Wait: {seconds: 100}\n")
     robot, clock = make_robot(tmp_path)
-    robot.scheduler.hooks.append(lambda now: clock.advance(0.03))
+    robot.scheduler.add_hook(lambda now: clock.advance(0.03))
     robot.scheduler.run(until_s=0.25)
     assert max(robot.trees[0].stats.lateness_s) >= 0.03 - 1e-9
 
@@ -152,7 +152,7 @@ def test_a_failing_hook_is_counted_and_the_trees_keep_ticking(tmp_path):
     def broken(now):
         raise ValueError("scenario bug")
 
-    robot.scheduler.hooks.append(broken)
+    robot.scheduler.add_hook(broken)
     robot.scheduler.run(until_s=0.2)
     assert robot.scheduler.hook_errors == 3
     assert robot.trees[0].stats.ticks == 3

@@ -33,7 +33,7 @@ def camera_on(tmp_path: Path, events: str) -> tuple[SimulatedCamera, ScenarioPla
     clock = VirtualClock()
     world = World()
     camera = SimulatedCamera(world, clock)
-    world.listeners.append(camera)
+    world.add_listener(camera)
     player = ScenarioPlayer(load_scenario(scenario_file(tmp_path, events)), world)
     camera.open()
     return camera, player, clock

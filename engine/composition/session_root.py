@@ -1,0 +1,177 @@
+"""The one place a running robot is built, every part included.
+
+:func:`build_session` takes a :class:`SessionPlan` (what ``vest run``'s options, checked,
+say: the behaviors, the robot config, the scenario, the clock, speech, the cloud link, the
+buttons, the live view, the recording, hot reload) and builds the robot with
+:func:`~engine.runtime.robot_factory.build_robot`, then every part around it in the order
+it must run: the scenario player first among the scheduler's hooks (the world moves, then
+the pollers read it, then the trees tick), the buttons' tree and hook, the live view's hub
+and server, the recorder, the reloader, the cloud link. Each part that runs beside the
+trees is on the robot's one :class:`~engine.runtime.lifecycle.Lifecycle`:
+:meth:`RunningSession.run` starts them in order and :meth:`RunningSession.close` stops
+them in reverse.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from engine.buttons.button_file import ButtonBoard
+from engine.buttons.wizard import Wizard
+from engine.clock import Clock
+from engine.hardware.config import RobotConfig
+from engine.recording.recorder import SessionRecorder
+from engine.runtime.reload import TreeReloader
+from engine.runtime.robot import Behaviors
+from engine.runtime.robot_factory import AssembledRobot, build_robot
+from engine.scenario.player import ScenarioPlayer
+from engine.scenario.scenario_file import Scenario, ScenarioEvent
+from engine.services.cloud_link import CloudLink
+from engine.services.interfaces import IotResults, Services, Speech
+from engine.session.events import WorldEvent
+from engine.session.stream import SessionStream
+from engine.speech.robot_speech import RobotSpeech
+from engine.view.hub import ViewHub
+from engine.view.server import LiveSource, ViewServer
+
+
+@dataclass(frozen=True)
+class ViewPlan:
+    """The live view's address (port 0: any free one) and its token (None on loopback)."""
+
+    host: str
+    port: int
+    token: str | None
+
+
+@dataclass
+class SessionPlan:
+    """Everything a run is built from. ``iot``: the cloud's service (the ``link`` when
+    there is one); ``fallback`` serves what the config has no device for; ``record``: the
+    new recording's path and ``facts`` (robot config, profile, scenario, person...)."""
+
+    behaviors: Behaviors
+    config: RobotConfig
+    scenario: Scenario
+    clock: Clock
+    speech: Speech | RobotSpeech
+    iot: IotResults
+    fallback: Services | None = None
+    link: CloudLink | None = None
+    buttons: ButtonBoard | None = None
+    view: ViewPlan | None = None
+    record: Path | None = None
+    facts: dict[str, str] = field(default_factory=dict)
+    reload: bool = False
+
+
+@dataclass
+class RunningSession:
+    """A robot built by :func:`build_session`, with what runs beside it."""
+
+    assembled: AssembledRobot
+    start_s: float
+    wizard: Wizard | None = None
+    view: ViewServer | None = None
+    recorder: SessionRecorder | None = None
+
+    def run(self, until_s: float) -> None:
+        """Start every part in order (the hardware phased on the first tick), then tick the
+        trees until ``until_s`` (clock seconds) or a stop."""
+        robot = self.assembled.robot
+        self.assembled.first_tick_s = self.assembled.clock.now()
+        self.assembled.lifecycle.start()
+        robot.scheduler.run(until_s=until_s, start_s=self.assembled.first_tick_s)
+
+    def close(self) -> None:
+        """Stop every part, last started first (the robot's buses and the vest at the end)."""
+        self.assembled.lifecycle.stop()
+
+
+def build_session(plan: SessionPlan) -> RunningSession:
+    """The robot of ``plan`` with every part it asks for, built but not yet running.
+
+    A part that cannot be made (the view's port taken, say) closes what was built and
+    raises: nothing is left open."""
+    assembled = build_robot(
+        plan.behaviors,
+        plan.config,
+        clock=plan.clock,
+        speech=plan.speech,
+        iot=plan.link if plan.link is not None else plan.iot,
+        fallback=plan.fallback,
+    )
+    try:
+        return _around(assembled, plan)
+    except BaseException:
+        assembled.lifecycle.stop()
+        raise
+
+
+def _around(assembled: AssembledRobot, plan: SessionPlan) -> RunningSession:
+    robot, session, lifecycle = assembled.robot, assembled.robot.session, assembled.lifecycle
+    start_s = plan.clock.now()  # after start-up, which takes simulated time too
+    running = RunningSession(assembled, start_s)
+    if plan.buttons is not None:  # priority 100: ticks before the behaviors
+        running.wizard = Wizard(plan.buttons, robot)
+        robot.scheduler.add_hook(running.wizard)
+        assembled.world.add_listener(running.wizard)
+    if plan.view is not None:
+        hub = ViewHub(plan.clock, device_stats=assembled.hardware.stats)
+        hub.begin(start_s, robot.trees)
+        session.subscribe(hub)
+        robot.scheduler.add_hook(hub.stats_hook)
+        view = ViewServer(
+            LiveSource(hub),
+            host=plan.view.host,
+            port=plan.view.port,
+            token=plan.view.token,
+            wizard=running.wizard,
+        )
+        running.view = view
+        lifecycle.add("view", start=view.start, stop=view.stop)
+    if plan.record is not None:
+        recorder = SessionRecorder(plan.record, plan.clock)
+        running.recorder = recorder
+        lifecycle.add("recording", stop=recorder.close)  # closed even if the run never starts
+        recorder.describe(**plan.facts)
+        recorder.begin(start_s)
+        session.subscribe(recorder)
+    player = ScenarioPlayer(
+        plan.scenario, assembled.world, start_s=start_s, on_event=_world_events(session)
+    )
+    robot.scheduler.add_hook(player, first=True)
+    if plan.reload:  # reload work runs beside the scheduler, swaps between ticks
+        wizard_tree = running.wizard.tree if running.wizard is not None else None
+        behaving = [tree for tree in robot.trees if tree is not wizard_tree]
+        reloader = TreeReloader(plan.behaviors.loader, behaving, plan.clock, session=session)
+        robot.scheduler.add_hook(reloader)
+        lifecycle.add("reloader", start=reloader.start, stop=reloader.stop)
+    lifecycle.add("session", start=lambda: robot.begin_session(start_s), stop=_nothing)
+    assembled.add_runners()  # the pollers and the camera, phased on the first tick
+    if plan.link is not None:
+        link = plan.link
+
+        def start_link() -> None:
+            link.bind(assembled.blackboard, session)
+            link.start()
+
+        lifecycle.add("cloud link", start=start_link, stop=link.stop)
+    return running
+
+
+def _nothing() -> None:
+    """A part with nothing to stop."""
+
+
+def _world_events(session: SessionStream) -> Callable[[float, ScenarioEvent], None]:
+    """What a scenario makes happen, published as the world's events; a scenario's press
+    is the therapist's, published by the buttons when they carry it out."""
+
+    def publish(at_s: float, event: ScenarioEvent) -> None:
+        if event.kind != "press":
+            session.publish(WorldEvent(at_s, event.kind, event.describe(), event.value))
+
+    return publish
