@@ -68,11 +68,11 @@ def run(way: str, seconds: float, folder: Path) -> dict[str, float]:
                 )
                 reader.start()
                 break
-    out, _ = process.communicate(timeout=seconds + 120)
+    out, err = process.communicate(timeout=seconds + 120)
     stop.set()
     rows = ROW.findall(out)
     if not rows:
-        raise SystemExit(f"no statistics from vest run ({way}):\n{out[-2000:]}")
+        raise SystemExit(f"no statistics from vest run ({way}):\n{out[-2000:]}{err[-2000:]}")
     return {
         "tick_p99_ms": max(float(r[3]) for r in rows),
         "late_p99_ms": max(float(r[4]) for r in rows),

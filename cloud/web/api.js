@@ -1,5 +1,7 @@
 // Talking to the service: JSON calls with the operator's bearer token, and the live
-// stream of server-sent events (read with fetch, which can send the token; EventSource cannot).
+// stream of server-sent events (through the client every page of vest shares).
+
+import { follow } from "/shared/stream.js";
 
 export class ApiError extends Error {
   constructor(status, message) {
@@ -43,31 +45,10 @@ export class Api {
     return data;
   }
 
-  // Calls onEvent(name, data) for each event until the stream ends or `signal` aborts.
-  async stream(onEvent, signal) {
-    const response = await fetch(this.base + "/events", {
-      headers: { Authorization: `Bearer ${this.token}`, Accept: "text/event-stream" },
-      signal,
-    });
-    if (!response.ok) throw new ApiError(response.status, `the live stream answered ${response.status}`);
-    const reader = response.body.pipeThrough(new TextDecoderStream()).getReader();
-    let buffer = "";
-    for (;;) {
-      const { value, done } = await reader.read();
-      if (done) return;
-      buffer += value;
-      let end;
-      while ((end = buffer.indexOf("\n\n")) >= 0) {
-        const block = buffer.slice(0, end);
-        buffer = buffer.slice(end + 2);
-        let name = "message";
-        const data = [];
-        for (const line of block.split("\n")) {
-          if (line.startsWith("event:")) name = line.slice(6).trim();
-          else if (line.startsWith("data:")) data.push(line.slice(5).trimStart());
-        }
-        if (data.length) onEvent(name, JSON.parse(data.join("\n")));
-      }
-    }
+  // Follows the live stream: onEvent(name, data) for each event, reconnecting with back-off,
+  // until `signal` aborts or the token is refused (onState("refused")).
+  follow(onEvent, onState, signal) {
+    const headers = { Authorization: `Bearer ${this.token}` };
+    return follow(this.base + "/events", { headers, onEvent, onState, signal });
   }
 }

@@ -66,22 +66,13 @@ function logout() {
 
 // -- the live stream -------------------------------------------------------------------------
 
-async function follow() {
-  let backoff_ms = 500;
-  for (;;) {
-    state.stream = new AbortController();
-    try {
-      setLink(true);
-      await state.api.stream(onEvent, state.stream.signal);
-      backoff_ms = 500;
-    } catch (error) {
-      if (state.stream.signal.aborted) return;
-      if (error instanceof ApiError && error.status === 401) return logout();
-      setLink(false);
-      await new Promise((resolve) => setTimeout(resolve, backoff_ms));
-      backoff_ms = Math.min(backoff_ms * 2, 10000);
-    }
-  }
+function follow() {
+  state.stream = new AbortController();
+  const onState = (link) => {
+    if (link === "refused") logout();
+    else setLink(link === "open");
+  };
+  state.api.follow(onEvent, onState, state.stream.signal);
 }
 
 function setLink(up) {

@@ -3,7 +3,8 @@
 A Starlette app on the one web stack (:mod:`engine.web`), run by uvicorn in a thread
 beside the robot:
 
-- ``GET /`` the page, ``/view.js``, ``/view.css``;
+- ``GET /`` the page, ``/view.js``, ``/view.css``, and ``/shared/`` what every page of
+  vest shares (the stream client);
 - ``GET /api/info`` live or replay (with the recording's length and its moments);
 - ``GET /api/snapshot[?at=S]`` every tree with its nodes' statuses, the blackboard, the
   recent actions and the statistics (now, or at S seconds into a recording);
@@ -38,14 +39,14 @@ from starlette.applications import Starlette
 from starlette.middleware import Middleware
 from starlette.requests import Request
 from starlette.responses import FileResponse, JSONResponse, PlainTextResponse, Response
-from starlette.routing import Route
+from starlette.routing import BaseRoute, Route
 
 from engine.buttons.wizard import Wizard
 from engine.errors import ConfigError
 from engine.view.hub import Change, ViewHub
 from engine.web.body_limit import BodyLimit
 from engine.web.guard import LoopbackOrToken, SecurityHeaders, check_listening
-from engine.web.serving import ServerThread, address_of, listening_socket
+from engine.web.serving import SHARED, ServerThread, address_of, listening_socket, shared_files
 from engine.web.sse import CONNECTED, KEEPALIVE, KEEPALIVE_S, event_stream, frame
 
 log = logging.getLogger(__name__)
@@ -145,7 +146,8 @@ class ViewServer:
 
     def app(self) -> Starlette:
         """The Starlette app: the routes above, behind the loopback-or-token rule."""
-        routes = [Route(path, self._file) for path in STATIC]
+        routes: list[BaseRoute] = [Route(path, self._file) for path in STATIC]
+        routes.append(shared_files())
         routes += [
             Route("/api/info", self._info),
             Route("/api/snapshot", self._snapshot),
@@ -164,7 +166,13 @@ class ViewServer:
             routes=routes,
             middleware=[
                 Middleware(SecurityHeaders),
-                Middleware(LoopbackOrToken, host=self.host, token=self.token, open_paths=STATIC),
+                Middleware(
+                    LoopbackOrToken,
+                    host=self.host,
+                    token=self.token,
+                    open_paths=STATIC,
+                    open_folders=[SHARED],
+                ),
                 Middleware(BodyLimit, max_bytes=MAX_PRESS_BYTES),
             ],
         )

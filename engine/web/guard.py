@@ -70,16 +70,26 @@ class SecurityHeaders:
 
 class LoopbackOrToken:
     """ASGI middleware for a server on ``host``: the rule above. ``open_paths`` need no
-    token (the page's files, which hold no data and ask with the token)."""
+    token (the page's files, which hold no data and ask with the token), nor does anything
+    under ``open_folders`` (each ending in ``/``)."""
 
     def __init__(
-        self, app: ASGIApp, *, host: str, token: str | None, open_paths: Collection[str] = ()
+        self,
+        app: ASGIApp,
+        *,
+        host: str,
+        token: str | None,
+        open_paths: Collection[str] = (),
+        open_folders: Collection[str] = (),
     ) -> None:
         check_listening(host, token, "a page")
         self.app = app
         self.loopback = is_loopback(host)
         self.token = token
         self.open_paths = frozenset(open_paths)
+        self.open_folders = tuple(open_folders)
+        if any(not folder.endswith("/") or folder == "/" for folder in self.open_folders):
+            raise ValueError(f"open folders end in '/' and are not the root: {open_folders}")
 
     async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
         if scope["type"] == "http":
@@ -89,13 +99,17 @@ class LoopbackOrToken:
                 return
         await self.app(scope, receive, send)
 
+    def _under_open_folder(self, path: str) -> bool:
+        return bool(self.open_folders) and path.startswith(self.open_folders)
+
     def _refusal(self, scope: Scope) -> str | None:
         if self.loopback:
             host = Headers(scope=scope).get("host", "")
             name = host if host.endswith("]") else host.rsplit(":", 1)[0]
             if name not in LOOPBACK_NAMES:
                 return "not this host: open the address vest printed"
-        if self.token is None or URL(scope=scope).path in self.open_paths:
+        path = URL(scope=scope).path
+        if self.token is None or path in self.open_paths or self._under_open_folder(path):
             return None
         given = QueryParams(scope["query_string"]).get("token", "")
         if not hmac.compare_digest(given.encode("utf-8", "replace"), self.token.encode()):

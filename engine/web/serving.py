@@ -9,14 +9,25 @@ from __future__ import annotations
 
 import socket
 import threading
+from pathlib import Path
 
 import uvicorn
+from starlette.routing import Mount
+from starlette.staticfiles import StaticFiles
 from starlette.types import ASGIApp
 
 from engine.errors import ConfigError
 
 GRACE_S = 3
 """How long requests in flight get to finish when a server stops."""
+SHARED = "/shared/"
+"""Where every app serves the files all pages share (engine/web/static/: the stream client)."""
+
+
+def shared_files() -> Mount:
+    """The route of the files every page shares, at :data:`SHARED` (they hold no data)."""
+    folder = Path(__file__).resolve().parent / "static"
+    return Mount(SHARED.rstrip("/"), StaticFiles(directory=folder), name="shared")
 
 
 def listening_socket(

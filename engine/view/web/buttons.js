@@ -1,6 +1,8 @@
 // The therapist's buttons: each press goes to the robot, which carries it out within a
 // tick; which buttons show follows what the robot is doing (server-sent events).
 
+import { follow } from "/shared/stream.js";
+
 const token = new URLSearchParams(location.search).get("token");
 const api = (path) => (token ? `${path}?token=${encodeURIComponent(token)}` : path);
 const $ = (selector) => document.querySelector(selector);
@@ -74,11 +76,14 @@ async function start() {
   }
   $("#trees-link").href = api("/");
   show(board.state);
-  const events = new EventSource(api("/api/buttons/events"));
-  events.onmessage = (message) => show(JSON.parse(message.data));
-  events.onerror = () => {
-    if (!ended) $("#state").textContent = "connection lost: retrying...";
+  const onEvent = (name, state) => {
+    show(state);
+    return !ended;
   };
+  const onState = (link) => {
+    if (!ended && link !== "open") $("#state").textContent = "connection lost: retrying...";
+  };
+  follow(api("/api/buttons/events"), { onEvent, onState });
 }
 
 document.addEventListener("keydown", (event) => {

@@ -1,6 +1,8 @@
 // The view of the robot's trees: live (server-sent changes) or a replay (a slider over a
 // recording). One data model for both: the server's snapshot, then changes applied to it.
 
+import { follow } from "/shared/stream.js";
+
 const token = new URLSearchParams(location.search).get("token");
 const api = (path, params = {}) => {
   const query = new URLSearchParams(params);
@@ -265,29 +267,28 @@ async function live() {
   $("#mode").textContent = "live";
   load(await getJson("/api/snapshot"));
   await draw();
-  const events = new EventSource(api("/api/events"));
-  events.onmessage = async (message) => {
-    const change = JSON.parse(message.data);
+  const onEvent = async (name, change) => {
     if (change.kind === "end") {
-      events.close();
       state.now = change.at;
       drawTables();
       $("#mode").textContent = `session ended at ${change.at.toFixed(2)} s`;
       document.body.dataset.ended = "true";
-      return;
+      return false;
     }
     if (change.kind === "resync" || change.kind === "tree") {
       load(await getJson("/api/snapshot"));
       await draw();
-      return;
+      return true;
     }
     apply(change);
     redrawSoon();
+    return true;
   };
-  events.onerror = () => {
-    if (document.body.dataset.ended !== "true") $("#mode").textContent = "live (connection lost: retrying)";
+  const onState = (link) => {
+    if (document.body.dataset.ended === "true") return;
+    $("#mode").textContent = link === "open" ? "live" : "live (connection lost: retrying)";
   };
-  events.onopen = () => { $("#mode").textContent = "live"; };
+  follow(api("/api/events"), { onEvent, onState });
 }
 
 // -- replay -------------------------------------------------------------------------------
