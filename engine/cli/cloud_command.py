@@ -23,7 +23,7 @@ if TYPE_CHECKING:
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    from cloud.settings import DEFAULT_DB
+    from cloud import DEFAULT_DB
 
     actions = parser.add_subparsers(dest="action", metavar="ACTION", required=True)
 

@@ -78,11 +78,12 @@ class RunningSession:
     recorder: SessionRecorder | None = None
 
     def run(self, until_s: float) -> None:
-        """Start every part in order (the hardware phased on the first tick), then tick the
-        trees until ``until_s`` (clock seconds) or a stop."""
-        robot = self.assembled.robot
-        self.assembled.first_tick_s = self.assembled.clock.now()
+        """Start every part in order, then tick the trees until ``until_s`` (clock
+        seconds) or a stop. The first tick is due when the session begins, after the parts
+        that come before it (pages, recorder, reloader) are up; the pollers and the camera
+        are phased on it."""
         self.assembled.lifecycle.start()
+        robot = self.assembled.robot
         robot.scheduler.run(until_s=until_s, start_s=self.assembled.first_tick_s)
 
     def close(self) -> None:
@@ -149,7 +150,12 @@ def _around(assembled: AssembledRobot, plan: SessionPlan) -> RunningSession:
         reloader = TreeReloader(plan.behaviors.loader, behaving, plan.clock, session=session)
         robot.scheduler.add_hook(reloader)
         lifecycle.add("reloader", start=reloader.start, stop=reloader.stop)
-    lifecycle.add("session", start=lambda: robot.begin_session(start_s), stop=_nothing)
+
+    def begin() -> None:  # every reader hears of every tree; the first tick is due now
+        assembled.first_tick_s = plan.clock.now()
+        robot.begin_session(start_s)
+
+    lifecycle.add("session", start=begin, stop=_nothing)
     assembled.add_runners()  # the pollers and the camera, phased on the first tick
     if plan.link is not None:
         link = plan.link
