@@ -120,7 +120,7 @@ class ViewServer:
             hint = "choose another with --view-port (0: any free one)"
             raise ConfigError(f"{error}; {hint}") from None
         self.host = host
-        self._server = ServerThread.of(self.app(), sock, "view")
+        self._server = ServerThread(self.app(), sock, "view")
         self.port = self._server.port
 
     @property

@@ -14,7 +14,7 @@ from pathlib import Path
 import uvicorn
 from starlette.routing import Mount
 from starlette.staticfiles import StaticFiles
-from starlette.types import ASGIApp
+from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
 from engine.errors import ConfigError
 
@@ -60,25 +60,35 @@ def address_of(host: str, port: int, path: str = "/") -> str:
 
 
 class ServerThread:
-    """``server`` (a uvicorn server of an app) serving on ``sock`` in a thread of its own,
-    beside the robot. The socket listens before :meth:`start`: a page that asks early waits
-    for its answer instead of being refused."""
+    """``app`` served by uvicorn on ``sock`` in a thread of its own, beside the robot.
 
-    def __init__(self, server: uvicorn.Server, sock: socket.socket, name: str) -> None:
-        self.server = server
+    :meth:`start` returns once the server is up (its app started), so a page that connects
+    right after hears everything from then on, and the server's start-up work is done
+    before the robot's first tick instead of during it."""
+
+    def __init__(self, app: ASGIApp, sock: socket.socket, name: str) -> None:
         self.sock = sock
         self.port = int(sock.getsockname()[1])
+        self._ready = threading.Event()
+        config = uvicorn.Config(
+            _noting_start(app, self._ready),
+            timeout_graceful_shutdown=GRACE_S,
+            log_level="warning",
+            lifespan="on",
+        )
+        self.server = uvicorn.Server(config)
         self._thread = threading.Thread(
-            target=server.run, kwargs={"sockets": [sock]}, name=name, daemon=True
+            target=self.server.run, kwargs={"sockets": [sock]}, name=name, daemon=True
         )
 
-    @classmethod
-    def of(cls, app: ASGIApp, sock: socket.socket, name: str) -> ServerThread:
-        config = uvicorn.Config(app, timeout_graceful_shutdown=GRACE_S, log_level="warning")
-        return cls(uvicorn.Server(config), sock, name)
-
     def start(self) -> None:
+        """Serve; returns once serving (a ConfigError if the server could not start)."""
         self._thread.start()
+        while not self._ready.wait(0.05):  # a server that failed to start ends its thread
+            if not self._thread.is_alive():
+                raise ConfigError(
+                    f"the {self._thread.name} server on port {self.port} did not start"
+                )
 
     def stop(self) -> None:
         """Ends the server (requests in flight get ``GRACE_S``) and frees its port."""
@@ -86,3 +96,21 @@ class ServerThread:
         if self._thread.is_alive():
             self._thread.join(timeout=GRACE_S + 5)
         self.sock.close()
+
+
+def _noting_start(app: ASGIApp, ready: threading.Event) -> ASGIApp:
+    """``app``, setting ``ready`` once uvicorn has started it (its lifespan's start-up)."""
+
+    async def noted(scope: Scope, receive: Receive, send: Send) -> None:
+        if scope["type"] != "lifespan":
+            await app(scope, receive, send)
+            return
+
+        async def send_noting(message: Message) -> None:
+            await send(message)
+            if message["type"] == "lifespan.startup.complete":
+                ready.set()
+
+        await app(scope, receive, send_noting)
+
+    return noted
