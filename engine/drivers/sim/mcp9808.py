@@ -31,44 +31,45 @@ import math
 import threading
 
 from engine.clock import Clock
+from engine.drivers.mcp9808_registers import (
+    CONFIG,
+    CONFIG_CRIT_LOCK,
+    CONFIG_INT_CLEAR,
+    CONFIG_LOCKS,
+    CONFIG_SHDN,
+    CONFIG_THYST,
+    CONFIG_WIN_LOCK,
+    CONFIG_WRITABLE,
+    DEVICE_ID,
+    DEVICE_ID_VALUE,
+    DEVICE_REVISION,
+    FLAG_CRIT,
+    FLAG_LOWER,
+    FLAG_UPPER,
+    LIMIT_MASK,
+    MANUFACTURER_ID,
+    MANUFACTURER_ID_VALUE,
+    OPERATING_MAX_C,
+    OPERATING_MIN_C,
+    RESOLUTION,
+    RESOLUTION_POWER_ON,
+    RESOLUTIONS,
+    SIGN,
+    T_AMBIENT,
+    T_CRIT,
+    T_LOWER,
+    T_UPPER,
+    TEMPERATURE_SIGNED_MASK,
+)
 from engine.drivers.sim.i2c_bus import SimI2CDevice
 
-CONFIG = 0x01
-T_UPPER = 0x02
-T_LOWER = 0x03
-T_CRIT = 0x04
-T_AMBIENT = 0x05
-MANUFACTURER_ID = 0x06
-DEVICE_ID = 0x07
-RESOLUTION = 0x08
-
-MANUFACTURER_ID_VALUE = 0x0054
-DEVICE_ID_VALUE = 0x0400
-
-CONFIG_THYST = 0x0600
-CONFIG_SHDN = 0x0100
-CONFIG_CRIT_LOCK = 0x0080
-CONFIG_WIN_LOCK = 0x0040
-CONFIG_INT_CLEAR = 0x0020
-CONFIG_WRITABLE = 0x07EF  # bits 10:0 except the read-only alert status (bit 4)
-
-FLAG_CRIT = 0x8000
-FLAG_UPPER = 0x4000
-FLAG_LOWER = 0x2000
-TEMPERATURE_MASK = 0x1FFF
-LIMIT_MASK = 0x1FFC
-
 # Resolution code -> (step in 1/16 degC, conversion time in seconds).
-RESOLUTIONS = {0b00: (8, 0.030), 0b01: (4, 0.065), 0b10: (2, 0.130), 0b11: (1, 0.250)}
-RESOLUTION_POWER_ON = 0b11
-
-TEMPERATURE_MIN_C = -40.0
-TEMPERATURE_MAX_C = 125.0
+_STEPS = {code: (round(step_c * 16), time_s) for code, (step_c, time_s) in RESOLUTIONS.items()}
 
 
 def _signed13(word: int) -> int:
-    word &= TEMPERATURE_MASK
-    return word - 0x2000 if word & 0x1000 else word
+    word &= TEMPERATURE_SIGNED_MASK
+    return word - 0x2000 if word & SIGN else word
 
 
 class SimMCP9808(SimI2CDevice):
@@ -103,14 +104,14 @@ class SimMCP9808(SimI2CDevice):
     @property
     def conversion_time_s(self) -> float:
         """Seconds per conversion at the current resolution."""
-        return RESOLUTIONS[self._resolution][1]
+        return _STEPS[self._resolution][1]
 
     @staticmethod
     def _checked(value: float) -> float:
-        if not TEMPERATURE_MIN_C <= value <= TEMPERATURE_MAX_C:
+        if not OPERATING_MIN_C <= value <= OPERATING_MAX_C:
             raise ValueError(
                 f"MCP9808 temperature {value} degC is outside its operating range "
-                f"{TEMPERATURE_MIN_C}..{TEMPERATURE_MAX_C}"
+                f"{OPERATING_MIN_C}..{OPERATING_MAX_C}"
             )
         return float(value)
 
@@ -138,7 +139,7 @@ class SimMCP9808(SimI2CDevice):
 
     # -- chip internals -----------------------------------------------------------------
     def _locked(self) -> bool:
-        return bool(self._config & (CONFIG_CRIT_LOCK | CONFIG_WIN_LOCK))
+        return bool(self._config & CONFIG_LOCKS)
 
     def _read_word(self, pointer: int) -> int:
         if pointer == CONFIG:
@@ -150,7 +151,7 @@ class SimMCP9808(SimI2CDevice):
         if pointer == MANUFACTURER_ID:
             return MANUFACTURER_ID_VALUE
         if pointer == DEVICE_ID:
-            return DEVICE_ID_VALUE
+            return DEVICE_ID_VALUE << 8 | DEVICE_REVISION
         return 0  # RFU (0x00) and reserved registers
 
     def _write_word(self, pointer: int, value: int) -> None:
@@ -166,7 +167,7 @@ class SimMCP9808(SimI2CDevice):
     def _write_config(self, value: int) -> None:
         value &= CONFIG_WRITABLE & ~CONFIG_INT_CLEAR
         old = self._config
-        locks = old & (CONFIG_CRIT_LOCK | CONFIG_WIN_LOCK)
+        locks = old & CONFIG_LOCKS
         new = value | locks  # locks clear only at power-on reset
         if locks:
             new = (new & ~CONFIG_THYST) | (old & CONFIG_THYST)
@@ -190,10 +191,10 @@ class SimMCP9808(SimI2CDevice):
         self.conversions += done
 
     def _convert(self) -> int:
-        step = RESOLUTIONS[self._resolution][0]
+        step = _STEPS[self._resolution][0]
         sixteenths = math.floor(self._temperature_c * 16)
         sixteenths -= sixteenths % step  # drop the bits below the resolution
-        word = sixteenths & TEMPERATURE_MASK
+        word = sixteenths & TEMPERATURE_SIGNED_MASK
         if sixteenths >= _signed13(self._limits[T_CRIT]):
             word |= FLAG_CRIT
         if sixteenths > _signed13(self._limits[T_UPPER]):
