@@ -32,32 +32,28 @@ from __future__ import annotations
 
 import threading
 
+from engine.drivers.mpr121_registers import (
+    BASELINE_0,
+    CONFIG1,
+    CONFIG1_DEFAULT,
+    CONFIG2,
+    CONFIG2_DEFAULT,
+    DATA_MAX,
+    ECR,
+    ECR_CL_SHIFT,
+    ECR_ELE_MASK,
+    ECR_ELEPROX_MASK,
+    FILTERED_DATA_0,
+    GPIO_FIRST,
+    GPIO_LAST,
+    PADS,
+    SOFT_RESET,
+    SOFT_RESET_MAGIC,
+    TOUCH_STATUS_H,
+    TOUCH_STATUS_L,
+    TOUCH_THRESHOLD_0,
+)
 from engine.drivers.sim.i2c_bus import SimI2CDevice
-
-# Register map (data sheet Table 1).
-TOUCH_STATUS_L = 0x00
-TOUCH_STATUS_H = 0x01
-FILTERED_DATA_0 = 0x04  # ELE0 LSB; 13 little-endian pairs up to 0x1D
-BASELINE_0 = 0x1E  # ELE0 baseline, upper 8 of 10 bits; 13 registers up to 0x2A
-TOUCH_THRESHOLD_0 = 0x41  # ELE0 touch threshold; release threshold follows, pairs to 0x5A
-DEBOUNCE = 0x5B
-CONFIG1 = 0x5C
-CONFIG2 = 0x5D
-ECR = 0x5E
-GPIO_FIRST = 0x73
-GPIO_LAST = 0x7A
-SOFT_RESET = 0x80
-
-SOFT_RESET_MAGIC = 0x63
-CONFIG1_DEFAULT = 0x10
-CONFIG2_DEFAULT = 0x24
-
-ECR_CL_SHIFT = 6  # calibration lock: 00 keep, 01 no tracking, 10 load 5 MSB, 11 load all
-ECR_ELEPROX_MASK = 0x30
-ECR_ELE_MASK = 0x0F
-
-PADS = 12
-DATA_MAX = 0x3FF  # filtered data and baseline are 10-bit
 
 
 class SimMPR121(SimI2CDevice):

@@ -7,8 +7,8 @@ from collections.abc import Callable, Sequence
 from typing import Any
 
 from engine.blackboard.catalogue import TOUCH_ANY, TOUCH_PADS, TOUCH_PAT, TOUCH_TOUCHED
-from engine.drivers import mpr121 as driver
-from engine.drivers.mpr121 import MPR121, PADS, check_thresholds
+from engine.drivers.mpr121 import MPR121, check_thresholds
+from engine.drivers.mpr121_registers import CONFIG2, PADS
 from engine.drivers.sim.mpr121 import SimMPR121
 from engine.files.yaml_source import YList, describe
 from engine.hardware.chips.fields import ChipFields
@@ -28,7 +28,7 @@ def _simulate(vest: SimPlacement, device: DeviceConfig) -> None:
 
 
 def _probe(address: int) -> Callable[[Any], object]:
-    return lambda bus: bus.read_byte_data(address, driver.CONFIG2)
+    return lambda bus: bus.read_byte_data(address, CONFIG2)
 
 
 def _poll(setup: PollSetup) -> PollParts:
