@@ -30,38 +30,26 @@ import math
 import threading
 
 from engine.clock import Clock
+from engine.drivers.ads1115_registers import (
+    CODE_MAX,
+    CODE_MIN,
+    CONFIG,
+    CONFIG_POWER_ON,
+    CONVERSION,
+    DATA_RATES_SPS,
+    DR_SHIFT,
+    HI_THRESH,
+    INPUT_MARGIN_V,
+    LO_THRESH,
+    MODE_SINGLE_SHOT,
+    MUX_INPUTS,
+    MUX_SHIFT,
+    OS,
+    PGA_FULL_SCALE_V,
+    PGA_SHIFT,
+    POINTER_MASK,
+)
 from engine.drivers.sim.i2c_bus import SimI2CDevice
-
-CONVERSION = 0x00
-CONFIG = 0x01
-LO_THRESH = 0x02
-HI_THRESH = 0x03
-POINTER_MASK = 0x03
-
-CONFIG_POWER_ON = 0x8583
-OS = 0x8000
-MUX_SHIFT = 12
-PGA_SHIFT = 9
-MODE_SINGLE_SHOT = 0x0100
-DR_SHIFT = 5
-
-# MUX code -> (positive input, negative input or None for GND).
-MUX_INPUTS: dict[int, tuple[int, int | None]] = {
-    0b000: (0, 1),
-    0b001: (0, 3),
-    0b010: (1, 3),
-    0b011: (2, 3),
-    0b100: (0, None),
-    0b101: (1, None),
-    0b110: (2, None),
-    0b111: (3, None),
-}
-PGA_FULL_SCALE_V = (6.144, 4.096, 2.048, 1.024, 0.512, 0.256, 0.256, 0.256)
-DATA_RATE_SPS = (8, 16, 32, 64, 128, 250, 475, 860)
-
-CODE_MAX = 0x7FFF
-CODE_MIN = -0x8000
-INPUT_MARGIN_V = 0.3  # absolute maximum: GND - 0.3 V .. VDD + 0.3 V
 
 
 def volts_to_code(volts: float, full_scale_v: float) -> int:
@@ -165,7 +153,7 @@ class SimADS1115(SimI2CDevice):
         return self._hi_thresh
 
     def _period_s(self) -> float:
-        return self._time_factor / DATA_RATE_SPS[(self._config >> DR_SHIFT) & 0x07]
+        return self._time_factor / DATA_RATES_SPS[(self._config >> DR_SHIFT) & 0x07]
 
     def _code_now(self) -> int:
         positive, negative = MUX_INPUTS[(self._config >> MUX_SHIFT) & 0x07]
