@@ -27,29 +27,28 @@ from __future__ import annotations
 
 from engine.clock import Clock
 from engine.drivers.sim.i2c_bus import SimI2CDevice
+from engine.drivers.srf02_registers import (
+    AUTOTUNE_MIN_HIGH,
+    AUTOTUNE_MIN_LOW,
+    BURST,
+    BUSY,
+    COMMAND,
+    FAKE_RANGE_FIRST,
+    FAKE_RANGE_LAST,
+    MAX_RANGE_CM,
+    POWER_UP_MIN_CM,
+    RANGE_CM,
+    RANGE_HIGH,
+    RANGE_INCHES,
+    RANGE_LOW,
+    RANGE_MICROSECONDS,
+    RANGING_TIME_S,
+    RESTART_AUTOTUNE,
+    TUNED_MIN_CM,
+    UNUSED,
+    UNUSED_VALUE,
+)
 
-COMMAND = 0x00  # write: command; read: software revision
-UNUSED = 0x01  # reads 0x80
-RANGE_HIGH = 0x02
-RANGE_LOW = 0x03
-AUTOTUNE_MIN_HIGH = 0x04
-AUTOTUNE_MIN_LOW = 0x05
-REGISTERS = 6
-
-RANGE_INCHES = 0x50
-RANGE_CM = 0x51
-RANGE_MICROSECONDS = 0x52
-FAKE_RANGE_FIRST = 0x56
-FAKE_RANGE_LAST = 0x58
-BURST = 0x5C
-RESTART_AUTOTUNE = 0x60
-
-BUSY = 0xFF
-UNUSED_VALUE = 0x80
-RANGING_TIME_S = 0.066
-MAX_RANGE_CM = 600.0
-POWER_UP_MIN_CM = 28.0
-TUNED_MIN_CM = 16.0
 TUNING_STEP_CM = 2.0  # per ranging: 28 cm to 16 cm in six rangings
 MICROSECONDS_PER_CM = 58.3  # out and back at 343 m/s
 CM_PER_INCH = 2.54
