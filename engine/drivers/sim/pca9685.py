@@ -29,25 +29,31 @@ from __future__ import annotations
 import errno
 
 from engine.clock import Clock
+from engine.drivers.pca9685_registers import (
+    ALL_LED_OFF_H,
+    ALL_LED_ON_L,
+    CHANNELS,
+    COUNTS,
+    FULL_BIT,
+    LED0_ON_L,
+    LED15_OFF_H,
+    LED_STRIDE,
+    MODE1,
+    MODE1_AI,
+    MODE1_EXTCLK,
+    MODE1_POWER_ON,
+    MODE1_RESTART,
+    MODE1_SLEEP,
+    MODE2,
+    MODE2_POWER_ON,
+    OSCILLATOR_WAKE_S,
+    PRE_SCALE,
+    PRE_SCALE_POWER_ON,
+    PRESCALE_MIN,
+    SUBADR1,
+)
 from engine.drivers.sim.i2c_bus import SimI2CDevice, bus_error
 
-MODE1 = 0x00
-MODE1_RESTART = 0x80
-MODE1_EXTCLK = 0x40
-MODE1_AI = 0x20
-MODE1_SLEEP = 0x10
-MODE2 = 0x01
-LED0_ON_L = 0x06
-LED15_OFF_H = 0x45
-ALL_LED_ON_L = 0xFA
-ALL_LED_OFF_H = 0xFD
-PRE_SCALE = 0xFE
-TEST_MODE = 0xFF
-FULL_BIT = 0x10  # bit 4 of LEDn_ON_H / LEDn_OFF_H
-CHANNELS = 16
-COUNTS = 4096
-PRESCALE_MIN = 3
-OSCILLATOR_WAKE_S = 500e-6
 _TIME_TOLERANCE_S = 1e-9  # sums of float seconds: 0.1 + 0.0005 - 0.1 < 0.0005
 
 
@@ -59,19 +65,21 @@ class SimPCA9685(SimI2CDevice):
         self._clock = clock
         self.oscillator_hz = oscillator_hz
         self._registers = bytearray(256)
-        self._registers[MODE1] = 0x11
-        self._registers[MODE2] = 0x04
-        self._registers[0x02:0x06] = bytes([0xE2, 0xE4, 0xE8, 0xE0])  # SUBADR1..3, ALLCALLADR
+        self._registers[MODE1] = MODE1_POWER_ON
+        self._registers[MODE2] = MODE2_POWER_ON
+        self._registers[SUBADR1:LED0_ON_L] = bytes(
+            [0xE2, 0xE4, 0xE8, 0xE0]
+        )  # SUBADR1..3, ALLCALLADR
         for channel in range(CHANNELS):
             self._registers[self._led(channel) + 3] = FULL_BIT
-        self._registers[PRE_SCALE] = 0x1E
+        self._registers[PRE_SCALE] = PRE_SCALE_POWER_ON
         self._pointer = 0
         self._restart_pending = False
         self._awake_since_s: float | None = None  # None while SLEEP is set
 
     @staticmethod
     def _led(channel: int) -> int:
-        return LED0_ON_L + 4 * channel
+        return LED0_ON_L + LED_STRIDE * channel
 
     # -- what the outputs do -------------------------------------------------------------------
     @property
