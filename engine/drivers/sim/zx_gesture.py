@@ -19,37 +19,28 @@ from __future__ import annotations
 
 from engine.clock import Clock
 from engine.drivers.sim.i2c_bus import SimI2CDevice
-
-STATUS = 0x00
-STATUS_DAV = 1 << 0
-STATUS_SWP = 1 << 2
-STATUS_HOVER = 1 << 3
-STATUS_HVG = 1 << 4
-STATUS_HB = 1 << 7
-DRE = 0x01
-DRCFG = 0x02
-DRCFG_FORCE = 1 << 6
-GESTURE = 0x04
-GSPEED = 0x05
-XPOS = 0x08
-ZPOS = 0x0A
-LRNG = 0x0C
-RRNG = 0x0E
-REGVER = 0xFE
-MODEL = 0xFF
-
-MAX_POSITION = 240
-
-# gesture -> (GESTURE register value, STATUS bit that announces it)
-GESTURES = {
-    "swipe_right": (0x01, STATUS_SWP),
-    "swipe_left": (0x02, STATUS_SWP),
-    "swipe_up": (0x03, STATUS_SWP),
-    "hover": (0x05, STATUS_HOVER),
-    "hover_left": (0x06, STATUS_HVG),
-    "hover_right": (0x07, STATUS_HVG),
-    "hover_up": (0x08, STATUS_HVG),
-}
+from engine.drivers.zx_gesture_registers import (
+    ADDRESSES,
+    DRCFG,
+    DRCFG_FORCE,
+    DRCFG_POWER_ON,
+    DRE,
+    GESTURE,
+    GESTURES,
+    GSPEED,
+    LRNG,
+    MAX_POSITION,
+    MODEL,
+    MODEL_ID,
+    REGISTER_MAP_VERSION,
+    REGVER,
+    RRNG,
+    STATUS,
+    STATUS_DAV,
+    STATUS_HB,
+    XPOS,
+    ZPOS,
+)
 
 
 class SimZXGesture(SimI2CDevice):
@@ -61,16 +52,16 @@ class SimZXGesture(SimI2CDevice):
         address: int = 0x10,
         *,
         sample_period_s: float = 0.02,
-        model: int = 0x01,
-        register_map_version: int = 0x01,
+        model: int = MODEL_ID,
+        register_map_version: int = REGISTER_MAP_VERSION,
     ) -> None:
-        if address not in (0x10, 0x11):
+        if address not in ADDRESSES:
             raise ValueError(f"a ZX sensor answers on 0x10 or 0x11, not 0x{address:02X}")
         super().__init__(address)
         self._clock = clock
         self.sample_period_s = sample_period_s
         self._registers = bytearray(256)
-        self._registers[DRCFG] = 0x81
+        self._registers[DRCFG] = DRCFG_POWER_ON
         self._registers[REGVER] = register_map_version
         self._registers[MODEL] = model
         self._pointer = 0

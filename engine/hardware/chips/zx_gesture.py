@@ -6,7 +6,7 @@ from collections.abc import Callable, Sequence
 from typing import Any
 
 from engine.blackboard.catalogue import GESTURE_LAST
-from engine.drivers import zx_gesture as driver
+from engine.drivers import zx_gesture_registers as registers
 from engine.drivers.sim.zx_gesture import SimZXGesture
 from engine.drivers.zx_gesture import ZXGesture
 from engine.hardware.chips.fields import ChipFields
@@ -54,7 +54,7 @@ def _simulate(vest: SimPlacement, device: DeviceConfig) -> None:
 
 def _probe(address: int) -> Callable[[Any], object]:
     return lambda bus: expect_identity(
-        "ZX model", bus.read_byte_data(address, driver.MODEL), driver.MODEL_ID
+        "ZX model", bus.read_byte_data(address, registers.MODEL), registers.MODEL_ID
     )
 
 
