@@ -47,56 +47,66 @@ import errno
 
 from engine.clock import Clock
 from engine.drivers.sim.i2c_bus import SimI2CBus, SimI2CDevice, bus_error
-
-POWER_ON_ADDRESS = 0x29
-
-SYSRANGE_START = 0x00
-SYSTEM_SEQUENCE_CONFIG = 0x01
-SYSTEM_INTERRUPT_CLEAR = 0x0B
-RESULT_INTERRUPT_STATUS = 0x13
-RESULT_RANGE_STATUS = 0x14
-RESULT_RANGE_MM = RESULT_RANGE_STATUS + 10  # 0x1E..0x1F, big-endian
-I2C_SLAVE_DEVICE_ADDRESS = 0x8A
-GLOBAL_CONFIG_SPAD_ENABLES_REF_0 = 0xB0  # six bytes, 0xB0..0xB5
-PAGE_SELECT = 0xFF
-PRIVATE_PAGE = 0x01
-STOP_VARIABLE = 0x91  # on the private page
-NVM_ENABLE_PAGE = 0x06  # bit 2 of NVM_CONTROL there switches NVM access on
-NVM_PAGE = 0x07
-NVM_CONTROL = 0x83  # page 6: enable bit; page 7: read strobe (0x00 starts, non-zero done)
-NVM_ENABLE = 0x04
-NVM_POWER = 0x81  # page 7: 0x01 while NVM is read
-NVM_DATA = 0x90  # page 7: the word read, big-endian, 0x90..0x93
-NVM_ADDRESS = 0x94  # page 7: which NVM word the strobe reads
-NVM_SPAD_INFO = 0x6B  # bits 14:8 reference SPAD count, bit 15 aperture type
-NVM_GOOD_SPAD_MAP = (0x24, 0x25)  # bytes 0..3, then 4..5 in the high half
-NVM_READ_DONE = 0x01
+from engine.drivers.vl53l0x_registers import (
+    DEVICE_RANGE_STATUS_MSRC_NO_TARGET,
+    DEVICE_RANGE_STATUS_SHIFT,
+    DEVICE_RANGE_STATUS_VALID,
+    FINAL_RANGE_CONFIG_MIN_COUNT_RATE_RTN_LIMIT,
+    GLOBAL_CONFIG_SPAD_ENABLES_REF_0,
+    GPIO_HV_MUX_ACTIVE_HIGH,
+    I2C_SLAVE_DEVICE_ADDRESS,
+    IDENTIFICATION_MODEL_ID,
+    IDENTITY,
+    INTERRUPT_NEW_SAMPLE_READY,
+    NVM_ADDRESS,
+    NVM_CONTROL,
+    NVM_DATA,
+    NVM_ENABLE,
+    NVM_ENABLE_PAGE,
+    NVM_GOOD_SPAD_MAP,
+    NVM_PAGE,
+    NVM_POWER,
+    NVM_READ_DONE,
+    NVM_SPAD_INFO,
+    PAGE_SELECT,
+    POWER_ON_ADDRESS,
+    PRIVATE_PAGE,
+    RANGE_OUT_OF_RANGE_MM,
+    RESULT_BLOCK_LENGTH,
+    RESULT_INTERRUPT_STATUS,
+    RESULT_RANGE_MM,
+    RESULT_RANGE_STATUS,
+    SEQUENCE_ALL,
+    SEQUENCE_PHASE_CALIBRATION,
+    SEQUENCE_VHV_CALIBRATION,
+    STOP_VARIABLE,
+    SYSRANGE_START,
+    SYSTEM_INTERRUPT_CLEAR,
+    SYSTEM_SEQUENCE_CONFIG,
+    TBOOT_MAX_S,
+)
 
 # A plausible factory calibration: 5 aperture SPADs; reference SPAD 13 is bad.
 DEFAULT_SPAD_COUNT = 5
 DEFAULT_GOOD_SPAD_MAP = bytes([0xFF, 0xDF, 0xFF, 0xFF, 0xFF, 0x3F])
 
-INTERRUPT_NEW_SAMPLE_READY = 0x04
-DEVICE_STATUS_RANGE_VALID = 11
-DEVICE_STATUS_MSRC_NO_TARGET = 4
-OUT_OF_RANGE_MM = 8190
-
-CALIBRATION_SEQUENCES = {0x01, 0x02}  # VHV and phase reference calibration
+CALIBRATION_SEQUENCES = {SEQUENCE_VHV_CALIBRATION, SEQUENCE_PHASE_CALIBRATION}
 CALIBRATION_TIME_S = 0.001
-BOOT_TIME_S = 0.0012  # tBOOT, datasheet maximum
 
 _POWER_ON_REGISTERS = {
-    0xC0: 0xEE,
-    0xC1: 0xAA,
-    0xC2: 0x10,
-    SYSTEM_SEQUENCE_CONFIG: 0xFF,
-    0x44: 0x00,  # FINAL_RANGE_CONFIG_MIN_COUNT_RATE_RTN_LIMIT, high byte
-    0x45: 0x20,  # ... low byte: 0.25 MCPS in Q9.7
-    0x84: 0x11,  # GPIO_HV_MUX_ACTIVE_HIGH
+    **{IDENTIFICATION_MODEL_ID + offset: value for offset, value in enumerate(IDENTITY)},
+    SYSTEM_SEQUENCE_CONFIG: SEQUENCE_ALL,
+    FINAL_RANGE_CONFIG_MIN_COUNT_RATE_RTN_LIMIT: 0x00,  # high byte
+    FINAL_RANGE_CONFIG_MIN_COUNT_RATE_RTN_LIMIT + 1: 0x20,  # low byte: 0.25 MCPS in Q9.7
+    GPIO_HV_MUX_ACTIVE_HIGH: 0x11,
     I2C_SLAVE_DEVICE_ADDRESS: POWER_ON_ADDRESS,
 }
 _POWER_ON_PRIVATE = {STOP_VARIABLE: 0x3C}  # a plausible stop variable; any value works
-_READ_ONLY = {0xC0, 0xC1, 0xC2, RESULT_INTERRUPT_STATUS, *range(0x14, 0x20)}
+_READ_ONLY = {
+    *range(IDENTIFICATION_MODEL_ID, IDENTIFICATION_MODEL_ID + len(IDENTITY)),
+    RESULT_INTERRUPT_STATUS,
+    *range(RESULT_RANGE_STATUS, RESULT_RANGE_STATUS + RESULT_BLOCK_LENGTH),
+}
 
 
 def _factory_nvm(spad_count: int, spad_aperture: bool, good_spad_map: bytes) -> dict[int, int]:
@@ -177,7 +187,7 @@ class SimVL53L0X(SimI2CDevice):
             self._detach()
             self._power_on_reset()
             return
-        self._boot_done_s = self._clock.now() + BOOT_TIME_S
+        self._boot_done_s = self._clock.now() + TBOOT_MAX_S
         self._attach()
 
     @property
@@ -246,10 +256,13 @@ class SimVL53L0X(SimI2CDevice):
         self.measurements += 1
         distance = self._sampled_mm
         if distance is None or distance > self.max_range_mm:
-            status, range_mm = DEVICE_STATUS_MSRC_NO_TARGET, OUT_OF_RANGE_MM
+            status, range_mm = DEVICE_RANGE_STATUS_MSRC_NO_TARGET, RANGE_OUT_OF_RANGE_MM
         else:
-            status, range_mm = DEVICE_STATUS_RANGE_VALID, min(round(distance), OUT_OF_RANGE_MM - 1)
-        self._registers[RESULT_RANGE_STATUS] = status << 3
+            status, range_mm = (
+                DEVICE_RANGE_STATUS_VALID,
+                min(round(distance), RANGE_OUT_OF_RANGE_MM - 1),
+            )
+        self._registers[RESULT_RANGE_STATUS] = status << DEVICE_RANGE_STATUS_SHIFT
         self._registers[RESULT_RANGE_MM] = range_mm >> 8
         self._registers[RESULT_RANGE_MM + 1] = range_mm & 0xFF
 
