@@ -22,39 +22,35 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 
+from engine.drivers.mcp3008_registers import (
+    CHANNELS,
+    CODE_COUNT,
+    CODE_MAX,
+    DIFFERENTIAL_PAIRS,
+    MAX_CLOCK_AT_2V7_HZ,
+    MAX_CLOCK_AT_5V_HZ,
+    SPI_MODES,
+    VDD_MAX_V,
+    VDD_MIN_V,
+    VREF_MIN_V,
+)
 from engine.drivers.sim.spi_bus import Bit, SimSpiDevice
-
-CHANNELS = 8
-CODE_MAX = 1023
-SUPPORTED_MODES = (0, 3)
-
-# Differential D2..D0 -> (IN+, IN-).
-DIFFERENTIAL_PAIRS = {
-    0b000: (0, 1),
-    0b001: (1, 0),
-    0b010: (2, 3),
-    0b011: (3, 2),
-    0b100: (4, 5),
-    0b101: (5, 4),
-    0b110: (6, 7),
-    0b111: (7, 6),
-}
 
 
 def max_clock_hz(vdd_v: float) -> float:
     """The highest SPI clock the data sheet allows at supply ``vdd_v`` (2.7..5.5 V)."""
-    fraction = (min(max(vdd_v, 2.7), 5.0) - 2.7) / (5.0 - 2.7)
-    return 1_350_000 + fraction * (3_600_000 - 1_350_000)
+    fraction = (min(max(vdd_v, VDD_MIN_V), 5.0) - VDD_MIN_V) / (5.0 - VDD_MIN_V)
+    return MAX_CLOCK_AT_2V7_HZ + fraction * (MAX_CLOCK_AT_5V_HZ - MAX_CLOCK_AT_2V7_HZ)
 
 
 class SimMCP3008(SimSpiDevice):
     """An MCP3008 whose eight inputs are set in volts against VSS."""
 
     def __init__(self, *, vref_v: float = 3.3, vdd_v: float = 3.3) -> None:
-        if not 2.7 <= vdd_v <= 5.5:
-            raise ValueError(f"MCP3008 supply {vdd_v} V is outside 2.7..5.5 V")
-        if not 0.25 <= vref_v <= vdd_v:
-            raise ValueError(f"MCP3008 VREF {vref_v} V is outside 0.25..VDD ({vdd_v}) V")
+        if not VDD_MIN_V <= vdd_v <= VDD_MAX_V:
+            raise ValueError(f"MCP3008 supply {vdd_v} V is outside {VDD_MIN_V}..{VDD_MAX_V} V")
+        if not VREF_MIN_V <= vref_v <= vdd_v:
+            raise ValueError(f"MCP3008 VREF {vref_v} V is outside {VREF_MIN_V}..VDD ({vdd_v}) V")
         self.vref_v = vref_v
         self.vdd_v = vdd_v
         self._inputs_v = [0.0] * CHANNELS
@@ -73,10 +69,10 @@ class SimMCP3008(SimSpiDevice):
 
     def code_for(self, volts: float) -> int:
         """The ideal code for an input of ``volts``."""
-        return max(0, min(CODE_MAX, math.floor(1024 * volts / self.vref_v)))
+        return max(0, min(CODE_MAX, math.floor(CODE_COUNT * volts / self.vref_v)))
 
     def frame(self, mosi_bits: Sequence[int], *, mode: int, speed_hz: int) -> list[Bit]:
-        if mode not in SUPPORTED_MODES or speed_hz > max_clock_hz(self.vdd_v):
+        if mode not in SPI_MODES or speed_hz > max_clock_hz(self.vdd_v):
             return [None] * len(mosi_bits)  # bits sampled on the wrong edge or too fast
         miso: list[Bit] = []
         start: int | None = None
