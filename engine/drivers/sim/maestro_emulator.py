@@ -42,15 +42,19 @@ from engine.drivers.maestro_protocol import (
     CMD_GET_ERRORS,
     CMD_GET_MOVING_STATE,
     CMD_GET_POSITION,
+    CMD_GET_SCRIPT_STATUS,
     CMD_GO_HOME,
     CMD_SET_ACCELERATION,
+    CMD_SET_MULTIPLE_TARGETS,
     CMD_SET_SPEED,
     CMD_SET_TARGET,
+    COMMAND_DATA_LENGTHS,
     ERROR_NAMES,
     ERROR_SERIAL_PROTOCOL,
     ERROR_SERIAL_TIMEOUT,
     MAX_ACCELERATION,
     MAX_DEVICE_NUMBER,
+    MINI_SSC_START,
     POLOLU_PROTOCOL_START,
     QUARTER_US_PER_US,
 )
@@ -58,32 +62,6 @@ from engine.drivers.sim.servo_channel import ServoChannel
 
 TICK_S = 0.010
 """The Maestro updates servo positions every 10 ms (at the default 20 ms period)."""
-
-# Commands the emulator knows but does not act on, with their data lengths, so that the
-# byte stream stays in step.
-CMD_SET_PWM = 0x8A
-CMD_SET_MULTIPLE_TARGETS = 0x9F
-CMD_STOP_SCRIPT = 0xA4
-CMD_RESTART_SCRIPT = 0xA7
-CMD_RESTART_SCRIPT_WITH_PARAMETER = 0xA8
-CMD_GET_SCRIPT_STATUS = 0xAE
-MINI_SSC_START = 0xFF
-
-_DATA_LENGTHS: dict[int, int] = {
-    CMD_SET_TARGET: 3,
-    CMD_SET_SPEED: 3,
-    CMD_SET_ACCELERATION: 3,
-    CMD_SET_PWM: 4,
-    CMD_GET_POSITION: 1,
-    CMD_GET_MOVING_STATE: 0,
-    CMD_SET_MULTIPLE_TARGETS: 2,  # at least; 2 + 2 * count in all
-    CMD_GET_ERRORS: 0,
-    CMD_GO_HOME: 0,
-    CMD_STOP_SCRIPT: 0,
-    CMD_RESTART_SCRIPT: 1,
-    CMD_RESTART_SCRIPT_WITH_PARAMETER: 3,
-    CMD_GET_SCRIPT_STATUS: 0,
-}
 
 DEFAULT_LIMITS_US = (992.0, 2000.0)
 """A new Maestro's Min and Max for every channel."""
@@ -315,7 +293,7 @@ class MaestroEmulator:
         return self._execute_if_complete(now_s)
 
     def _start(self, command: int, now_s: float) -> bytes:
-        if command not in _DATA_LENGTHS:
+        if command not in COMMAND_DATA_LENGTHS:
             self._state = "idle"
             self._raise_error(ERROR_SERIAL_PROTOCOL)
             return b""
@@ -325,7 +303,7 @@ class MaestroEmulator:
         return self._execute_if_complete(now_s)
 
     def _execute_if_complete(self, now_s: float) -> bytes:
-        needed = _DATA_LENGTHS[self._command]
+        needed = COMMAND_DATA_LENGTHS[self._command]
         if self._command == CMD_SET_MULTIPLE_TARGETS and self._packet:
             needed = 2 + 2 * self._packet[0]
         if len(self._packet) < needed:

@@ -25,6 +25,7 @@ from collections.abc import Sequence
 from typing import Protocol
 
 from engine.drivers.sim.i2c_bus import SimI2CBus, SimI2CDevice, bus_error
+from engine.drivers.tca9548a_registers import ADDRESSES, CHANNELS, CONTROL_NONE
 
 
 class DownstreamBus(Protocol):
@@ -64,13 +65,13 @@ class SimTCA9548A(SimI2CDevice):
         *,
         upstream: SimI2CBus | None = None,
     ) -> None:
-        if not 0x70 <= address <= 0x77:
+        if address not in ADDRESSES:
             raise ValueError(f"a TCA9548A answers on 0x70..0x77, not 0x{address:02X}")
-        if len(downstream) > 8:
+        if len(downstream) > CHANNELS:
             raise ValueError(f"a TCA9548A has 8 channels, got {len(downstream)} buses")
         super().__init__(address)
         self.downstream = list(downstream)
-        self.control = 0x00
+        self.control = CONTROL_NONE
         self.upstream = upstream
         self._bridged: dict[int, _Bridged] = {}
         if upstream is not None:
@@ -79,7 +80,7 @@ class SimTCA9548A(SimI2CDevice):
     # -- the pins -----------------------------------------------------------------------------
     def reset(self) -> None:
         """Pulse the RESET pin: every channel disconnected."""
-        self.control = 0x00
+        self.control = CONTROL_NONE
         self.refresh()
 
     @property
