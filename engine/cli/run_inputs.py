@@ -30,7 +30,7 @@ from engine.nodes.registry import NodeRegistry, default_registry
 from engine.remote_commands import COMMAND_TYPES
 from engine.runtime.robot import Behaviors, load_behaviors
 from engine.scenario.scenario_file import Scenario, ScenarioEvent, load_scenario
-from engine.values.params import did_you_mean
+from engine.values.param_problems import did_you_mean
 
 PROJECT = Path(__file__).resolve().parents[2]
 """The folder vest was installed from (a checkout): its defaults are found from anywhere."""

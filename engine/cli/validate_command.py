@@ -44,7 +44,7 @@ from engine.loader.tree_resources import collisions
 from engine.nodes.registry import NodeRegistry, default_registry
 from engine.runtime.robot import declared_beside, tree_files
 from engine.scenario.scenario_file import load_scenario
-from engine.values.params import did_you_mean
+from engine.values.param_problems import did_you_mean
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

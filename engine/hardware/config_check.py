@@ -35,18 +35,8 @@ from engine.hardware.config_buses import check_buses
 from engine.hardware.config_camera import check_camera
 from engine.hardware.config_cross_checks import CrossChecks
 from engine.hardware.config_safety import check_safety
-from engine.values.params import (
-    RATE_HZ,
-    Boolean,
-    CheckContext,
-    Integer,
-    Key,
-    Param,
-    ParamProblem,
-    ParamType,
-    Text,
-    did_you_mean,
-)
+from engine.values.param_problems import CheckContext, ParamProblem, did_you_mean
+from engine.values.params import RATE_HZ, Boolean, Integer, Key, Param, ParamType, Text
 
 TOP_FIELDS: tuple[str, ...] = ("name", "description", "simulated", "buses", "gpio", "audio")
 TOP_FIELDS += ("camera", "devices", "safety")

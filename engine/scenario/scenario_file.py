@@ -29,19 +29,17 @@ from engine.blackboard.catalogue import default_catalogue
 from engine.files.problems import LoadError, Mark, Problems
 from engine.files.yaml_source import YList, YMap, YValue, describe, load_yaml, plain
 from engine.speech.audio import AudioFileError, read_wav
+from engine.values.param_problems import CheckContext, ParamProblem, did_you_mean
 from engine.values.params import (
     REQUIRED,
     SECONDS,
     AnyValue,
-    CheckContext,
     Choice,
     Integer,
     Number,
     Param,
-    ParamProblem,
     ParamType,
     Text,
-    did_you_mean,
 )
 
 GESTURES = (

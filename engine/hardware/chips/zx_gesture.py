@@ -14,7 +14,8 @@ from engine.hardware.chips.kind import ChipKind, SimPlacement, expect_identity
 from engine.hardware.config import ENGINE_GESTURES, ZX_GESTURES, ChipSpec, DeviceConfig
 from engine.hardware.managed_buses import ManagedI2C
 from engine.hardware.readings import PollParts, PollSetup, Staged
-from engine.values.params import Choice, did_you_mean
+from engine.values.param_problems import did_you_mean
+from engine.values.params import Choice
 
 
 def _gesture_names_check(fields: ChipFields) -> dict[str, str] | None:
