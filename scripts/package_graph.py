@@ -31,7 +31,7 @@ def modules() -> dict[str, Path]:
 
 
 def package_of(module: str) -> str:
-    """engine.drivers.sim.i2c_bus -> engine.drivers; engine.clock -> engine.clock."""
+    """engine.drivers.bus_manager -> engine.drivers; engine.clock -> engine.clock."""
     return ".".join(module.split(".")[:2])
 
 

@@ -14,11 +14,11 @@ from dataclasses import dataclass
 from engine.blackboard.board import Blackboard
 from engine.clock import Clock
 from engine.drivers.camera import Camera, OpenCvCamera
-from engine.drivers.sim.camera import SimulatedCamera
 from engine.errors import ConfigError
 from engine.hardware.config import CAMERA_NAME, CameraConfig
 from engine.hardware.device_health import DeviceHealth
 from engine.scenario.world import World
+from engine.sim.camera import SimulatedCamera
 from engine.vision.classifier import DEFAULT_MODEL, HandModel
 from engine.vision.hand_watcher import HandWatcher
 

@@ -18,7 +18,6 @@ from engine.blackboard.board import Blackboard
 from engine.blackboard.catalogue import default_catalogue
 from engine.clock import RealClock, VirtualClock
 from engine.drivers import mcp9808_registers, vl53l0x
-from engine.drivers.sim.i2c_bus import SimI2CBus
 from engine.errors import DeviceError
 from engine.hardware.assembly import build_hardware
 from engine.hardware.config import SIDES, BusConfig, RobotConfig
@@ -26,6 +25,7 @@ from engine.hardware.config_file import load_robot_config
 from engine.hardware.robot_hardware import Hardware
 from engine.hardware.sim_vest import SimVest, build_sim_vest
 from engine.scenario.world import World
+from engine.sim.i2c_bus import SimI2CBus
 
 from .conftest import MUXED, ROOT, SimRobot
 

@@ -7,10 +7,10 @@ from typing import Any
 
 from engine.blackboard.catalogue import TEMPERATURE_C, TEMPERATURE_F
 from engine.drivers import mcp9808_registers as registers
-from engine.drivers.sim.mcp9808 import SimMCP9808
 from engine.hardware.chips.kind import ChipKind, SimPlacement, expect_identity
 from engine.hardware.config import ChipSpec, DeviceConfig
 from engine.hardware.sensor_services import TemperatureSensor
+from engine.sim.mcp9808 import SimMCP9808
 from engine.values.params import Choice, Param
 
 

@@ -6,11 +6,11 @@ from collections.abc import Callable
 from typing import Any
 
 from engine.drivers import pca9685_registers as registers
-from engine.drivers.sim.pca9685 import SimPCA9685
 from engine.hardware.actuator_services import HardwareLeds
 from engine.hardware.chips.fields import ChipFields
 from engine.hardware.chips.kind import ChipKind, DevicesTogether, SimPlacement
 from engine.hardware.config import PCA9685_ALL_CALL, ChipSpec, DeviceConfig
+from engine.sim.pca9685 import SimPCA9685
 from engine.values.params import REQUIRED, Boolean, Integer, Number, Param
 
 LED_FIELDS = ("red", "green", "blue")

@@ -7,10 +7,10 @@ from typing import Any
 
 from engine.blackboard.catalogue import ULTRASOUND_CM
 from engine.drivers import srf02_registers as registers
-from engine.drivers.sim.srf02 import SimSRF02
 from engine.hardware.chips.kind import ChipKind, SimPlacement, expect_identity
 from engine.hardware.config import ChipSpec, DeviceConfig
 from engine.hardware.sensor_services import UltrasoundSensor
+from engine.sim.srf02 import SimSRF02
 
 
 def _simulate(vest: SimPlacement, device: DeviceConfig) -> None:

@@ -7,13 +7,13 @@ from typing import Any
 
 from engine.blackboard.catalogue import GESTURE_LAST
 from engine.drivers import zx_gesture_registers as registers
-from engine.drivers.sim.zx_gesture import SimZXGesture
 from engine.drivers.zx_gesture import ZXGesture
 from engine.hardware.chips.fields import ChipFields
 from engine.hardware.chips.kind import ChipKind, SimPlacement, expect_identity
 from engine.hardware.config import ENGINE_GESTURES, ZX_GESTURES, ChipSpec, DeviceConfig
 from engine.hardware.managed_buses import ManagedI2C
 from engine.hardware.readings import PollParts, PollSetup, Staged
+from engine.sim.zx_gesture import SimZXGesture
 from engine.values.param_problems import did_you_mean
 from engine.values.params import Choice
 

@@ -24,8 +24,8 @@ import errno
 from collections.abc import Sequence
 from typing import Protocol
 
-from engine.drivers.sim.i2c_bus import SimI2CBus, SimI2CDevice, bus_error
 from engine.drivers.tca9548a_registers import ADDRESSES, CHANNELS, CONTROL_NONE
+from engine.sim.i2c_bus import SimI2CBus, SimI2CDevice, bus_error
 
 
 class DownstreamBus(Protocol):

@@ -52,7 +52,7 @@ from engine.drivers.pca9685_registers import (
     PRESCALE_MIN,
     SUBADR1,
 )
-from engine.drivers.sim.i2c_bus import SimI2CDevice, bus_error
+from engine.sim.i2c_bus import SimI2CDevice, bus_error
 
 _TIME_TOLERANCE_S = 1e-9  # sums of float seconds: 0.1 + 0.0005 - 0.1 < 0.0005
 

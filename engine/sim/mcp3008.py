@@ -34,7 +34,7 @@ from engine.drivers.mcp3008_registers import (
     VDD_MIN_V,
     VREF_MIN_V,
 )
-from engine.drivers.sim.spi_bus import Bit, SimSpiDevice
+from engine.sim.spi_bus import Bit, SimSpiDevice
 
 
 def max_clock_hz(vdd_v: float) -> float:

@@ -26,7 +26,6 @@ command (0x5C) only makes the chip busy, and the address-change sequence (0xA0, 
 from __future__ import annotations
 
 from engine.clock import Clock
-from engine.drivers.sim.i2c_bus import SimI2CDevice
 from engine.drivers.srf02_registers import (
     AUTOTUNE_MIN_HIGH,
     AUTOTUNE_MIN_LOW,
@@ -48,6 +47,7 @@ from engine.drivers.srf02_registers import (
     UNUSED,
     UNUSED_VALUE,
 )
+from engine.sim.i2c_bus import SimI2CDevice
 
 TUNING_STEP_CM = 2.0  # per ranging: 28 cm to 16 cm in six rangings
 MICROSECONDS_PER_CM = 58.3  # out and back at 343 m/s

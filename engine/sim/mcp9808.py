@@ -61,7 +61,7 @@ from engine.drivers.mcp9808_registers import (
     T_UPPER,
     TEMPERATURE_SIGNED_MASK,
 )
-from engine.drivers.sim.i2c_bus import SimI2CDevice
+from engine.sim.i2c_bus import SimI2CDevice
 
 # Resolution code -> (step in 1/16 degC, conversion time in seconds).
 _STEPS = {code: (round(step_c * 16), time_s) for code, (step_c, time_s) in RESOLUTIONS.items()}

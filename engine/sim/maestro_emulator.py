@@ -58,7 +58,7 @@ from engine.drivers.maestro_protocol import (
     POLOLU_PROTOCOL_START,
     QUARTER_US_PER_US,
 )
-from engine.drivers.sim.servo_channel import ServoChannel
+from engine.sim.servo_channel import ServoChannel
 
 TICK_S = 0.010
 """The Maestro updates servo positions every 10 ms (at the default 20 ms period)."""

@@ -53,7 +53,7 @@ from engine.drivers.mpr121_registers import (
     TOUCH_STATUS_L,
     TOUCH_THRESHOLD_0,
 )
-from engine.drivers.sim.i2c_bus import SimI2CDevice
+from engine.sim.i2c_bus import SimI2CDevice
 
 
 class SimMPR121(SimI2CDevice):

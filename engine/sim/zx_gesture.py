@@ -18,7 +18,6 @@ gestures are performed on request rather than recognised from hand motion.
 from __future__ import annotations
 
 from engine.clock import Clock
-from engine.drivers.sim.i2c_bus import SimI2CDevice
 from engine.drivers.zx_gesture_registers import (
     ADDRESSES,
     DRCFG,
@@ -41,6 +40,7 @@ from engine.drivers.zx_gesture_registers import (
     XPOS,
     ZPOS,
 )
+from engine.sim.i2c_bus import SimI2CDevice
 
 
 class SimZXGesture(SimI2CDevice):

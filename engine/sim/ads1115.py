@@ -49,7 +49,7 @@ from engine.drivers.ads1115_registers import (
     PGA_SHIFT,
     POINTER_MASK,
 )
-from engine.drivers.sim.i2c_bus import SimI2CDevice
+from engine.sim.i2c_bus import SimI2CDevice
 
 
 def volts_to_code(volts: float, full_scale_v: float) -> int:

@@ -46,7 +46,6 @@ from __future__ import annotations
 import errno
 
 from engine.clock import Clock
-from engine.drivers.sim.i2c_bus import SimI2CBus, SimI2CDevice, bus_error
 from engine.drivers.vl53l0x_registers import (
     DEVICE_RANGE_STATUS_MSRC_NO_TARGET,
     DEVICE_RANGE_STATUS_SHIFT,
@@ -85,6 +84,7 @@ from engine.drivers.vl53l0x_registers import (
     SYSTEM_SEQUENCE_CONFIG,
     TBOOT_MAX_S,
 )
+from engine.sim.i2c_bus import SimI2CBus, SimI2CDevice, bus_error
 
 # A plausible factory calibration: 5 aperture SPADs; reference SPAD 13 is bad.
 DEFAULT_SPAD_COUNT = 5
