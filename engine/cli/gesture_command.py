@@ -208,8 +208,9 @@ def main(args: argparse.Namespace) -> int:
 
 def _classify(args: argparse.Namespace) -> int:
     from engine.cli.output import shown, tell
+    from engine.media.images import read_image
     from engine.vision.classifier import DEFAULT_MODEL, HandModel
-    from engine.vision.preprocess import fills_window, read_image, scaled_window
+    from engine.vision.preprocess import fills_window, scaled_window
 
     model = HandModel.load(args.model or DEFAULT_MODEL)
     side = model.settings.side_px

@@ -16,16 +16,10 @@ import cv2
 import numpy as np
 
 from engine.clock import Clock
-from engine.drivers.camera import CameraError
+from engine.media.camera import CameraError
+from engine.media.images import Frame, read_image
 from engine.scenario.world import ShownHand, World
-from engine.vision.preprocess import (
-    SIDE_PX,
-    Frame,
-    Preprocessing,
-    filling,
-    fills_window,
-    read_image,
-)
+from engine.vision.preprocess import SIDE_PX, Preprocessing, filling, fills_window
 from engine.vision.shown_hand import render_shown_hand
 from engine.vision.synthetic_hands import render_frame
 

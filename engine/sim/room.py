@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from engine.clock import Clock
-from engine.speech.audio import SPEECH_RATE_HZ, Audio
+from engine.media.audio import SPEECH_RATE_HZ, Audio
 
 HUM_DBFS = -60.0
 """The room's background, RMS below full scale (a quiet therapy room)."""

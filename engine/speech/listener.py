@@ -21,7 +21,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 from engine.clock import Clock
-from engine.speech.audio import Audio
+from engine.media.audio import Audio
 from engine.speech.recognizer import Recognizer
 from engine.speech.settling import Settling
 from engine.speech.speaker import SelfHearing

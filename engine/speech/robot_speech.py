@@ -19,13 +19,13 @@ from typing import Any
 from engine.blackboard.board import Blackboard
 from engine.blackboard.catalogue import SPEECH_HEARD, SPEECH_NOT_LISTENED
 from engine.clock import Clock
-from engine.drivers.audio_devices import AlsaMicrophone, AlsaSpeaker, AudioDeviceError
 from engine.errors import ConfigError
 from engine.files.yaml_values import plain
 from engine.hardware.config import AudioConfig
 from engine.loader.substitution import Profile
+from engine.media.audio import Audio, read_wav, with_noise, write_wav
+from engine.media.audio_devices import AlsaMicrophone, AlsaSpeaker, AudioDeviceError
 from engine.sim.room import RoomSpeaker, SimulatedRoom
-from engine.speech.audio import Audio, read_wav, with_noise, write_wav
 from engine.speech.listener import Heard, Listener, NotListenedListener
 from engine.speech.recognizer import RecognizerError, WhisperRecognizer
 from engine.speech.settings import SPEECH_PROFILE_PARAMS

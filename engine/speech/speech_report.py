@@ -5,9 +5,9 @@ from __future__ import annotations
 
 import shutil
 
-from engine.drivers.audio_devices import probe
 from engine.hardware.config import AudioConfig
 from engine.hardware.device_report import DeviceRow
+from engine.media.audio_devices import probe
 from engine.speech.recognizer import RecognizerError, WhisperRecognizer, whisper_model_dir
 from engine.speech.voice_models import joe_voice_model, load_voice
 from engine.speech.voices import VoiceError

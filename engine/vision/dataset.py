@@ -23,14 +23,13 @@ import numpy as np
 import numpy.typing as npt
 
 from engine.errors import ConfigError
+from engine.media.images import Frame, read_image
 from engine.vision.preprocess import (
     LABELS,
-    Frame,
     Preprocessing,
     crop,
     filling,
     fills_window,
-    read_image,
     window_input,
 )
 from engine.vision.synthetic_hands import NO_HAND

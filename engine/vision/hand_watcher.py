@@ -24,10 +24,10 @@ import threading
 from engine.blackboard.board import Blackboard
 from engine.blackboard.catalogue import HAND_CONFIDENCE, HAND_FINGERS, HAND_HELD, HAND_SHOWN
 from engine.clock import Clock, ClockEvent
-from engine.drivers.camera import Camera, CameraError
 from engine.hardware.device_health import DeviceHealth
+from engine.media.camera import Camera, CameraError
+from engine.media.images import Frame
 from engine.vision.classifier import FingerCounter, HandReading
-from engine.vision.preprocess import Frame
 
 log = logging.getLogger(__name__)
 REOPEN_S = 2.0

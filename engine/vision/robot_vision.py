@@ -13,10 +13,10 @@ from dataclasses import dataclass
 
 from engine.blackboard.board import Blackboard
 from engine.clock import Clock
-from engine.drivers.camera import Camera, OpenCvCamera
 from engine.errors import ConfigError
 from engine.hardware.config import CAMERA_NAME, CameraConfig
 from engine.hardware.device_health import DeviceHealth
+from engine.media.camera import Camera, OpenCvCamera
 from engine.scenario.world import World
 from engine.sim.camera import SimulatedCamera
 from engine.vision.classifier import DEFAULT_MODEL, HandModel

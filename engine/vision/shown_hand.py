@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from engine.vision.preprocess import SIDE_PX, Frame
+from engine.media.images import Frame
+from engine.vision.preprocess import SIDE_PX
 from engine.vision.synthetic_hands import HandPose, Random, draw_hand
 
 

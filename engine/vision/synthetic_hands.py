@@ -29,7 +29,8 @@ import numpy as np
 import numpy.typing as npt
 
 from engine.errors import ConfigError
-from engine.vision.preprocess import SIDE_PX, Frame
+from engine.media.images import Frame
+from engine.vision.preprocess import SIDE_PX
 from engine.vision.synthetic_rooms import background, camera_effects
 
 STYLES = ("studio", "wallpaper", "varied", "variant")

@@ -11,7 +11,7 @@ import cv2
 import numpy as np
 import numpy.typing as npt
 
-from engine.vision.preprocess import Frame
+from engine.media.images import Frame
 
 Random = np.random.Generator
 

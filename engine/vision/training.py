@@ -25,6 +25,7 @@ import numpy as np
 import numpy.typing as npt
 
 from engine.errors import ConfigError
+from engine.media.images import Frame
 from engine.vision.classifier import MODEL_FORMAT, HandModel
 from engine.vision.dataset import (
     NONE_INDEX,
@@ -38,7 +39,7 @@ from engine.vision.dataset import (
     split,
 )
 from engine.vision.evaluation import Evaluation
-from engine.vision.preprocess import LABELS, Frame, Preprocessing
+from engine.vision.preprocess import LABELS, Preprocessing
 
 log = logging.getLogger(__name__)
 

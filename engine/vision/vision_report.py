@@ -4,12 +4,12 @@ read; the model loaded, its input shape, the providers it runs on, and one infer
 from __future__ import annotations
 
 from engine.clock import Clock, RealClock
-from engine.drivers.camera import CameraError
 from engine.errors import ConfigError
 from engine.hardware.config import CAMERA_NAME, CameraConfig
 from engine.hardware.device_report import DeviceRow
+from engine.media.camera import CameraError
+from engine.media.images import Frame
 from engine.scenario.world import World
-from engine.vision.preprocess import Frame
 from engine.vision.robot_vision import load_hand_model, open_camera
 
 

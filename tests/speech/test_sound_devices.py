@@ -8,8 +8,8 @@ import pytest
 
 from engine.cli import main
 from engine.clock import RealClock
-from engine.drivers.audio_devices import probe
 from engine.hardware.config import AudioConfig
+from engine.media.audio_devices import probe
 from engine.speech.robot_speech import build_speech
 
 

@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 
 from engine.clock import VirtualClock
-from engine.drivers.camera import CameraError
 from engine.files.problems import LoadError
+from engine.media.camera import CameraError
 from engine.scenario.player import ScenarioPlayer
 from engine.scenario.scenario_file import load_scenario
 from engine.scenario.world import World

@@ -17,7 +17,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 from engine.errors import DeviceError
-from engine.speech.audio import SPEECH_RATE_HZ, Audio
+from engine.media.audio import SPEECH_RATE_HZ, Audio
 
 log = logging.getLogger(__name__)
 CAPTURE_CHUNK_S = 0.064

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import cv2
 
-from engine.vision.preprocess import MAX_FRAME_PX, read_image
+from engine.media.images import MAX_FRAME_PX, read_image
 
 
 def check_media(path: Path, *, video: bool) -> str | None:

@@ -14,7 +14,7 @@ import cv2
 import numpy as np
 
 from engine.errors import DeviceError
-from engine.vision.preprocess import Frame
+from engine.media.images import Frame
 
 log = logging.getLogger(__name__)
 
