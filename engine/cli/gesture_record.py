@@ -25,8 +25,8 @@ from engine.clock import EpochClock
 from engine.errors import ConfigError
 from engine.media.camera import CameraError, OpenCvCamera
 from engine.media.images import Frame, read_image
-from engine.vision.dataset import FOLDERS, IMAGE_SUFFIXES
-from engine.vision.synthetic_hands import NO_HAND
+from engine.vision_training.dataset import FOLDERS, IMAGE_SUFFIXES
+from engine.vision_training.synthetic_hands import NO_HAND
 
 SESSION = re.compile(r"[A-Za-z0-9_.]+")
 FRAMES_APART = 3

@@ -46,6 +46,7 @@ from engine.files.yaml_source import read_text
 from engine.loader.tree_checks import spoken_quote_warnings
 from engine.recording.recorder import SessionRecorder
 from engine.recording.session_file import check_new
+from engine.robot_io.robot_speech import RobotSpeech, audio_folder, build_speech, speech_settings
 from engine.runtime.reload import TreeReloader
 from engine.runtime.robot import Behaviors
 from engine.runtime.robot_factory import build_robot
@@ -57,7 +58,6 @@ from engine.services.simulated import simulated_services
 from engine.session.events import WorldEvent
 from engine.session.sentences import TOLD_KINDS
 from engine.session.stream import SessionStream
-from engine.speech.robot_speech import RobotSpeech, audio_folder, build_speech, speech_settings
 from engine.view.hub import ViewHub
 from engine.view.server import LiveSource, ViewServer
 

@@ -29,12 +29,12 @@ from engine.hardware.safety_envelope import (
     with_envelope,
 )
 from engine.hardware.sim_vest import SimVest, UnwiredSenses, build_sim_vest
+from engine.robot_io.robot_speech import RobotSpeech
+from engine.robot_io.robot_vision import RobotVision, build_vision
 from engine.runtime.robot import Behaviors, Robot
 from engine.scenario.world import World
 from engine.services.interfaces import IotResults, Services, Speech
 from engine.session.stream import SessionStream
-from engine.speech.robot_speech import RobotSpeech
-from engine.vision.robot_vision import RobotVision, build_vision
 
 
 @dataclass

@@ -20,8 +20,8 @@ from engine.media.camera import CameraError
 from engine.media.images import Frame, read_image
 from engine.scenario.world import ShownHand, World
 from engine.vision.preprocess import SIDE_PX, Preprocessing, filling, fills_window
-from engine.vision.shown_hand import render_shown_hand
-from engine.vision.synthetic_hands import render_frame
+from engine.vision_training.shown_hand import render_shown_hand
+from engine.vision_training.synthetic_hands import render_frame
 
 
 class SimulatedCamera:

@@ -9,7 +9,7 @@ who speaks over the robot is therefore not heard; what can be known of it is tol
 ``on_not_listened(from_s, until_s, why)``: here, speech already under way when the robot
 stops (its start was lost). Telling speech *within* the robot's voice apart from its echo
 needs echo cancellation, which a microphone here does not have; the simulated room knows
-who spoke when, and tells it itself (:mod:`engine.speech.robot_speech`).
+who spoke when, and tells it itself (:mod:`engine.robot_io.robot_speech`).
 """
 
 from __future__ import annotations

@@ -10,7 +10,7 @@ from engine.cli import main
 from engine.clock import RealClock
 from engine.hardware.config import AudioConfig
 from engine.media.audio_devices import probe
-from engine.speech.robot_speech import build_speech
+from engine.robot_io.robot_speech import build_speech
 
 
 def test_a_missing_card_is_named_by_the_probe() -> None:

@@ -11,8 +11,8 @@ from engine.clock import VirtualClock
 from engine.hardware.device_health import DeviceHealth
 from engine.media.camera import CameraError
 from engine.media.images import Frame
+from engine.robot_io.hand_watcher import HandWatcher, SteadyCount
 from engine.vision.classifier import HandReading
-from engine.vision.hand_watcher import HandWatcher, SteadyCount
 
 FINGERS, CONFIDENCE, SHOWN = "/vision/hand/fingers", "/vision/hand/confidence", "/vision/hand/shown"
 CAMERA_OK = "/devices/camera/ok"

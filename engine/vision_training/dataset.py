@@ -32,7 +32,7 @@ from engine.vision.preprocess import (
     fills_window,
     window_input,
 )
-from engine.vision.synthetic_hands import NO_HAND
+from engine.vision_training.synthetic_hands import NO_HAND
 
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp")
 FOLDERS = (*(str(label) for label in LABELS), NO_HAND)

@@ -17,10 +17,10 @@ from engine.errors import ConfigError
 from engine.hardware.config import CAMERA_NAME, CameraConfig
 from engine.hardware.device_health import DeviceHealth
 from engine.media.camera import Camera, OpenCvCamera
+from engine.robot_io.hand_watcher import HandWatcher
 from engine.scenario.world import World
 from engine.sim.camera import SimulatedCamera
 from engine.vision.classifier import DEFAULT_MODEL, HandModel
-from engine.vision.hand_watcher import HandWatcher
 
 
 @dataclass

@@ -31,7 +31,7 @@ import numpy.typing as npt
 from engine.errors import ConfigError
 from engine.media.images import Frame
 from engine.vision.preprocess import SIDE_PX
-from engine.vision.synthetic_rooms import background, camera_effects
+from engine.vision_training.synthetic_rooms import background, camera_effects
 
 STYLES = ("studio", "wallpaper", "varied", "variant")
 TRAINING_STYLES = ("studio", "wallpaper")

@@ -1,6 +1,6 @@
 """The rooms the drawn hands are held up in: backgrounds and what a webcam adds.
 
-Part of the hand generator (:mod:`engine.vision.synthetic_hands`): ``studio`` rooms are
+Part of the hand generator (:mod:`engine.vision_training.synthetic_hands`): ``studio`` rooms are
 plain, graded or cluttered; ``wallpaper`` walls are busy patterns (plaids, dots, bricks,
 grain); ``variant`` walls, never trained on, are striped, checked or smoothly textured.
 """

@@ -9,8 +9,8 @@ from engine.hardware.config import CAMERA_NAME, CameraConfig
 from engine.hardware.device_report import DeviceRow
 from engine.media.camera import CameraError
 from engine.media.images import Frame
+from engine.robot_io.robot_vision import load_hand_model, open_camera
 from engine.scenario.world import World
-from engine.vision.robot_vision import load_hand_model, open_camera
 
 
 def describe_vision(config: CameraConfig, clock: Clock) -> list[DeviceRow]:

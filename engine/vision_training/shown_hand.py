@@ -6,7 +6,7 @@ import numpy as np
 
 from engine.media.images import Frame
 from engine.vision.preprocess import SIDE_PX
-from engine.vision.synthetic_hands import HandPose, Random, draw_hand
+from engine.vision_training.synthetic_hands import HandPose, Random, draw_hand
 
 
 def render_shown_hand(

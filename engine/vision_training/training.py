@@ -3,7 +3,7 @@
 Adam (learning rate 5e-4, warmed up over the first 300 steps, halved at 60 % and 85 % of
 the epochs: at 1e-3 from the first step this deep network without normalisation often
 dies into always answering "every count alike"), batches of 64, the
-pictures augmented afresh every epoch (:func:`~engine.vision.dataset.augment`), then the
+pictures augmented afresh every epoch (:func:`~engine.vision_training.dataset.augment`), then the
 shared preprocessing. Pictures with no hand are trained towards the same probability for
 every count, so the shipped model is "not sure" of an empty frame. The held-out pictures
 are never trained on; after the last epoch the model is exported (ONNX, one file) with
@@ -27,7 +27,8 @@ import numpy.typing as npt
 from engine.errors import ConfigError
 from engine.media.images import Frame
 from engine.vision.classifier import MODEL_FORMAT, HandModel
-from engine.vision.dataset import (
+from engine.vision.preprocess import LABELS, Preprocessing
+from engine.vision_training.dataset import (
     NONE_INDEX,
     Picture,
     augment,
@@ -38,8 +39,7 @@ from engine.vision.dataset import (
     network_inputs,
     split,
 )
-from engine.vision.evaluation import Evaluation
-from engine.vision.preprocess import LABELS, Preprocessing
+from engine.vision_training.evaluation import Evaluation
 
 log = logging.getLogger(__name__)
 
@@ -111,7 +111,7 @@ def train(
     (the model is measured elsewhere: ``vest gesture eval``) and the evaluation is empty."""
     import torch
 
-    from engine.vision.hand_network import HandNetwork, export_onnx, load_onnx_weights
+    from engine.vision_training.hand_network import HandNetwork, export_onnx, load_onnx_weights
 
     folders = [data] if isinstance(data, Path) else list(data)
     own = find_pictures(folders[0])
