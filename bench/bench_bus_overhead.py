@@ -45,7 +45,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # run from a check
 from engine.clock import RealClock, stopwatch
 from engine.drivers.bus_manager import BusManager
 from engine.drivers.device_stats import percentile
-from engine.drivers.sim.i2c_bus import RegisterFile, SimI2CBus, SimI2CDevice
+from engine.sim.i2c_bus import RegisterFile, SimI2CBus, SimI2CDevice
 
 TARGET_MEDIAN_ADDED_US = 50.0
 GAP_S = 0.0005  # pause before each isolated transaction, real seconds

@@ -89,7 +89,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # run from a check
 from py_trees.common import Status
 
 from engine.clock import RealClock, stopwatch
-from engine.drivers.srf02 import RANGING_TIME_S
+from engine.drivers.srf02_registers import RANGING_TIME_S
 from engine.hardware.config import RobotConfig
 from engine.hardware.config_file import load_robot_config
 from engine.hardware.robot_hardware import Hardware

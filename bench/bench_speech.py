@@ -42,7 +42,7 @@ from engine.blackboard.catalogue import default_catalogue  # noqa: E402
 from engine.dialogs.library import load_dialog  # noqa: E402
 from engine.dialogs.model import Dialog, DialogRule, FollowUp  # noqa: E402
 from engine.dialogs.words import normalize  # noqa: E402
-from engine.speech.audio import SPEECH_RATE_HZ, Audio, noise, with_noise  # noqa: E402
+from engine.media.audio import SPEECH_RATE_HZ, Audio, noise, with_noise  # noqa: E402
 from engine.speech.recognizer import WhisperRecognizer  # noqa: E402
 from engine.speech.vad import SileroVad, SpeechDetector  # noqa: E402
 from engine.speech.voice_models import load_voice  # noqa: E402

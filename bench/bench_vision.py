@@ -36,11 +36,11 @@ import numpy as np  # noqa: E402
 import onnxruntime as ort  # noqa: E402
 
 from engine.vision.classifier import DEFAULT_MODEL, HandModel  # noqa: E402
-from engine.vision.dataset import centred_inputs, find_pictures  # noqa: E402
-from engine.vision.evaluation import Evaluation  # noqa: E402
 from engine.vision.preprocess import network_input  # noqa: E402
-from engine.vision.synthetic_hands import render_frame  # noqa: E402
-from engine.vision.training import evaluate_pictures  # noqa: E402
+from engine.vision_training.dataset import centred_inputs, find_pictures  # noqa: E402
+from engine.vision_training.evaluation import Evaluation  # noqa: E402
+from engine.vision_training.synthetic_hands import render_frame  # noqa: E402
+from engine.vision_training.training import evaluate_pictures  # noqa: E402
 
 PAPER_FPS = 7.0
 TARGET_FPS = 500.0

@@ -31,17 +31,8 @@ from engine.blackboard.catalogue import (
 )
 from engine.colors import NAMED_COLORS, parse_color
 from engine.errors import ServiceError
-from engine.values.params import (
-    SECONDS,
-    SPEED_DPS,
-    CheckContext,
-    Number,
-    Param,
-    ParamProblem,
-    ParamType,
-    Text,
-    did_you_mean,
-)
+from engine.values.param_problems import CheckContext, ParamProblem, did_you_mean
+from engine.values.params import SECONDS, SPEED_DPS, Number, Param, ParamType, Text
 from engine.values.templates import Template
 
 MAX_SAID_CHARS = 1000

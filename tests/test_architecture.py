@@ -80,6 +80,35 @@ def test_no_import_circle_between_engine_modules() -> None:
     assert _cycles(graph) == []
 
 
+def _package(module: str) -> str:
+    """engine.drivers.bus_manager -> engine.drivers; engine.clock -> engine.clock."""
+    return ".".join(module.split(".")[:2])
+
+
+def test_no_import_circle_between_engine_packages() -> None:
+    """Packages form layers too (scripts/package_graph.py prints them): drivers below the
+    simulated vest, speech and vision below the robot's assembly of them, even where no
+    two modules import each other. An import inside a function counts."""
+    modules = _modules()
+    graph: dict[str, set[str]] = defaultdict(set)
+    why: dict[tuple[str, str], str] = {}
+    for name, path in modules.items():
+        source = _package(name)
+        graph[source]
+        for target in _imports(path, modules):
+            edge = (source, _package(target))
+            if edge[1] not in (source, "engine"):
+                graph[source].add(edge[1])
+                why.setdefault(edge, f"{path.relative_to(ROOT)} imports {target}")
+    circles = [
+        " <-> ".join(cycle)
+        + "; "
+        + "; ".join(why[a, b] for a in cycle for b in cycle if (a, b) in why)
+        for cycle in _cycles(graph)
+    ]
+    assert circles == []
+
+
 def test_no_engine_module_is_too_long_to_read_in_one_sitting() -> None:
     long = {
         str(path.relative_to(ENGINE.parent)): lines
@@ -151,7 +180,8 @@ def test_the_cloud_service_loads_no_robot_code() -> None:
         "import sys, cloud.app, cloud.server; from engine.cli import build_parser;"
         "build_parser('cloud').parse_args(['cloud', 'add-operator', 'ana']);"
         "robot = ('py_trees', 'engine.nodes', 'engine.speech', 'engine.vision', 'cv2',"
-        " 'onnxruntime', 'faster_whisper', 'engine.drivers', 'engine.hardware');"
+        " 'onnxruntime', 'faster_whisper', 'engine.drivers', 'engine.hardware', 'engine.sim',"
+        " 'engine.media', 'engine.robot_io', 'engine.vision_training');"
         "print(sorted(m for m in sys.modules if m.startswith(robot)))"
     )
     loaded = subprocess.run(

@@ -33,7 +33,7 @@ from engine.nodes import (
 from engine.nodes.context import TreeContext
 from engine.services import Job
 from engine.testing import TreeHarness
-from engine.values.params import CheckContext, ParamIssue
+from engine.values.param_problems import CheckContext, ParamIssue
 
 REPO = Path(__file__).resolve().parents[1]
 GUIDE = REPO / "docs" / "developer-guide.md"

@@ -21,10 +21,11 @@ import pytest
 
 from engine.cli import main
 from engine.errors import ConfigError
+from engine.media.audio import AudioFileError, read_wav
+from engine.media.image_size import image_size
+from engine.media.images import read_image
 from engine.services.done_commands import DoneCommands
-from engine.speech.audio import AudioFileError, read_wav
-from engine.vision.image_size import image_size
-from engine.vision.preprocess import Preprocessing, load_settings, read_image
+from engine.vision.preprocess import Preprocessing, load_settings
 
 ROOT = Path(__file__).resolve().parents[1]
 

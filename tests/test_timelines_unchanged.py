@@ -9,7 +9,7 @@ and by a hair its length), and the frame where the VAD finds the end of speech (
 lines are recordings checked in beside it (examples/scenarios/voices/: the same sound
 everywhere), and on a virtual clock a scripted line is heard at its recording's end plus
 0.4 s (the VAD's 0.3 s of silence and 0.1 s to spare), whatever frame the VAD ended it
-on: the tolerance is 0.1 s of VAD disagreement (engine/speech/robot_speech.py,
+on: the tolerance is 0.1 s of VAD disagreement (engine/robot_io/robot_speech.py,
 `heard_when`). What the recognizer writes is the model's, prompted with the dialogs'
 phrases: it can change when dialogs/default.yaml does; re-record the files then, and read
 the diff."""

@@ -36,7 +36,7 @@ from engine.files.problems import LoadError, Mark, Problems
 from engine.files.yaml_source import YList, YMap, YScalar, YValue, describe, load_yaml, plain
 from engine.loader.tree_definition import TreeDefinition
 from engine.loader.tree_file import TreeLoader
-from engine.values.params import did_you_mean
+from engine.values.param_problems import did_you_mean
 
 ACTIONS = ("say", "led", "move", "play", "do")
 CONTROLS = ("pause", "resume", "stop")

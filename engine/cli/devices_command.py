@@ -49,11 +49,11 @@ def main(args: argparse.Namespace) -> int:
             vest.clock.sleep(SIMULATED_WARM_UP_S)
         rows = describe_devices(hardware)
         if config.camera is not None and not args.no_camera:
-            from engine.vision.vision_report import describe_vision
+            from engine.robot_io.vision_report import describe_vision
 
             rows += describe_vision(config.camera, clock)
         if not args.no_speech:
-            from engine.speech.speech_report import describe_speech
+            from engine.robot_io.speech_report import describe_speech
 
             rows += describe_speech(config.audio, config.simulated)
     finally:

@@ -21,7 +21,7 @@ from engine.cli.run_inputs import dialogs_folder
 from engine.dialogs.library import DialogLibrary, load_dialog
 from engine.dialogs.model import Dialog, DialogRule, FollowUp
 from engine.errors import ConfigError
-from engine.speech.audio import Audio, with_noise
+from engine.media.audio import Audio, with_noise
 from engine.speech.hearing import hear
 from engine.speech.recognizer import WhisperRecognizer
 from engine.speech.vad import SileroVad

@@ -29,7 +29,7 @@ from engine.cli.output import writable_folder
 
 ACTIONS = ("classify", "record", "generate", "train", "eval")
 STYLE_NAMES = ("studio", "wallpaper", "varied", "variant")
-"""The hand generator's styles (engine/vision/synthetic_hands.py; not imported here)."""
+"""The hand generator's styles (engine/vision_training/synthetic_hands.py; not imported here)."""
 PREPROCESS_MODES = ("gray", "edges")
 """How a picture becomes the network's input (engine/vision/preprocess.py's MODES)."""
 
@@ -97,7 +97,7 @@ def _held_out(text: str) -> float:
 
 
 def _label(text: str) -> str:
-    from engine.vision.dataset import FOLDERS
+    from engine.vision_training.dataset import FOLDERS
 
     if text not in FOLDERS:
         raise argparse.ArgumentTypeError(f"must be one of {', '.join(FOLDERS)}, got {text!r}")
@@ -208,8 +208,9 @@ def main(args: argparse.Namespace) -> int:
 
 def _classify(args: argparse.Namespace) -> int:
     from engine.cli.output import shown, tell
+    from engine.media.images import read_image
     from engine.vision.classifier import DEFAULT_MODEL, HandModel
-    from engine.vision.preprocess import fills_window, read_image, scaled_window
+    from engine.vision.preprocess import fills_window, scaled_window
 
     model = HandModel.load(args.model or DEFAULT_MODEL)
     side = model.settings.side_px
@@ -246,7 +247,7 @@ def _classify(args: argparse.Namespace) -> int:
 
 
 def _generate(args: argparse.Namespace) -> int:
-    from engine.vision.synthetic_hands import write_dataset
+    from engine.vision_training.synthetic_hands import write_dataset
 
     writable_folder(args.data)
     written = write_dataset(args.data, args.count, args.seed, style=args.style)
@@ -266,7 +267,7 @@ def _train(args: argparse.Namespace) -> int:
     from engine.files.yaml_source import resolved
     from engine.vision.classifier import HandModel
     from engine.vision.preprocess import Preprocessing
-    from engine.vision.training import TrainingSettings, train
+    from engine.vision_training.training import TrainingSettings, train
 
     if args.output.suffix != ".onnx":
         raise ConfigError(f"{args.output}: the model's file name must end in .onnx")
@@ -325,8 +326,8 @@ def _train(args: argparse.Namespace) -> int:
 
 def _evaluate(args: argparse.Namespace) -> int:
     from engine.vision.classifier import HandModel
-    from engine.vision.dataset import find_pictures
-    from engine.vision.training import evaluate_pictures
+    from engine.vision_training.dataset import find_pictures
+    from engine.vision_training.training import evaluate_pictures
 
     model = HandModel.load(args.model)
     evaluation = evaluate_pictures(model, find_pictures(args.data))

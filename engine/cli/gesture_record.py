@@ -22,11 +22,11 @@ import cv2
 
 from engine.cli.output import writable_folder
 from engine.clock import EpochClock
-from engine.drivers.camera import CameraError, OpenCvCamera
 from engine.errors import ConfigError
-from engine.vision.dataset import FOLDERS, IMAGE_SUFFIXES
-from engine.vision.preprocess import Frame, read_image
-from engine.vision.synthetic_hands import NO_HAND
+from engine.media.camera import CameraError, OpenCvCamera
+from engine.media.images import Frame, read_image
+from engine.vision_training.dataset import FOLDERS, IMAGE_SUFFIXES
+from engine.vision_training.synthetic_hands import NO_HAND
 
 SESSION = re.compile(r"[A-Za-z0-9_.]+")
 FRAMES_APART = 3

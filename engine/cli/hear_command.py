@@ -22,7 +22,7 @@ from engine.clock import RealClock
 from engine.dialogs.library import DialogLibrary
 from engine.dialogs.model import Dialog
 from engine.errors import ConfigError, UsageError
-from engine.speech.audio import read_wav
+from engine.media.audio import read_wav
 from engine.speech.hearing import Hearing, conversation
 from engine.speech.recognizer import WhisperRecognizer
 

@@ -7,8 +7,8 @@ import json
 
 from engine.clock import Clock
 from engine.dialogs.model import Dialog
-from engine.drivers.audio_devices import AlsaMicrophone
 from engine.hardware.config_file import load_robot_config
+from engine.media.audio_devices import AlsaMicrophone
 from engine.speech.listener import Heard, Listener
 from engine.speech.recognizer import Recognizer
 from engine.speech.vad import SileroVad, SpeechDetector

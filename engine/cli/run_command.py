@@ -44,13 +44,13 @@ from engine.files.problems import LoadError
 from engine.files.yaml_source import read_text
 from engine.loader.tree_checks import spoken_quote_warnings
 from engine.recording.session_file import check_new
+from engine.robot_io.robot_speech import RobotSpeech, audio_folder, build_speech, speech_settings
 from engine.runtime.robot import Behaviors
 from engine.scenario.scenario_file import Scenario
 from engine.services.cloud_link import CloudLink
 from engine.services.interfaces import Speech
 from engine.services.simulated import simulated_services
 from engine.session.sentences import TOLD_KINDS
-from engine.speech.robot_speech import RobotSpeech, audio_folder, build_speech, speech_settings
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

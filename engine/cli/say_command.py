@@ -15,8 +15,8 @@ from engine.cli.run_inputs import resolve_profile
 from engine.clock import RealClock
 from engine.errors import ConfigError, ServiceError, UsageError
 from engine.loader.substitution import load_profile
-from engine.speech.audio import Audio, write_wav
-from engine.speech.robot_speech import speech_settings
+from engine.media.audio import Audio, write_wav
+from engine.robot_io.robot_speech import speech_settings
 from engine.speech.settings import VOICE_NAMES
 from engine.speech.speaker import Speaker
 from engine.speech.voice_models import load_voice
@@ -97,8 +97,8 @@ def main(args: argparse.Namespace) -> int:
             ) from None
         print(f"{args.output}: {audio.seconds:.2f} s at {audio.rate_hz} Hz")
         return 0
-    from engine.drivers.audio_devices import AlsaSpeaker
     from engine.hardware.config_file import load_robot_config
+    from engine.media.audio_devices import AlsaSpeaker
 
     config = load_robot_config(args.hardware) if args.hardware is not None else None
     device = args.device or (config.audio.speaker if config else None) or "default"

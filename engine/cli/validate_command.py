@@ -14,18 +14,16 @@ from pathlib import Path
 
 from engine.buttons.button_file import ButtonBoard, load_buttons
 from engine.cli.output import tell
+from engine.cli.robot_checks import check_on_robot, check_scenario_events, list_lengths
 from engine.cli.run_inputs import (
     DEFAULT_BUTTONS,
     DEFAULT_DIALOGS,
     DEFAULT_HARDWARE,
     button_warnings,
-    check_on_robot,
     check_presses,
-    check_scenario_events,
     default_buttons,
     dialogs_folder,
     found,
-    list_lengths,
     load_checked_buttons,
     load_config,
     resolve_profile,
@@ -44,7 +42,7 @@ from engine.loader.tree_resources import collisions
 from engine.nodes.registry import NodeRegistry, default_registry
 from engine.runtime.robot import declared_beside, tree_files
 from engine.scenario.scenario_file import load_scenario
-from engine.values.params import did_you_mean
+from engine.values.param_problems import did_you_mean
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

@@ -23,6 +23,7 @@ from engine.buttons.wizard import Wizard
 from engine.clock import Clock
 from engine.hardware.config import RobotConfig
 from engine.recording.recorder import SessionRecorder
+from engine.robot_io.robot_speech import RobotSpeech
 from engine.runtime.reload import TreeReloader
 from engine.runtime.robot import Behaviors
 from engine.runtime.robot_factory import AssembledRobot, build_robot
@@ -32,7 +33,6 @@ from engine.services.cloud_link import CloudLink
 from engine.services.interfaces import IotResults, Services, Speech
 from engine.session.events import WorldEvent
 from engine.session.stream import SessionStream
-from engine.speech.robot_speech import RobotSpeech
 from engine.view.hub import ViewHub
 from engine.view.server import LiveSource, ViewServer
 

@@ -54,7 +54,7 @@ from engine.files.yaml_source import (
     resolved,
 )
 from engine.services.interfaces import ON_REQUEST_SENSORS
-from engine.values.params import CheckContext, ParamProblem, did_you_mean
+from engine.values.param_problems import CheckContext, ParamProblem, did_you_mean
 from engine.values.templates import CompiledTemplate, compile_template
 
 MAX_PHRASE_EXPANSIONS = 200

@@ -1,9 +1,9 @@
-"""Device drivers, bus managers and the simulated vest.
+"""Device drivers and bus managers (the simulated vest's chips are in :mod:`engine.sim`).
 
 Drivers speak to a bus handed to them (:mod:`engine.drivers.bus_protocols`: an
 ``smbus2.SMBus``-compatible I2C bus, an ``spidev``-compatible SPI node, a pyserial port);
 they never open a bus themselves, so the same driver runs on the robot and on the
-register-level models in :mod:`engine.drivers.sim`. Their errors, and the readings they
+register-level models in :mod:`engine.sim`. Their errors, and the readings they
 refuse as impossible for their chip, are in :mod:`engine.drivers.device_errors`.
 
 A bus is owned by a :class:`~engine.drivers.bus_manager.BusManager` (queue and worker),

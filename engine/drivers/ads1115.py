@@ -22,41 +22,35 @@ from __future__ import annotations
 import math
 
 from engine.clock import Clock
+from engine.drivers.ads1115_registers import (
+    CODE_MAX,
+    CODE_MIN,
+    COMP_QUE_DISABLE,
+    CONFIG,
+    CONVERSION,
+    DATA_RATES_SPS,
+    DR_SHIFT,
+    INPUT_MARGIN_V,
+    MODE_SINGLE_SHOT,
+    MUX_SHIFT,
+    MUX_SINGLE_ENDED,
+    OS,
+    PGA_FULL_SCALE_V,
+    PGA_GAINS,
+    PGA_SHIFT,
+)
 from engine.drivers.bus_protocols import I2CBus
 from engine.drivers.device_errors import ImplausibleReadingError, i2c_place, not_found
 from engine.errors import DeviceError
 
-# Pointer register values.
-CONVERSION = 0x00
-CONFIG = 0x01
-LO_THRESH = 0x02
-HI_THRESH = 0x03
-
-# Config register fields.
-OS_START = 0x8000  # write: start a single conversion; read: 1 = idle, 0 = converting
-MUX_SHIFT = 12
-MUX_SINGLE_ENDED = 0b100  # 100..111: AIN0..AIN3 against GND
-PGA_SHIFT = 9
-MODE_SINGLE_SHOT = 0x0100
-DR_SHIFT = 5
-COMP_QUE_DISABLE = 0x0003
-
 # PGA gain -> full-scale range in volts (+/-), in PGA code order.
-GAIN_FULL_SCALE_V: dict[float, float] = {
-    2 / 3: 6.144,
-    1: 4.096,
-    2: 2.048,
-    4: 1.024,
-    8: 0.512,
-    16: 0.256,
-}
-DATA_RATES_SPS = (8, 16, 32, 64, 128, 250, 475, 860)
+GAIN_FULL_SCALE_V: dict[float, float] = dict(
+    zip(PGA_GAINS, PGA_FULL_SCALE_V[: len(PGA_GAINS)], strict=True)
+)
 
 OSCILLATOR_TOLERANCE = 0.10  # the internal oscillator is within 10 %
 MAX_POLLS = 10
-CODE_MIN = -0x8000
-CODE_MAX = 0x7FFF
-INPUT_MIN_V = -0.3  # absolute maximum below GND: a single-ended input never reads lower
+INPUT_MIN_V = -INPUT_MARGIN_V  # below GND: a single-ended input never reads lower
 
 
 def raw_to_volts(raw: int, full_scale_v: float) -> float:
@@ -163,13 +157,13 @@ class ADS1115:
         """
         if not 0 <= channel <= 3:
             raise ValueError(f"ADS1115 channel {channel} is outside 0..3")
-        self._write_register(CONFIG, OS_START | self._config(channel))
+        self._write_register(CONFIG, OS | self._config(channel))
         self._clock.sleep(self.conversion_time_s)
         poll_interval_s = OSCILLATOR_TOLERANCE / self.data_rate_sps
         for _ in range(MAX_POLLS):
             config = self._read_register(CONFIG)
             self._check_config(config, channel)
-            if config & OS_START:
+            if config & OS:
                 msb, lsb = self._read_bytes(CONVERSION)
                 return self._checked_code(word_to_code(msb, lsb))
             self._clock.sleep(poll_interval_s)
@@ -187,7 +181,7 @@ class ADS1115:
     def _check_config(self, config: int, channel: int) -> None:
         """The config register echoes what was written (OS aside); anything else is garbled."""
         expected = self._config(channel)
-        if config & ~OS_START != expected:
+        if config & ~OS != expected:
             raise ImplausibleReadingError(
                 chip="ADS1115",
                 place=i2c_place(self.address),
@@ -227,7 +221,7 @@ class ADS1115:
             raise
         except OSError as error:
             raise not_found("ADS1115", self.address, error) from error
-        if echoed & ~OS_START != expected:
+        if echoed & ~OS != expected:
             raise DeviceError(
                 f"ADS1115 at I2C 0x{self.address:02X} failed its identity check: config "
                 f"register reads 0x{echoed:04X} after writing 0x{expected:04X}; is another "

@@ -28,17 +28,15 @@ answer, and when the bus is idle runs the transaction in the calling thread, sav
 hand-off to the worker and back (tens of microseconds, most of the manager's cost). The
 worker waits on the injected clock, so a :class:`~engine.clock.VirtualClock` drives it too.
 
-This module is the queue and the worker. The parts: what one transaction does
-(:mod:`~engine.drivers.transaction_runner`), the retry and offline rules
-(:mod:`~engine.drivers.bus_policy`), the claims (:mod:`~engine.drivers.device_table`), the
+This module is the worker. The parts: the queue (:mod:`~engine.drivers.job_queue`), what
+one transaction does (:mod:`~engine.drivers.transaction_runner`), the retry and offline
+rules (:mod:`~engine.drivers.bus_policy`), the claims (:mod:`~engine.drivers.device_table`), the
 statistics (:mod:`~engine.drivers.device_stats`) and the drivers' handles
 (:mod:`~engine.drivers.device_handle`).
 """
 
 from __future__ import annotations
 
-import heapq
-import itertools
 import logging
 import threading
 from collections.abc import Callable, Iterable
@@ -55,7 +53,8 @@ from engine.drivers.bus_errors import (
 from engine.drivers.bus_policy import RETRYABLE_ERRNOS, BusPolicy, Priority
 from engine.drivers.device_handle import DeviceHandle
 from engine.drivers.device_stats import DeviceStats, percentile
-from engine.drivers.transaction_runner import Job, TransactionRunner, fail_future
+from engine.drivers.job_queue import Job, JobQueue, fail_future
+from engine.drivers.transaction_runner import TransactionRunner
 from engine.errors import DeviceError
 
 __all__ = [
@@ -137,8 +136,7 @@ class BusManager(TransactionRunner[BusT]):
             ),
         )
         self._threaded = threaded
-        self._queue: list[tuple[int, int, Job]] = []
-        self._sequence = itertools.count()
+        self._queue = JobQueue()
         self._closed = False
         # Threaded: the bus token, held while a transaction or probe runs (on the worker, or
         # in the thread of a call() that found the bus idle). Not threaded: a plain lock.
@@ -193,22 +191,6 @@ class BusManager(TransactionRunner[BusT]):
             self._table.add(device, address, probe)
         self._notify(device, True)
         return DeviceHandle(self, device, address)
-
-    def release(self, device: str) -> None:
-        """Give up ``device``'s claim; its queued transactions fail when their turn comes."""
-        with self._lock:
-            self._table.remove(device)
-
-    @property
-    def devices(self) -> dict[str, int | None]:
-        """Claimed device names and their addresses."""
-        with self._lock:
-            return {name: record.address for name, record in self._table.records.items()}
-
-    def holder(self, address: int | None) -> str | None:
-        """The name of the device that claimed ``address``, if any."""
-        with self._lock:
-            return self._table.holders.get(address)
 
     # -- transactions --------------------------------------------------------------------
     def submit(
@@ -279,8 +261,7 @@ class BusManager(TransactionRunner[BusT]):
             if self._closed:
                 return
             self._closed = True
-            pending = [job for _, _, job in sorted(self._queue, key=lambda e: e[:2])]
-            self._queue.clear()
+            pending = self._queue.drain()
         self._doorbell.set()
         for job in pending:
             fail_future(job.future, self._closed_error(job.device, queued=True))
@@ -326,7 +307,7 @@ class BusManager(TransactionRunner[BusT]):
                 if may_run_here and not (self._busy or self._queue or self._table.offline):
                     self._busy = run_here = True
                 else:
-                    heapq.heappush(self._queue, (job.priority, next(self._sequence), job))
+                    self._queue.push(job)
                     ring, self._worker_asleep = self._worker_asleep, False
         if refusal is not None:
             fail_future(job.future, refusal)
@@ -377,7 +358,7 @@ class BusManager(TransactionRunner[BusT]):
                 run = False
                 if not self._busy:  # else a call() holds the bus and rings when it is done
                     if self._queue:
-                        job = heapq.heappop(self._queue)[2]
+                        job = self._queue.pop()
                         run = True
                     elif self._table.offline:
                         due_s = self._table.next_probe_due()

@@ -2,7 +2,7 @@
 
 A driver never opens a bus: it is handed an object with one of these interfaces, so the
 same driver runs on the robot's ``/dev/i2c-1`` (``smbus2.SMBus``), on a register-level
-model (:mod:`engine.drivers.sim`), behind a multiplexer channel or a bus manager's
+model (:mod:`engine.sim`), behind a multiplexer channel or a bus manager's
 transaction (:class:`~engine.drivers.forwarding_bus.ForwardingI2C`), or on anyone else's
 compatible object. These are structural types (``typing.Protocol``): nothing inherits them,
 and ``isinstance(bus, I2CBus)`` checks that the methods are there.

@@ -1,7 +1,7 @@
 """Digital output lines: the protocol drivers use, and Linux's GPIO character device.
 
 Drivers that toggle a pin (the VL53L0X XSHUT chain) take an :class:`OutputLine`, so the
-same code drives a real pin, a simulated one (:mod:`engine.drivers.sim.gpio`) or anyone
+same code drives a real pin, a simulated one (:mod:`engine.sim.gpio`) or anyone
 else's object with a ``set(high)`` method.
 
 :class:`GpioOutputLine` talks to ``/dev/gpiochipN`` through the kernel's v2 uAPI ioctls

@@ -27,6 +27,32 @@ CMD_GO_HOME = 0xA2
 POLOLU_PROTOCOL_START = 0xAA
 """First byte of a Pololu-protocol packet (also the baud-rate indication byte)."""
 
+# Commands the engine does not send (the emulator reads past them).
+CMD_SET_PWM = 0x8A
+CMD_SET_MULTIPLE_TARGETS = 0x9F
+CMD_STOP_SCRIPT = 0xA4
+CMD_RESTART_SCRIPT = 0xA7
+CMD_RESTART_SCRIPT_WITH_PARAMETER = 0xA8
+CMD_GET_SCRIPT_STATUS = 0xAE
+MINI_SSC_START = 0xFF  # first byte of a Mini SSC packet
+
+# Data bytes after each command byte, so that a reader of the byte stream stays in step.
+COMMAND_DATA_LENGTHS: dict[int, int] = {
+    CMD_SET_TARGET: 3,
+    CMD_SET_SPEED: 3,
+    CMD_SET_ACCELERATION: 3,
+    CMD_SET_PWM: 4,
+    CMD_GET_POSITION: 1,
+    CMD_GET_MOVING_STATE: 0,
+    CMD_SET_MULTIPLE_TARGETS: 2,  # at least; 2 + 2 * count in all
+    CMD_GET_ERRORS: 0,
+    CMD_GO_HOME: 0,
+    CMD_STOP_SCRIPT: 0,
+    CMD_RESTART_SCRIPT: 1,
+    CMD_RESTART_SCRIPT_WITH_PARAMETER: 3,
+    CMD_GET_SCRIPT_STATUS: 0,
+}
+
 DEFAULT_DEVICE_NUMBER = 12
 MAX_DEVICE_NUMBER = 127
 MAX_14_BIT = 0x3FFF

@@ -17,19 +17,22 @@ Code = 1024 * VIN / VREF, so volts = code * VREF / 1024.
 from __future__ import annotations
 
 from engine.drivers.bus_protocols import SpiDevice
+from engine.drivers.mcp3008_registers import (
+    CHANNEL_SHIFT,
+    CHANNELS,
+    CODE_COUNT,
+    MAX_CLOCK_AT_5V_HZ,
+    NULL_BIT,
+    RESULT_HIGH_MASK,
+    SINGLE_ENDED,
+    SPI_MODES,
+    START_BIT,
+    VDD_MAX_V,
+    VREF_MIN_V,
+)
 from engine.errors import DeviceError
 
-CHANNELS = 8
-START_BIT = 0x01
-SINGLE_ENDED = 0x80  # SGL/DIFF = 1, in the second byte's top bit
-CHANNEL_SHIFT = 4
-NULL_BIT = 0x04  # in the second answer byte, just above B9 B8
-RESULT_HIGH_MASK = 0x03
-CODE_COUNT = 1024
-
-SPI_MODE = 0  # the chip also accepts mode 3
-MAX_CLOCK_AT_2V7_HZ = 1_350_000  # the data sheet's limit at the lowest supply
-MAX_CLOCK_AT_5V_HZ = 3_600_000
+SPI_MODE = SPI_MODES[0]  # the chip also accepts mode 3
 MIN_CLOCK_HZ = 10_000  # slower, the sample capacitor droops
 
 
@@ -55,8 +58,8 @@ class MCP3008:
     def __init__(
         self, spi: SpiDevice, *, vref_v: float = 3.3, max_speed_hz: int = 1_000_000
     ) -> None:
-        if not 0.25 <= vref_v <= 5.5:
-            raise ValueError(f"MCP3008 VREF {vref_v} V is outside 0.25..5.5 V")
+        if not VREF_MIN_V <= vref_v <= VDD_MAX_V:
+            raise ValueError(f"MCP3008 VREF {vref_v} V is outside {VREF_MIN_V}..{VDD_MAX_V} V")
         if not MIN_CLOCK_HZ <= max_speed_hz <= MAX_CLOCK_AT_5V_HZ:
             raise ValueError(
                 f"MCP3008 SPI clock {max_speed_hz} Hz is outside "

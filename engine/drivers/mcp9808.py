@@ -16,39 +16,34 @@ from dataclasses import dataclass
 
 from engine.drivers.bus_protocols import I2CBus
 from engine.drivers.device_errors import ImplausibleReadingError, i2c_place, not_found
+from engine.drivers.mcp9808_registers import (
+    CONFIG,
+    CONFIG_SHDN,
+    DEVICE_ID,
+    DEVICE_ID_VALUE,
+    FLAG_CRIT,
+    FLAG_LOWER,
+    FLAG_UPPER,
+    LIMIT_MASK,
+    MANUFACTURER_ID,
+    MANUFACTURER_ID_VALUE,
+    OPERATING_MAX_C,
+    OPERATING_MIN_C,
+    RESOLUTION,
+    RESOLUTIONS,
+    SIGN,
+    T_AMBIENT,
+    T_CRIT,
+    T_LOWER,
+    T_UPPER,
+    TEMPERATURE_MASK,
+)
 from engine.errors import DeviceError
-
-CONFIG = 0x01
-T_UPPER = 0x02
-T_LOWER = 0x03
-T_CRIT = 0x04
-T_AMBIENT = 0x05
-MANUFACTURER_ID = 0x06
-DEVICE_ID = 0x07
-RESOLUTION = 0x08
-
-MANUFACTURER_ID_VALUE = 0x0054
-DEVICE_ID_VALUE = 0x04  # upper byte of register 0x07; the lower byte is the revision
-
-CONFIG_SHDN = 0x0100
-CONFIG_LOCKS = 0x00C0  # critical lock (bit 7), window lock (bit 6)
-
-FLAG_CRIT = 0x8000  # TA >= TCRIT
-FLAG_UPPER = 0x4000  # TA > TUPPER
-FLAG_LOWER = 0x2000  # TA < TLOWER
-SIGN = 0x1000
-TEMPERATURE_MASK = 0x0FFF
-LIMIT_MASK = 0x1FFC
 
 # Resolution in degC -> (register code, conversion time in seconds).
 RESOLUTIONS_C: dict[float, tuple[int, float]] = {
-    0.5: (0b00, 0.030),
-    0.25: (0b01, 0.065),
-    0.125: (0b10, 0.130),
-    0.0625: (0b11, 0.250),
+    step_c: (code, time_s) for code, (step_c, time_s) in RESOLUTIONS.items()
 }
-OPERATING_MIN_C = -40.0  # the chip's operating range: it reports nothing outside it
-OPERATING_MAX_C = 125.0
 LIMIT_MIN_C = -256.0
 LIMIT_MAX_C = 255.75
 

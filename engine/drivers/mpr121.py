@@ -18,25 +18,26 @@ from __future__ import annotations
 
 from engine.drivers.bus_protocols import I2CBus
 from engine.drivers.device_errors import ImplausibleReadingError, i2c_place, not_found
+from engine.drivers.mpr121_registers import (
+    BASELINE_0,
+    CONFIG1,
+    CONFIG2,
+    CONFIG2_DEFAULT,
+    DEBOUNCE,
+    ECR,
+    ECR_CL_LOAD_5_MSB,
+    ECR_STOP,
+    FILTERED_DATA_0,
+    MHD_RISING,
+    PADS,
+    SOFT_RESET,
+    SOFT_RESET_MAGIC,
+    STATUS_NOT_PADS_MASK,
+    TOUCH_STATUS_L,
+    TOUCH_THRESHOLD_0,
+)
 from engine.errors import DeviceError
 
-# Register map (data sheet Table 1).
-TOUCH_STATUS_L = 0x00  # ELE0..7; 0x01 holds ELE8..11, ELEPROX and the over-current flag
-FILTERED_DATA_0 = 0x04  # ELE0 LSB, MSB; little-endian 10-bit pairs
-BASELINE_0 = 0x1E  # upper 8 of the 10 baseline bits, one register per pad
-MHD_RISING = 0x2B  # baseline filter: MHDR, NHDR, NCLR, FDLR, MHDF, NHDF, NCLF, FDLF, NHDT..
-TOUCH_THRESHOLD_0 = 0x41  # ELE0 touch threshold, ELE0 release threshold, ELE1 ... to 0x58
-DEBOUNCE = 0x5B
-CONFIG1 = 0x5C  # FFI (first filter iterations), CDC (charge current, uA)
-CONFIG2 = 0x5D  # CDT (charge time), SFI (second filter iterations), ESI (sample interval)
-ECR = 0x5E  # electrode configuration: CL (7:6), ELEPROX_EN (5:4), ELE_EN (3:0)
-SOFT_RESET = 0x80
-
-SOFT_RESET_MAGIC = 0x63
-CONFIG2_AFTER_RESET = 0x24
-
-ECR_STOP = 0x00
-ECR_CL_LOAD_5_MSB = 0b10 << 6  # baseline tracking on, initial baseline from first data
 ECR_RUN_12_PADS = ECR_CL_LOAD_5_MSB | 12
 
 # Baseline filter, rising (MHD, NHD, NCL, FDL), falling (same) and touched (NHD, NCL,
@@ -44,12 +45,6 @@ ECR_RUN_12_PADS = ECR_CL_LOAD_5_MSB | 12
 BASELINE_FILTER = (0x01, 0x01, 0x0E, 0x00, 0x01, 0x05, 0x01, 0x00, 0x00, 0x00, 0x00)
 CONFIG1_16UA = 0x10  # 6 first-filter samples, 16 uA charge current
 CONFIG2_HALF_US_1MS = 0x20  # 0.5 us charge time, 4 second-filter samples, 1 ms period
-
-PADS = 12
-STATUS_PAD_MASK = (1 << PADS) - 1
-# Above the pads: ELEPROX (off: proximity is not enabled), two reserved bits and OVCF
-# (over-current on REXT, which stops the chip). None of them can be set while it runs here.
-STATUS_NOT_PADS_MASK = 0xFFFF & ~STATUS_PAD_MASK
 
 
 def _check_threshold(name: str, value: int) -> None:
@@ -116,11 +111,11 @@ class MPR121:
             raise
         except OSError as error:
             raise not_found("MPR121", self.address, error) from error
-        if config2 != CONFIG2_AFTER_RESET:
+        if config2 != CONFIG2_DEFAULT:
             raise DeviceError(
                 f"MPR121 at I2C 0x{self.address:02X} failed its identity check: CONFIG2 "
                 f"(0x{CONFIG2:02X}) reads 0x{config2:02X} after a soft reset, expected "
-                f"0x{CONFIG2_AFTER_RESET:02X}; is another chip at this address?"
+                f"0x{CONFIG2_DEFAULT:02X}; is another chip at this address?"
             )
         self._write(ECR, ECR_STOP)  # the chip ignores configuration writes while running
         self._write_thresholds(self._touch_threshold, self._release_threshold)

@@ -18,38 +18,27 @@ import threading
 from engine.clock import Clock
 from engine.drivers.bus_protocols import I2CBus
 from engine.drivers.device_errors import ImplausibleReadingError, device_error, i2c_place
+from engine.drivers.pca9685_registers import (
+    ALL_LED_OFF_H,
+    CHANNELS,
+    COUNTS,
+    FULL,
+    LED0_ON_L,
+    LED_STRIDE,
+    MODE1,
+    MODE1_AI,
+    MODE1_RESTART,
+    MODE1_SLEEP,
+    MODE2,
+    MODE2_OUTDRV,
+    OSCILLATOR_WAKE_S,
+    PRE_SCALE,
+    PRESCALE_MAX,
+    PRESCALE_MIN,
+)
 from engine.errors import DeviceError
 
 CHIP = "PCA9685"
-CHANNELS = 16
-COUNTS = 4096  # PWM counts per period
-
-# -- register map ---------------------------------------------------------------------------
-MODE1 = 0x00
-MODE1_RESTART = 0x80
-MODE1_EXTCLK = 0x40
-MODE1_AI = 0x20  # register pointer auto-increment
-MODE1_SLEEP = 0x10  # oscillator off
-MODE1_SUB1 = 0x08
-MODE1_SUB2 = 0x04
-MODE1_SUB3 = 0x02
-MODE1_ALLCALL = 0x01
-MODE2 = 0x01
-MODE2_INVRT = 0x10
-MODE2_OCH = 0x08
-MODE2_OUTDRV = 0x04  # totem-pole outputs (power-on default)
-LED0_ON_L = 0x06
-LED_STRIDE = 4
-ALL_LED_ON_L = 0xFA
-ALL_LED_ON_H = 0xFB
-ALL_LED_OFF_L = 0xFC
-ALL_LED_OFF_H = 0xFD
-PRE_SCALE = 0xFE
-FULL = 0x1000  # bit 4 of the _H register, as a bit of the 16-bit ON / OFF value
-
-PRESCALE_MIN = 3
-PRESCALE_MAX = 255
-OSCILLATOR_WAKE_S = 500e-6
 
 
 # -- pure conversions ---------------------------------------------------------------------------

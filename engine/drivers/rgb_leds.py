@@ -9,7 +9,8 @@ from __future__ import annotations
 from collections.abc import Mapping
 
 from engine.colors import parse_color
-from engine.drivers.pca9685 import CHANNELS, PCA9685
+from engine.drivers.pca9685 import PCA9685
+from engine.drivers.pca9685_registers import CHANNELS
 
 Rgb = tuple[float, float, float]
 

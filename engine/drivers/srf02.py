@@ -23,22 +23,23 @@ from __future__ import annotations
 from engine.clock import Clock
 from engine.drivers.bus_protocols import I2CBus
 from engine.drivers.device_errors import ImplausibleReadingError, i2c_place, not_found
+from engine.drivers.srf02_registers import (
+    BUSY,
+    COMMAND,
+    MAX_RANGE_CM,
+    RANGE_CM,
+    RANGE_HIGH,
+    RANGING_TIME_S,
+    TUNED_MIN_CM,
+    UNUSED,
+    UNUSED_VALUE,
+)
 from engine.errors import DeviceError
 
-COMMAND = 0x00  # write: command; read: software revision (0xFF while ranging)
-UNUSED = 0x01  # reads 0x80
-RANGE_HIGH = 0x02
-
-RANGE_CM = 0x51
-BUSY = 0xFF
-UNUSED_VALUE = 0x80
-
-RANGING_TIME_S = 0.066
 POLL_INTERVAL_S = 0.005
 MAX_POLLS = 10
-MIN_RANGE_CM = 16  # the tuned minimum; a fresh chip starts at 28 cm
+MIN_RANGE_CM = round(TUNED_MIN_CM)  # a fresh chip starts at POWER_UP_MIN_CM
 PLAUSIBLE_MIN_CM = 15  # below its minimum range the chip reports the minimum, never less
-MAX_RANGE_CM = 600  # the chip's 6 m; farther is "no echo", 0
 
 
 class SRF02:

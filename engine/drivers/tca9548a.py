@@ -28,10 +28,9 @@ from typing import Any
 from engine.drivers.bus_protocols import I2CBus
 from engine.drivers.device_errors import device_error
 from engine.drivers.forwarding_bus import ForwardingI2C
+from engine.drivers.tca9548a_registers import ADDRESSES, CHANNELS, CONTROL_NONE
 
 CHIP = "TCA9548A"
-CHANNELS = 8
-ADDRESSES = range(0x70, 0x78)
 
 
 def channel_mask(channel: int) -> int:
@@ -120,7 +119,7 @@ class TCA9548A:
 
     def deselect_all(self) -> None:
         """Disconnect every channel."""
-        self._write_control(0x00)
+        self._write_control(CONTROL_NONE)
 
     def selected(self) -> list[int]:
         """The channels connected now, as the chip reports them (bus errors as raised)."""

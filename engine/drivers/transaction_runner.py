@@ -11,36 +11,24 @@ the worker thread, or at once in the caller's thread) is the manager's business.
 
 from __future__ import annotations
 
-import contextlib
 import logging
 import threading
 from collections.abc import Callable
-from concurrent.futures import Future, InvalidStateError
-from dataclasses import dataclass
-from typing import Any, Generic, TypeVar
+from typing import Generic, TypeVar
 
 from engine.clock import Clock, stopwatch
 from engine.drivers.bus_policy import BusPolicy, Priority
 from engine.drivers.device_stats import DeviceRecord, DeviceStats, snapshot
 from engine.drivers.device_table import DeviceTable
+from engine.drivers.job_queue import Job, fail_future
 from engine.errors import DeviceError
 
-__all__ = ["Job", "TransactionRunner", "fail_future"]
+__all__ = ["TransactionRunner"]
 
 # The manager's logger: its messages keep the name they had before the split.
 _log = logging.getLogger("engine.drivers.bus_manager")
 
 BusT = TypeVar("BusT")
-
-
-@dataclass(slots=True)
-class Job:
-    """One transaction: ``fn(bus)`` for ``device``, its future and its priority."""
-
-    device: str
-    fn: Callable[[Any], Any]
-    future: Future[Any]
-    priority: Priority
 
 
 class TransactionRunner(Generic[BusT]):
@@ -96,6 +84,23 @@ class TransactionRunner(Generic[BusT]):
         if address is None:
             return f"{self._kind} bus {self._name}"
         return f"{self._kind} 0x{address:02X} on bus {self._name}"
+
+    # -- claims --------------------------------------------------------------------------
+    def release(self, device: str) -> None:
+        """Give up ``device``'s claim; its queued transactions fail when their turn comes."""
+        with self._lock:
+            self._table.remove(device)
+
+    @property
+    def devices(self) -> dict[str, int | None]:
+        """Claimed device names and their addresses."""
+        with self._lock:
+            return {name: record.address for name, record in self._table.records.items()}
+
+    def holder(self, address: int | None) -> str | None:
+        """The name of the device that claimed ``address``, if any."""
+        with self._lock:
+            return self._table.holders.get(address)
 
     def is_online(self, device: str) -> bool:
         with self._lock:
@@ -216,9 +221,3 @@ class TransactionRunner(Generic[BusT]):
             self._on_status(device, ok)
         except Exception:
             _log.exception("on_status(%r, %r) raised; the bus carries on", device, ok)
-
-
-def fail_future(future: Future[Any], error: BaseException) -> None:
-    """Fail ``future`` unless its caller cancelled it meanwhile."""
-    with contextlib.suppress(InvalidStateError):
-        future.set_exception(error)

@@ -41,8 +41,6 @@ from engine.drivers import vl53l0x_registers as reg
 from engine.drivers.bus_protocols import I2CBus
 from engine.drivers.device_errors import ImplausibleReadingError, device_error, i2c_place
 from engine.drivers.vl53l0x_spads import (
-    NVM_GOOD_SPAD_MAP,
-    NVM_SPAD_INFO,
     SPAD_MAP_BYTES,
     ReferenceSpads,
     from_nvm_words,
@@ -58,20 +56,19 @@ from engine.drivers.vl53l0x_tuning import DEFAULT_TUNING, TUNING_SIGNAL_RATE_LIM
 from engine.errors import DeviceError
 
 CHIP = "VL53L0X"
-DEFAULT_ADDRESS = 0x29
+DEFAULT_ADDRESS = reg.POWER_ON_ADDRESS
 # What the chip kind probes with (engine.hardware.chips.vl53l0x):
 IDENTIFICATION_MODEL_ID = reg.IDENTIFICATION_MODEL_ID  # the first identity register
 IDENTITY = reg.IDENTITY  # 0xC0..0xC2
 
-# Bits 6:3 of RESULT_RANGE_STATUS: the device's range status; 11 means a valid range.
-DEVICE_RANGE_STATUS_VALID = 11
+DEVICE_RANGE_STATUS_VALID = reg.DEVICE_RANGE_STATUS_VALID
 DEVICE_RANGE_STATUS_TOO_CLOSE = frozenset({8, 10})
 """Device range statuses of a target closer than the chip can range ("min range fail")."""
-RANGE_OUT_OF_RANGE_MM = 8190  # the chip reports 8190 or 8191 when nothing is in range
+RANGE_OUT_OF_RANGE_MM = reg.RANGE_OUT_OF_RANGE_MM
 RANGE_CODE_MAX = 8191  # the range field never holds more
 MAX_RANGE_MM = 2000  # the chip's reach (long-range mode); a valid range beyond it is garbled
 
-BOOT_TIME_S = 0.002  # after XSHUT rises; the datasheet's tBOOT is 1.2 ms max
+BOOT_TIME_S = 0.002  # after XSHUT rises, with a margin over tBOOT (reg.TBOOT_MAX_S)
 POLL_INTERVAL_S = 0.002
 
 
@@ -85,7 +82,7 @@ def signal_rate_limit_to_register(limit_mcps: float) -> int:
 
 def device_range_status(status_byte: int) -> int:
     """The device range status (bits 6:3) of RESULT_RANGE_STATUS; 11 is a valid range."""
-    return (status_byte >> 3) & 0x0F
+    return (status_byte >> reg.DEVICE_RANGE_STATUS_SHIFT) & 0x0F
 
 
 def decode_range(status_byte: int, range_mm: int) -> int | None:
@@ -252,7 +249,9 @@ class VL53L0X:
                     (reg.POWER_MANAGEMENT, 0x01),
                 )
             )
-            words = [self._read_nvm_word(word) for word in (NVM_SPAD_INFO, *NVM_GOOD_SPAD_MAP)]
+            words = [
+                self._read_nvm_word(word) for word in (reg.NVM_SPAD_INFO, *reg.NVM_GOOD_SPAD_MAP)
+            ]
             self._write_all(((reg.NVM_POWER, 0x00), (reg.PAGE_SELECT, reg.NVM_ENABLE_PAGE)))
             self._write(reg.NVM_CONTROL, self._read(reg.NVM_CONTROL) & ~reg.NVM_ENABLE)
             self._write_all(((reg.PAGE_SELECT, 0x01), *reg.LEAVE_PRIVATE_PAGE))

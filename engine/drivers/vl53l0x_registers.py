@@ -7,6 +7,8 @@ API reads the factory NVM. 16-bit registers are big-endian.
 
 from __future__ import annotations
 
+POWER_ON_ADDRESS = 0x29  # and again after every boot (XSHUT high)
+
 SYSRANGE_START = 0x00
 SYSRANGE_START_SINGLESHOT = 0x01  # bit 0: start; clears itself once ranging has begun
 SYSTEM_SEQUENCE_CONFIG = 0x01
@@ -17,6 +19,12 @@ RESULT_INTERRUPT_STATUS = 0x13
 RESULT_INTERRUPT_MASK = 0x07
 RESULT_RANGE_STATUS = 0x14
 RESULT_RANGE_MM_OFFSET = 10  # range in mm, big-endian 16-bit, at RESULT_RANGE_STATUS + 10
+RESULT_RANGE_MM = RESULT_RANGE_STATUS + RESULT_RANGE_MM_OFFSET  # 0x1E..0x1F
+# Bits 6:3 of RESULT_RANGE_STATUS: the device's range status; 11 means a valid range.
+DEVICE_RANGE_STATUS_SHIFT = 3
+DEVICE_RANGE_STATUS_VALID = 11
+DEVICE_RANGE_STATUS_MSRC_NO_TARGET = 4
+RANGE_OUT_OF_RANGE_MM = 8190  # the chip reports 8190 or 8191 when nothing is in range
 RESULT_BLOCK_LENGTH = 12
 FINAL_RANGE_CONFIG_MIN_COUNT_RATE_RTN_LIMIT = 0x44  # 16-bit, Q9.7 MCPS
 MSRC_CONFIG_CONTROL = 0x60
@@ -42,6 +50,7 @@ IDENTITY = (0xEE, 0xAA, 0x10)  # registers 0xC0, 0xC1, 0xC2 (model, ?, revision)
 # dynamic SPAD settings; pages 6 and 7 give access to the factory NVM.
 POWER_MANAGEMENT = 0x80
 PAGE_SELECT = 0xFF
+PRIVATE_PAGE = 0x01
 STOP_VARIABLE = 0x91
 DYNAMIC_SPAD_NUM_REQUESTED_REF_SPAD = 0x4E  # private page
 DYNAMIC_SPAD_REF_EN_START_OFFSET = 0x4F  # private page
@@ -53,6 +62,11 @@ NVM_ENABLE = 0x04
 NVM_POWER = 0x81  # page 7
 NVM_DATA = 0x90  # page 7: the word read, big-endian, 0x90..0x93
 NVM_ADDRESS = 0x94  # page 7: the word to read
+NVM_READ_DONE = 0x01  # NVM_CONTROL on page 7 once the strobe has read the word
+# NVM words: the reference SPAD count (bits 14:8) and kind (bit 15, 1 = aperture), and
+# the 6-byte map of working reference SPADs (bytes 0..3, then 4..5 in the high half).
+NVM_SPAD_INFO = 0x6B
+NVM_GOOD_SPAD_MAP = (0x24, 0x25)
 ENTER_PRIVATE_PAGE = ((POWER_MANAGEMENT, 0x01), (PAGE_SELECT, 0x01), (0x00, 0x00))
 LEAVE_PRIVATE_PAGE = ((0x00, 0x01), (PAGE_SELECT, 0x00), (POWER_MANAGEMENT, 0x00))
 
@@ -61,3 +75,5 @@ SEQUENCE_DSS_PRE_FINAL = 0xE8  # DSS, pre-range and final range; no TCC, no MSRC
 SEQUENCE_VHV_CALIBRATION = 0x01
 SEQUENCE_PHASE_CALIBRATION = 0x02
 VHV_CALIBRATION_START = 0x40
+
+TBOOT_MAX_S = 0.0012  # boot time after XSHUT rises, data sheet maximum

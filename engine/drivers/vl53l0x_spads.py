@@ -24,9 +24,6 @@ FIRST_APERTURE_SPAD = 12  # with the array's start at 0xB4 (GLOBAL_CONFIG_REF_EN
 MAX_NON_APERTURE_SPADS = 12
 MAX_APERTURE_SPADS = 32
 
-NVM_SPAD_INFO = 0x6B
-NVM_GOOD_SPAD_MAP = (0x24, 0x25)
-
 
 @dataclass(frozen=True)
 class ReferenceSpads:

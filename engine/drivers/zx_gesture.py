@@ -19,46 +19,28 @@ import threading
 
 from engine.drivers.bus_protocols import I2CBus
 from engine.drivers.device_errors import ImplausibleReadingError, device_error, i2c_place
+from engine.drivers.zx_gesture_registers import (
+    ADDRESSES,
+    DRE,
+    GESTURE,
+    GESTURES,
+    MAX_POSITION,
+    MODEL,
+    MODEL_ID,
+    REGISTER_MAP_VERSION,
+    REGVER,
+    STATUS,
+    STATUS_DAV,
+    STATUS_GESTURES,
+    XPOS,
+    ZPOS,
+)
 from engine.errors import DeviceError
 
 CHIP = "ZX gesture sensor"
-ADDRESSES = (0x10, 0x11)
 
-# -- register map -----------------------------------------------------------------------------
-STATUS = 0x00
-STATUS_DAV = 1 << 0  # new position data
-STATUS_OVF = 1 << 1  # brightness overflow (unused, reads 0)
-STATUS_SWP = 1 << 2  # swipe gesture available
-STATUS_HOVER = 1 << 3  # hover gesture available
-STATUS_HVG = 1 << 4  # hover-move gesture available
-STATUS_EDGE = 1 << 5  # edge detection (unused, reads 0)
-STATUS_HB = 1 << 7  # heartbeat: toggles on every STATUS read
-STATUS_GESTURES = STATUS_SWP | STATUS_HOVER | STATUS_HVG
-DRE = 0x01  # data-ready (DR pin) enables
-DRCFG = 0x02  # DR pin configuration
-GESTURE = 0x04
-GSPEED = 0x05
-DCM = 0x06
-XPOS = 0x08
-ZPOS = 0x0A
-LRNG = 0x0C
-RRNG = 0x0E
-REGVER = 0xFE
-MODEL = 0xFF
-
-MODEL_ID = 0x01  # XZ01
-REGISTER_MAP_VERSION = 0x01
-MAX_POSITION = 240
-
-GESTURE_NAMES = {
-    0x01: "swipe_right",
-    0x02: "swipe_left",
-    0x03: "swipe_up",
-    0x05: "hover",
-    0x06: "hover_left",
-    0x07: "hover_right",
-    0x08: "hover_up",
-}
+# GESTURE register value -> the engine's gesture name.
+GESTURE_NAMES = {code: name for name, (code, _) in GESTURES.items()}
 
 
 def gesture_name(code: int) -> str | None:

@@ -6,7 +6,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 from engine.errors import ConfigError
-from engine.values.params import did_you_mean
+from engine.values.param_problems import did_you_mean
 
 
 @dataclass(frozen=True, order=True)

@@ -37,10 +37,8 @@ from typing import Any
 from engine.drivers.servo_joints import Joint
 from engine.errors import ConfigError
 from engine.files.problems import Mark
-from engine.values.params import (
-    Param,
-    did_you_mean,
-)
+from engine.values.param_problems import did_you_mean
+from engine.values.params import Param
 
 BUS_KINDS = ("i2c", "spi", "serial")
 SIDES = ("left", "center", "right")

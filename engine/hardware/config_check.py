@@ -16,7 +16,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-from engine.blackboard.catalogue import KeyCatalogue, range_key
+from engine.blackboard.catalogue import KeyCatalogue
 from engine.files.problems import Mark, Problems
 from engine.files.yaml_source import YMap, YScalar, YValue, describe, plain
 from engine.hardware.chips import ChipRegistry, default_chips
@@ -34,19 +34,10 @@ from engine.hardware.config_audio import check_audio
 from engine.hardware.config_buses import check_buses
 from engine.hardware.config_camera import check_camera
 from engine.hardware.config_cross_checks import CrossChecks
+from engine.hardware.config_keys import check_device_keys
 from engine.hardware.config_safety import check_safety
-from engine.values.params import (
-    RATE_HZ,
-    Boolean,
-    CheckContext,
-    Integer,
-    Key,
-    Param,
-    ParamProblem,
-    ParamType,
-    Text,
-    did_you_mean,
-)
+from engine.values.param_problems import CheckContext, ParamProblem, did_you_mean
+from engine.values.params import RATE_HZ, Boolean, Integer, Param, ParamType, Text
 
 TOP_FIELDS: tuple[str, ...] = ("name", "description", "simulated", "buses", "gpio", "audio")
 TOP_FIELDS += ("camera", "devices", "safety")
@@ -227,7 +218,7 @@ class ConfigChecker:
         rate_hz = self._rate(raw, spec)
         options = self._options(raw, spec)
         extra = kind.check_fields(ChipFields(self, name, raw, spec, options))
-        keys = self._keys(raw, spec, (extra or {}).get("side"))
+        keys = check_device_keys(self, raw, spec, (extra or {}).get("side"))
         if bus is None or options is None or extra is None or keys is None:
             return None
         if spec.has_address and address is None:
@@ -342,62 +333,6 @@ class ConfigChecker:
                 continue
             values[param.name] = _numeric_choice(param.name, converted)
         return values if ok else None
-
-    def _keys(self, raw: YMap, spec: ChipSpec, side: str | None) -> dict[str, str] | None:
-        keys = dict(spec.outputs)
-        if spec.role == "range" and side is not None:
-            keys["range"] = range_key(side)
-        section = self.mapping(raw.get("keys"), "'keys'", "e.g. keys: {any: /sensors/touch/any}")
-        ok = True
-        if section is not None:
-            if not spec.outputs:
-                self.problems.add(
-                    section.mark,
-                    f"{spec.chip} feeds no keys of its own here",
-                    "give each pad its 'key' under 'pads'" if spec.role == "force" else None,
-                )
-                return None
-            for output, value in section.items():
-                if output not in spec.outputs:
-                    self.problems.add(
-                        section.key_marks[output],
-                        f"{spec.chip} has no reading {output!r}",
-                        did_you_mean(output, list(spec.outputs))
-                        or "readings: " + ", ".join(spec.outputs),
-                    )
-                    ok = False
-                    continue
-                default = self.ctx.catalogue.lookup(spec.outputs[output])
-                kinds = (default.kind,) if default is not None else ("state",)
-                key = self.convert(Key(kinds=kinds), value, output)
-                if key is None or not self._same_type(keys.get(output), key, value, output):
-                    ok = False
-                else:
-                    keys[output] = key
-        missing = [output for output, key in keys.items() if not key]
-        if missing and spec.role == "range" and side is None:
-            return None  # the missing 'side' was reported
-        if missing:
-            self.problems.add(raw.mark, f"{spec.chip} needs keys for " + ", ".join(missing))
-            return None
-        return keys if ok else None
-
-    def _same_type(self, default: str | None, key: str, raw: YValue, output: str) -> bool:
-        """A reading goes to a key that holds its kind of value (or to any /vars/ key):
-        touch's pads (a list) mapped onto /sensors/touch/any (a bool) would never fire."""
-        catalogue = self.ctx.catalogue
-        expected = catalogue.lookup(default) if default else None
-        target = catalogue.lookup(key)
-        if expected is None or target is None or target.value_type is object:
-            return True
-        if target.value_type is expected.value_type:
-            return True
-        self.problems.add(
-            raw.mark,
-            f"reading {output!r} is a {expected.type_name}, but {key} holds a {target.type_name}",
-            f"map it to {default} or to a /vars/ key",
-        )
-        return False
 
 
 def _identifier(name: str) -> str:

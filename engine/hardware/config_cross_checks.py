@@ -9,7 +9,7 @@ from engine.files.problems import Mark, Problems
 from engine.files.yaml_source import YMap
 from engine.hardware.chips import ChipRegistry
 from engine.hardware.config import BusConfig, DeviceConfig, hex_address
-from engine.values.params import did_you_mean
+from engine.values.param_problems import did_you_mean
 
 
 class CrossChecks:

@@ -29,7 +29,8 @@ from typing import Any
 from engine.files.yaml_source import YList, YMap, describe, plain
 from engine.hardware.chips.fields import ConfigChecks
 from engine.hardware.config import DeviceConfig, SafetyConfig
-from engine.values.params import Choice, Number, Param, did_you_mean
+from engine.values.param_problems import did_you_mean
+from engine.values.params import Choice, Number, Param
 
 OWN_CHECKS = ("arms", "joint_limits")
 FIELDS: tuple[Param[Any], ...] = (

@@ -8,7 +8,7 @@ from typing import Any
 from engine.files.problems import Problem
 from engine.hardware.config import CAMERA_NAME, RobotConfig
 from engine.hardware.sim_vest import SPI_FAULTS
-from engine.values.params import did_you_mean
+from engine.values.param_problems import did_you_mean
 
 
 def check_fault_events(events: Iterable[Any], config: RobotConfig) -> list[Problem]:

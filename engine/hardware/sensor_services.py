@@ -10,7 +10,8 @@ from typing import Any, TypeVar
 from engine.clock import Clock
 from engine.drivers.bus_manager import DeviceHandle
 from engine.drivers.mcp9808 import MCP9808, celsius_to_fahrenheit
-from engine.drivers.srf02 import MAX_POLLS, POLL_INTERVAL_S, RANGING_TIME_S, SRF02
+from engine.drivers.srf02 import MAX_POLLS, POLL_INTERVAL_S, SRF02
+from engine.drivers.srf02_registers import RANGING_TIME_S
 from engine.errors import ServiceError
 from engine.hardware.config import DeviceConfig
 from engine.hardware.services import FutureResultJob, OnDevice

@@ -3,17 +3,17 @@ the scenario's world.
 
 :func:`build_sim_vest` makes, for a :class:`~engine.hardware.config.RobotConfig`:
 
-- a :class:`~engine.drivers.sim.i2c_bus.SimI2CBus` per I2C bus with the config's chips
+- a :class:`~engine.sim.i2c_bus.SimI2CBus` per I2C bus with the config's chips
   soldered on at their addresses (VL53L0X chips on XSHUT lines wait in hardware standby
   at 0x29 until the start-up chain switches them on and moves them; a TCA9548A bridges
   one downstream bus per channel);
-- a :class:`~engine.drivers.sim.spi_bus.SimSpiDev` per SPI node (an MCP3008);
-- a :class:`~engine.drivers.sim.maestro_emulator.MaestroEmulator` on a pseudo-terminal for
+- a :class:`~engine.sim.spi_bus.SimSpiDev` per SPI node (an MCP3008);
+- a :class:`~engine.sim.maestro_emulator.MaestroEmulator` on a pseudo-terminal for
   the Maestro, with each joint's pulse limits as the channel's Min/Max;
 
 and listens to the :class:`~engine.scenario.world.World`: a touched pad is a finger on the
 MPR121's electrode; a squeeze is newtons on an FSR 406, volts on the ADC input
-(:func:`~engine.drivers.sim.fsr.fsr406_volts`); an obstacle is the distance each VL53L0X
+(:func:`~engine.sim.fsr.fsr406_volts`); an obstacle is the distance each VL53L0X
 looks at, by its ``side``; a gesture is a hand in front of the ZX sensor (a "wave" is a
 swipe to the right); the room's temperature is the MCP9808's air; an object ahead is the
 SRF02's echo. The drivers then read all of it at register level, exactly as on the robot.
@@ -37,17 +37,17 @@ from typing import Any
 from engine.blackboard.board import Blackboard
 from engine.clock import Clock, VirtualClock
 from engine.drivers.gpio import OutputLine
-from engine.drivers.sim.fsr import fsr406_volts
-from engine.drivers.sim.gpio import SimOutputLine
-from engine.drivers.sim.i2c_bus import SimI2CBus, SimI2CDevice
-from engine.drivers.sim.maestro_emulator import MaestroEmulator
-from engine.drivers.sim.mcp3008 import SimMCP3008
-from engine.drivers.sim.spi_bus import Bit, SimSpiDev, SimSpiDevice
-from engine.drivers.sim.tca9548a import SimTCA9548A
 from engine.hardware.branching_clock import BranchingClock
 from engine.hardware.chips import ChipRegistry, default_chips
 from engine.hardware.config import BusConfig, DeviceConfig, RobotConfig
 from engine.scenario.world import EVENT_KEYS, World
+from engine.sim.fsr import fsr406_volts
+from engine.sim.gpio import SimOutputLine
+from engine.sim.i2c_bus import SimI2CBus, SimI2CDevice
+from engine.sim.maestro_emulator import MaestroEmulator
+from engine.sim.mcp3008 import SimMCP3008
+from engine.sim.spi_bus import Bit, SimSpiDev, SimSpiDevice
+from engine.sim.tca9548a import SimTCA9548A
 
 _log = logging.getLogger("vest.sim_vest")
 
@@ -94,7 +94,7 @@ class SimVest:
     Also what :func:`~engine.hardware.assembly.build_hardware` opens instead of real buses
     (:meth:`open_i2c`, :meth:`open_spi`, :meth:`serial_port`, :meth:`output_line`).
     ``chips`` maps each device name to its model (``vest.chips["touch"]`` is a
-    :class:`~engine.drivers.sim.mpr121.SimMPR121`).
+    :class:`~engine.sim.mpr121.SimMPR121`).
     """
 
     def __init__(

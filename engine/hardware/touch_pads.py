@@ -6,10 +6,10 @@ from __future__ import annotations
 from collections.abc import Iterable
 from typing import Any
 
-from engine.drivers.mpr121 import PADS
+from engine.drivers.mpr121_registers import PADS
 from engine.files.problems import Problem
 from engine.hardware.config import DeviceConfig, RobotConfig
-from engine.values.params import did_you_mean
+from engine.values.param_problems import did_you_mean
 
 
 def default_pad_name(electrode: int) -> str:

@@ -8,7 +8,7 @@ from engine.files.problems import Mark, Problems
 from engine.files.yaml_source import YMap, YScalar, YValue, describe, plain
 from engine.loader.substitution import unresolved
 from engine.nodes.spec import NodeType
-from engine.values.params import CheckContext, ParamProblem, did_you_mean
+from engine.values.param_problems import CheckContext, ParamProblem, did_you_mean
 
 
 def node_arguments(

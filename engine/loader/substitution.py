@@ -16,7 +16,7 @@ from engine.files.problems import LoadError, Mark, Problem, Problems
 from engine.files.yaml_source import YList, YMap, YScalar, YValue, describe, load_yaml
 from engine.files.yaml_values import plain
 from engine.speech.settings import SPEECH_PROFILE_PARAMS, check_speech_params
-from engine.values.params import did_you_mean
+from engine.values.param_problems import did_you_mean
 
 _REFERENCE = re.compile(r"\$\{([^}]*)\}")
 _NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")

@@ -16,7 +16,7 @@ from typing import Any
 from engine.blackboard.catalogue import VARIABLES_PREFIX, KeyCatalogue
 from engine.files.problems import Mark, Problem
 from engine.loader.tree_definition import NodeDefinition, TreeDefinition
-from engine.values.params import did_you_mean
+from engine.values.param_problems import did_you_mean
 from engine.values.templates import CompiledTemplate
 
 CURLY_QUOTES = re.compile("[\u2018\u2019\u201a\u201b\u201c\u201d\u201e\u201f\u2032\u2033]")

@@ -48,7 +48,7 @@ from engine.loader.tree_definition import NodeDefinition, TreeDefinition
 from engine.loader.tree_settings import SETTINGS, read_settings
 from engine.nodes.registry import NodeRegistry
 from engine.nodes.spec import NodeType
-from engine.values.params import CheckContext, did_you_mean
+from engine.values.param_problems import CheckContext, did_you_mean
 
 TOP_KEYS = ("name", "description", *(setting.name for setting in SETTINGS), "params", "root")
 SUBTREE = "Subtree"

@@ -19,15 +19,8 @@ from typing import Any
 from engine.files.problems import Problems
 from engine.files.yaml_source import YMap, plain
 from engine.loader.substitution import ParamValue, substitute, unresolved
-from engine.values.params import (
-    RATE_HZ,
-    CheckContext,
-    Choice,
-    Integer,
-    Number,
-    Param,
-    ParamProblem,
-)
+from engine.values.param_problems import CheckContext, ParamProblem
+from engine.values.params import RATE_HZ, Choice, Integer, Number, Param
 
 DEFAULT_RATE_HZ = 10.0
 PRIORITY = Integer(0, 99)

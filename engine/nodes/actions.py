@@ -18,17 +18,16 @@ from engine.nodes.event_reader import EQUALS, ONE_OF, EventReader, check_choice,
 from engine.remote_commands import LED_ARGS, MOVE_ARGS, SAY_ARGS
 from engine.services.interfaces import ON_REQUEST_SENSORS
 from engine.services.jobs import ImmediateJob, Job
+from engine.values.param_problems import CheckContext, ParamIssue
 from engine.values.params import (
     DISTANCE_MM,
     SECONDS,
     SPEED_DPS,
     AnyValue,
-    CheckContext,
     Choice,
     Key,
     Number,
     Param,
-    ParamIssue,
     Text,
 )
 

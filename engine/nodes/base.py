@@ -38,7 +38,8 @@ from py_trees.common import Status
 from engine.nodes.context import TreeContext
 from engine.nodes.spec import NodeType
 from engine.services.jobs import Job
-from engine.values.params import CheckContext, Param, ParamIssue
+from engine.values.param_problems import CheckContext, ParamIssue
+from engine.values.params import Param
 
 
 def node_path(node: py_trees.behaviour.Behaviour) -> str:

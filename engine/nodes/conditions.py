@@ -9,18 +9,8 @@ from typing import Any
 from engine.blackboard.catalogue import TOUCH_PAT, VARIABLES_PREFIX, KeySpec
 from engine.nodes.base import Condition
 from engine.nodes.event_reader import EQUALS, ONE_OF, EventReader, check_choice, wanted
-from engine.values.params import (
-    SECONDS,
-    CheckContext,
-    Integer,
-    Key,
-    ListOf,
-    Number,
-    Param,
-    ParamIssue,
-    Scalar,
-    Text,
-)
+from engine.values.param_problems import CheckContext, ParamIssue
+from engine.values.params import SECONDS, Integer, Key, ListOf, Number, Param, Scalar, Text
 
 _COMPARISONS = ("equals", "not_equals", "above", "below", "between")
 _WORDS_FOR_BOOLEANS = ("true", "false", "yes", "no", "on", "off")

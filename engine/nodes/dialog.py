@@ -12,7 +12,8 @@ from engine.errors import ServiceError
 from engine.nodes.base import Leaf
 from engine.services.jobs import ImmediateJob, Job
 from engine.session.events import NotUnderstood
-from engine.values.params import CheckContext, Key, Param, ParamIssue, Text, did_you_mean
+from engine.values.param_problems import CheckContext, ParamIssue, did_you_mean
+from engine.values.params import Key, Param, Text
 from engine.values.templates import CompiledTemplate
 
 

@@ -7,7 +7,8 @@ from typing import Any
 
 from engine.blackboard.events import EVENT_LOG_LENGTH, EventLog
 from engine.nodes.base import Leaf, node_path
-from engine.values.params import CheckContext, ListOf, Param, ParamIssue, Scalar
+from engine.values.param_problems import CheckContext, ParamIssue
+from engine.values.params import ListOf, Param, Scalar
 
 EQUALS = Param("equals", Scalar(), None, "only events with this value count")
 ONE_OF = Param("one_of", ListOf(Scalar(), 1), None, "only events with one of these values count")

@@ -23,7 +23,8 @@ from engine.remote_commands import (
     checked_args,
 )
 from engine.services.jobs import ImmediateJob, Job
-from engine.values.params import SECONDS, CheckContext, Key, Param
+from engine.values.param_problems import CheckContext
+from engine.values.params import SECONDS, Key, Param
 
 
 class CarryOut(ServiceAction):

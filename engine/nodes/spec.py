@@ -16,7 +16,8 @@ from typing import Any, Literal
 import py_trees
 
 from engine.nodes.context import TreeContext
-from engine.values.params import CheckContext, Key, ListOf, Param, ParamIssue
+from engine.values.param_problems import CheckContext, ParamIssue
+from engine.values.params import Key, ListOf, Param
 from engine.values.templates import CompiledTemplate
 
 Kind = Literal["composite", "decorator", "condition", "action"]

@@ -7,7 +7,7 @@ scheduler whose hooks poll the devices, and the camera's vision worker when the 
 has a camera. Every speech, LED and servo call passes through the config's safety envelope,
 whose watcher stops the arms between ticks when a person is too close or presses too hard.
 The caller hands in the speech (the assembled
-:class:`~engine.speech.robot_speech.RobotSpeech`, or any Speech service, e.g. a recording
+:class:`~engine.robot_io.robot_speech.RobotSpeech`, or any Speech service, e.g. a recording
 fake, with heard text then staged as text) and the cloud's service. What it opens is on
 the robot's :class:`~engine.runtime.lifecycle.Lifecycle`; the composition root
 (:mod:`engine.composition.session_root`) adds every other part of a run around it.
@@ -29,13 +29,13 @@ from engine.hardware.safety_envelope import (
     with_envelope,
 )
 from engine.hardware.sim_vest import SimVest, UnwiredSenses, build_sim_vest
+from engine.robot_io.robot_speech import RobotSpeech
+from engine.robot_io.robot_vision import RobotVision, build_vision
 from engine.runtime.lifecycle import Lifecycle
 from engine.runtime.robot import Behaviors, Robot
 from engine.scenario.world import World
 from engine.services.interfaces import IotResults, Services, Speech
 from engine.session.stream import SessionStream
-from engine.speech.robot_speech import RobotSpeech
-from engine.vision.robot_vision import RobotVision, build_vision
 
 
 @dataclass

@@ -28,20 +28,18 @@ from typing import Any
 from engine.blackboard.catalogue import default_catalogue
 from engine.files.problems import LoadError, Mark, Problems
 from engine.files.yaml_source import YList, YMap, YValue, describe, load_yaml, plain
-from engine.speech.audio import AudioFileError, read_wav
+from engine.media.audio import AudioFileError, read_wav
+from engine.values.param_problems import CheckContext, ParamProblem, did_you_mean
 from engine.values.params import (
     REQUIRED,
     SECONDS,
     AnyValue,
-    CheckContext,
     Choice,
     Integer,
     Number,
     Param,
-    ParamProblem,
     ParamType,
     Text,
-    did_you_mean,
 )
 
 GESTURES = (
@@ -354,7 +352,7 @@ def _check_showing(value: dict[str, Any], body: YValue, folder: Path, problems: 
         return False
     if given[0] == "fingers":
         return True
-    from engine.vision.media import check_media  # OpenCV: only for scenarios that need it
+    from engine.media.media_check import check_media  # OpenCV: only for scenarios that need it
 
     path = folder / value[given[0]]
     why = check_media(path, video=given[0] == "video")

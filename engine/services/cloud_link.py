@@ -25,7 +25,6 @@ delivered again is refused (reported FAILED with why) rather than risk running i
 from __future__ import annotations
 
 import logging
-import math
 import queue
 import threading
 from pathlib import Path
@@ -34,12 +33,12 @@ from typing import Any
 import requests
 
 from engine.blackboard.board import Blackboard
-from engine.blackboard.catalogue import DEVICES_PREFIX, IOT_CANCELED, IOT_INBOX, SENSORS_PREFIX
-from engine.blackboard.events import EventLog
+from engine.blackboard.catalogue import IOT_CANCELED, IOT_INBOX
 from engine.clock import Clock
 from engine.services.done_commands import DoneCommands
 from engine.services.jobs import ImmediateJob, Job
-from engine.session.events import KeyChanged, SessionEvent
+from engine.services.telemetry import TelemetrySnapshot, json_safe
+from engine.session.events import KeyChanged
 from engine.session.stream import SessionStream
 
 log = logging.getLogger(__name__)
@@ -52,7 +51,6 @@ in the service stays QUEUED, and an operator can still cancel it. Meanwhile the 
 extends the lease of the one it carries out three times a lease (``lease_s`` comes with
 the command), so the service neither delivers it again nor shows it QUEUED."""
 DEFAULT_LEASE_S = 30.0
-TELEMETRY_PREFIXES = (SENSORS_PREFIX, DEVICES_PREFIX)
 PROGRESS_EVERY_S = 2.0
 """How often the robot tells the service it is still at a command (at most a third of
 the lease): an operator's cancel stops the robot within this."""
@@ -66,41 +64,6 @@ def _positive(value: Any, default: float) -> float:
     if isinstance(value, int | float) and not isinstance(value, bool) and value > 0:
         return float(value)
     return default
-
-
-def _json_safe(value: Any) -> Any:
-    """Numbers that JSON cannot carry (NaN, infinity) as None; containers walked; an
-    event key as its latest event's value (None before the first)."""
-    if isinstance(value, EventLog):
-        return _json_safe(value.latest.value) if value.latest is not None else None
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    if isinstance(value, dict):
-        return {str(k): _json_safe(v) for k, v in value.items()}
-    if isinstance(value, list | tuple):
-        return [_json_safe(v) for v in value]
-    if value is None or isinstance(value, bool | int | float | str):
-        return value
-    return str(value)
-
-
-class TelemetrySnapshot:
-    """A session reader: the latest committed value of each sensor and device key, kept
-    for the telemetry thread, which takes a copy (:meth:`take`)."""
-
-    def __init__(self) -> None:
-        self._values: dict[str, Any] = {}
-        self._lock = threading.Lock()
-
-    def on_event(self, event: SessionEvent) -> None:
-        if isinstance(event, KeyChanged) and event.key.startswith(TELEMETRY_PREFIXES):
-            value = _json_safe(event.value)
-            with self._lock:
-                self._values[event.key] = value
-
-    def take(self) -> dict[str, Any]:
-        with self._lock:
-            return dict(self._values)
 
 
 class CloudLink:
@@ -174,7 +137,7 @@ class CloudLink:
     def report(self, command_id: str, status: str, result: Any = None) -> Job:
         """Queue the report (it is sent, and retried, by the reporter); done at once. A
         command that did not come from the cloud (a scenario's, say) is not reported there."""
-        report = {"status": status.upper(), "result": _json_safe(result)}
+        report = {"status": status.upper(), "result": json_safe(result)}
         with self._carrying_out:
             if command_id not in self._from_cloud:
                 log.debug("command %s did not come from the cloud; not reported there", command_id)

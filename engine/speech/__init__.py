@@ -2,5 +2,5 @@
 
 microphone -> :mod:`vad` (Silero) -> :mod:`recognizer` (Whisper biased by the dialogs)
 -> dialog matcher; answers -> :mod:`voices` (the Piper-format neural voice, or espeak-ng)
--> speaker. Audio devices live in :mod:`engine.drivers` (``audio_in``, ``audio_out``).
+-> speaker. Audio clips and devices live in :mod:`engine.media`.
 """

@@ -10,7 +10,7 @@ import string
 from dataclasses import dataclass
 
 from engine.dialogs.model import Dialog, FollowUp, Verdict
-from engine.speech.audio import SPEECH_RATE_HZ, Audio
+from engine.media.audio import SPEECH_RATE_HZ, Audio
 from engine.speech.recognizer import Recognizer
 from engine.speech.vad import SpeechDetector, SpeechProbability
 from engine.values.templates import CompiledTemplate

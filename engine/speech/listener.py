@@ -9,7 +9,7 @@ who speaks over the robot is therefore not heard; what can be known of it is tol
 ``on_not_listened(from_s, until_s, why)``: here, speech already under way when the robot
 stops (its start was lost). Telling speech *within* the robot's voice apart from its echo
 needs echo cancellation, which a microphone here does not have; the simulated room knows
-who spoke when, and tells it itself (:mod:`engine.speech.robot_speech`).
+who spoke when, and tells it itself (:mod:`engine.robot_io.robot_speech`).
 """
 
 from __future__ import annotations
@@ -21,7 +21,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 from engine.clock import Clock
-from engine.speech.audio import Audio
+from engine.media.audio import Audio
 from engine.speech.recognizer import Recognizer
 from engine.speech.settling import Settling
 from engine.speech.speaker import SelfHearing

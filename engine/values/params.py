@@ -6,78 +6,12 @@ type and the value found, and a hint where one helps. The loader adds the place.
 
 from __future__ import annotations
 
-import difflib
 import math
 import re
-from collections.abc import Iterable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, Generic, Literal, Protocol, TypeVar, overload
+from typing import Any, Generic, Literal, TypeVar, overload
 
-if TYPE_CHECKING:
-    from engine.blackboard.catalogue import KeyCatalogue
-
-
-class KnownDialogs(Protocol):
-    """What a check may ask of the loaded dialogs: their names (the library answers it)."""
-
-    @property
-    def names(self) -> list[str]: ...
-
-    def get(self, name: str) -> object | None: ...
-
-
-class ParamProblem(Exception):  # noqa: N818 - a problem report, not a failure
-    """A parameter value is wrong: ``message`` says what, ``hint`` how to fix it."""
-
-    def __init__(self, message: str, hint: str | None = None) -> None:
-        super().__init__(message)
-        self.message = message
-        self.hint = hint
-
-
-@dataclass(frozen=True)
-class ParamIssue:
-    """A problem across a node's parameters, found once they are all converted.
-
-    ``param`` names the parameter whose value the loader points at (None: the node
-    itself); ``message`` says what is wrong, ``hint`` how to fix it.
-    """
-
-    param: str | None
-    message: str
-    hint: str | None = None
-
-
-@dataclass(frozen=True)
-class CheckContext:
-    """What parameter checks may consult at load time (never hardware)."""
-
-    catalogue: KeyCatalogue
-    dialogs: KnownDialogs | None = None
-
-
-def _shown(value: Any) -> str:
-    if isinstance(value, str):
-        return repr(value)
-    if value is None:
-        return "nothing"
-    if isinstance(value, dict):
-        return "a mapping"
-    if isinstance(value, list):
-        return "a list"
-    return repr(value)
-
-
-def did_you_mean(word: str, choices: Iterable[str]) -> str | None:
-    """``"did you mean 'x'?"`` for the choice closest to ``word``, or None."""
-    choices = list(choices)
-    close = difflib.get_close_matches(word, choices, n=1, cutoff=0.6)
-    if not close:
-        lowered = {c.lower(): c for c in choices}
-        if word.lower() in lowered:
-            close = [lowered[word.lower()]]
-    return f"did you mean {close[0]!r}?" if close else None
-
+from engine.values.param_problems import CheckContext, ParamProblem, did_you_mean, shown
 
 T = TypeVar("T")
 
@@ -107,7 +41,7 @@ class Text(ParamType[str]):
 
     def convert(self, value: Any, ctx: CheckContext) -> str:
         if isinstance(value, bool) or value is None or isinstance(value, dict | list):
-            raise ParamProblem(f"must be text, got {_shown(value)}", "put the text in quotes")
+            raise ParamProblem(f"must be text, got {shown(value)}", "put the text in quotes")
         return str(value)
 
 
@@ -122,7 +56,7 @@ class Number(ParamType[float]):
 
     def convert(self, value: Any, ctx: CheckContext) -> float:
         if isinstance(value, bool) or not isinstance(value, int | float):
-            raise ParamProblem(f"must be a number, got {_shown(value)}", self._example())
+            raise ParamProblem(f"must be a number, got {shown(value)}", self._example())
         try:
             number = float(value)
         except OverflowError:
@@ -167,7 +101,7 @@ class Integer(ParamType[int]):
 
     def convert(self, value: Any, ctx: CheckContext) -> int:
         if isinstance(value, bool) or not isinstance(value, int):
-            raise ParamProblem(f"must be a whole number, got {_shown(value)}")
+            raise ParamProblem(f"must be a whole number, got {shown(value)}")
         if self.minimum is not None and value < self.minimum:
             raise ParamProblem(f"must be at least {self.minimum}, got {value}")
         if self.maximum is not None and value > self.maximum:
@@ -198,7 +132,7 @@ class Boolean(ParamType[bool]):
 
     def convert(self, value: Any, ctx: CheckContext) -> bool:
         if not isinstance(value, bool):
-            raise ParamProblem(f"must be true or false, got {_shown(value)}")
+            raise ParamProblem(f"must be true or false, got {shown(value)}")
         return value
 
 
@@ -211,7 +145,7 @@ class Choice(ParamType[str]):
         if not isinstance(value, str) or value not in self.options:
             hint = did_you_mean(str(value), self.options) if isinstance(value, str) else None
             options = ", ".join(self.options)
-            raise ParamProblem(f"must be one of {options}; got {_shown(value)}", hint)
+            raise ParamProblem(f"must be one of {options}; got {shown(value)}", hint)
         return value
 
     def describe(self) -> str:
@@ -255,7 +189,7 @@ class Key(ParamType[str]):
     def convert(self, value: Any, ctx: CheckContext) -> str:
         if not isinstance(value, str):
             raise ParamProblem(
-                f"must be a blackboard key like /sensors/touch/any, got {_shown(value)}"
+                f"must be a blackboard key like /sensors/touch/any, got {shown(value)}"
             )
         if not value.startswith("/"):
             raise ParamProblem(
@@ -310,7 +244,7 @@ class ListOf(ParamType[list[Any]]):
 
     def convert(self, value: Any, ctx: CheckContext) -> list[Any]:
         if not isinstance(value, list):
-            raise ParamProblem(f"must be a list like [a, b], got {_shown(value)}")
+            raise ParamProblem(f"must be a list like [a, b], got {shown(value)}")
         if len(value) < self.min_items:
             raise ParamProblem(f"needs at least {self.min_items} items, got {len(value)}")
         if self.max_items is not None and len(value) > self.max_items:
@@ -345,7 +279,7 @@ class Scalar(ParamType[Any]):
 
     def convert(self, value: Any, ctx: CheckContext) -> Any:
         if isinstance(value, dict | list) or value is None:
-            raise ParamProblem(f"must be a number, text or true/false, got {_shown(value)}")
+            raise ParamProblem(f"must be a number, text or true/false, got {shown(value)}")
         return value
 
 

@@ -13,13 +13,8 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
-from engine.values.params import (
-    CheckContext,
-    ParamProblem,
-    ParamType,
-    check_key_characters,
-    did_you_mean,
-)
+from engine.values.param_problems import CheckContext, ParamProblem, did_you_mean
+from engine.values.params import ParamType, check_key_characters
 
 _FORMATTER = string.Formatter()
 

@@ -21,7 +21,8 @@ import numpy.typing as npt
 import onnxruntime as ort
 
 from engine.errors import ConfigError
-from engine.vision.preprocess import Frame, Preprocessing, load_settings, network_input
+from engine.media.images import Frame
+from engine.vision.preprocess import Preprocessing, load_settings, network_input
 
 log = logging.getLogger(__name__)
 PREFERRED_PROVIDERS = (

@@ -34,10 +34,7 @@ import numpy.typing as npt
 from engine.errors import ConfigError
 from engine.files.problems import LoadError
 from engine.files.yaml_source import read_bytes
-from engine.vision.image_size import image_size
-
-Frame = npt.NDArray[np.uint8]
-"""An image as OpenCV holds it: rows x columns (x 3 for BGR colour), uint8."""
+from engine.media.images import MAX_FRAME_PX, Frame
 
 SIDE_PX = 128
 LABELS = (0, 1, 2, 3, 4, 5)
@@ -52,9 +49,6 @@ MAX_KERNEL_PX = 101
 """The widest blur or threshold window (the paper's are 3 and 11 px)."""
 """The largest window a model may read (the paper's is 128)."""
 MAX_SETTINGS_BYTES = 64 * 1024
-MAX_IMAGE_BYTES = 64 * 1024 * 1024
-MAX_FRAME_PX = 8192
-"""The widest or tallest frame or picture vest reads."""
 
 
 @dataclass(frozen=True)
@@ -238,30 +232,6 @@ def network_input(frame: Frame, settings: Preprocessing) -> npt.NDArray[np.float
     """What the network reads for ``frame``: its window (:func:`crop`) read by the
     settings' mode, shape (1, side, side)."""
     return window_input(crop(frame, settings), settings)[np.newaxis]
-
-
-def read_image(path: Path) -> Frame:
-    """An image file (PNG, JPEG, BMP, GIF, WebP) as a BGR frame, read by the one safe
-    reader and measured from its header before it is decoded: ValueError naming the file
-    when it cannot be read, is no picture, or is larger than :data:`MAX_FRAME_PX` a side
-    (a small file can hold a huge picture)."""
-    try:
-        raw = read_bytes(path, max_bytes=MAX_IMAGE_BYTES, kind="picture", too_big_hint="")
-    except LoadError as error:
-        raise ValueError(f"{path}: {error.problems[0].message}") from None
-    size = image_size(raw)
-    if size is None:
-        raise ValueError(f"{path}: not a picture vest reads (PNG, JPEG, BMP, GIF or WebP)")
-    width, height = size
-    if not (0 < width <= MAX_FRAME_PX and 0 < height <= MAX_FRAME_PX):
-        raise ValueError(
-            f"{path}: a {width}x{height} px picture; at most {MAX_FRAME_PX}x{MAX_FRAME_PX}"
-        )
-    data = np.frombuffer(raw, dtype=np.uint8)
-    image = cv2.imdecode(data, cv2.IMREAD_COLOR) if data.size else None
-    if image is None:
-        raise ValueError(f"{path}: not an image OpenCV can read")
-    return np.asarray(image, dtype=np.uint8)
 
 
 def load_settings(path: Path) -> dict[str, Any]:

@@ -9,7 +9,7 @@ import pytest
 
 from engine.clock import VirtualClock
 from engine.drivers.device_errors import ImplausibleReadingError
-from engine.drivers.sim.i2c_bus import SimI2CBus
+from engine.sim.i2c_bus import SimI2CBus
 
 R = TypeVar("R")
 

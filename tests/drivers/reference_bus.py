@@ -29,8 +29,8 @@ from collections.abc import Sequence
 import pytest
 
 from engine.clock import VirtualClock
-from engine.drivers.sim.i2c_bus import SimI2CBus
-from engine.drivers.sim.vl53l0x import SimVL53L0X
+from engine.sim.i2c_bus import SimI2CBus
+from engine.sim.vl53l0x import SimVL53L0X
 
 WriteTransfer = tuple[int, bytes]
 """One write transfer: the 7-bit address and the bytes sent (register pointer first)."""

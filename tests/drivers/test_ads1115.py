@@ -10,10 +10,10 @@ import pytest
 from engine.clock import VirtualClock
 from engine.drivers.ads1115 import ADS1115, lowest_single_ended_code, raw_to_volts
 from engine.drivers.force_calibration import ForceCalibration
-from engine.drivers.sim.ads1115 import SimADS1115
-from engine.drivers.sim.fsr import fsr406_volts
-from engine.drivers.sim.i2c_bus import SimI2CBus
 from engine.errors import DeviceError
+from engine.sim.ads1115 import SimADS1115
+from engine.sim.fsr import fsr406_volts
+from engine.sim.i2c_bus import SimI2CBus
 
 ADDRESS = 0x48
 

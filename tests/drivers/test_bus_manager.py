@@ -31,8 +31,8 @@ from engine.drivers.bus_manager import (
     percentile,
 )
 from engine.drivers.device_errors import ImplausibleReadingError
-from engine.drivers.sim.i2c_bus import RegisterFile, SimI2CBus, SimI2CDevice
 from engine.errors import ConfigError, DeviceError
+from engine.sim.i2c_bus import RegisterFile, SimI2CBus, SimI2CDevice
 
 WAIT_S = 5.0  # generous bound on waits for the worker thread, so a bug fails instead of hanging
 

@@ -8,10 +8,10 @@ import smbus2
 
 from engine.clock import VirtualClock
 from engine.drivers.bus_protocols import I2CBus, SerialPort, SpiDevice
-from engine.drivers.sim.i2c_bus import SimI2CBus
-from engine.drivers.sim.mcp3008 import SimMCP3008
-from engine.drivers.sim.spi_bus import SimSpiDev
 from engine.drivers.tca9548a import TCA9548A, LockedBus
+from engine.sim.i2c_bus import SimI2CBus
+from engine.sim.mcp3008 import SimMCP3008
+from engine.sim.spi_bus import SimSpiDev
 
 
 def test_the_real_simulated_and_wrapped_i2c_buses_are_all_smbus2_compatible() -> None:

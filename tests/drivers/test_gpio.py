@@ -19,8 +19,8 @@ from engine.drivers.gpio import (
     pack_line_values,
     pack_output_request,
 )
-from engine.drivers.sim.gpio import SimOutputLine
 from engine.errors import DeviceError
+from engine.sim.gpio import SimOutputLine
 
 
 def test_struct_sizes_and_ioctl_numbers_match_linux_gpio_h():

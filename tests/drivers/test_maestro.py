@@ -34,8 +34,8 @@ from engine.drivers.maestro_protocol import (
     us_to_quarter_us,
 )
 from engine.drivers.servo_joints import Joint, ServoJoints
-from engine.drivers.sim.maestro_emulator import MaestroEmulator
 from engine.errors import DeviceError
+from engine.sim.maestro_emulator import MaestroEmulator
 
 
 @pytest.fixture

@@ -5,8 +5,8 @@ from __future__ import annotations
 import pytest
 
 from engine.drivers.mcp3008 import MCP3008, command_bytes, raw_to_volts
-from engine.drivers.sim.mcp3008 import SimMCP3008
-from engine.drivers.sim.spi_bus import SimSpiDev
+from engine.sim.mcp3008 import SimMCP3008
+from engine.sim.spi_bus import SimSpiDev
 
 
 def decode(answer: list[int]) -> int:

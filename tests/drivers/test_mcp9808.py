@@ -15,9 +15,9 @@ from engine.drivers.mcp9808 import (
     celsius_to_limit_word,
     raw_to_celsius,
 )
-from engine.drivers.sim.i2c_bus import SimI2CBus, SimI2CDevice
-from engine.drivers.sim.mcp9808 import SimMCP9808
 from engine.errors import DeviceError
+from engine.sim.i2c_bus import SimI2CBus, SimI2CDevice
+from engine.sim.mcp9808 import SimMCP9808
 
 ADDRESS = 0x18
 

@@ -9,9 +9,9 @@ import pytest
 
 from engine.clock import VirtualClock
 from engine.drivers.mpr121 import MPR121
-from engine.drivers.sim.i2c_bus import RegisterFile, SimI2CBus, SimI2CDevice
-from engine.drivers.sim.mpr121 import SimMPR121
 from engine.errors import DeviceError
+from engine.sim.i2c_bus import RegisterFile, SimI2CBus, SimI2CDevice
+from engine.sim.mpr121 import SimMPR121
 
 
 class OtherChip(SimI2CDevice):

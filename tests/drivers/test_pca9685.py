@@ -16,9 +16,9 @@ from engine.drivers.pca9685 import (
     frequency_range_hz,
     prescale_for,
 )
-from engine.drivers.sim.i2c_bus import SimI2CBus
-from engine.drivers.sim.pca9685 import SimPCA9685
 from engine.errors import DeviceError
+from engine.sim.i2c_bus import SimI2CBus
+from engine.sim.pca9685 import SimPCA9685
 
 
 @pytest.fixture

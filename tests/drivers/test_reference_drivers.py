@@ -17,13 +17,13 @@ from collections.abc import Callable
 import pytest
 
 from engine.clock import VirtualClock
-from engine.drivers.sim.ads1115 import SimADS1115
-from engine.drivers.sim.fsr import fsr406_volts
-from engine.drivers.sim.i2c_bus import SimI2CBus
-from engine.drivers.sim.mcp9808 import SimMCP9808
-from engine.drivers.sim.mpr121 import SimMPR121
-from engine.drivers.sim.pca9685 import SimPCA9685
-from engine.drivers.sim.vl53l0x import SimVL53L0X
+from engine.sim.ads1115 import SimADS1115
+from engine.sim.fsr import fsr406_volts
+from engine.sim.i2c_bus import SimI2CBus
+from engine.sim.mcp9808 import SimMCP9808
+from engine.sim.mpr121 import SimMPR121
+from engine.sim.pca9685 import SimPCA9685
+from engine.sim.vl53l0x import SimVL53L0X
 
 from .reference_bus import NvmOff, ReferenceI2C, TransactionBudgetError, load_reference_driver
 

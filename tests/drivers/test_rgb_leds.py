@@ -7,8 +7,8 @@ import pytest
 from engine.clock import VirtualClock
 from engine.drivers.pca9685 import PCA9685
 from engine.drivers.rgb_leds import RgbLeds, color_to_rgb
-from engine.drivers.sim.i2c_bus import SimI2CBus
-from engine.drivers.sim.pca9685 import SimPCA9685
+from engine.sim.i2c_bus import SimI2CBus
+from engine.sim.pca9685 import SimPCA9685
 
 FACE = {"left_eye": (0, 1, 2), "right_eye": (3, 4, 5), "mouth": (6, 7, 8)}
 

@@ -17,8 +17,8 @@ from engine.drivers.servo_joints import (
     speed_dps_to_maestro,
     us_to_angle,
 )
-from engine.drivers.sim.maestro_emulator import MaestroEmulator
 from engine.errors import ConfigError, ServiceError
+from engine.sim.maestro_emulator import MaestroEmulator
 
 NECK = Joint("neck_pan", 0, -60.0, 60.0, 120.0, min_us=1000.0, max_us=2000.0)
 ARM = Joint("arm_left", 1, 0.0, 90.0, 45.0, min_us=1100.0, max_us=1820.0, home_deg=10.0)

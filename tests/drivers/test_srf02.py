@@ -8,10 +8,10 @@ from typing import Any
 import pytest
 
 from engine.clock import VirtualClock
-from engine.drivers.sim.i2c_bus import SimI2CBus
-from engine.drivers.sim.srf02 import SimSRF02
 from engine.drivers.srf02 import MIN_RANGE_CM, SRF02
 from engine.errors import DeviceError
+from engine.sim.i2c_bus import SimI2CBus
+from engine.sim.srf02 import SimSRF02
 
 ADDRESS = 0x70
 

@@ -7,13 +7,13 @@ import threading
 import pytest
 
 from engine.clock import VirtualClock
-from engine.drivers.sim.i2c_bus import SimI2CBus
-from engine.drivers.sim.tca9548a import SimTCA9548A
-from engine.drivers.sim.vl53l0x import SimVL53L0X
-from engine.drivers.sim.zx_gesture import SimZXGesture
 from engine.drivers.tca9548a import TCA9548A, channel_mask
 from engine.drivers.vl53l0x import VL53L0X
 from engine.errors import DeviceError
+from engine.sim.i2c_bus import SimI2CBus
+from engine.sim.tca9548a import SimTCA9548A
+from engine.sim.vl53l0x import SimVL53L0X
+from engine.sim.zx_gesture import SimZXGesture
 
 
 @pytest.fixture

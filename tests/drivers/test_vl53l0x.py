@@ -8,8 +8,6 @@ from typing import Any
 import pytest
 
 from engine.clock import VirtualClock
-from engine.drivers.sim.i2c_bus import SimI2CBus, SimI2CDevice
-from engine.drivers.sim.vl53l0x import SimVL53L0X
 from engine.drivers.vl53l0x import (
     VL53L0X,
     decode_range,
@@ -17,6 +15,8 @@ from engine.drivers.vl53l0x import (
     signal_rate_limit_to_register,
 )
 from engine.errors import DeviceError
+from engine.sim.i2c_bus import SimI2CBus, SimI2CDevice
+from engine.sim.vl53l0x import SimVL53L0X
 
 
 @pytest.fixture

@@ -16,8 +16,6 @@ import errno
 import pytest
 
 from engine.clock import VirtualClock
-from engine.drivers.sim.i2c_bus import SimI2CBus, bus_error
-from engine.drivers.sim.vl53l0x import SimVL53L0X
 from engine.drivers.vl53l0x import VL53L0X
 from engine.drivers.vl53l0x_spads import ReferenceSpads, select_reference_spads
 from engine.drivers.vl53l0x_timing import (
@@ -27,6 +25,8 @@ from engine.drivers.vl53l0x_timing import (
 )
 from engine.drivers.vl53l0x_tuning import DEFAULT_TUNING
 from engine.errors import DeviceError
+from engine.sim.i2c_bus import SimI2CBus, bus_error
+from engine.sim.vl53l0x import SimVL53L0X
 
 from .reference_bus import NvmOff, RecordingBus, ReferenceI2C, load_reference_driver
 

@@ -8,10 +8,10 @@ from typing import Any
 import pytest
 
 from engine.clock import VirtualClock
-from engine.drivers.sim.i2c_bus import SimI2CBus
-from engine.drivers.sim.zx_gesture import SimZXGesture
 from engine.drivers.zx_gesture import ZXGesture, decode_position, gesture_name
 from engine.errors import DeviceError
+from engine.sim.i2c_bus import SimI2CBus
+from engine.sim.zx_gesture import SimZXGesture
 
 
 @pytest.fixture

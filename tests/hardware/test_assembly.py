@@ -17,8 +17,7 @@ import pytest
 from engine.blackboard.board import Blackboard
 from engine.blackboard.catalogue import default_catalogue
 from engine.clock import RealClock, VirtualClock
-from engine.drivers import mcp9808, vl53l0x
-from engine.drivers.sim.i2c_bus import SimI2CBus
+from engine.drivers import mcp9808_registers, vl53l0x
 from engine.errors import DeviceError
 from engine.hardware.assembly import build_hardware
 from engine.hardware.config import SIDES, BusConfig, RobotConfig
@@ -26,6 +25,7 @@ from engine.hardware.config_file import load_robot_config
 from engine.hardware.robot_hardware import Hardware
 from engine.hardware.sim_vest import SimVest, build_sim_vest
 from engine.scenario.world import World
+from engine.sim.i2c_bus import SimI2CBus
 
 from .conftest import MUXED, ROOT, SimRobot
 
@@ -186,7 +186,7 @@ def test_upstream_chips_and_chips_behind_the_mux_never_get_each_other_s_transfer
         target=keep_asking,
         args=(
             "temperature",
-            lambda bus: bus.read_i2c_block_data(0x18, mcp9808.MANUFACTURER_ID, 2),
+            lambda bus: bus.read_i2c_block_data(0x18, mcp9808_registers.MANUFACTURER_ID, 2),
             [0x00, 0x54],
         ),
     )

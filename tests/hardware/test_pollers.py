@@ -11,11 +11,6 @@ import pytest
 
 from engine.clock import Clock, RealClock, VirtualClock
 from engine.drivers.bus_manager import BusManager
-from engine.drivers.sim.i2c_bus import SimI2CBus
-from engine.drivers.sim.mcp3008 import SimMCP3008
-from engine.drivers.sim.mpr121 import SimMPR121
-from engine.drivers.sim.spi_bus import SimSpiDev
-from engine.drivers.sim.zx_gesture import SimZXGesture
 from engine.files.problems import Mark
 from engine.hardware.branching_clock import BranchingClock
 from engine.hardware.chips import default_chips
@@ -24,6 +19,11 @@ from engine.hardware.device_health import DeviceHealth
 from engine.hardware.pollers import Poller, PollerThreads, make_poller
 from engine.hardware.readings import Staged
 from engine.hardware.sim_vest import SpiSocket
+from engine.sim.i2c_bus import SimI2CBus
+from engine.sim.mcp3008 import SimMCP3008
+from engine.sim.mpr121 import SimMPR121
+from engine.sim.spi_bus import SimSpiDev
+from engine.sim.zx_gesture import SimZXGesture
 
 HERE = Mark("test", 1, 1)
 

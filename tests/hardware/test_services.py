@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import pytest
 
-from engine.drivers.sim.pca9685 import SimPCA9685
 from engine.errors import DeviceError, ServiceError
+from engine.sim.pca9685 import SimPCA9685
 
 from .conftest import SimRobot
 

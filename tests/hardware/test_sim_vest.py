@@ -13,7 +13,7 @@ import pytest
 from engine.blackboard.board import Blackboard
 from engine.blackboard.catalogue import default_catalogue
 from engine.clock import VirtualClock
-from engine.drivers import zx_gesture
+from engine.drivers import zx_gesture_registers
 from engine.drivers.servo_joints import angle_to_us
 from engine.files.problems import Mark
 from engine.hardware.assembly import build_hardware
@@ -251,8 +251,8 @@ def test_an_unplugged_gesture_sensor_latches_no_gesture_for_later(sim_config: Ro
         world.happened("gesture", "wave")
         clock.advance(1.5)  # plugged back in
 
-        status = vest.i2c["i2c"].read_byte_data(0x10, zx_gesture.STATUS)
+        status = vest.i2c["i2c"].read_byte_data(0x10, zx_gesture_registers.STATUS)
 
-        assert status & zx_gesture.STATUS_GESTURES == 0
+        assert status & zx_gesture_registers.STATUS_GESTURES == 0
     finally:
         vest.close()

@@ -10,7 +10,7 @@ import pytest
 from engine.blackboard.catalogue import default_catalogue
 from engine.dialogs.library import load_dialog
 from engine.dialogs.model import Dialog
-from engine.speech.audio import Audio, with_noise
+from engine.media.audio import Audio, with_noise
 from engine.speech.recognizer import WhisperRecognizer
 from engine.speech.vad import SileroVad
 from engine.speech.voice_models import load_voice

@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 from engine.cli import main
-from engine.speech.audio import read_wav, write_wav
+from engine.media.audio import read_wav, write_wav
 
 ROOT = Path(__file__).resolve().parents[2]
 

@@ -8,7 +8,7 @@ from collections.abc import Callable
 import pytest
 
 from engine.dialogs.model import Dialog
-from engine.speech.audio import Audio
+from engine.media.audio import Audio
 from engine.speech.hearing import hear
 from engine.speech.recognizer import WhisperRecognizer
 from engine.speech.vad import SileroVad
@@ -87,7 +87,7 @@ def test_the_answer_to_the_robot_s_question_is_heard_as_the_follow_up(
 def test_noise_alone_is_not_heard_as_anything(
     vad: SileroVad, recognizer: WhisperRecognizer, default_dialog: Dialog
 ) -> None:
-    from engine.speech.audio import noise
+    from engine.media.audio import noise
 
     for level in (-40.0, -25.0):
         hearing = hear(noise(5.0, level, seed=3), vad, recognizer, default_dialog)

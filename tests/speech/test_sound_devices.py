@@ -8,9 +8,9 @@ import pytest
 
 from engine.cli import main
 from engine.clock import RealClock
-from engine.drivers.audio_devices import probe
 from engine.hardware.config import AudioConfig
-from engine.speech.robot_speech import build_speech
+from engine.media.audio_devices import probe
+from engine.robot_io.robot_speech import build_speech
 
 
 def test_a_missing_card_is_named_by_the_probe() -> None:

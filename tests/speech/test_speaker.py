@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from engine.clock import VirtualClock
-from engine.speech.audio import Audio
+from engine.media.audio import Audio
 from engine.speech.speaker import SelfHearing, Speaker
 
 

@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 
 from engine.cli import main
-from engine.speech.audio import Audio, read_wav, write_wav
+from engine.media.audio import Audio, read_wav, write_wav
 from engine.speech.voices import Voice
 
 ROOT = Path(__file__).resolve().parents[2]

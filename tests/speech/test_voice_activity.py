@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from engine.speech.audio import SPEECH_RATE_HZ, Audio, noise, with_noise
+from engine.media.audio import SPEECH_RATE_HZ, Audio, noise, with_noise
 from engine.speech.vad import FRAME_S, SileroVad, SpeechDetector
 
 

@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 from engine.errors import ConfigError
-from engine.vision.dataset import find_pictures, load_pictures, split
 from engine.vision.preprocess import Preprocessing
+from engine.vision_training.dataset import find_pictures, load_pictures, split
 
 
 def lab_folder(root: Path) -> Path:

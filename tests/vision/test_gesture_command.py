@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from engine.cli import main
-from engine.vision.synthetic_hands import render_frame
+from engine.vision_training.synthetic_hands import render_frame
 
 REAL_HANDS = Path(__file__).resolve().parents[2] / "examples" / "hands-real"
 

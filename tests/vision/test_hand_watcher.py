@@ -8,11 +8,11 @@ import numpy as np
 from engine.blackboard.board import Blackboard
 from engine.blackboard.catalogue import default_catalogue
 from engine.clock import VirtualClock
-from engine.drivers.camera import CameraError
 from engine.hardware.device_health import DeviceHealth
+from engine.media.camera import CameraError
+from engine.media.images import Frame
+from engine.robot_io.hand_watcher import HandWatcher, SteadyCount
 from engine.vision.classifier import HandReading
-from engine.vision.hand_watcher import HandWatcher, SteadyCount
-from engine.vision.preprocess import Frame
 
 FINGERS, CONFIDENCE, SHOWN = "/vision/hand/fingers", "/vision/hand/confidence", "/vision/hand/shown"
 CAMERA_OK = "/devices/camera/ok"

@@ -14,9 +14,14 @@ torch = pytest.importorskip(
 )
 
 from engine.vision.classifier import HandModel  # noqa: E402
-from engine.vision.hand_network import HandNetwork, WithSoftmax, export_onnx, parameter_count  # noqa: E402
-from engine.vision.synthetic_hands import write_dataset  # noqa: E402
-from engine.vision.training import (  # noqa: E402
+from engine.vision_training.hand_network import (  # noqa: E402
+    HandNetwork,
+    WithSoftmax,
+    export_onnx,
+    parameter_count,
+)
+from engine.vision_training.synthetic_hands import write_dataset  # noqa: E402
+from engine.vision_training.training import (  # noqa: E402
     TrainingSettings,
     learning_rate_factor,
     soft_targets,

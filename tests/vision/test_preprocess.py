@@ -11,13 +11,13 @@ import numpy as np
 import pytest
 
 from engine.errors import ConfigError
+from engine.media.images import read_image
 from engine.vision.preprocess import (
     Preprocessing,
     as_input,
     crop,
     edges,
     network_input,
-    read_image,
     scaled_window,
 )
 

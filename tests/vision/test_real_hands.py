@@ -10,9 +10,9 @@ from pathlib import Path
 import numpy as np
 
 from engine.vision.classifier import DEFAULT_MODEL, HandModel
-from engine.vision.dataset import find_pictures
 from engine.vision.preprocess import LABELS
-from engine.vision.training import evaluate_pictures
+from engine.vision_training.dataset import find_pictures
+from engine.vision_training.training import evaluate_pictures
 
 HELD_OUT = Path(__file__).resolve().parents[2] / "examples" / "hands-real" / "held-out"
 

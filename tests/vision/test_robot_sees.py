@@ -12,9 +12,9 @@ import pytest
 
 from engine.cli import main
 from engine.vision.classifier import HandModel
-from engine.vision.dataset import centred_inputs
-from engine.vision.evaluation import Evaluation
-from engine.vision.synthetic_hands import render_frame
+from engine.vision_training.dataset import centred_inputs
+from engine.vision_training.evaluation import Evaluation
+from engine.vision_training.synthetic_hands import render_frame
 
 ROOT = Path(__file__).resolve().parents[2]
 

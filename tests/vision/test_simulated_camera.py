@@ -12,12 +12,12 @@ import numpy as np
 import pytest
 
 from engine.clock import VirtualClock
-from engine.drivers.camera import CameraError
-from engine.drivers.sim.camera import SimulatedCamera
 from engine.files.problems import LoadError
+from engine.media.camera import CameraError
 from engine.scenario.player import ScenarioPlayer
 from engine.scenario.scenario_file import load_scenario
 from engine.scenario.world import World
+from engine.sim.camera import SimulatedCamera
 from engine.vision.preprocess import Preprocessing, crop
 
 WINDOW = (slice(116, 244), slice(256, 384))  # the centred 128 x 128 window of 640 x 360

@@ -7,13 +7,13 @@ from typing import Any
 
 from engine.blackboard.catalogue import FORCE_SQUEEZE
 from engine.drivers.ads1115 import ADS1115
-from engine.drivers.sim.ads1115 import SimADS1115
 from engine.hardware.chips.fields import ChipFields
 from engine.hardware.chips.force_pads import force_fields, force_poll, show_forces
 from engine.hardware.chips.kind import ChipKind, SimPlacement
 from engine.hardware.config import ChipSpec, DeviceConfig
 from engine.hardware.managed_buses import ManagedI2C
 from engine.hardware.readings import PollParts, PollSetup
+from engine.sim.ads1115 import SimADS1115
 from engine.values.params import Choice, Param
 
 

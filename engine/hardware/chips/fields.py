@@ -14,7 +14,8 @@ from typing import Any, Protocol
 from engine.files.problems import Problems
 from engine.files.yaml_source import YMap, YValue
 from engine.hardware.config import ChipSpec
-from engine.values.params import CheckContext, Param, ParamType
+from engine.values.param_problems import CheckContext
+from engine.values.params import Param, ParamType
 
 
 class ConfigChecks(Protocol):

@@ -14,13 +14,13 @@ from typing import Any, Protocol
 
 from engine.clock import Clock
 from engine.drivers.bus_manager import DeviceHandle
-from engine.drivers.sim.i2c_bus import SimI2CBus, SimI2CDevice
 from engine.errors import DeviceError
 from engine.files.problems import Mark, Problems
 from engine.hardware.chips.fields import ChipFields
 from engine.hardware.config import BusConfig, ChipSpec, DeviceConfig
 from engine.hardware.readings import PollMaker, Staged
 from engine.scenario.world import World
+from engine.sim.i2c_bus import SimI2CBus, SimI2CDevice
 
 FieldsCheck = Callable[[ChipFields], dict[str, Any] | None]
 """Checks a device's structured fields; returns the values for its DeviceConfig (e.g.

@@ -6,11 +6,11 @@ from collections.abc import Callable
 from typing import Any
 
 from engine.blackboard.catalogue import TEMPERATURE_C, TEMPERATURE_F
-from engine.drivers import mcp9808 as driver
-from engine.drivers.sim.mcp9808 import SimMCP9808
+from engine.drivers import mcp9808_registers as registers
 from engine.hardware.chips.kind import ChipKind, SimPlacement, expect_identity
 from engine.hardware.config import ChipSpec, DeviceConfig
 from engine.hardware.sensor_services import TemperatureSensor
+from engine.sim.mcp9808 import SimMCP9808
 from engine.values.params import Choice, Param
 
 
@@ -23,7 +23,7 @@ def _simulate(vest: SimPlacement, device: DeviceConfig) -> None:
 def _probe(address: int) -> Callable[[Any], object]:
     return lambda bus: expect_identity(
         "MCP9808 manufacturer ID",
-        bus.read_i2c_block_data(address, driver.MANUFACTURER_ID, 2),
+        bus.read_i2c_block_data(address, registers.MANUFACTURER_ID, 2),
         [0x00, 0x54],
     )
 

@@ -7,9 +7,8 @@ from collections.abc import Callable, Sequence
 from typing import Any
 
 from engine.blackboard.catalogue import TOUCH_ANY, TOUCH_PADS, TOUCH_PAT, TOUCH_TOUCHED
-from engine.drivers import mpr121 as driver
-from engine.drivers.mpr121 import MPR121, PADS, check_thresholds
-from engine.drivers.sim.mpr121 import SimMPR121
+from engine.drivers.mpr121 import MPR121, check_thresholds
+from engine.drivers.mpr121_registers import CONFIG2, PADS
 from engine.files.yaml_source import YList, describe
 from engine.hardware.chips.fields import ChipFields
 from engine.hardware.chips.kind import ChipKind, SimPlacement
@@ -17,6 +16,7 @@ from engine.hardware.config import ChipSpec, DeviceConfig
 from engine.hardware.managed_buses import ManagedI2C
 from engine.hardware.readings import PollParts, PollSetup, Staged
 from engine.hardware.touch_pads import default_pad_name, pad_names
+from engine.sim.mpr121 import SimMPR121
 from engine.values.params import Integer, Param
 
 _PAD_NAME = re.compile(r"[a-z][a-z0-9_]*\Z")
@@ -28,7 +28,7 @@ def _simulate(vest: SimPlacement, device: DeviceConfig) -> None:
 
 
 def _probe(address: int) -> Callable[[Any], object]:
-    return lambda bus: bus.read_byte_data(address, driver.CONFIG2)
+    return lambda bus: bus.read_byte_data(address, CONFIG2)
 
 
 def _poll(setup: PollSetup) -> PollParts:

@@ -5,12 +5,12 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
-from engine.drivers import pca9685 as driver
-from engine.drivers.sim.pca9685 import SimPCA9685
+from engine.drivers import pca9685_registers as registers
 from engine.hardware.actuator_services import HardwareLeds
 from engine.hardware.chips.fields import ChipFields
 from engine.hardware.chips.kind import ChipKind, DevicesTogether, SimPlacement
 from engine.hardware.config import PCA9685_ALL_CALL, ChipSpec, DeviceConfig
+from engine.sim.pca9685 import SimPCA9685
 from engine.values.params import REQUIRED, Boolean, Integer, Number, Param
 
 LED_FIELDS = ("red", "green", "blue")
@@ -81,7 +81,7 @@ def _simulate(vest: SimPlacement, device: DeviceConfig) -> None:
 
 
 def _probe(address: int) -> Callable[[Any], object]:
-    return lambda bus: bus.read_byte_data(address, driver.PRE_SCALE)
+    return lambda bus: bus.read_byte_data(address, registers.PRE_SCALE)
 
 
 def _all_call(checks: DevicesTogether, mine: list[DeviceConfig]) -> None:

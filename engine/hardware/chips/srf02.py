@@ -6,11 +6,11 @@ from collections.abc import Callable
 from typing import Any
 
 from engine.blackboard.catalogue import ULTRASOUND_CM
-from engine.drivers import srf02 as driver
-from engine.drivers.sim.srf02 import SimSRF02
+from engine.drivers import srf02_registers as registers
 from engine.hardware.chips.kind import ChipKind, SimPlacement, expect_identity
 from engine.hardware.config import ChipSpec, DeviceConfig
 from engine.hardware.sensor_services import UltrasoundSensor
+from engine.sim.srf02 import SimSRF02
 
 
 def _simulate(vest: SimPlacement, device: DeviceConfig) -> None:
@@ -20,7 +20,7 @@ def _simulate(vest: SimPlacement, device: DeviceConfig) -> None:
 
 def _probe(address: int) -> Callable[[Any], object]:
     return lambda bus: expect_identity(
-        "SRF02 register 1", bus.read_byte_data(address, driver.UNUSED), driver.UNUSED_VALUE
+        "SRF02 register 1", bus.read_byte_data(address, registers.UNUSED), registers.UNUSED_VALUE
     )
 
 

@@ -7,13 +7,13 @@ from typing import Any
 
 from engine.drivers import vl53l0x as driver
 from engine.drivers.bus_manager import Priority
-from engine.drivers.sim.vl53l0x import SimVL53L0X
 from engine.drivers.vl53l0x import VL53L0X
 from engine.hardware.chips.fields import ChipFields
 from engine.hardware.chips.kind import ChipKind, DevicesTogether, SimPlacement, expect_identity
 from engine.hardware.config import SIDES, VL53L0X_BOOT_ADDRESS, ChipSpec, DeviceConfig, hex_address
 from engine.hardware.managed_buses import ManagedI2C
 from engine.hardware.readings import PollParts, PollSetup, Staged
+from engine.sim.vl53l0x import SimVL53L0X
 from engine.values.params import Choice, Integer, Number, Param, Text
 
 

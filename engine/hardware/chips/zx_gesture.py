@@ -6,15 +6,16 @@ from collections.abc import Callable, Sequence
 from typing import Any
 
 from engine.blackboard.catalogue import GESTURE_LAST
-from engine.drivers import zx_gesture as driver
-from engine.drivers.sim.zx_gesture import SimZXGesture
+from engine.drivers import zx_gesture_registers as registers
 from engine.drivers.zx_gesture import ZXGesture
 from engine.hardware.chips.fields import ChipFields
 from engine.hardware.chips.kind import ChipKind, SimPlacement, expect_identity
 from engine.hardware.config import ENGINE_GESTURES, ZX_GESTURES, ChipSpec, DeviceConfig
 from engine.hardware.managed_buses import ManagedI2C
 from engine.hardware.readings import PollParts, PollSetup, Staged
-from engine.values.params import Choice, did_you_mean
+from engine.sim.zx_gesture import SimZXGesture
+from engine.values.param_problems import did_you_mean
+from engine.values.params import Choice
 
 
 def _gesture_names_check(fields: ChipFields) -> dict[str, str] | None:
@@ -54,7 +55,7 @@ def _simulate(vest: SimPlacement, device: DeviceConfig) -> None:
 
 def _probe(address: int) -> Callable[[Any], object]:
     return lambda bus: expect_identity(
-        "ZX model", bus.read_byte_data(address, driver.MODEL), driver.MODEL_ID
+        "ZX model", bus.read_byte_data(address, registers.MODEL), registers.MODEL_ID
     )
 
 

@@ -1,1 +1,0 @@
-"""The simulated vest: register-level models of the vest's chips behind real bus interfaces."""

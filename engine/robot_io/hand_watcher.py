@@ -1,0 +1,202 @@
+"""The vision worker: camera frames through the finger-count network onto the blackboard.
+
+Every frame it stages ``/vision/hand/fingers`` (0..5, or None when no hand is seen or the
+network is not sure) and ``/vision/hand/confidence``; when a count changes and holds for
+``steady_frames`` frames it stages one ``/vision/hand/shown`` event, and
+``/vision/hand/held`` keeps that count until another (or no hand) holds as long. Trees only read
+the blackboard: the camera, the preprocessing and the network never run in a tick.
+
+On a real clock it is a thread (:meth:`start`): it reads a frame when one is due at the
+camera's rate, and a frame that comes while the network is still busy is dropped, never
+queued (the camera keeps one frame; the next deadline skips ahead). On a virtual clock
+(``vest run --fast``, the tests) the scheduler calls it as a hook and it reads the frames
+due by then, in order, so a run is the same every time.
+
+The camera is a device like the chips: ``/devices/<camera>/ok`` is False while it gives
+no frames, and it is re-opened every ``reopen_s`` until it answers again.
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+
+from engine.blackboard.board import Blackboard
+from engine.blackboard.catalogue import HAND_CONFIDENCE, HAND_FINGERS, HAND_HELD, HAND_SHOWN
+from engine.clock import Clock, ClockEvent
+from engine.hardware.device_health import DeviceHealth
+from engine.media.camera import Camera, CameraError
+from engine.media.images import Frame
+from engine.vision.classifier import FingerCounter, HandReading
+
+log = logging.getLogger(__name__)
+REOPEN_S = 2.0
+STOP_WAIT_S = 5.0
+"""How long stopping waits for a frame being read (a webcam gives one within a second)."""
+
+
+class SteadyCount:
+    """Turns per-frame counts into events: a count is *shown* once it changes and holds
+    for ``steady_frames`` frames in a row. "No count" that holds as long ends what was
+    shown, so the same count shown again is a new event."""
+
+    def __init__(self, steady_frames: int) -> None:
+        self.steady_frames = steady_frames
+        self.shown: int | None = None
+        self._candidate: int | None = None
+        self._streak = 0
+
+    def reset(self) -> None:
+        """Forget what was shown (the camera saw nothing for a while)."""
+        self.shown, self._candidate, self._streak = None, None, 0
+
+    def add(self, fingers: int | None) -> int | None:
+        """The count newly shown by this frame, or None."""
+        if fingers == self._candidate:
+            self._streak += 1
+        else:
+            self._candidate, self._streak = fingers, 1
+        if self._streak != self.steady_frames or fingers == self.shown:
+            return None
+        self.shown = fingers
+        return fingers
+
+
+class HandWatcher:
+    """Reads ``camera`` at ``fps`` frames a second, counts fingers with ``model`` (a
+    :class:`~engine.vision.classifier.HandModel`) and
+    stages the results on ``blackboard``; ``health`` is the camera's device health."""
+
+    def __init__(
+        self,
+        camera: Camera,
+        model: FingerCounter,
+        blackboard: Blackboard,
+        clock: Clock,
+        health: DeviceHealth,
+        *,
+        fps: float,
+        steady_frames: int,
+        reopen_s: float = REOPEN_S,
+    ) -> None:
+        self.camera, self.model = camera, model
+        self.blackboard, self.clock, self.health = blackboard, clock, health
+        self.period_s = 1.0 / fps
+        self.reopen_s = reopen_s
+        self.steady = SteadyCount(steady_frames)
+        self.frames = 0
+        self.dropped = 0
+        self._open = False
+        self._next_s: float | None = None
+        self._retry_s = 0.0
+        self._stop: ClockEvent | None = None
+        self._thread: threading.Thread | None = None
+
+    # -- one frame ------------------------------------------------------------------------
+    def process(self, frame: Frame) -> HandReading:
+        """Count the fingers in ``frame`` and stage what was seen."""
+        reading = self.model.read(frame)
+        self.frames += 1
+        self.blackboard.stage(HAND_FINGERS, reading.fingers)
+        self.blackboard.stage(HAND_CONFIDENCE, round(reading.confidence, 4))
+        held = self.steady.shown
+        shown = self.steady.add(reading.fingers)
+        if shown is not None:
+            self.blackboard.stage_event(HAND_SHOWN, shown)
+        if self.steady.shown != held:
+            self.blackboard.stage(HAND_HELD, self.steady.shown)
+        return reading
+
+    def take_frame(self) -> HandReading | None:
+        """Open the camera if it is not (at most every ``reopen_s``), read one frame and
+        process it; None when the camera gives none (it is then offline)."""
+        now = self.clock.now()
+        if not self._open:
+            if now < self._retry_s:
+                return None
+            try:
+                self.camera.open()
+            except CameraError as error:
+                self._failed(str(error), now)
+                return None
+            self._open = True
+            self.health.driver_status(True)
+        try:
+            frame = self.camera.read()
+            return self.process(frame)
+        except CameraError as error:
+            self.camera.close()
+            self._open = False
+            self._failed(str(error), now)
+        except ValueError as error:  # frames the window does not fit (a camera's own size)
+            self.camera.close()
+            self._open = False
+            self._failed(f"{self.camera.name}: {error}", now)
+        return None
+
+    def _failed(self, why: str, now_s: float) -> None:
+        if self.health.driver_ok:
+            log.info("%s; trying again every %g s", why, self.reopen_s)  # the timeline says so
+            self.blackboard.stage(HAND_FINGERS, None)
+            self.blackboard.stage(HAND_CONFIDENCE, None)
+            if self.steady.shown is not None:
+                self.blackboard.stage(HAND_HELD, None)
+            self.steady.reset()
+        self.health.driver_status(False, why)
+        self._retry_s = now_s + self.reopen_s
+
+    # -- on a virtual clock: a scheduler hook ---------------------------------------------
+    def __call__(self, now_s: float) -> None:
+        """Take every frame due by ``now_s`` (clock seconds)."""
+        if self._next_s is None:
+            self._next_s = now_s
+        while self._next_s <= now_s + 1e-9:
+            self.take_frame()
+            self._next_s += self.period_s
+
+    # -- on a real clock: a thread ---------------------------------------------------------
+    def start(self) -> None:
+        """Start the worker thread (real clock)."""
+        if self._thread is not None:
+            return
+        self._stop = self.clock.event()
+        self._thread = threading.Thread(target=self._run, name="vision", daemon=True)
+        self._thread.start()
+
+    def _run(self) -> None:
+        assert self._stop is not None
+        try:
+            self._frames_until_stopped(self._stop)
+        finally:
+            self.camera.close()  # by the thread that reads it, never under its feet
+            self._open = False
+
+    def _frames_until_stopped(self, stop: ClockEvent) -> None:
+        next_s = self.clock.now()
+        while not stop.is_set():
+            if self.clock.sleep_until(next_s, stop):
+                break
+            try:
+                self.take_frame()
+            except Exception:  # a bug must not end the robot's sight silently
+                log.exception("the vision worker failed on a frame")
+            next_s += self.period_s
+            now = self.clock.now()
+            if next_s < now:  # behind: drop the frames we had no time for
+                missed = int((now - next_s) / self.period_s) + 1
+                self.dropped += missed
+                next_s += missed * self.period_s
+
+    def stop(self) -> None:
+        """Stop the worker (if running: it closes the camera when its read returns) or
+        close the camera."""
+        if self._stop is not None:
+            self._stop.set()
+        if self._thread is not None:
+            self._thread.join(timeout=STOP_WAIT_S)
+            if self._thread.is_alive():  # a read stuck on a dying camera: it closes it after
+                log.warning("%s: still reading; it closes when its read returns", self.camera.name)
+            self._thread = None
+            return
+        self.camera.close()
+        self._open = False
