@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import socket
 import threading
+from collections.abc import Callable
 from pathlib import Path
 
 import uvicorn
@@ -31,7 +32,7 @@ def shared_files() -> Mount:
 
 
 def listening_socket(
-    host: str, port: int, *, shared: bool = False, listen: bool = True, named: str = ""
+    host: str, port: int, *, shared: bool = False, named: str = ""
 ) -> socket.socket:
     """A TCP socket bound to ``host``:``port`` (0: any free port; ``shared``: other
     processes may bind it too). A ConfigError names the address when it cannot be had, as
@@ -43,8 +44,7 @@ def listening_socket(
         if shared:
             sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEPORT, 1)
         sock.bind((host, port))
-        if listen:
-            sock.listen(2048)
+        sock.listen(2048)
         return sock
     except OSError as error:
         where = named or f"{host}:{port}"
@@ -60,13 +60,21 @@ def address_of(host: str, port: int, path: str = "/") -> str:
 
 
 class ServerThread:
-    """``app`` served by uvicorn on ``sock`` in a thread of its own, beside the robot.
+    """``app`` served by uvicorn on ``sock`` in a thread of its own, beside the robot (or
+    beside a test). ``make_server`` makes the uvicorn server of a config (a subclass that
+    does more when it stops, say; default uvicorn's own).
 
     :meth:`start` returns once the server is up (its app started), so a page that connects
     right after hears everything from then on, and the server's start-up work is done
     before the robot's first tick instead of during it."""
 
-    def __init__(self, app: ASGIApp, sock: socket.socket, name: str) -> None:
+    def __init__(
+        self,
+        app: ASGIApp,
+        sock: socket.socket,
+        name: str,
+        make_server: Callable[[uvicorn.Config], uvicorn.Server] = uvicorn.Server,
+    ) -> None:
         self.sock = sock
         self.port = int(sock.getsockname()[1])
         self._ready = threading.Event()
@@ -76,7 +84,7 @@ class ServerThread:
             log_level="warning",
             lifespan="on",
         )
-        self.server = uvicorn.Server(config)
+        self.server = make_server(config)
         self._thread = threading.Thread(
             target=self.server.run, kwargs={"sockets": [sock]}, name=name, daemon=True
         )

@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import json
 import queue
-import socket
 import subprocess
 import sys
 import threading
@@ -18,10 +17,9 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-import uvicorn
 
 from cloud.app import create_app
-from cloud.server import server_for
+from cloud.server import CloudServer
 from cloud.services import CloudStore
 from cloud.settings import Settings
 from cloud.store.database import Database
@@ -29,7 +27,7 @@ from cloud.store.directory import Directory
 from cloud.store.ledger import CommandLedger
 from cloud.throwaway_postgres import PostgresCluster
 from engine.clock import Clock, EpochClock, VirtualClock
-from engine.web.serving import listening_socket
+from engine.web.serving import ServerThread, listening_socket
 
 
 @pytest.fixture(scope="session")
@@ -89,24 +87,22 @@ StartService = Callable[..., Running]
 def start_service() -> Iterator[StartService]:
     """Starts real uvicorn servers on free loopback ports (stopped after the test).
 
-    The socket listens before the server starts, so requests queue until it accepts them
-    and a test never waits for the server to come up."""
-    running: list[tuple[uvicorn.Server, threading.Thread, socket.socket, CloudStore]] = []
+    Each is up when started: the one server thread the robot's pages use
+    (:class:`engine.web.serving.ServerThread`), with the service's own uvicorn server."""
+    running: list[tuple[ServerThread, CloudStore]] = []
 
     def start(settings: Settings, clock: Clock | None = None) -> Running:
         store = CloudStore.open(settings, clock or EpochClock())
-        sock = listening_socket("127.0.0.1", 0, shared=False)
-        server = server_for(create_app(settings, store=store), log_level="warning")
-        thread = threading.Thread(target=server.run, kwargs={"sockets": [sock]}, daemon=True)
-        thread.start()
-        running.append((server, thread, sock, store))
-        return Running(f"http://127.0.0.1:{sock.getsockname()[1]}", store)
+        sock = listening_socket("127.0.0.1", 0)
+        app = create_app(settings, store=store)
+        server = ServerThread(app, sock, "cloud", lambda config: CloudServer(config, store))
+        server.start()
+        running.append((server, store))
+        return Running(f"http://127.0.0.1:{server.port}", store)
 
     yield start
-    for server, thread, sock, store in running:
-        server.should_exit = True
-        thread.join(timeout=10)
-        sock.close()
+    for server, store in running:
+        server.stop()
         store.close()
 
 
