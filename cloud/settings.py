@@ -8,6 +8,8 @@ over the environment). Worker processes receive their settings through the same 
 
 from __future__ import annotations
 
+import difflib
+import os
 from typing import Any
 
 from pydantic import Field, ValidationError
@@ -46,6 +48,12 @@ class Settings(BaseSettings):
     token_cache_s: float = Field(5.0, ge=0, le=60, allow_inf_nan=False)
 
     def __init__(self, **values: Any) -> None:
+        known = {ENV_PREFIX + name.upper() for name in type(self).model_fields}
+        for variable in sorted(os.environ):
+            if variable.startswith(ENV_PREFIX) and variable not in known:
+                close = difflib.get_close_matches(variable, known, n=1)
+                hint = f" (did you mean {close[0]}?)" if close else ""
+                raise ConfigError(f"{variable}: no such setting{hint}")
         try:
             super().__init__(**values)
         except ValidationError as error:
@@ -56,7 +64,12 @@ class Settings(BaseSettings):
         return {ENV_PREFIX + name.upper(): str(value) for name, value in self.model_dump().items()}
 
 
+FLAGS = {"db_url": "--db", "lease_s": "--lease-s", "default_timeout_s": "--timeout-s"}
+"""The settings ``vest cloud serve`` also takes on its command line."""
+
+
 def _problem(item: Any) -> str:
-    """One setting's problem in a line: its name, what it must be, what it was."""
+    """One setting's problem in a line: where it is given, what it must be, what it was."""
     name = ".".join(str(part) for part in item["loc"]) or "settings"
-    return f"{name}: {item['msg'][0].lower()}{item['msg'][1:]} (got {item['input']!r})"
+    given = " or ".join(filter(None, (FLAGS.get(name), ENV_PREFIX + name.upper())))
+    return f"{name} ({given}): {item['msg'][0].lower()}{item['msg'][1:]} (got {item['input']!r})"

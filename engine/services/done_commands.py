@@ -14,8 +14,9 @@ from engine.files.yaml_source import read_bytes
 log = logging.getLogger("engine.services.cloud_link")
 DONE_KEPT = 1000
 MAX_DONE_BYTES = 16 * 1024 * 1024
-REPORTED = ("SUCCEEDED", "FAILED")
-"""What a robot reports of a command it finished."""
+REPORTED = ("SUCCEEDED", "FAILED", "CANCELED")
+"""How a command the robot carried out ended: reported (SUCCEEDED, FAILED), or canceled by
+the operator while it ran (kept here, never sent: the service knows)."""
 
 
 class DoneCommands:

@@ -64,7 +64,11 @@ def test_a_database_that_cannot_be_opened_is_named(capsys: pytest.CaptureFixture
         (["--workers", "2"], 2, "needs a PostgreSQL --db"),
         (["--port", "0"], 2, "--port 0: use 1..65535"),
         (["--workers", "0"], 2, "--workers 0: use 1..64"),
-        (["--lease-s", "nan"], 1, "lease_s: input should be a finite number"),
+        (
+            ["--lease-s", "nan"],
+            1,
+            "lease_s (--lease-s or VEST_CLOUD_LEASE_S): input should be a fi",
+        ),
         (["--db", "nonsense"], 1, "use sqlite:///FILE or postgresql://"),
         (["--db", "postgresql://ana:secret@127.0.0.1:1/vest"], 1, "ana:***@"),
     ],
@@ -86,3 +90,28 @@ def test_a_port_already_taken_is_named(tmp_path: Path, capsys: pytest.CaptureFix
         db = f"sqlite:///{tmp_path / 'c.db'}"
         assert main(["cloud", "serve", "--db", db, "--port", str(port)]) == 1
     assert f"--port {port}: cannot listen there" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(
+    ("variable", "value", "message"),
+    [
+        ("VEST_CLOUD_LEASE_S", "abc", "lease_s (--lease-s or VEST_CLOUD_LEASE_S): input should be"),
+        ("VEST_CLOUD_MAX_WAIT_S", "1e999", "max_wait_s (VEST_CLOUD_MAX_WAIT_S): input should be"),
+        (
+            "VEST_CLOUD_LEASE",
+            "3",
+            "VEST_CLOUD_LEASE: no such setting (did you mean VEST_CLOUD_LEASE_S?)",
+        ),
+    ],
+)
+def test_a_setting_from_the_environment_that_cannot_be_used_is_named(
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+    variable: str,
+    value: str,
+    message: str,
+) -> None:
+    monkeypatch.setenv(variable, value)
+    assert main(["cloud", "add-operator", "ana", "--db", f"sqlite:///{tmp_path / 'c.db'}"]) == 1
+    assert message in capsys.readouterr().err

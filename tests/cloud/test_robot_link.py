@@ -85,3 +85,13 @@ def test_finished_commands_are_remembered_across_a_restart(tmp_path: Path) -> No
     again = DoneCommands(tmp_path / "done.json")  # the robot restarted
     assert again.get("c-1") == {"status": "SUCCEEDED", "result": {"said": "hi"}}
     assert again.get("c-2") is None
+
+
+def test_a_command_the_operator_canceled_is_remembered_not_taken_for_damage(
+    tmp_path: Path,
+) -> None:
+    done = DoneCommands(tmp_path / "done.json")
+    done.add("c-1", {"status": "CANCELED", "result": None})  # as the link keeps a cancel
+    again = DoneCommands(tmp_path / "done.json")  # the robot restarted
+    assert again.damaged is None
+    assert again.get("c-1") == {"status": "CANCELED", "result": None}
