@@ -33,7 +33,7 @@ from engine.loader.tree_definition import TreeDefinition
 from engine.runtime.robot import Robot
 from engine.runtime.scheduler import RunningTree
 from engine.session.events import BehaviorsPaused, ButtonPressed
-from engine.web.mailbox import Mailbox
+from engine.web.broadcast import Broadcast
 
 PAGE_QUEUE = 16
 """State updates a page may fall behind by before it is sent only the newest."""
@@ -55,7 +55,8 @@ class Wizard:
         self.presses = 0
         self._pressed: queue.SimpleQueue[tuple[int, str]] = queue.SimpleQueue()
         self._lock = threading.Lock()
-        self._pages: list[Mailbox[dict[str, Any]]] = []
+        self.states: Broadcast[dict[str, Any]] = Broadcast(robot.clock, PAGE_QUEUE)
+        """Each new state, for the pages' streams (the state now: :meth:`state`)."""
         self._state: dict[str, Any] = self._current_state()
 
     # -- from any thread ----------------------------------------------------------------------
@@ -77,25 +78,10 @@ class Wizard:
         with self._lock:
             return dict(self._state)
 
-    def subscribe(self) -> Mailbox[dict[str, Any]]:
-        """A page's mailbox: the state now, then each new one (a page that falls behind
-        gets only the newest)."""
-        page: Mailbox[dict[str, Any]] = Mailbox(self.robot.clock, PAGE_QUEUE)
-        with self._lock:
-            self._pages.append(page)
-            page.give(dict(self._state))
-        return page
-
-    def unsubscribe(self, page: Mailbox[dict[str, Any]]) -> None:
-        with self._lock:
-            if page in self._pages:
-                self._pages.remove(page)
-
     def close(self) -> None:
         """Tell every page the session ended."""
-        with self._lock:
-            for page in self._pages:
-                page.give({"ended": True})
+        self.states.publish({"ended": True})
+        self.states.close()
 
     # -- a scenario's presses ---------------------------------------------------------------
     def world_changed(self, world: Any, what: str) -> None:
@@ -198,5 +184,4 @@ class Wizard:
             if state == self._state:
                 return
             self._state = state
-            for page in self._pages:
-                page.give(dict(state))
+        self.states.publish(dict(state))

@@ -25,6 +25,7 @@ import math
 import re
 import sys
 from pathlib import Path
+from urllib.parse import urlsplit
 
 from engine.cli.output import shown, tell
 from engine.cli.run_inputs import (
@@ -51,6 +52,7 @@ from engine.services.cloud_link import CloudLink
 from engine.services.interfaces import Speech
 from engine.services.simulated import simulated_services
 from engine.session.sentences import TOLD_KINDS
+from engine.view.server import ViewServer
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -176,6 +178,16 @@ def _positive_seconds(text: str) -> float:
     return value
 
 
+def _is_service_url(text: str) -> bool:
+    """An http(s) URL with a host, and a port when one is given (1..65535)."""
+    try:
+        parts = urlsplit(text)
+        port = parts.port
+    except ValueError:  # [::1 unclosed, port 99999 or not a number
+        return False
+    return parts.scheme in ("http", "https") and bool(parts.hostname) and port != 0
+
+
 def _cloud_link(args: argparse.Namespace) -> CloudLink | None:
     """The link to the cloud for --cloud URL --token-file FILE; ConfigError or UsageError
     for what is wrong with them."""
@@ -183,8 +195,11 @@ def _cloud_link(args: argparse.Namespace) -> CloudLink | None:
         return None
     if args.cloud is None or args.token_file is None:
         raise UsageError("--cloud URL and --token-file FILE go together")
-    if not args.cloud.startswith(("http://", "https://")):
-        raise UsageError(f"--cloud {args.cloud}: give an http:// or https:// URL")
+    if not _is_service_url(args.cloud):
+        raise UsageError(
+            f"--cloud {args.cloud}: give the service's http:// or https:// URL "
+            "(e.g. https://cloud.example.org or http://127.0.0.1:8080)"
+        )
     if args.fast:
         raise UsageError("--cloud runs in real time: leave out --fast")
     try:
@@ -249,6 +264,17 @@ def main(args: argparse.Namespace) -> int:
             if event.kind == "hear" and event.value["wav"] is None:
                 speech.prepare(event.value["text"])
     paged = args.view or (args.buttons is not None and not args.fast)  # a page when asked
+    duration = args.duration if args.duration is not None else scenario.duration_s
+
+    def view_is_up(view: ViewServer) -> None:  # a page goes with the run: where, how long
+        tell_view(view)
+        tell(
+            "the session runs until Ctrl-C"
+            if math.isinf(duration)
+            else f"the session lasts {duration:g} s (--duration S to change it), and "
+            "the page with it"
+        )
+
     running = build_session(
         SessionPlan(
             behaviors,
@@ -261,6 +287,7 @@ def main(args: argparse.Namespace) -> int:
             link=link,
             buttons=inputs.buttons,
             view=view_plan(args) if paged else None,
+            on_view_up=view_is_up,
             record=args.record,
             facts={
                 "robot_config": str(args.hardware),
@@ -290,15 +317,6 @@ def main(args: argparse.Namespace) -> int:
                 tell(f"warning: speech {part}: {shown(why)}")
         session.subscribe(timeline, TOLD_KINDS)  # every reader reads the one session stream
         timeline.on_closed = robot.scheduler.stop
-        duration = args.duration if args.duration is not None else scenario.duration_s
-        if running.view is not None:  # a page goes with the run: say where and for how long
-            tell_view(running.view)
-            tell(
-                "the session runs until Ctrl-C"
-                if math.isinf(duration)
-                else f"the session lasts {duration:g} s (--duration S to change it), and "
-                "the page with it"
-            )
         # a signal that came during start-up stops the run before its first tick
         args.stop_signals.on_stop(robot.scheduler.stop)
         timeline.start()

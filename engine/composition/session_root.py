@@ -62,6 +62,8 @@ class SessionPlan:
     link: CloudLink | None = None
     buttons: ButtonBoard | None = None
     view: ViewPlan | None = None
+    on_view_up: Callable[[ViewServer], None] | None = None
+    """Told once the view serves (to say its address: a page opened then misses nothing)."""
     record: Path | None = None
     facts: dict[str, str] = field(default_factory=dict)
     reload: bool = False
@@ -132,7 +134,14 @@ def _around(assembled: AssembledRobot, plan: SessionPlan) -> RunningSession:
             wizard=running.wizard,
         )
         running.view = view
-        lifecycle.add("view", start=view.start, stop=view.stop)
+        on_view_up = plan.on_view_up
+
+        def start_view() -> None:
+            view.start()
+            if on_view_up is not None:
+                on_view_up(view)
+
+        lifecycle.add("view", start=start_view, stop=view.stop)
     if plan.record is not None:
         recorder = SessionRecorder(plan.record, plan.clock)
         running.recorder = recorder

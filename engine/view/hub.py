@@ -5,9 +5,9 @@ A reader of the session stream: the scheduler's thread tells the hub each event 
 version, a node's status after a tick, a blackboard change, and everything told in words:
 actions and how they ended, turns, safety, presses, what was heard; every second the tick
 and bus statistics come from its hook). The hub keeps the present state for a page that
-connects, and gives each change to every connected page's bounded mailbox. A page that
-cannot keep up loses changes (its mailbox overflows, and it is told to fetch the state
-again), never a tick: nothing here waits for a browser.
+connects, and publishes each change once on a bounded broadcast every page reads. A page
+that cannot keep up loses changes (it is told to fetch the state again), never a tick:
+nothing here waits for a browser, and publishing costs the same for one page or many.
 """
 
 from __future__ import annotations
@@ -23,7 +23,7 @@ from engine.drivers.device_stats import DeviceStats
 from engine.runtime.scheduler import RunningTree
 from engine.session.events import KeyChanged, NodeStatus, SessionEvent, TreeStarted
 from engine.session.sentences import event_line, tone
-from engine.web.mailbox import Mailbox
+from engine.web.broadcast import Broadcast
 
 Change = dict[str, Any]
 QUEUE_CHANGES = 5000
@@ -64,7 +64,8 @@ class ViewHub:
         self.device_stats = device_stats
         self.capacity = capacity
         self._lock = threading.Lock()
-        self._pages: list[Mailbox[Change]] = []
+        self.changes: Broadcast[Change] = Broadcast(clock, capacity)
+        """Every change, for the pages' streams (the state to start from: :meth:`snapshot`)."""
         self._trees: dict[str, Change] = {}
         self._dots: dict[tuple[str, int], str] = {}
         self._statuses: dict[str, dict[int, Change]] = {}
@@ -146,31 +147,12 @@ class ViewHub:
         self._publish(change)
 
     def _publish(self, change: Change) -> None:
-        with self._lock:
-            pages = list(self._pages)
-        for page in pages:
-            page.give(change)
-
-    # -- the pages' streams -----------------------------------------------------------------
-    def subscribe(self) -> Mailbox[Change]:
-        """A new page's mailbox: every change from now on (the state: :meth:`snapshot`)."""
-        page: Mailbox[Change] = Mailbox(self.clock, self.capacity)
-        with self._lock:
-            self._pages.append(page)
-        return page
-
-    def unsubscribe(self, page: Mailbox[Change]) -> None:
-        with self._lock:
-            if page in self._pages:
-                self._pages.remove(page)
+        self.changes.publish(change)  # once, however many pages watch
 
     def close(self) -> None:
         """Tell every page the session ended."""
         self._publish({"kind": "end", "at": self._at(self.clock.now())})
-        with self._lock:
-            pages, self._pages = list(self._pages), []
-        for page in pages:
-            page.close()
+        self.changes.close()
 
     def snapshot(self) -> Change:
         """The present state: every tree with its nodes' statuses, the blackboard, what

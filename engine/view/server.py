@@ -45,6 +45,7 @@ from engine.buttons.wizard import Wizard
 from engine.errors import ConfigError
 from engine.view.hub import Change, ViewHub
 from engine.web.body_limit import BodyLimit
+from engine.web.broadcast import Reader
 from engine.web.guard import LoopbackOrToken, SecurityHeaders, check_listening
 from engine.web.serving import SHARED, ServerThread, address_of, listening_socket, shared_files
 from engine.web.sse import CONNECTED, KEEPALIVE, KEEPALIVE_S, event_stream, frame
@@ -59,7 +60,11 @@ STATIC = {
     "/buttons.js": "buttons.js",
     "/buttons.css": "buttons.css",
 }
+MAX_STREAMS = 32
+"""Live streams open at once (the view's and the buttons'); more are answered 503."""
 MAX_PRESS_BYTES = 1024
+PRESS_READ_TIMEOUT_S = 2.0
+"""A press's body comes at once from the page; shorter than a server's grace on stopping."""
 DOT_TIMEOUT_S = 20.0
 
 
@@ -114,6 +119,7 @@ class ViewServer:
         self.wizard = wizard
         self._svg: dict[tuple[str, int], bytes] = {}
         self._svg_lock = threading.Lock()
+        self._streams = 0  # open now; counted on the event loop
         try:
             sock = listening_socket(host, port, named=f"the view on {host}:{port}")
         except ConfigError as error:
@@ -146,7 +152,8 @@ class ViewServer:
 
     def app(self) -> Starlette:
         """The Starlette app: the routes above, behind the loopback-or-token rule."""
-        routes: list[BaseRoute] = [Route(path, self._file) for path in STATIC]
+        files = [path for path in STATIC if self.wizard is not None or "buttons" not in path]
+        routes: list[BaseRoute] = [Route(path, self._file) for path in files]
         routes.append(shared_files())
         routes += [
             Route("/api/info", self._info),
@@ -173,7 +180,9 @@ class ViewServer:
                     open_paths=STATIC,
                     open_folders=[SHARED],
                 ),
-                Middleware(BodyLimit, max_bytes=MAX_PRESS_BYTES),
+                Middleware(
+                    BodyLimit, max_bytes=MAX_PRESS_BYTES, read_timeout_s=PRESS_READ_TIMEOUT_S
+                ),
             ],
         )
 
@@ -232,7 +241,8 @@ class ViewServer:
 
     async def _events(self, request: Request) -> Response:
         assert isinstance(self.source, LiveSource)
-        return event_stream(_changes(self.source.hub))
+        hub = self.source.hub
+        return self._stream(_changes(hub, hub.changes.reader()))  # listening from now
 
     def _buttons(self, request: Request) -> Response:
         assert self.wizard is not None
@@ -241,7 +251,24 @@ class ViewServer:
 
     async def _button_events(self, request: Request) -> Response:
         assert self.wizard is not None
-        return event_stream(_button_states(self.wizard))
+        return self._stream(_button_states(self.wizard))
+
+    def _stream(self, frames: AsyncIterator[str]) -> Response:
+        """``frames`` as a stream, unless :data:`MAX_STREAMS` are open already (each page
+        open costs the robot's process a little on every change). On the event loop."""
+        if self._streams >= MAX_STREAMS:
+            why = f"{MAX_STREAMS} pages are watching this robot already; close one\n"
+            return PlainTextResponse(why, status_code=503)
+
+        async def counted() -> AsyncIterator[str]:
+            self._streams += 1  # once streaming: a page that left before is not counted
+            try:
+                async for text in frames:
+                    yield text
+            finally:
+                self._streams -= 1
+
+        return event_stream(counted())
 
     async def _press(self, request: Request) -> Response:
         wizard = self.wizard
@@ -267,37 +294,37 @@ class ViewServer:
         return JSONResponse({"pressed": button.label}, status_code=202)
 
 
-async def _changes(hub: ViewHub) -> AsyncIterator[str]:
-    """The live changes, as they come; a page that fell behind is told to start over."""
-    page = hub.subscribe()
-    try:
-        yield CONNECTED
-        while (taken := await page.take(KEEPALIVE_S)) is not None:
-            if not taken.items:
-                yield KEEPALIVE
-                continue
-            changes = taken.items
-            if taken.overflowed:  # behind: fetch the state again (and hear of the end)
-                changes = [{"kind": "resync"}] + [c for c in changes if c.get("kind") == "end"]
-            yield "".join(frame(change) for change in changes)
-    finally:
-        hub.unsubscribe(page)
+async def _changes(hub: ViewHub, reader: Reader) -> AsyncIterator[str]:
+    """The live changes, as they come. The first says to fetch the state (now that nothing
+    published is missed: the page may have read it before it was listening); a page that
+    fell behind is told so again."""
+    yield CONNECTED + frame({"kind": "resync"})
+    while (taken := await hub.changes.take(reader, KEEPALIVE_S)) is not None:
+        if not taken.items:
+            yield KEEPALIVE
+            continue
+        changes = taken.items
+        if taken.overflowed:  # behind: fetch the state again (and hear of the end)
+            ends = [c for c in changes if c.item.get("kind") == "end"]
+            yield frame({"kind": "resync"}) + "".join(c.text(frame) for c in ends)
+            continue
+        yield "".join(change.text(frame) for change in changes)
 
 
 async def _button_states(wizard: Wizard) -> AsyncIterator[str]:
-    """The buttons shown, whenever they change, until the session ends."""
-    page = wizard.subscribe()
-    try:
-        yield CONNECTED
-        while (taken := await page.take(KEEPALIVE_S)) is not None:
-            if not taken.items:
-                yield KEEPALIVE
-            for state in taken.items:
-                yield frame(state)
-                if state.get("ended"):
-                    return
-    finally:
-        wizard.unsubscribe(page)
+    """The buttons shown now, then whenever they change, until the session ends; a page
+    that fell behind gets the newest."""
+    reader = wizard.states.reader()
+    yield CONNECTED + frame(wizard.state())
+    while (taken := await wizard.states.take(reader, KEEPALIVE_S)) is not None:
+        if not taken.items:
+            yield KEEPALIVE
+            continue
+        newest = taken.items[-1] if taken.overflowed else None
+        for state in [newest] if newest is not None else taken.items:
+            yield state.text(frame)
+            if state.item.get("ended"):
+                return
 
 
 def _number(text: str) -> float | None:

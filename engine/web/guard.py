@@ -105,7 +105,9 @@ class LoopbackOrToken:
     def _refusal(self, scope: Scope) -> str | None:
         if self.loopback:
             host = Headers(scope=scope).get("host", "")
-            name = host if host.endswith("]") else host.rsplit(":", 1)[0]
+            name, colon, port = host.rpartition(":") if not host.endswith("]") else ("", "", "")
+            if not colon or not port.isdigit():  # no port given, or not one
+                name = host
             if name not in LOOPBACK_NAMES:
                 return "not this host: open the address vest printed"
         path = URL(scope=scope).path

@@ -37,6 +37,7 @@ def listening_socket(
     """A TCP socket bound to ``host``:``port`` (0: any free port; ``shared``: other
     processes may bind it too). A ConfigError names the address when it cannot be had, as
     ``named`` (the options that chose it; default the address itself)."""
+    host = host.strip("[]")  # an IPv6 address as written in a URL: [::1]
     try:
         family = socket.getaddrinfo(host, port, type=socket.SOCK_STREAM)[0][0]
         sock = socket.socket(family, socket.SOCK_STREAM, socket.IPPROTO_TCP)
@@ -54,7 +55,7 @@ def listening_socket(
 def address_of(host: str, port: int, path: str = "/") -> str:
     """How a browser reaches ``path`` on ``host``:``port`` (on every address, this
     machine's name)."""
-    shown = socket.gethostname() if host in ("0.0.0.0", "::") else host
+    shown = socket.gethostname() if host in ("0.0.0.0", "::") else host.strip("[]")
     shown = f"[{shown}]" if ":" in shown else shown
     return f"http://{shown}:{port}{path}"
 

@@ -63,6 +63,9 @@ def test_vest_run_carries_out_a_say_from_the_cloud_and_reports_it(
     [
         (["--cloud", "http://x"], "go together"),
         (["--cloud", "ftp://x", "--token-file", "t"], "http:// or https://"),
+        (["--cloud", "http://", "--token-file", "t"], "give the service's http://"),
+        (["--cloud", "http://[::1", "--token-file", "t"], "give the service's http://"),
+        (["--cloud", "http://127.0.0.1:99999", "--token-file", "t"], "give the service's"),
         (["--cloud", "http://x", "--token-file", "/no/such/token"], "file not found"),
         (["--cloud", "http://x", "--token-file", "/dev/zero"], "(name a token file)"),
         (["--cloud", "http://x", "--token-file", "/etc"], "/etc:1:1: is a folder, not a file"),
