@@ -8,14 +8,19 @@ Nagle's algorithm on: every request took ~45 ms more).
 
 from __future__ import annotations
 
+import asyncio
 import gc
 import logging
 import os
+import signal
 import socket
 import sys
+import threading
+from types import FrameType
 
 import uvicorn
 from fastapi import FastAPI
+from starlette.types import ASGIApp, Message, Receive, Scope, Send
 from uvicorn.supervisors import Multiprocess
 
 from cloud.services import CloudStore
@@ -71,8 +76,9 @@ def serve_workers(settings: Settings, host: str, port: int, workers: int) -> Non
     uvicorn's own supervisor (``Multiprocess``) starts them, checks they answer, and starts
     another when one dies; each worker reads its settings from the environment
     (:meth:`Settings.environment`) and serves on the socket made here (made as TCP, so
-    Nagle's algorithm is off). Stopping gives requests in flight ``GRACE_S`` to finish; a
-    long-poll still waiting then ends and its robot asks the next service."""
+    Nagle's algorithm is off). Stopping ends the waiting long-polls and live streams at
+    once, as one process does (:func:`app_from_environment`), and gives requests in flight
+    ``GRACE_S`` to finish."""
     sock = listening_socket(host, port, shared=True, named=f"--host {host} --port {port}")
     os.environ.update(settings.environment())
     _say_where(host, port, workers)
@@ -86,13 +92,44 @@ def serve_workers(settings: Settings, host: str, port: int, workers: int) -> Non
     Multiprocess(config, sockets=[sock]).run()
 
 
-def app_from_environment() -> FastAPI:
-    """A worker's app: the settings its supervisor put in the environment."""
+def app_from_environment() -> ASGIApp:
+    """A worker's app: the settings its supervisor put in the environment. Once started,
+    SIGTERM or SIGINT first tells its store the service is closing (long-polls answer 204,
+    streams end), then reaches uvicorn's own handler, which stops the worker."""
     from cloud.app import create_app
 
     app = create_app(Settings())
+    store: CloudStore = app.state.store
     tune_garbage_collector()
-    return app
+
+    async def closing_on_signals(scope: Scope, receive: Receive, send: Send) -> None:
+        if scope["type"] != "lifespan" or threading.current_thread() is not threading.main_thread():
+            await app(scope, receive, send)
+            return
+        loop = asyncio.get_running_loop()
+
+        async def send_then_listen(message: Message) -> None:
+            await send(message)
+            if message["type"] == "lifespan.startup.complete":  # uvicorn's handlers are in
+                for signum in (signal.SIGTERM, signal.SIGINT):
+                    _close_first(signum, loop, store)
+
+        await app(scope, receive, send_then_listen)
+
+    return closing_on_signals
+
+
+def _close_first(signum: int, loop: asyncio.AbstractEventLoop, store: CloudStore) -> None:
+    """On ``signum``, the store hears it is closing (on its loop), then the handler that
+    was there."""
+    then = signal.getsignal(signum)
+
+    def handler(number: int, frame: FrameType | None) -> None:
+        loop.call_soon_threadsafe(store.begin_closing)
+        if callable(then):
+            then(number, frame)
+
+    signal.signal(signum, handler)
 
 
 def _say_where(host: str, port: int, workers: int) -> None:
