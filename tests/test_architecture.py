@@ -4,107 +4,49 @@ from the clock, and no module outside a chip's own names the chip."""
 from __future__ import annotations
 
 import ast
+import importlib.util
 import re
 import subprocess
 import sys
-from collections import defaultdict
 from pathlib import Path
+from types import ModuleType
 
 ROOT = Path(__file__).resolve().parents[1]
 ENGINE = ROOT / "engine"
 MAX_LINES = 420  # "about 400": a module one reads in one sitting
 
 
-def _modules() -> dict[str, Path]:
-    modules = {}
-    for path in ENGINE.rglob("*.py"):
-        parts = path.relative_to(ENGINE.parent).with_suffix("").parts
-        name = ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
-        modules[name] = path
-    return modules
+def _load_package_graph() -> ModuleType:
+    """scripts/package_graph.py: the one reading of the engine's imports (modules and
+    packages; relative imports and imports inside functions count)."""
+    spec = importlib.util.spec_from_file_location(
+        "package_graph", ROOT / "scripts/package_graph.py"
+    )
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
 
 
-def _imports(path: Path, modules: dict[str, Path]) -> set[str]:
-    found: set[str] = set()
-    for node in ast.walk(ast.parse(path.read_text())):
-        if isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
-            candidates = [node.module, *(f"{node.module}.{a.name}" for a in node.names)]
-        elif isinstance(node, ast.Import):
-            candidates = [a.name for a in node.names]
-        else:
-            continue
-        found.update(c for c in candidates if c in modules)
-    return found
-
-
-def _cycles(graph: dict[str, set[str]]) -> list[list[str]]:
-    """Strongly connected components with more than one module (Tarjan)."""
-    index: dict[str, int] = {}
-    low: dict[str, int] = {}
-    stack: list[str] = []
-    on_stack: set[str] = set()
-    found: list[list[str]] = []
-
-    def visit(node: str) -> None:
-        index[node] = low[node] = len(index)
-        stack.append(node)
-        on_stack.add(node)
-        for target in graph[node]:
-            if target not in index:
-                visit(target)
-                low[node] = min(low[node], low[target])
-            elif target in on_stack:
-                low[node] = min(low[node], index[target])
-        if low[node] == index[node]:
-            component = []
-            while True:
-                member = stack.pop()
-                on_stack.discard(member)
-                component.append(member)
-                if member == node:
-                    break
-            if len(component) > 1:
-                found.append(sorted(component))
-
-    for node in list(graph):
-        if node not in index:
-            visit(node)
-    return found
+GRAPH = _load_package_graph()
 
 
 def test_no_import_circle_between_engine_modules() -> None:
-    modules = _modules()
-    graph: dict[str, set[str]] = defaultdict(set)
-    for name, path in modules.items():
-        graph[name] |= _imports(path, modules) - {name}
-    assert _cycles(graph) == []
-
-
-def _package(module: str) -> str:
-    """engine.drivers.bus_manager -> engine.drivers; engine.clock -> engine.clock."""
-    return ".".join(module.split(".")[:2])
+    modules = GRAPH.modules()
+    graph = {name: set(GRAPH.imports(path, modules)) - {name} for name, path in modules.items()}
+    assert GRAPH.components(graph) == []
 
 
 def test_no_import_circle_between_engine_packages() -> None:
     """Packages form layers too (scripts/package_graph.py prints them): drivers below the
     simulated vest, speech and vision below the robot's assembly of them, even where no
     two modules import each other. An import inside a function counts."""
-    modules = _modules()
-    graph: dict[str, set[str]] = defaultdict(set)
-    why: dict[tuple[str, str], str] = {}
-    for name, path in modules.items():
-        source = _package(name)
-        graph[source]
-        for target in _imports(path, modules):
-            edge = (source, _package(target))
-            if edge[1] not in (source, "engine"):
-                graph[source].add(edge[1])
-                why.setdefault(edge, f"{path.relative_to(ROOT)} imports {target}")
+    graph, why = GRAPH.package_graph()
     circles = [
         " <-> ".join(cycle)
         + "; "
-        + "; ".join(why[a, b] for a in cycle for b in cycle if (a, b) in why)
-        for cycle in _cycles(graph)
+        + "; ".join(line for a in cycle for b in cycle for line in why.get((a, b), [])[:1])
+        for cycle in GRAPH.components(graph)
     ]
     assert circles == []
 
