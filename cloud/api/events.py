@@ -19,23 +19,22 @@ revoked.
 
 from __future__ import annotations
 
-import json
 from collections.abc import AsyncIterator
 from typing import Any
 
 from fastapi import APIRouter, Request
-from fastapi.responses import StreamingResponse
 from starlette.concurrency import run_in_threadpool
+from starlette.responses import Response
 
 from cloud.api.deps import CurrentOperator, StoreDep
 from cloud.api.robots import robot_public
 from cloud.api.schemas import CommandPublic
 from cloud.services import CloudStore
 from cloud.store.directory import Principal
+from engine.web.sse import KEEPALIVE, KEEPALIVE_S, event_stream, frame
 
 router = APIRouter(tags=["operator"])
 TELEMETRY_EVERY_S = 1.0
-KEEPALIVE_S = 15.0
 STREAM_S = 300.0
 
 
@@ -58,13 +57,13 @@ class OperatorView:
         robots = [robot_public(self.store, row).model_dump() for row in rows]
         if robots != self._robots:
             self._robots = robots
-            events.append(_event("robots", robots))
+            events.append(frame(robots, "robots"))
         for row in rows:
             for command in reversed(self.store.ledger.recent(row.id)):
                 if self._versions.get(command.id) != command.version:
                     self._versions[command.id] = command.version
                     events.append(
-                        _event("command", CommandPublic.of(command, row.name).model_dump())
+                        frame(CommandPublic.of(command, row.name).model_dump(), "command")
                     )
             fresh = {
                 key: reading
@@ -73,7 +72,7 @@ class OperatorView:
             }
             if fresh:
                 self._telemetry.update({(row.id, key): r["at_s"] for key, r in fresh.items()})
-                events.append(_event("telemetry", {"robot": row.name, "values": fresh}))
+                events.append(frame({"robot": row.name, "values": fresh}, "telemetry"))
         return events
 
     async def wait(self, timeout_s: float) -> bool:
@@ -82,13 +81,8 @@ class OperatorView:
 
 
 @router.get("/events")
-async def events(request: Request, store: StoreDep, operator: CurrentOperator) -> StreamingResponse:
-    view = OperatorView(store, operator)
-    return StreamingResponse(
-        _stream(request, store, view),
-        media_type="text/event-stream",
-        headers={"Cache-Control": "no-store", "X-Accel-Buffering": "no"},
-    )
+async def events(request: Request, store: StoreDep, operator: CurrentOperator) -> Response:
+    return event_stream(_stream(request, store, OperatorView(store, operator)))
 
 
 async def _stream(request: Request, store: CloudStore, view: OperatorView) -> AsyncIterator[str]:
@@ -107,9 +101,5 @@ async def _stream(request: Request, store: CloudStore, view: OperatorView) -> As
             yield "".join(changes)
         elif store.clock.now() - quiet_since_s >= KEEPALIVE_S:
             quiet_since_s = store.clock.now()
-            yield ": still here\n\n"
+            yield KEEPALIVE
         await view.wait(TELEMETRY_EVERY_S)
-
-
-def _event(name: str, data: Any) -> str:
-    return f"event: {name}\ndata: {json.dumps(data, separators=(',', ':'))}\n\n"

@@ -1,16 +1,17 @@
-"""The service's upkeep, every ``flush_s``, in a thread: the telemetry kept in memory is
-written, and commands whose lease or timeout ran out are stored so (reads never write)."""
+"""The service's upkeep, every ``flush_s``, on a periodic worker (:mod:`engine.periodic`):
+the telemetry kept in memory is written, and commands whose lease or timeout ran out are
+stored so (reads never write)."""
 
 from __future__ import annotations
 
 import logging
-import threading
 
 from sqlalchemy.exc import SQLAlchemyError
 
 from cloud.store.ledger import CommandLedger
 from cloud.store.telemetry import Telemetry
 from engine.clock import Clock
+from engine.periodic import Periodic
 
 log = logging.getLogger(__name__)
 
@@ -27,18 +28,12 @@ class Upkeep:
         self.ledger = ledger
         self.clock = clock
         self.flush_s = flush_s
-        self._stop = clock.event()
-        self._thread = threading.Thread(target=self._run, name="cloud-upkeep", daemon=True)
-        self._thread.start()
+        self._worker = Periodic(clock, flush_s, self._flush, name="cloud-upkeep", final=True)
+        self._worker.start()
 
     def close(self) -> None:
-        self._stop.set()
-        self._thread.join(timeout=10)
-        self._flush()
-
-    def _run(self) -> None:
-        while not self.clock.wait(self._stop, self.flush_s):
-            self._flush()
+        """Stop, after one more flush."""
+        self._worker.stop()
 
     def _flush(self) -> None:
         try:

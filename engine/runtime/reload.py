@@ -15,7 +15,6 @@ from __future__ import annotations
 
 import logging
 import queue
-import threading
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -26,6 +25,7 @@ from engine.clock import Clock
 from engine.files.problems import LoadError, Mark, Problem
 from engine.loader.tree_definition import TreeDefinition
 from engine.loader.tree_file import TreeLoader
+from engine.periodic import Periodic
 from engine.runtime.scheduler import RunningTree
 from engine.session.events import TreeReloaded
 from engine.session.stream import SessionStream
@@ -81,12 +81,11 @@ class TreeReloader:
             for tree in trees
         }
         self._ready: queue.SimpleQueue[_Prepared] = queue.SimpleQueue()
-        self._stop = clock.event()
-        self._worker: threading.Thread | None = None
+        self._worker = Periodic(clock, check_every_s, self._queue_changed, name="vest-reload")
 
     # -- the scheduler's side -------------------------------------------------------------
     def __call__(self, now_s: float) -> None:
-        if self._worker is not None:
+        if self._worker.running:
             self._swap_ready()
             return
         if now_s < self._next_check_s:
@@ -122,22 +121,16 @@ class TreeReloader:
     # -- the worker's side ------------------------------------------------------------------
     def start(self) -> None:
         """Check and prepare reloads on a thread of their own until :meth:`stop`."""
-        if self._worker is None:
-            self._stop.clear()
-            self._worker = threading.Thread(target=self._watch, name="vest-reload", daemon=True)
-            self._worker.start()
+        self._worker.start()
 
     def stop(self) -> None:
         """End the worker (a reload it was preparing is dropped)."""
-        self._stop.set()
-        if self._worker is not None:
-            self._worker.join()
-            self._worker = None
+        self._worker.stop()
 
-    def _watch(self) -> None:
-        while not self.clock.wait(self._stop, self.check_every_s):
-            for prepared in self._prepare_changed():
-                self._ready.put(prepared)
+    def _queue_changed(self) -> None:
+        """A round of the worker: the changed trees, prepared for the scheduler to swap."""
+        for prepared in self._prepare_changed():
+            self._ready.put(prepared)
 
     def _prepare_changed(self) -> list[_Prepared]:
         prepared = []
