@@ -5,7 +5,8 @@ the cloud's alike."""
 from __future__ import annotations
 
 import shutil
-from collections.abc import Iterator
+import socket
+from collections.abc import Callable, Iterator
 from typing import TYPE_CHECKING
 
 import pytest
@@ -45,3 +46,37 @@ def page(browser: Browser) -> Iterator[Page]:
     yield opened
     context.close()
     assert errors == [], f"the page threw: {errors}"
+
+
+def read_answer(client: socket.socket, stream_until: bytes = b"") -> str:
+    """An HTTP answer read from ``client`` as it comes, in however many packets: its head
+    and the body its Content-Length names; a stream (200 with no length) until it holds
+    ``stream_until``."""
+    answer = b""
+    while True:
+        head, blank, body = answer.partition(b"\r\n\r\n")
+        if blank:
+            length = _content_length(head)
+            if length is not None and len(body) >= length:
+                break
+            if length is None and stream_until in body:
+                break
+        part = client.recv(4096)
+        if not part:
+            break
+        answer += part
+    return answer.decode()
+
+
+def _content_length(head: bytes) -> int | None:
+    for line in head.split(b"\r\n")[1:]:
+        name, _, value = line.partition(b":")
+        if name.strip().lower() == b"content-length":
+            return int(value)
+    return None
+
+
+@pytest.fixture
+def http_answer() -> Callable[..., str]:
+    """:func:`read_answer`, for tests that speak HTTP on a raw socket."""
+    return read_answer

@@ -4,7 +4,7 @@ watched by too many pages refuses more instead of slowing down."""
 from __future__ import annotations
 
 import socket
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 
 import pytest
 
@@ -21,26 +21,29 @@ def view() -> Iterator[ViewServer]:
     server.stop()
 
 
-def open_stream(port: int) -> tuple[socket.socket, str]:
-    """A page's stream, and what came first on it."""
-    page = socket.create_connection(("127.0.0.1", port), timeout=10)
-    page.sendall(b"GET /api/events HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n")
-    first = b""
-    while b"\r\n\r\n" not in first or (b"200 OK" in first and b"resync" not in first):
-        part = page.recv(4096)
-        if not part:
-            break
-        first += part
-    return page, first.decode()
+@pytest.fixture
+def open_stream(http_answer: Callable[..., str]) -> Callable[[int], tuple[socket.socket, str]]:
+    """A page's stream on ``port``, and what came first on it (or the whole refusal)."""
+
+    def opened(port: int) -> tuple[socket.socket, str]:
+        page = socket.create_connection(("127.0.0.1", port), timeout=10)
+        page.sendall(b"GET /api/events HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n")
+        return page, http_answer(page, stream_until=b"resync")
+
+    return opened
 
 
-def test_a_page_hears_first_to_fetch_the_state_so_it_misses_nothing(view: ViewServer) -> None:
+def test_a_page_hears_first_to_fetch_the_state_so_it_misses_nothing(
+    view: ViewServer, open_stream: Callable[[int], tuple[socket.socket, str]]
+) -> None:
     page, first = open_stream(view.port)
     with page:
         assert first.startswith("HTTP/1.1 200") and 'data: {"kind":"resync"}' in first
 
 
-def test_a_robot_watched_by_too_many_pages_refuses_one_more(view: ViewServer) -> None:
+def test_a_robot_watched_by_too_many_pages_refuses_one_more(
+    view: ViewServer, open_stream: Callable[[int], tuple[socket.socket, str]]
+) -> None:
     pages = [open_stream(view.port) for _ in range(MAX_STREAMS)]
     try:
         assert all(first.startswith("HTTP/1.1 200") for _, first in pages)

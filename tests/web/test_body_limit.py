@@ -4,7 +4,7 @@ client on a flaky link holds nothing for long, and a server stopping never waits
 from __future__ import annotations
 
 import socket
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 
 import pytest
 from starlette.applications import Starlette
@@ -31,38 +31,32 @@ def port() -> Iterator[int]:
     server.stop()
 
 
-def ask(port: int, request: bytes) -> str:
-    """The whole answer: its head, and as much body as it says it has."""
-    with socket.create_connection(("127.0.0.1", port), timeout=10) as client:
-        client.sendall(request)
-        answer = b""
-        while b"\r\n\r\n" not in answer or len(answer.partition(b"\r\n\r\n")[2]) < length(answer):
-            part = client.recv(4096)
-            if not part:
-                break
-            answer += part
-        return answer.decode()
+Ask = Callable[[int, bytes], str]
 
 
-def length(answer: bytes) -> int:
-    for line in answer.partition(b"\r\n\r\n")[0].split(b"\r\n"):
-        name, _, value = line.partition(b":")
-        if name.strip().lower() == b"content-length":
-            return int(value)
-    return 0
+@pytest.fixture
+def ask(http_answer: Callable[..., str]) -> Ask:
+    """Send ``request`` to ``port``; the whole answer."""
+
+    def asked(port: int, request: bytes) -> str:
+        with socket.create_connection(("127.0.0.1", port), timeout=10) as client:
+            client.sendall(request)
+            return http_answer(client)
+
+    return asked
 
 
-def test_a_body_within_the_limit_is_read(port: int) -> None:
+def test_a_body_within_the_limit_is_read(port: int, ask: Ask) -> None:
     answer = ask(port, b"POST / HTTP/1.1\r\nHost: x\r\nContent-Length: 5\r\n\r\nhello")
     assert answer.startswith("HTTP/1.1 200") and answer.endswith("got 5 bytes")
 
 
-def test_a_body_that_stalls_is_refused_with_408(port: int) -> None:
+def test_a_body_that_stalls_is_refused_with_408(port: int, ask: Ask) -> None:
     answer = ask(port, b'POST / HTTP/1.1\r\nHost: x\r\nContent-Length: 50\r\n\r\n{"but')
     assert answer.startswith("HTTP/1.1 408") and "did not come within 0.3 s" in answer
 
 
-def test_a_streamed_body_over_the_limit_is_refused_with_413(port: int) -> None:
+def test_a_streamed_body_over_the_limit_is_refused_with_413(port: int, ask: Ask) -> None:
     chunk = b"80\r\n" + b"x" * 128 + b"\r\n"
     request = b"POST / HTTP/1.1\r\nHost: x\r\nTransfer-Encoding: chunked\r\n\r\n" + chunk
     assert ask(port, request).startswith("HTTP/1.1 413")
