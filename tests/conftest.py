@@ -7,9 +7,12 @@ from __future__ import annotations
 import shutil
 import socket
 from collections.abc import Callable, Iterator
+from pathlib import Path
 from typing import TYPE_CHECKING
 
 import pytest
+
+from engine.privacy.site_data import SiteKey, site_key
 
 if TYPE_CHECKING:
     from playwright.sync_api import Browser, Page
@@ -22,6 +25,36 @@ CHROMIUM_FLAGS = [
     "--disable-component-update",
     "--disable-sync",
 ]
+
+
+@pytest.fixture(autouse=True)
+def site_data(tmp_path_factory: pytest.TempPathFactory, monkeypatch: pytest.MonkeyPatch) -> Path:
+    """Every test's site keeps its data (key, index, consent, audit) in a folder of its
+    own (VEST_DATA), never in the user's: what one test records no other reads."""
+    folder = tmp_path_factory.mktemp("site") / "data"
+    monkeypatch.setenv("VEST_DATA", str(folder))
+    return folder
+
+
+@pytest.fixture
+def the_site_key(site_data: Path) -> SiteKey:
+    """The key of the test's site (made now when the test has not made it yet)."""
+    return site_key(site_data, create=True)
+
+
+@pytest.fixture
+def consenting(site_data: Path) -> Callable[..., None]:
+    """Writes a consent record: ``consenting("kid-17", "sensors", "speech_text")``."""
+
+    def write(person: str, *covers: str) -> None:
+        site_data.mkdir(mode=0o700, parents=True, exist_ok=True)
+        with open(site_data / "consent.yaml", "a", encoding="utf-8") as file:
+            file.write(
+                f"{person}:\n  given_by: guardian\n  given_on: 2026-01-05\n"
+                f"  covers: [{', '.join(covers)}]\n"
+            )
+
+    return write
 
 
 @pytest.fixture(scope="module")

@@ -10,6 +10,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from engine.cli import main
+from engine.privacy.site_data import SiteKey
 from engine.recording.replay import Recording
 from engine.recording.told import told_events
 from engine.session.events import ButtonPressed
@@ -113,11 +114,13 @@ def test_the_envelope_refuses_a_button_s_arm_move_while_someone_leans_on_the_che
     assert "safety: something is" in refused and "the arms stay still" in refused
 
 
-def test_a_press_is_kept_in_the_session_recording(tmp_path, capsys, monkeypatch):
+def test_a_press_is_kept_in_the_session_recording(
+    tmp_path, capsys, monkeypatch, the_site_key: SiteKey
+):
     monkeypatch.chdir(ROOT)
     recorded = tmp_path / "session.db"
     run(tmp_path, capsys, "{at: 1.0, press: Hello}", extra=("--record", str(recorded)))
-    recording = Recording.open(recorded)
+    recording = Recording.open(recorded, the_site_key)
     try:
         [press] = [e for e in told_events(recording) if isinstance(e, ButtonPressed)]
         assert (press.t_s, press.label, press.by) == (1.0, "Hello", "scenario")

@@ -15,6 +15,7 @@ import pytest
 
 from engine.cli import main
 from engine.clock import VirtualClock
+from engine.privacy.site_data import SiteKey
 from engine.recording.replay import Recording
 from engine.recording.report import not_understood, person_moments, report_html
 from engine.recording.told import told_events
@@ -40,8 +41,10 @@ events:
 
 
 @pytest.fixture
-def session(tmp_path: Path, capsys, monkeypatch) -> tuple[Path, str]:
-    """The story run on a virtual clock, recorded, with --person; (recording, timeline)."""
+def session(tmp_path: Path, capsys, monkeypatch, consenting) -> tuple[Path, str]:
+    """The story run on a virtual clock, recorded, with --person, whose guardian consented
+    to keeping what they said as text; (recording, timeline)."""
+    consenting("kid-17", "sensors", "speech_text")
     monkeypatch.chdir(ROOT)
     scenario = tmp_path / "story.yaml"
     scenario.write_text(STORY)
@@ -52,20 +55,28 @@ def session(tmp_path: Path, capsys, monkeypatch) -> tuple[Path, str]:
     return recording, capsys.readouterr().out.split("\n\n")[0]
 
 
-def test_the_recording_tells_what_the_terminal_told_line_for_line(session) -> None:
+def test_the_recording_tells_what_the_terminal_told_line_for_line(
+    session, the_site_key: SiteKey
+) -> None:
     path, timeline = session
     printed = [line.split(None, 2)[1:] for line in timeline.splitlines()[1:]]
-    told = [list(line) for e in told_events(Recording.open(path)) if (line := event_line(e))]
+    told = [
+        list(line)
+        for e in told_events(Recording.open(path, the_site_key))
+        if (line := event_line(e))
+    ]
     assert [[who, what] for who, what in printed] == told
 
 
 def test_an_utterance_cut_short_is_told_as_cut_in_the_timeline_the_json_and_the_record(
-    session, tmp_path, capsys
+    session, tmp_path, capsys, the_site_key: SiteKey
 ) -> None:
     path, timeline = session
     sorry = "Sorry, I did not understand."
     assert f'dialog         cut short: says "{sorry}" (iot_command interrupted it)' in timeline
-    [cut] = [e for e in told_events(Recording.open(path)) if isinstance(e, ActionEnded)]
+    [cut] = [
+        e for e in told_events(Recording.open(path, the_site_key)) if isinstance(e, ActionEnded)
+    ]
     assert (cut.tree, cut.outcome, cut.why) == ("dialog", "cut", "iot_command interrupted it")
     story = str(tmp_path / "story.yaml")
     assert main(["run", "--fast", "--speech", "text", "--json", "--scenario", story]) == 0
@@ -77,9 +88,10 @@ def test_an_utterance_cut_short_is_told_as_cut_in_the_timeline_the_json_and_the_
 
 def test_the_report_lists_the_therapist_s_press_and_a_sentence_not_understood_once(
     session,
+    the_site_key: SiteKey,
 ) -> None:
     path, _ = session
-    recording = Recording.open(path)
+    recording = Recording.open(path, the_site_key)
     moments = person_moments(recording)
     press = next(m for m in moments if m.who == "the therapist")
     assert press.did == "pressed the button \u201cHello\u201d"
@@ -112,9 +124,11 @@ def test_the_live_view_tells_turns_safety_and_presses_in_words() -> None:
     ]
 
 
-def test_a_recording_of_the_first_format_still_replays_and_reports(tmp_path) -> None:
+def test_a_recording_of_the_first_format_still_replays_and_reports(
+    tmp_path, the_site_key: SiteKey
+) -> None:
     kept = Path(__file__).parent / "recordings" / "unplug_touch.format1.db"
-    recording = Recording.open(kept)
+    recording = Recording.open(kept, the_site_key)
     assert recording.format == 1
     told = [event_line(e) for e in told_events(recording)]
     assert ("touch_thanks", 'says "Thank you"') in told

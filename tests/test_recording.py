@@ -10,6 +10,8 @@ from pathlib import Path
 import pytest
 
 from engine.cli import main
+from engine.privacy.sealed_sqlite import connect_sealed
+from engine.privacy.site_data import SiteKey
 from engine.recording.replay import Recording
 from engine.recording.session_file import COLUMNS
 
@@ -26,23 +28,29 @@ def demo(tmp_path: Path, capsys, monkeypatch) -> Path:
     return path
 
 
-def test_the_recording_holds_every_tree_as_vest_render_draws_it(demo: Path) -> None:
-    recording = Recording.open(demo)
+def test_the_recording_holds_every_tree_as_vest_render_draws_it(
+    demo: Path, the_site_key: SiteKey
+) -> None:
+    recording = Recording.open(demo, the_site_key)
     names = [tree.name for tree in recording.trees]
     assert {"hug", "dialog", "touch_thanks", "finger_game"} <= set(names)
     hug = next(tree for tree in recording.trees if tree.name == "hug")
     assert hug.rate_hz == 20.0 and len(hug.digest) == 64
     assert hug.nodes[0].index == 0 and hug.nodes[0].depth == 0
     source, dot = (
-        sqlite3.connect(demo).execute("SELECT source, dot FROM trees WHERE tree = 'hug'").fetchone()
+        connect_sealed(demo, the_site_key)
+        .execute("SELECT source, dot FROM trees WHERE tree = 'hug'")
+        .fetchone()
     )
     assert "name: hug" in source
     assert all(f"n{node.index} [" in dot for node in hug.nodes)
     assert recording.duration_s == pytest.approx(32.0, abs=0.2)
 
 
-def test_at_a_moment_the_hug_is_running_and_the_squeeze_is_on_the_blackboard(demo: Path) -> None:
-    recording = Recording.open(demo)
+def test_at_a_moment_the_hug_is_running_and_the_squeeze_is_on_the_blackboard(
+    demo: Path, the_site_key: SiteKey
+) -> None:
+    recording = Recording.open(demo, the_site_key)
     hug = next(tree for tree in recording.trees_at(3.5) if tree.name == "hug")
     statuses = recording.statuses_at(3.5)
     root = statuses[("hug", hug.version, 0)]
@@ -83,8 +91,10 @@ def test_a_file_that_is_not_a_recording_is_named(tmp_path: Path, capsys) -> None
     assert "gone.db: no such recording" in capsys.readouterr().err
 
 
-def test_a_recording_from_a_newer_vest_is_refused_by_its_format(demo: Path, capsys) -> None:
-    with sqlite3.connect(demo) as db:
+def test_a_recording_from_a_newer_vest_is_refused_by_its_format(
+    demo: Path, capsys, the_site_key: SiteKey
+) -> None:
+    with connect_sealed(demo, the_site_key) as db:
         db.execute("UPDATE meta SET value = '99' WHERE key = 'format'")
     assert main(["replay", str(demo)]) == 1
     assert "recorded in format 99, newer than this vest reads (2)" in capsys.readouterr().err
@@ -134,21 +144,25 @@ def test_recording_again_under_the_name_of_an_earlier_session_keeps_that_session
     assert demo.read_bytes() == before
 
 
-def test_at_the_moment_of_an_action_the_tree_that_took_it_shows_running(demo: Path) -> None:
-    recording = Recording.open(demo)
+def test_at_the_moment_of_an_action_the_tree_that_took_it_shows_running(
+    demo: Path, the_site_key: SiteKey
+) -> None:
+    recording = Recording.open(demo, the_site_key)
     squeeze = next(a for a in recording.actions() if a.tree == "hug")
     hug = next(tree for tree in recording.trees_at(squeeze.at_s) if tree.name == "hug")
     assert recording.statuses_at(squeeze.at_s)[("hug", hug.version, 0)].status == "RUNNING"
 
 
-def test_a_damaged_recording_is_named_not_a_traceback(demo: Path, tmp_path: Path, capsys) -> None:
+def test_a_damaged_recording_is_named_not_a_traceback(
+    demo: Path, tmp_path: Path, capsys, the_site_key: SiteKey
+) -> None:
     no_nodes = tmp_path / "no_nodes.db"
     no_nodes.write_bytes(demo.read_bytes())
-    with sqlite3.connect(no_nodes) as db:
+    with connect_sealed(no_nodes, the_site_key) as db:
         db.execute("DROP TABLE nodes")
     bad_length = tmp_path / "bad_length.db"
     bad_length.write_bytes(demo.read_bytes())
-    with sqlite3.connect(bad_length) as db:
+    with connect_sealed(bad_length, the_site_key) as db:
         db.execute("UPDATE meta SET value = 'nan' WHERE key = 'duration_s'")
     for broken, why in [(no_nodes, "no table 'nodes'"), (bad_length, "duration nan")]:
         for command in (["replay", str(broken)], ["report", str(broken)]):
@@ -157,11 +171,13 @@ def test_a_damaged_recording_is_named_not_a_traceback(demo: Path, tmp_path: Path
             assert f"{broken.name}: a damaged recording ({why})" in err, err
 
 
-def test_a_recording_cut_off_mid_write_is_recovered_on_opening(demo: Path, tmp_path: Path) -> None:
+def test_a_recording_cut_off_mid_write_is_recovered_on_opening(
+    demo: Path, tmp_path: Path, the_site_key: SiteKey
+) -> None:
     """A robot that lost power while writing leaves SQLite's journal beside the file."""
     cut = tmp_path / "cut.db"
     cut.write_bytes(demo.read_bytes())
-    writer = sqlite3.connect(cut)
+    writer = connect_sealed(cut, the_site_key)
     writer.execute("PRAGMA journal_mode=DELETE")
     writer.execute("BEGIN")
     writer.execute("DELETE FROM actions")  # half a batch, never committed
@@ -171,12 +187,14 @@ def test_a_recording_cut_off_mid_write_is_recovered_on_opening(demo: Path, tmp_p
     kept = journal.read_bytes()
     writer.close()  # (closing rolls back; put the hot journal back as a power cut leaves it)
     journal.write_bytes(kept)
-    recording = Recording.open(cut)
+    recording = Recording.open(cut, the_site_key)
     assert len(recording.actions()) > 10
 
 
-def test_an_event_s_message_is_not_kept_once_the_node_waits_again(demo: Path) -> None:
-    recording = Recording.open(demo)
+def test_an_event_s_message_is_not_kept_once_the_node_waits_again(
+    demo: Path, the_site_key: SiteKey
+) -> None:
+    recording = Recording.open(demo, the_site_key)
     wave = next(tree for tree in recording.trees if tree.name == "wave_greeting")
     on_event = next(node for node in wave.nodes if node.type == "OnEvent")
     changes = recording.node_changes("wave_greeting", wave.version, on_event.index)
@@ -204,9 +222,9 @@ def test_an_event_s_message_is_not_kept_once_the_node_waits_again(demo: Path) ->
     ],
 )
 def test_a_damaged_recording_is_named_in_one_line_by_replay_and_report(
-    demo: Path, capsys, damage: str
+    demo: Path, capsys, damage: str, the_site_key: SiteKey
 ) -> None:
-    with sqlite3.connect(demo) as connection:
+    with connect_sealed(demo, the_site_key) as connection:
         connection.executescript(damage)
     for command in (["replay", str(demo), "--at", "5"], ["report", str(demo)]):
         code = main(command)
@@ -217,9 +235,11 @@ def test_a_damaged_recording_is_named_in_one_line_by_replay_and_report(
 
 
 def test_a_recording_cut_short_says_where_in_replay_and_report_and_exits_1(
-    demo: Path, capsys
+    demo: Path, capsys, the_site_key: SiteKey
 ) -> None:
-    with sqlite3.connect(demo) as connection:  # as a full disk leaves it: never finished
+    with connect_sealed(
+        demo, the_site_key
+    ) as connection:  # as a full disk leaves it: never finished
         connection.execute("DELETE FROM meta WHERE key = 'duration_s'")
         connection.execute("DELETE FROM actions WHERE at_s > 10")
         connection.execute("DELETE FROM statuses WHERE at_s > 10")
@@ -247,7 +267,7 @@ def test_a_recording_whose_meta_is_a_view_that_never_ends_is_refused(
 
 
 def test_a_value_of_another_kind_in_any_column_is_a_damaged_recording_never_a_traceback(
-    demo: Path, tmp_path: Path, capsys
+    demo: Path, tmp_path: Path, capsys, the_site_key: SiteKey
 ) -> None:
     """Every column a reader uses, given text where a number is, a number where a word
     is, bytes anywhere: replay and report name the recording as damaged."""
@@ -256,7 +276,7 @@ def test_a_value_of_another_kind_in_any_column_is_a_damaged_recording_never_a_tr
             for value in ("'x'", "X'00ff'", "1.5"):
                 copy = tmp_path / f"{table}.{column}.db"
                 shutil.copy(demo, copy)
-                with sqlite3.connect(copy) as connection:  # one row: keys stay unique
+                with connect_sealed(copy, the_site_key) as connection:  # one row: keys stay unique
                     connection.execute(
                         f"UPDATE {table} SET {column} = {value} "
                         f"WHERE rowid = (SELECT max(rowid) FROM {table})"

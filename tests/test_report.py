@@ -8,6 +8,7 @@ from pathlib import Path
 import pytest
 
 from engine.cli import main
+from engine.privacy.site_data import SiteKey
 from engine.recording.replay import Recording
 from engine.recording.report import outages, person_moments
 
@@ -24,10 +25,10 @@ def record(tmp_path: Path, scenario: str, capsys, monkeypatch) -> Path:
 
 
 def test_each_thing_the_person_did_is_paired_with_the_robot_s_answer(
-    tmp_path: Path, capsys, monkeypatch
+    tmp_path: Path, capsys, monkeypatch, the_site_key: SiteKey
 ) -> None:
     recording = Recording.open(
-        record(tmp_path, "examples/scenarios/demo.yaml", capsys, monkeypatch)
+        record(tmp_path, "examples/scenarios/demo.yaml", capsys, monkeypatch), the_site_key
     )
     moments = person_moments(recording)
     did = [(round(m.at_s, 1), m.answer.tree if m.answer else None) for m in moments]
@@ -37,10 +38,10 @@ def test_each_thing_the_person_did_is_paired_with_the_robot_s_answer(
 
 
 def test_the_demo_s_report_lists_the_therapist_s_press_as_what_the_therapist_did(
-    tmp_path: Path, capsys, monkeypatch
+    tmp_path: Path, capsys, monkeypatch, the_site_key: SiteKey
 ) -> None:
     path = record(tmp_path, "examples/scenarios/demo.yaml", capsys, monkeypatch)
-    moments = person_moments(Recording.open(path))
+    moments = person_moments(Recording.open(path, the_site_key))
     [press] = [m for m in moments if m.who == "the therapist"]
     assert (round(press.at_s, 1), press.did) == (7.0, "pressed the button \u201cWell done\u201d")
     assert press.answer is not None and press.answer.tree == "buttons"
@@ -50,10 +51,12 @@ def test_the_demo_s_report_lists_the_therapist_s_press_as_what_the_therapist_did
 
 
 def test_a_device_that_dropped_out_is_listed_with_how_long(
-    tmp_path: Path, capsys, monkeypatch
+    tmp_path: Path, capsys, monkeypatch, the_site_key: SiteKey
 ) -> None:
     path = record(tmp_path, "examples/scenarios/unplug_touch.yaml", capsys, monkeypatch)
-    [(since, back)] = [(s, b) for d, s, b in outages(Recording.open(path)) if d == "touch"]
+    [(since, back)] = [
+        (s, b) for d, s, b in outages(Recording.open(path, the_site_key)) if d == "touch"
+    ]
     assert 2.0 <= since < 2.5 and back is not None and 6.0 <= back < 8.5
 
 
@@ -73,10 +76,10 @@ def test_vest_report_writes_one_printable_page_with_its_pictures_inside(
 
 
 def test_the_answer_to_a_touch_the_robot_could_not_feel_is_not_the_hug_after_it(
-    tmp_path: Path, capsys, monkeypatch
+    tmp_path: Path, capsys, monkeypatch, the_site_key: SiteKey
 ) -> None:
     path = record(tmp_path, "examples/scenarios/unplug_touch.yaml", capsys, monkeypatch)
-    moments = {round(m.at_s): m for m in person_moments(Recording.open(path))}
+    moments = {round(m.at_s): m for m in person_moments(Recording.open(path, the_site_key))}
     assert moments[3].answer is None  # pad 5 touched while the touch sensor was unplugged
     assert moments[4].answer is not None and moments[4].answer.tree == "hug"
     assert [a.action for a in moments[4].answers] == ["led", "say"]

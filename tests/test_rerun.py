@@ -3,13 +3,13 @@ have changed in a real session (the py_trees users' wish, issue #419)."""
 
 from __future__ import annotations
 
-import os
 import shutil
 from pathlib import Path
 
 import pytest
 
 from engine.cli import main
+from engine.privacy.site_data import site_key
 from engine.recording.replay import Recording
 from engine.recording.rerun import compare, rerun
 from engine.runtime.robot import load_behaviors
@@ -20,13 +20,16 @@ ROOT = Path(__file__).resolve().parents[1]
 @pytest.fixture(scope="module")
 def session(tmp_path_factory: pytest.TempPathFactory) -> Recording:
     path = tmp_path_factory.mktemp("rerun") / "demo.db"
-    here = Path.cwd()
-    try:
-        os.chdir(ROOT)
-        assert main(["run", "--fast", "--speech", "text", "--record", str(path)]) == 0
-    finally:
-        os.chdir(here)
-    return Recording.open(path)
+    site = tmp_path_factory.mktemp("rerun-site")
+    (site / "consent.yaml").write_text(  # what was heard is kept: the dialog replays too
+        "kid-3:\n  given_by: guardian\n  given_on: 2026-01-05\n  covers: [sensors, speech_text]\n"
+    )
+    with pytest.MonkeyPatch.context() as patch:
+        patch.chdir(ROOT)
+        patch.setenv("VEST_DATA", str(site))
+        args = ["run", "--fast", "--speech", "text", "--record", str(path), "--person", "kid-3"]
+        assert main(args) == 0
+    return Recording.open(path, site_key(site, create=False))
 
 
 def trees(folder: Path) -> object:

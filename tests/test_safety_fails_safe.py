@@ -23,6 +23,7 @@ from engine.cli import main
 from engine.clock import VirtualClock
 from engine.hardware.config_file import load_robot_config
 from engine.hardware.safety_envelope import EnvelopeWatcher, SafetyEnvelope, with_envelope
+from engine.privacy.site_data import SiteKey
 from engine.recording.replay import Recording
 from engine.recording.told import told_events
 from engine.services.simulated import simulated_services
@@ -266,7 +267,9 @@ def test_validate_names_a_distance_rule_on_a_robot_without_range_sensors(
     assert "no_ranges.yaml:" in said
 
 
-def test_the_recording_keeps_which_rule_and_which_device_refused(tmp_path, capsys, monkeypatch):
+def test_the_recording_keeps_which_rule_and_which_device_refused(
+    tmp_path, capsys, monkeypatch, the_site_key: SiteKey
+):
     monkeypatch.chdir(ROOT)
     tree = tmp_path / "arm_up.yaml"
     tree.write_text(ARM_UP)
@@ -279,7 +282,9 @@ def test_the_recording_keeps_which_rule_and_which_device_refused(tmp_path, capsy
     args = ["run", "--fast", "--speech", "text", "--scenario", str(scenario)]
     assert main([*args, "--trees", str(tree), "--record", str(record)]) == 0
     capsys.readouterr()
-    [refused] = [e for e in told_events(Recording.open(record)) if isinstance(e, SafetyAction)]
+    [refused] = [
+        e for e in told_events(Recording.open(record, the_site_key)) if isinstance(e, SafetyAction)
+    ]
     assert refused.action == "refused" and refused.rule == "still_within_mm"
     assert set(refused.devices) == set(RANGE_SENSORS)
 

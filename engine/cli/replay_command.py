@@ -14,6 +14,7 @@ from pathlib import Path
 
 from engine.buttons.button_file import BUTTONS_TREE
 from engine.cli.output import tell
+from engine.cli.site_access import open_recording
 from engine.cli.view_options import add_view_arguments, start_view
 from engine.clock import RealClock
 from engine.errors import UsageError
@@ -53,7 +54,9 @@ def _serve(recording: Recording, args: argparse.Namespace) -> int:
 
 
 def main(args: argparse.Namespace) -> int:
-    recording = Recording.open(args.recording)
+    recording, site = open_recording(args.recording, "replay")
+    if site is not None:
+        site.close()
     try:
         duration = recording.duration_s
         if args.view:
@@ -68,6 +71,8 @@ def main(args: argparse.Namespace) -> int:
                 nodes = f"{len(tree.nodes)} node{'' if len(tree.nodes) == 1 else 's'}"
                 print(f"  {tree.name}: {nodes} at {tree.rate_hz:g} Hz{reloads}")
             print(f"  {len(recording.actions())} actions; vest replay {args.recording} --at S")
+            if recording.meta.get("left_out"):
+                print(f"  not kept (no consent): {recording.meta['left_out']}")
             return _whole(recording)
         if args.at > duration:
             raise UsageError(f"--at {args.at:g}: the session lasted {duration:.2f} s")

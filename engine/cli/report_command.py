@@ -10,7 +10,7 @@ import argparse
 from pathlib import Path
 
 from engine.cli.output import tell, write_file
-from engine.recording.replay import Recording
+from engine.cli.site_access import open_recording
 from engine.recording.report import report_html
 
 
@@ -27,14 +27,18 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def main(args: argparse.Namespace) -> int:
-    recording = Recording.open(args.recording)
+    recording, site = open_recording(args.recording, "report")
     try:
         page = report_html(recording)
         cut = recording.cut_short
+        output = args.output or args.recording.with_suffix(".html")
+        write_file(output, page.encode("utf-8"), f"{output}", "the report")
+        if site is not None:  # a report names the person in the clear: erased with them
+            site.output_written(output, site.person_of(args.recording), "report")
     finally:
         recording.close()
-    output = args.output or args.recording.with_suffix(".html")
-    write_file(output, page.encode("utf-8"), f"{output}", "the report")
+        if site is not None:
+            site.close()
     print(f"report: {output}")
     if cut is not None:  # the report is written, and says so too
         tell(f"vest report: {cut}")

@@ -30,20 +30,23 @@ from urllib.parse import urlsplit
 from engine.cli.output import shown, tell
 from engine.cli.run_inputs import (
     DEFAULT_HARDWARE,
+    RunInputs,
     button_warnings,
     default_buttons,
     found,
     load_run_inputs,
 )
+from engine.cli.site_access import open_site
 from engine.cli.timeline import Timeline
 from engine.cli.validate_command import turn_warnings
 from engine.cli.view_options import add_view_arguments, tell_view, view_plan
 from engine.clock import Clock, EpochClock, RealClock, VirtualClock
-from engine.composition.session_root import SessionPlan, build_session
+from engine.composition.session_root import RecordPlan, SessionPlan, build_session
 from engine.errors import ConfigError, UsageError
 from engine.files.problems import LoadError
 from engine.files.yaml_source import read_text
 from engine.loader.tree_checks import spoken_quote_warnings
+from engine.privacy.site import Site
 from engine.recording.session_file import check_new
 from engine.robot_io.robot_speech import RobotSpeech, audio_folder, build_speech, speech_settings
 from engine.runtime.robot import Behaviors
@@ -141,8 +144,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         type=_pseudonym,
         default=None,
         metavar="PSEUDONYM",
-        help="whose session this is, by pseudonym (e.g. kid-17; never a name): kept in the "
-        "recording and shown in its report",
+        help="whose session this is, by pseudonym (e.g. kid-17; never a name): their consent "
+        "record decides what is recorded and sent to the cloud; the session is listed under "
+        "them (vest data list)",
     )
     parser.add_argument(
         "--hardware",
@@ -234,16 +238,32 @@ def main(args: argparse.Namespace) -> int:
         scenario=args.scenario,
         buttons=args.buttons or default_buttons(with_our_scenario=args.scenario is None),
     )
-    behaviors, config, scenario = inputs.behaviors, inputs.config, inputs.scenario
+    config, scenario = inputs.config, inputs.scenario
     if args.fast and not config.simulated:
         raise ConfigError(f"{args.hardware}: --fast needs a simulated vest (simulated: true)")
     if args.buttons is not None and args.scenario is None and not args.fast:
         # only buttons asked for: a session the therapist leads, until Ctrl-C
         scenario = Scenario(duration_s=math.inf, events=(), path=Path("(the buttons alone)"))
-    if args.person is not None and args.record is None:
-        raise UsageError("--person names whose session is recorded: add --record FILE")
+    site = open_site()  # the key is made on first use
+    try:
+        return _run_for_site(args, site, inputs, scenario)
+    finally:
+        site.close()
+
+
+def _run_for_site(
+    args: argparse.Namespace, site: Site, inputs: RunInputs, scenario: Scenario
+) -> int:
+    behaviors, config = inputs.behaviors, inputs.config
+    for erased in site.finish_erasures():
+        tell(f"finished erasing {erased.person} (cut off earlier)")
+    for purged in site.purge():  # kept as long as the site said, no longer
+        tell(f"purged {purged.path} (older than {site.settings.keep_sessions_days:g} days)")
+    consent = site.consent_of(args.person or "")
     if args.record is not None:
-        check_new(args.record)  # before anything starts: an earlier session is never lost
+        check_new(args.record, site.key)  # before anything starts: never over a session
+    if args.record is not None or args.cloud is not None:
+        tell(f"privacy: {consent.describe()}")
     link = _cloud_link(args)
     clock: Clock = VirtualClock() if args.fast else RealClock()
     if link is not None:
@@ -288,13 +308,13 @@ def main(args: argparse.Namespace) -> int:
             buttons=inputs.buttons,
             view=view_plan(args) if paged else None,
             on_view_up=view_is_up,
-            record=args.record,
+            record=RecordPlan(args.record, site) if args.record is not None else None,
+            consent=consent,
             facts={
                 "robot_config": str(args.hardware),
                 "profile": _profile_name(behaviors),
                 "scenario": str(scenario.path),
                 "started": f"{EpochClock().now():.3f}",
-                "person": args.person or "",
             },
             reload=not args.fast,
         )

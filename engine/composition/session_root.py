@@ -22,6 +22,8 @@ from engine.buttons.button_file import ButtonBoard
 from engine.buttons.wizard import Wizard
 from engine.clock import Clock
 from engine.hardware.config import RobotConfig
+from engine.privacy.consent import Consent, without_record
+from engine.privacy.site import Site
 from engine.recording.recorder import SessionRecorder
 from engine.robot_io.robot_speech import RobotSpeech
 from engine.runtime.reload import TreeReloader
@@ -46,6 +48,14 @@ class ViewPlan:
     token: str | None
 
 
+@dataclass(frozen=True)
+class RecordPlan:
+    """A new recording at ``path``, sealed with ``site``'s key and put in its index."""
+
+    path: Path
+    site: Site
+
+
 @dataclass
 class SessionPlan:
     """Everything a run is built from. ``iot``: the cloud's service (the ``link`` when
@@ -64,8 +74,11 @@ class SessionPlan:
     view: ViewPlan | None = None
     on_view_up: Callable[[ViewServer], None] | None = None
     """Told once the view serves (to say its address: a page opened then misses nothing)."""
-    record: Path | None = None
+    record: RecordPlan | None = None
     facts: dict[str, str] = field(default_factory=dict)
+    consent: Consent = field(default_factory=lambda: without_record(""))
+    """What the person (``consent.person``; '' for none) agreed may be kept and sent: what
+    is recorded, and whether sensor readings go to the cloud as telemetry."""
     reload: bool = False
 
 
@@ -143,11 +156,26 @@ def _around(assembled: AssembledRobot, plan: SessionPlan) -> RunningSession:
 
         lifecycle.add("view", start=start_view, stop=view.stop)
     if plan.record is not None:
-        recorder = SessionRecorder(plan.record, plan.clock)
+        record, consent = plan.record, plan.consent
+        recorder = SessionRecorder(record.path, plan.clock, record.site.key, consent)
         running.recorder = recorder
-        lifecycle.add("recording", stop=recorder.close)  # closed even if the run never starts
-        recorder.describe(**plan.facts)
+
+        def close_recording() -> None:
+            recorder.close()
+            if recorder.length_s is not None:
+                record.site.session_ended(record.path, recorder.length_s)
+
+        lifecycle.add("recording", stop=close_recording)  # closed even if it never starts
+        recorder.describe(
+            **plan.facts,
+            person=consent.person,
+            kept=",".join(sorted(consent.covers)),
+            left_out=recorder.keeps.left_out(),
+        )
         recorder.begin(start_s)
+        record.site.session_started(
+            record.path, consent.person, plan.facts.get("profile", ""), tuple(consent.covers)
+        )
         session.subscribe(recorder)
     player = ScenarioPlayer(
         plan.scenario, assembled.world, start_s=start_s, on_event=_world_events(session)
@@ -168,6 +196,9 @@ def _around(assembled: AssembledRobot, plan: SessionPlan) -> RunningSession:
     assembled.add_runners()  # the pollers and the camera, phased on the first tick
     if plan.link is not None:
         link = plan.link
+
+        if not plan.consent.allows("cloud_telemetry"):
+            link.telemetry.devices_only()
 
         def start_link() -> None:
             link.bind(assembled.blackboard, session)

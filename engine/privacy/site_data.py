@@ -57,7 +57,20 @@ def site_key(folder: Path, *, create: bool) -> SiteKey:
                 f"{path}: no site key here, so no recording of this site can be read "
                 "(set VEST_DATA to the site's data folder)"
             )
-        return _make_key(folder, path)
+        try:
+            folder.mkdir(mode=OWNER_ONLY_FOLDER, parents=True, exist_ok=True)
+        except OSError as error:
+            why = error.strerror or error
+            raise ConfigError(f"{folder}: cannot keep the site's data there ({why})") from None
+        try:
+            return make_key_file(path)
+        except FileExistsError:  # another vest made it a moment ago: use that one
+            pass
+    return read_key_file(path)
+
+
+def read_key_file(path: Path) -> SiteKey:
+    """The key held in ``path``; ConfigError when others may read it or it is not a key."""
     if not path.is_file():
         raise ConfigError(f"{path}: is not a file; the site key is one line of hex")
     mode = stat.S_IMODE(path.stat().st_mode)
@@ -76,17 +89,17 @@ def site_key(folder: Path, *, create: bool) -> SiteKey:
     return SiteKey(key, path)
 
 
-def _make_key(folder: Path, path: Path) -> SiteKey:
+def make_key_file(path: Path) -> SiteKey:
+    """A new random key written to ``path``, owner-only; FileExistsError when a file is
+    there (O_EXCL: two vests starting at once never write two keys over each other)."""
+    key = secrets.token_bytes(KEY_BYTES)
     try:
-        folder.mkdir(mode=OWNER_ONLY_FOLDER, parents=True, exist_ok=True)
-        key = secrets.token_bytes(KEY_BYTES)
-        # O_EXCL: two vests starting at once never write two keys over each other
         descriptor = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL, OWNER_ONLY_FILE)
     except FileExistsError:
-        return site_key(folder, create=False)
+        raise
     except OSError as error:
         why = error.strerror or error
-        raise ConfigError(f"{folder}: cannot keep the site's data there ({why})") from None
+        raise ConfigError(f"{path}: cannot write the site key there ({why})") from None
     with os.fdopen(descriptor, "w", encoding="ascii") as file:
         file.write(key.hex() + "\n")
     return SiteKey(key, path)

@@ -4,7 +4,9 @@ A reader of the session stream (:mod:`engine.session.events`): the scheduler's t
 only turns each event into a row (a tree version, a node's status, a blackboard change, an
 action and how it ended, a scenario event, a turn, a safety decision, a press...) and puts
 it on a bounded queue; a writer thread beside it stores the rows in the SQLite file
-(:mod:`engine.recording.session_file`) in batches.
+(:mod:`engine.recording.session_file`, encrypted with the site's key) in batches. Only
+what the person consented to is kept (:mod:`engine.recording.kept_by_consent`); the file
+says what was left out (``meta``: ``person``, ``kept``, ``left_out``).
 Should the disk fall so far behind that the queue fills, notes are dropped and counted,
 never waited for: the robot's ticks come first, and the file says how many were lost.
 """
@@ -16,12 +18,15 @@ import hashlib
 import json
 import logging
 import queue
-import sqlite3
 import threading
 from pathlib import Path
 from typing import Any
 
 from engine.clock import Clock
+from engine.privacy.consent import Consent
+from engine.privacy.sealed_sqlite import Error
+from engine.privacy.site_data import SiteKey
+from engine.recording.kept_by_consent import KeptByConsent
 from engine.recording.session_file import create
 from engine.session.events import (
     ActionEnded,
@@ -45,17 +50,28 @@ their own, or are kept as the blackboard keys they came from)."""
 
 
 class SessionRecorder:
-    """Records one session into ``path``: a session reader (``on_event``); times are
-    clock seconds minus ``start_s``."""
+    """Records one session into ``path``, encrypted with ``key``, keeping what ``consent``
+    allows: a session reader (``on_event``); times are clock seconds minus ``start_s``."""
 
-    def __init__(self, path: Path, clock: Clock, *, capacity: int = CAPACITY) -> None:
+    def __init__(
+        self,
+        path: Path,
+        clock: Clock,
+        key: SiteKey,
+        consent: Consent,
+        *,
+        capacity: int = CAPACITY,
+    ) -> None:
         self.path = path
         self.clock = clock
         self.start_s = clock.now()
         self.dropped = 0
         self._broken = False
-        self._connection: sqlite3.Connection | None = create(path)
+        self.keeps = KeptByConsent(consent)
+        self._connection: Any = create(path, key)
         self._seq = 0  # the order of the session's events across tables
+        self.length_s: float | None = None
+        """How long the session lasted (seconds), once closed."""
         self.stopped_why: str | None = None
         """Why the recording stopped before the session ended (a full disk), or None."""
         self._queue: queue.Queue[Row | None] = queue.Queue(maxsize=capacity)
@@ -77,6 +93,11 @@ class SessionRecorder:
 
     # -- as the robot runs (the scheduler's thread) ---------------------------------------
     def on_event(self, event: SessionEvent) -> None:
+        kept = self.keeps.kept(event)
+        if kept is not None:
+            self._keep(kept)
+
+    def _keep(self, event: SessionEvent) -> None:
         if isinstance(event, NodeStatus):
             self._note(
                 "INSERT INTO statuses VALUES (?, ?, ?, ?, ?, ?, ?)",
@@ -211,7 +232,7 @@ class SessionRecorder:
                         continue
                     connection.execute(*item)
                 connection.commit()
-            except sqlite3.Error as error:  # a full disk: the robot goes on, the record stops
+            except Error as error:  # a full disk: the robot goes on, the record stops
                 log.error("recording %s stopped: %s", self.path, error)
                 self.stopped_why = str(error)
                 self._broken = True
@@ -221,7 +242,8 @@ class SessionRecorder:
         """Write what is still queued, how long the session was and what was lost."""
         if self._connection is None:
             return
-        self.describe(duration_s=f"{self._at(self.clock.now()):.3f}", dropped=str(self.dropped))
+        self.length_s = self._at(self.clock.now())
+        self.describe(duration_s=f"{self.length_s:.3f}", dropped=str(self.dropped))
         if not self._broken:  # a writer that stopped reads no more: nothing to wait for
             self._queue.put(None)
             self._thread.join()

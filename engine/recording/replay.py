@@ -9,13 +9,14 @@ from __future__ import annotations
 
 import json
 import math
-import sqlite3
 import threading
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from engine.errors import ConfigError
+from engine.privacy.sealed_sqlite import Connection, Error
+from engine.privacy.site_data import SiteKey
 from engine.recording.session_file import open_for_reading, whole_number
 
 STATUS_MARKS = {"SUCCESS": "ok", "FAILURE": "no", "RUNNING": "..", "INVALID": "  "}
@@ -83,8 +84,10 @@ class RecordedAction:
 class Recording:
     """A recording opened for reading (:func:`Recording.open`)."""
 
-    def __init__(self, path: Path, connection: sqlite3.Connection) -> None:
+    def __init__(self, path: Path, connection: Connection, *, plain: bool = False) -> None:
         self.path = path
+        self.plain = plain
+        """Made before recordings were sealed: readable by anyone (``vest data seal``)."""
         self._connection = connection
         self._lock = threading.Lock()  # the replay view asks from several threads
         self.meta = dict(self._rows("SELECT key, value FROM meta"))
@@ -94,14 +97,18 @@ class Recording:
         """ConfigError naming the file when it turns out damaged."""
         with self._lock:
             try:
-                return self._connection.execute(sql, parameters).fetchall()
-            except (sqlite3.Error, OverflowError) as error:
+                rows: list[Any] = self._connection.execute(sql, parameters).fetchall()
+                return rows
+            except (Error, OverflowError) as error:
                 raise ConfigError(f"{self.path}: a damaged recording ({error})") from None
 
     @classmethod
-    def open(cls, path: Path) -> Recording:
-        """ConfigError naming the file when it is not a recording this vest reads."""
-        return cls(path, open_for_reading(path))
+    def open(cls, path: Path, key: SiteKey | None) -> Recording:
+        """The recording at ``path``, decrypted with the site's ``key``; ConfigError naming
+        the file when it is not a recording this vest reads (or not with this key; None:
+        only a plain recording, made before they were sealed, can be read)."""
+        opened = open_for_reading(path, key)
+        return cls(path, opened.connection, plain=opened.plain)
 
     def close(self) -> None:
         with self._lock:

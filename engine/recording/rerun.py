@@ -8,6 +8,8 @@ is then checked against a real session before it meets a child.
 
 The therapist's button presses are not played again: the buttons' own actions, and the
 moves back to rest of the trees they interrupted, are left out of the comparison.
+A recording keeps only what the person consented to: one that kept no speech as text
+(``meta`` ``left_out``) is played again without what was heard, so its dialogs differ.
 """
 
 from __future__ import annotations

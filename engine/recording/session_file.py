@@ -1,4 +1,5 @@
-"""The session recording file: one SQLite database (docs/view-and-recordings.md describes it).
+"""The session recording file: one SQLite database, encrypted with the site's key
+(:mod:`engine.privacy.sealed_sqlite`; docs/view-and-recordings.md describes it).
 
 Times are seconds since the session started (its first tick's clock time). Tables:
 
@@ -22,15 +23,25 @@ session's events in the order they happened, across tables)
 
 A later version of vest reads every earlier format; it refuses a newer one by name.
 Format 1 (before the session's events were kept) has no ``events`` table and no outcome
-of an action but its error.
+of an action but its error. Recordings made before they were sealed are plain SQLite: they
+are still read (:attr:`Opened.plain` says so), and ``vest data seal`` encrypts them.
 """
 
 from __future__ import annotations
 
-import sqlite3
+from dataclasses import dataclass
 from pathlib import Path
 
 from engine.errors import ConfigError
+from engine.privacy.sealed_sqlite import (
+    Connection,
+    Error,
+    connect_plain,
+    connect_sealed,
+    could_be_sealed,
+    is_plain_sqlite,
+)
+from engine.privacy.site_data import SiteKey, check_apart
 
 FORMAT_VERSION = 2
 TABLES = ("meta", "trees", "nodes", "statuses", "blackboard", "actions", "world")
@@ -74,44 +85,48 @@ CREATE INDEX events_by_time ON events (at_s);
 """
 
 
-def check_new(path: Path) -> None:
+def check_new(path: Path, key: SiteKey) -> None:
     """ConfigError unless a recording can be made at ``path``: never over a file that is
-    there (an earlier session is never lost), never as a folder."""
+    there (an earlier session is never lost), never as a folder, never beside the key."""
     if path.is_dir():
         raise ConfigError(f"--record {path}: is a folder; name a file")
     folder = path.parent if str(path.parent) else Path(".")
     if not folder.is_dir():
         raise ConfigError(f"--record {path}: cannot write a recording there (no folder {folder})")
     if path.exists() or path.is_symlink():
-        what = "an earlier session" if _is_recording(path) else "something else"
+        what = "an earlier session" if _is_recording(path, key) else "something else"
         raise ConfigError(
             f"--record {path}: holds {what}, which a new recording would replace; name "
             "another file (or remove that one first)"
         )
-
-
-def create(path: Path) -> sqlite3.Connection:
-    """A new, empty recording at ``path``; ConfigError when a file is there already, or the
-    folder is missing or not writable."""
-    check_new(path)
     try:
-        connection = sqlite3.connect(str(path), check_same_thread=False)
+        check_apart(path, key)
+    except ConfigError as error:
+        raise ConfigError(f"--record {error}") from None
+
+
+def create(path: Path, key: SiteKey) -> Connection:
+    """A new, empty recording at ``path``, encrypted with ``key``; ConfigError when a file
+    is there already, or the folder is missing or not writable."""
+    check_new(path, key)
+    try:
+        connection = connect_sealed(path, key)
         connection.executescript(SCHEMA)
         connection.execute("INSERT INTO meta VALUES ('format', ?)", (str(FORMAT_VERSION),))
         connection.commit()
-    except (OSError, sqlite3.Error) as error:
+    except (OSError, Error, ConfigError) as error:
         raise ConfigError(f"--record {path}: cannot write a recording there ({error})") from None
     return connection
 
 
-def _is_recording(path: Path) -> bool:
+def _is_recording(path: Path, key: SiteKey) -> bool:
+    """Whether ``path`` is a recording of this site (or a plain one of earlier vests)."""
     if not path.is_file():  # a FIFO would block the open until a writer came
         return False
     try:
-        with open(path, "rb") as file:
-            if file.read(16) != b"SQLite format 3\x00":
-                return False
-        connection = sqlite3.connect(f"file:{path}?mode=ro", uri=True)
+        connection = connect_plain(path) if is_plain_sqlite(path) else None
+        if connection is None:
+            connection = connect_sealed(path, key, read_only=True)
         try:
             kind = connection.execute(
                 "SELECT type FROM sqlite_master WHERE name = 'meta'"
@@ -121,30 +136,65 @@ def _is_recording(path: Path) -> bool:
             row = connection.execute("SELECT value FROM meta WHERE key = 'format'").fetchone()
         finally:
             connection.close()
-    except (OSError, sqlite3.Error):
+    except (OSError, Error, ConfigError):
         return False
     return row is not None
 
 
-def open_for_reading(path: Path) -> sqlite3.Connection:
-    """An existing recording, read-only; ConfigError naming the file when it is not one,
-    or is of a newer format than this vest reads."""
+def check_kind(path: Path) -> None:
+    """ConfigError when ``path`` is missing or cannot be a recording (plain or sealed),
+    before any key is looked for."""
     if not path.is_file():
         raise ConfigError(f"{path}: no such recording")
+    if not (is_plain_sqlite(path) or could_be_sealed(path)):
+        raise ConfigError(f"{path}: not a vest recording (vest run --record makes them)")
+
+
+@dataclass(frozen=True)
+class Opened:
+    """A recording opened for reading: its connection, and whether the file is plain (made
+    before recordings were sealed)."""
+
+    connection: Connection
+    plain: bool
+
+
+def open_for_reading(path: Path, key: SiteKey | None) -> Opened:
+    """An existing recording, read-only, decrypted with ``key``; ConfigError naming the
+    file when it is not one, cannot be read with this key (another site's, changed or
+    damaged: the encryption is authenticated) or without one (``key`` None: this machine
+    has no site key), or is of a newer format than this vest reads."""
+    check_kind(path)
+    plain = is_plain_sqlite(path)
+    if key is None and not plain:
+        raise ConfigError(
+            f"{path}: encrypted, and this machine has no site key to read it (set VEST_DATA "
+            "to the data folder of the site that recorded it)"
+        )
     journal = path.with_name(path.name + "-journal")
     if journal.exists():  # cut off mid-write: SQLite rolls the last batch back on opening
         try:
-            with sqlite3.connect(str(path)) as recovering:
-                recovering.execute("SELECT count(*) FROM sqlite_master").fetchone()
-        except sqlite3.Error as error:
+            # opened for writing once: a read-only connection cannot roll back
+            recovering = (
+                connect_sealed(path, key)
+                if key is not None and not plain
+                else connect_plain(path, False)
+            )
+            recovering.execute("SELECT count(*) FROM sqlite_master").fetchone()
+            recovering.close()
+        except Error as error:
             raise ConfigError(
                 f"{path}: an interrupted recording that cannot be recovered ({error})"
             ) from None
     try:
         # one connection, used from the view's threads one query at a time (Recording locks)
-        connection = sqlite3.connect(f"file:{path}?mode=ro", uri=True, check_same_thread=False)
+        connection = (
+            connect_sealed(path, key, read_only=True)
+            if key is not None and not plain
+            else connect_plain(path)
+        )
         kinds = dict(connection.execute("SELECT name, type FROM sqlite_master").fetchall())
-    except sqlite3.Error:
+    except Error:
         raise ConfigError(f"{path}: not a vest recording (vest run --record makes them)") from None
     not_tables = sorted(name for name in (*TABLES, "events") if kinds.get(name, "table") != "table")
     if not_tables:  # a view in a table's place could ask anything of the reader (a loop)
@@ -152,7 +202,7 @@ def open_for_reading(path: Path) -> sqlite3.Connection:
         raise ConfigError(f"{path}: not a vest recording ({not_tables[0]!r} is not a table)")
     try:
         row = connection.execute("SELECT value FROM meta WHERE key = 'format'").fetchone()
-    except sqlite3.Error:
+    except Error:
         raise ConfigError(f"{path}: not a vest recording (vest run --record makes them)") from None
     version = whole_number(row[0]) if row is not None else None
     if version is None:
@@ -166,7 +216,7 @@ def open_for_reading(path: Path) -> sqlite3.Connection:
     if missing:
         raise ConfigError(f"{path}: a damaged recording (no table {missing[0]!r})")
     _check_kinds_of_values(connection, path, set(kinds))
-    return connection
+    return Opened(connection, plain)
 
 
 def whole_number(value: object) -> int | None:
@@ -233,7 +283,7 @@ COLUMNS: dict[str, dict[str, tuple[tuple[str, ...], bool]]] = {
 MAX_DEPTH = 1000
 
 
-def _check_kinds_of_values(connection: sqlite3.Connection, path: Path, tables: set[str]) -> None:
+def _check_kinds_of_values(connection: Connection, path: Path, tables: set[str]) -> None:
     """ConfigError naming the first column that holds another kind of value than vest
     writes there (text where a time is, a picture's bytes where a name is): one query a
     table, so no reader meets such a value later."""
@@ -250,7 +300,7 @@ def _check_kinds_of_values(connection: sqlite3.Connection, path: Path, tables: s
                     f"SELECT typeof({column}) FROM {table} "
                     f"WHERE typeof({column}) NOT IN ({allowed}) LIMIT 1"
                 ).fetchone()
-            except sqlite3.Error as error:
+            except Error as error:
                 raise ConfigError(f"{path}: a damaged recording ({error})") from None
             if wrong is not None:
                 raise ConfigError(

@@ -42,9 +42,18 @@ class TelemetrySnapshot:
     def __init__(self) -> None:
         self._values: dict[str, Any] = {}
         self._lock = threading.Lock()
+        self.prefixes: tuple[str, ...] = TELEMETRY_PREFIXES
+        """The keys sent: sensors and devices, or devices alone when the person did not
+        consent to telemetry (:meth:`devices_only`)."""
+
+    def devices_only(self) -> None:
+        """From now on only the robot's own device keys are sent, never a sensor reading."""
+        with self._lock:
+            self.prefixes = (DEVICES_PREFIX,)
+            self._values = {k: v for k, v in self._values.items() if k.startswith(DEVICES_PREFIX)}
 
     def on_event(self, event: SessionEvent) -> None:
-        if isinstance(event, KeyChanged) and event.key.startswith(TELEMETRY_PREFIXES):
+        if isinstance(event, KeyChanged) and event.key.startswith(self.prefixes):
             value = json_safe(event.value)
             with self._lock:
                 self._values[event.key] = value

@@ -17,6 +17,7 @@ from playwright.sync_api import Page, expect
 
 from engine.cli import main
 from engine.errors import ConfigError
+from engine.privacy.site_data import SiteKey
 from engine.recording.replay import Recording
 from engine.view.replay_source import ReplaySource
 from engine.view.server import ViewServer
@@ -73,13 +74,13 @@ def test_the_live_page_draws_every_tree_and_the_hug_lights_up(page: Page, live_d
 
 
 @pytest.fixture
-def replay(tmp_path: Path, monkeypatch, capsys) -> Iterator[str]:
+def replay(tmp_path: Path, monkeypatch, capsys, the_site_key: SiteKey) -> Iterator[str]:
     """The demo recorded on the virtual clock, served as a replay."""
     monkeypatch.chdir(ROOT)
     recorded = tmp_path / "demo.db"
     assert main(["run", "--fast", "--speech", "text", "--record", str(recorded)]) == 0
     capsys.readouterr()
-    recording = Recording.open(recorded)
+    recording = Recording.open(recorded, the_site_key)
     server = ViewServer(ReplaySource(recording), port=0, token=None)
     server.start()
     yield server.url

@@ -1,0 +1,234 @@
+"""A site (a clinic, a lab): its data folder, key, consent records, index of sessions and
+audit trail, and what a site does with them: keep sessions as long as it said, erase a
+person on request, rotate its key.
+
+Settings, in ``site.yaml`` in the data folder (optional)::
+
+    keep_sessions_days: 365     # sessions older than this are purged (default 365)
+
+Times are seconds since the epoch (UTC) from the injected clock (an
+:class:`~engine.clock.EpochClock` in use).
+"""
+
+from __future__ import annotations
+
+import datetime
+import os
+import shutil
+from dataclasses import dataclass
+from pathlib import Path
+
+from engine.clock import Clock
+from engine.errors import ConfigError
+from engine.files.problems import Problems
+from engine.files.yaml_source import load_yaml
+from engine.files.yaml_values import YMap, YScalar
+from engine.privacy.consent import Consent, ConsentBook
+from engine.privacy.sealed_sqlite import connect_sealed, rekey
+from engine.privacy.site_data import KEY_FILE, SiteKey, make_key_file, read_key_file, site_key
+from engine.privacy.site_records import RECORDS_FILE, SessionEntry, SiteRecords
+
+SETTINGS_FILE = "site.yaml"
+KEEP_DAYS = 365
+NEW_KEY_FILE = "site.key.new"
+DAY_S = 86_400.0
+
+
+@dataclass(frozen=True)
+class SiteSettings:
+    keep_sessions_days: float = KEEP_DAYS
+
+    @classmethod
+    def load(cls, folder: Path) -> SiteSettings:
+        """``folder/site.yaml`` (defaults when missing); LoadError at file:line:column."""
+        path = folder / SETTINGS_FILE
+        if not path.exists():
+            return cls()
+        document = load_yaml(path)
+        if document is None:
+            return cls()
+        problems = Problems()
+        if not isinstance(document, YMap):
+            problems.add(document.mark, "site settings are a mapping: keep_sessions_days: N")
+            problems.raise_if_any()
+        assert isinstance(document, YMap)
+        problems.unknown_fields(document.key_marks, ("keep_sessions_days",), "site")
+        days = document.get("keep_sessions_days")
+        keep = float(KEEP_DAYS)
+        if days is not None:
+            value = days.value if isinstance(days, YScalar) else None
+            if isinstance(value, bool) or not isinstance(value, int | float) or not value > 0:
+                problems.add(days.mark, "keep_sessions_days: a number of days above 0")
+            else:
+                keep = float(value)
+        problems.raise_if_any()
+        return cls(keep)
+
+
+@dataclass(frozen=True)
+class Erased:
+    """What an erasure removed: files (recordings, reports, exports) and those that were
+    already gone."""
+
+    person: str
+    removed: list[Path]
+    already_gone: list[Path]
+
+
+class Site:
+    """The site whose data folder is ``folder``; ``who`` is the user acting (for the audit
+    trail)."""
+
+    def __init__(self, folder: Path, key: SiteKey, clock: Clock, who: str) -> None:
+        self.folder, self.key, self.clock, self.who = folder, key, clock, who
+        self.settings = SiteSettings.load(folder)
+        self.consents = ConsentBook.load(folder)
+        self.rotation_cut_off = False
+        """A key rotation began and did not finish: some recordings are on the new key
+        (``vest data rekey`` finishes it)."""
+        rotation = folder / NEW_KEY_FILE
+        if rotation.exists():
+            new = read_key_file(rotation)
+            if _reads_with(folder / RECORDS_FILE, new):  # cut off at its very last step
+                os.replace(rotation, folder / KEY_FILE)
+                self.key = SiteKey(new.key, folder / KEY_FILE)
+            else:
+                self.rotation_cut_off = True
+        self.records = SiteRecords(folder, self.key)
+
+    @classmethod
+    def open(cls, folder: Path, *, clock: Clock, who: str, create: bool = True) -> Site:
+        """The site in ``folder``: its key made on first use when ``create``."""
+        return cls(folder, site_key(folder, create=create), clock, who)
+
+    def close(self) -> None:
+        self.records.close()
+
+    # -- sessions -----------------------------------------------------------------------
+    def today(self) -> datetime.date:
+        return datetime.datetime.fromtimestamp(self.clock.now(), datetime.UTC).date()
+
+    def consent_of(self, person: str) -> Consent:
+        return self.consents.of(person, self.today())
+
+    def audit(self, action: str, person: str, what: str) -> None:
+        self.records.audit(self.clock.now(), self.who, action, person, what)
+
+    def session_started(self, path: Path, person: str, profile: str, kept: tuple[str, ...]) -> None:
+        """Indexes a new recording (and audits it)."""
+        where = path.resolve()
+        self.records.add_session(where, person, self.clock.now(), profile, kept)
+        self.audit("record", person, str(where))
+
+    def session_ended(self, path: Path, length_s: float) -> None:
+        self.records.end_session(path.resolve(), length_s)
+
+    def output_written(self, path: Path, person: str, kind: str) -> None:
+        """Notes a report or export written in the clear about ``person`` (erased with them)."""
+        self.records.add_output(path.resolve(), person, kind, self.clock.now())
+        self.audit(f"{kind} written", person, str(path.resolve()))
+
+    def person_of(self, recording: Path) -> str:
+        """The pseudonym a recording belongs to ('' for none or one not in the index)."""
+        entry = self.records.session_at(recording.resolve())
+        return entry.person if entry is not None else ""
+
+    # -- retention ----------------------------------------------------------------------
+    def purge(self) -> list[SessionEntry]:
+        """Removes every session older than the site keeps them (file and index entry,
+        each audited); returns them."""
+        oldest = self.clock.now() - self.settings.keep_sessions_days * DAY_S
+        purged = [entry for entry in self.records.sessions() if entry.started < oldest]
+        for entry in purged:
+            _remove(entry.path)
+            self.records.forget_session(entry.path)
+            days = self.settings.keep_sessions_days
+            self.audit("purge", entry.person, f"{entry.path} (older than {days:g} days)")
+        return purged
+
+    # -- erasure ------------------------------------------------------------------------
+    def erase(self, person: str) -> Erased:
+        """Removes everything held about ``person``: recordings, reports, exports, the
+        index's entries and the consent record, leaving one audit line. Marked first, so
+        an erasure cut off half-way finishes on the next run (:meth:`finish_erasures`)."""
+        self.records.begin_erasing(person, self.clock.now())
+        return self._erase(person)
+
+    def finish_erasures(self) -> list[Erased]:
+        """Finishes erasures that were cut off."""
+        return [self._erase(person) for person in self.records.unfinished_erasures()]
+
+    def _erase(self, person: str) -> Erased:
+        removed: list[Path] = []
+        gone: list[Path] = []
+        paths = [e.path for e in self.records.sessions(person)]
+        paths += [path for path, _ in self.records.outputs(person)]
+        for path in paths:
+            (removed if _remove(path) else gone).append(path)
+        self.consents.forget(self.folder, person)
+        what = f"{len(removed)} files removed"
+        self.records.finish_erasing(person, (self.clock.now(), self.who, what))
+        return Erased(person, removed, gone)
+
+    # -- the key ------------------------------------------------------------------------
+    def rekey(self, *, drop_missing: bool = False) -> tuple[list[Path], list[Path]]:
+        """Encrypts the site's records and every indexed recording with a new key, then
+        retires the old one; returns (re-encrypted, missing). Cut off, it is run again:
+        files already on the new key are left as they are. ConfigError listing recordings
+        that are not where the index says (moved, on a USB stick) unless
+        ``drop_missing``: with the old key gone, those could never be read again."""
+        sessions = self.records.sessions()
+        missing = [entry.path for entry in sessions if not entry.path.is_file()]
+        if missing and not drop_missing:
+            raise ConfigError(
+                f"{len(missing)} recordings are not where the index says ({missing[0]}...): "
+                "put them back, or add --drop-missing to give them up (they could never be "
+                "read again)"
+            )
+        new = site_key_in_rotation(self.folder)
+        done: list[Path] = []
+        self.records.close()
+        # the site's records last: while they are on the old key, the rotation is unfinished
+        for path in [*(e.path for e in sessions if e.path.is_file()), self.folder / RECORDS_FILE]:
+            if _reads_with(path, new):
+                continue
+            rekey(path, self.key, new)
+            done.append(path)
+        os.replace(new.path, self.folder / KEY_FILE)
+        self.key = SiteKey(new.key, self.folder / KEY_FILE)
+        self.records = SiteRecords(self.folder, self.key)
+        for path in missing:
+            self.records.forget_session(path)
+            self.audit("rekey", "", f"{path}: missing, given up")
+        self.audit("rekey", "", f"{len(done)} files on a new key")
+        return done, missing
+
+
+def site_key_in_rotation(folder: Path) -> SiteKey:
+    """The new key of a rotation under way (``site.key.new``), made when there is none."""
+    path = folder / NEW_KEY_FILE
+    try:
+        return make_key_file(path)
+    except FileExistsError:
+        return read_key_file(path)
+
+
+def _reads_with(path: Path, key: SiteKey) -> bool:
+    try:
+        connect_sealed(path, key, read_only=True).close()
+    except ConfigError:
+        return False
+    return True
+
+
+def _remove(path: Path) -> bool:
+    """Removes a file (and its SQLite journal) or a folder; False when it was not there."""
+    if path.is_dir() and not path.is_symlink():
+        shutil.rmtree(path)
+        return True
+    journal = path.with_name(path.name + "-journal")
+    journal.unlink(missing_ok=True)
+    if not (path.exists() or path.is_symlink()):
+        return False
+    path.unlink()
+    return True
