@@ -2,6 +2,10 @@
 the person did and how the robot answered, how fast; how often each behaviour acted; what
 it did not understand; devices that dropped out; the sensors over the session. One HTML
 file with its pictures inside, printable on A4.
+
+With --person PSEUDONYM instead of a file: that person's progress across every session the
+site holds of them (vest data list --person): what they did, how the robot answered and
+how fast, what it did not understand, per behaviour, session by session.
 """
 
 from __future__ import annotations
@@ -10,23 +14,39 @@ import argparse
 from pathlib import Path
 
 from engine.cli.output import tell, write_file
-from engine.cli.site_access import open_recording
+from engine.cli.site_access import open_recording, open_site, pseudonym
+from engine.errors import UsageError
+from engine.recording.progress import SessionSummary, progress_html, summarize
+from engine.recording.replay import Recording
 from engine.recording.report import report_html
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("recording", type=Path, metavar="FILE", help="made by vest run --record")
+    parser.add_argument(
+        "recording", type=Path, nargs="?", metavar="FILE", help="made by vest run --record"
+    )
+    parser.add_argument(
+        "--person",
+        type=pseudonym,
+        default=None,
+        metavar="PSEUDONYM",
+        help="instead of one FILE: the person's progress across their sessions",
+    )
     parser.add_argument(
         "-o",
         "--output",
         type=Path,
         default=None,
         metavar="REPORT.html",
-        help="default: FILE with .html",
+        help="default: FILE with .html, or PSEUDONYM-progress.html",
     )
 
 
 def main(args: argparse.Namespace) -> int:
+    if (args.recording is None) == (args.person is None):
+        raise UsageError("name a recording FILE, or --person PSEUDONYM for their progress")
+    if args.person is not None:
+        return _progress(args.person, args.output or Path(f"{args.person}-progress.html"))
     recording, site = open_recording(args.recording, "report")
     try:
         page = report_html(recording)
@@ -43,4 +63,33 @@ def main(args: argparse.Namespace) -> int:
     if cut is not None:  # the report is written, and says so too
         tell(f"vest report: {cut}")
         return 1
+    return 0
+
+
+def _progress(person: str, output: Path) -> int:
+    site = open_site(create=False)
+    try:
+        entries = site.records.sessions(person)
+        if not entries:
+            raise UsageError(f"the site holds no session of {person} (vest data list)")
+        summaries: list[SessionSummary] = []
+        gone: list[Path] = []
+        for entry in entries:
+            if not entry.path.is_file():
+                gone.append(entry.path)
+                continue
+            recording = Recording.open(entry.path, site.key)
+            try:
+                summaries.append(summarize(recording, entry.started))
+            finally:
+                recording.close()
+            site.audit("report", person, str(entry.path))
+        page = progress_html(person, summaries, gone)
+        write_file(output, page.encode("utf-8"), f"{output}", "the report")
+        site.output_written(output, person, "report")
+    finally:
+        site.close()
+    print(f"progress of {person} over {len(summaries)} sessions: {output}")
+    for path in gone:
+        tell(f"warning: {path}: not there any more; left out of the progress")
     return 0

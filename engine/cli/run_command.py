@@ -22,7 +22,6 @@ from __future__ import annotations
 
 import argparse
 import math
-import re
 import sys
 from pathlib import Path
 from urllib.parse import urlsplit
@@ -36,7 +35,7 @@ from engine.cli.run_inputs import (
     found,
     load_run_inputs,
 )
-from engine.cli.site_access import open_site
+from engine.cli.site_access import open_site, pseudonym
 from engine.cli.timeline import Timeline
 from engine.cli.validate_command import turn_warnings
 from engine.cli.view_options import add_view_arguments, tell_view, view_plan
@@ -141,7 +140,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         "--person",
-        type=_pseudonym,
+        type=pseudonym,
         default=None,
         metavar="PSEUDONYM",
         help="whose session this is, by pseudonym (e.g. kid-17; never a name): their consent "
@@ -160,16 +159,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def _profile_name(behaviors: Behaviors) -> str:
     profile = behaviors.loader.profile
     return "" if profile is None else str(profile.path or profile.name)
-
-
-def _pseudonym(text: str) -> str:
-    """A pseudonym: 1..40 letters, digits, '-', '_' or '.', starting with a letter or digit."""
-    if not re.fullmatch(r"[A-Za-z0-9][A-Za-z0-9._-]{0,39}", text):
-        raise argparse.ArgumentTypeError(
-            f"{text!r} is not a pseudonym: use 1 to 40 letters, digits, '-', '_' or '.' "
-            "(e.g. kid-17), never a person's name"
-        )
-    return text
 
 
 def _positive_seconds(text: str) -> float:

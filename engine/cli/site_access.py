@@ -3,8 +3,10 @@ own), opened with its key (:mod:`engine.privacy.site`), and the recordings it re
 
 from __future__ import annotations
 
+import argparse
 import getpass
 import os
+import re
 from pathlib import Path
 
 from engine.cli.output import tell
@@ -15,6 +17,19 @@ from engine.privacy.site import Site
 from engine.privacy.site_data import data_folder
 from engine.recording.replay import Recording
 from engine.recording.session_file import check_kind
+
+PSEUDONYM = re.compile(r"[A-Za-z0-9][A-Za-z0-9._-]{0,39}")
+
+
+def pseudonym(text: str) -> str:
+    """A pseudonym (argparse type): 1..40 letters, digits, '-', '_' or '.', starting with
+    a letter or digit."""
+    if not PSEUDONYM.fullmatch(text):
+        raise argparse.ArgumentTypeError(
+            f"{text!r} is not a pseudonym: use 1 to 40 letters, digits, '-', '_' or '.' "
+            "(e.g. kid-17), never a person's name"
+        )
+    return text
 
 
 def acting_user() -> str:

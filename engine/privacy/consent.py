@@ -123,6 +123,11 @@ class ConsentBook:
         path = folder / CONSENT_FILE
         if not path.exists():
             return cls({})
+        return cls.load_file(path)
+
+    @classmethod
+    def load_file(cls, path: Path) -> ConsentBook:
+        """The records in the consent file ``path``; LoadError at file:line:column."""
         document = load_yaml(path)
         problems = Problems()
         records: dict[str, Consent] = {}

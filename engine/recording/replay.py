@@ -17,7 +17,7 @@ from typing import Any
 from engine.errors import ConfigError
 from engine.privacy.sealed_sqlite import Connection, Error
 from engine.privacy.site_data import SiteKey
-from engine.recording.session_file import open_for_reading, whole_number
+from engine.recording.session_file import TABLES, open_for_reading, whole_number
 
 STATUS_MARKS = {"SUCCESS": "ok", "FAILURE": "no", "RUNNING": "..", "INVALID": "  "}
 """How a status reads in the terminal: success, failure, running, not ticked."""
@@ -229,6 +229,17 @@ class Recording:
         scenario's events); none for a robot in a real room."""
         rows = self._rows("SELECT at_s, kind, description FROM world ORDER BY rowid")
         return [(at, kind, description) for at, kind, description in rows]
+
+    def table(self, name: str) -> list[dict[str, Any]]:
+        """Every row of the recording's table ``name`` (one of :data:`TABLES` or
+        ``events``), each as {column: value}, in the order written (for an export)."""
+        if name not in (*TABLES, "events"):
+            raise ValueError(f"no table {name!r} in a recording")
+        if name == "events" and self.format < 2:
+            return []
+        columns = [row[1] for row in self._rows(f"PRAGMA table_info({name})")]
+        rows = self._rows(f"SELECT {', '.join(columns)} FROM {name} ORDER BY rowid")
+        return [dict(zip(columns, row, strict=True)) for row in rows]
 
     def ordered_rows(self, table: str, columns: str, until_s: float) -> list[Any]:
         """Rows of ``table`` up to ``until_s`` with their order across tables (format 2's

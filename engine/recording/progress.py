@@ -1,0 +1,178 @@
+"""A person's progress across sessions (``vest report --person kid-17``): how what they
+did, how the robot answered, how fast, and what it did not understand changed from one
+session to the next, overall and per behaviour. One HTML page, printable on A4.
+
+Each session is summed up from its recording the way its own report reads it
+(:func:`~engine.recording.moments.person_moments`); a session whose file is gone is
+listed as such, never silently left out.
+"""
+
+from __future__ import annotations
+
+import datetime
+import html
+import statistics
+from collections import defaultdict
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from engine.recording.moments import not_understood, person_moments
+from engine.recording.replay import Recording
+from engine.recording.report import STYLE
+from engine.recording.report_plots import per_session_plot
+
+THE_PERSON = "the person"
+
+
+@dataclass(frozen=True)
+class SessionSummary:
+    """One session of a person. Counts are of what the person did (not the therapist or an
+    operator); ``answer_s`` holds each answer time in seconds; ``by_behaviour`` the answer
+    times of each behaviour (tree) that answered."""
+
+    path: Path
+    started: float
+    length_s: float
+    did: int
+    answer_s: tuple[float, ...]
+    not_understood: int
+    not_listened: int
+    by_behaviour: dict[str, tuple[float, ...]] = field(default_factory=dict)
+
+    @property
+    def answered(self) -> int:
+        return len(self.answer_s)
+
+    @property
+    def median_answer_s(self) -> float | None:
+        return statistics.median(self.answer_s) if self.answer_s else None
+
+    @property
+    def day(self) -> str:
+        return datetime.datetime.fromtimestamp(self.started, datetime.UTC).strftime("%Y-%m-%d")
+
+
+def summarize(recording: Recording, started: float) -> SessionSummary:
+    """What ``recording`` (which began at ``started``, seconds since the epoch) says of
+    the person."""
+    moments = [m for m in person_moments(recording) if m.who == THE_PERSON]
+    acts = [m for m in moments if not m.not_listened]
+    behaviours: dict[str, list[float]] = defaultdict(list)
+    times: list[float] = []
+    for moment in acts:
+        answer, took = moment.answer, moment.response_s
+        if answer is None or took is None or all(a.outcome == "failed" for a in moment.answers):
+            continue
+        times.append(took)
+        behaviours[answer.tree].append(took)
+    return SessionSummary(
+        recording.path,
+        started,
+        recording.duration_s,
+        len(acts),
+        tuple(times),
+        len(not_understood(recording)),
+        len(moments) - len(acts),
+        {tree: tuple(found) for tree, found in behaviours.items()},
+    )
+
+
+def progress_html(person: str, sessions: list[SessionSummary], gone: list[Path]) -> str:
+    """The progress page of ``person`` over ``sessions`` (oldest first); ``gone``: indexed
+    sessions whose files are no longer there."""
+    name = html.escape(person)
+    labels = [f"{n}: {s.day}" for n, s in enumerate(sessions, 1)]
+    parts = [
+        '<!doctype html>\n<html lang="en"><head><meta charset="utf-8">',
+        f"<title>Progress: {name}</title>",
+        f"<style>{STYLE(encoding='utf-8')}</style></head><body>",
+        f"<h1>Progress of {name}</h1>",
+        f'<p class="meta">{len(sessions)} sessions'
+        + (f" from {sessions[0].day} to {sessions[-1].day}" if sessions else "")
+        + "</p>",
+        f"<p>{html.escape(_in_words(sessions))}</p>",
+    ]
+    if gone:
+        listed = ", ".join(html.escape(str(path)) for path in gone)
+        parts.append(f'<p class="warning">Not there any more, so not counted: {listed}.</p>')
+    parts += [
+        "<h2>Session by session</h2>",
+        _sessions_table(sessions),
+        per_session_plot(
+            "What the person did and what the robot answered",
+            "times",
+            [
+                ("did", "#2e7d32", [float(s.did) for s in sessions]),
+                ("answered", "#1565c0", [float(s.answered) for s in sessions]),
+                ("not understood", "#c62828", [float(s.not_understood) for s in sessions]),
+            ],
+            labels,
+        ),
+        per_session_plot(
+            "Typical time to the robot's answer",
+            "s",
+            [("median", "#6a1b9a", [s.median_answer_s for s in sessions])],
+            labels,
+        ),
+        "<h2>Per behaviour: how often it answered (typical answer time)</h2>",
+        _behaviours_table(sessions),
+        "</body></html>\n",
+    ]
+    return "\n".join(parts)
+
+
+def _in_words(sessions: list[SessionSummary]) -> str:
+    if not sessions:
+        return "No session of this person is held."
+    first, last = sessions[0], sessions[-1]
+    words = (
+        f"In the first session the person did {first.did} things and the robot answered "
+        f"{first.answered}; in the latest, {last.did} and {last.answered}."
+    )
+    if first.median_answer_s is not None and last.median_answer_s is not None:
+        words += (
+            f" Typical answer time: {first.median_answer_s:.2f} s, then "
+            f"{last.median_answer_s:.2f} s."
+        )
+    words += (
+        f" Not understood: {first.not_understood}, then {last.not_understood}."
+        if len(sessions) > 1
+        else f" Not understood: {first.not_understood}."
+    )
+    return words
+
+
+def _seconds(value: float | None) -> str:
+    return "-" if value is None else f"{value:.2f} s"
+
+
+def _sessions_table(sessions: list[SessionSummary]) -> str:
+    heads = ["#", "day", "length", "did", "answered", "typical answer", "not understood"]
+    heads.append("spoke over the robot")
+    rows = "".join(
+        f"<tr><td class='num'>{n}</td><td>{s.day}</td><td class='num'>{s.length_s:.0f} s</td>"
+        f"<td class='num'>{s.did}</td><td class='num'>{s.answered}</td>"
+        f"<td class='num'>{_seconds(s.median_answer_s)}</td>"
+        f"<td class='num'>{s.not_understood}</td><td class='num'>{s.not_listened}</td></tr>"
+        for n, s in enumerate(sessions, 1)
+    )
+    head = "".join(f"<th>{h}</th>" for h in heads)
+    body = rows or f"<tr><td colspan={len(heads)}>no sessions</td></tr>"
+    return f"<table><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>"
+
+
+def _behaviours_table(sessions: list[SessionSummary]) -> str:
+    trees = sorted({tree for s in sessions for tree in s.by_behaviour})
+    head = "<th>behaviour</th>" + "".join(
+        f"<th class='num'>{n}</th>" for n in range(1, len(sessions) + 1)
+    )
+    rows = []
+    for tree in trees:
+        cells = []
+        for s in sessions:
+            times = s.by_behaviour.get(tree, ())
+            typical = f" ({statistics.median(times):.2f} s)" if times else ""
+            cells.append(f"<td class='num'>{len(times)}{typical}</td>")
+        rows.append(f"<tr><td>{html.escape(tree)}</td>{''.join(cells)}</tr>")
+    body = "".join(rows) or f"<tr><td colspan={len(sessions) + 1}>no behaviour answered</td></tr>"
+    return f"<table><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>"
