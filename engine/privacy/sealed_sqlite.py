@@ -67,6 +67,19 @@ def connect_sealed(path: Path, key: SiteKey, *, read_only: bool = False) -> Conn
     return connection
 
 
+def check_every_page(connection: Connection, path: Path) -> None:
+    """ConfigError naming the first page of the sealed database that fails its check (a
+    byte changed since it was written): every page is read once."""
+    try:
+        failed = connection.execute("PRAGMA cipher_integrity_check").fetchone()
+    except sqlcipher3.Error as error:
+        failed = (str(error),)
+    if failed is not None:
+        raise ConfigError(
+            f"{path}: changed or damaged since it was written ({str(failed[0]).lower()})"
+        )
+
+
 def connect_plain(path: Path, read_only: bool = True) -> Connection:
     """A connection to an unencrypted SQLite file (a recording made before recordings
     were sealed); read-only unless asked."""

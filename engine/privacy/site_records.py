@@ -84,6 +84,7 @@ class SiteRecords:
         self._connection: Connection = connect_sealed(self.path, key)
         self.path.chmod(0o600)  # the owner's alone, as the key is
         self._connection.execute("PRAGMA busy_timeout = 10000")  # another vest writing
+        self._connection.execute("PRAGMA secure_delete = ON")  # an erased row is overwritten
         self._connection.executescript(SCHEMA)
         self._connection.commit()
 

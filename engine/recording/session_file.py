@@ -36,6 +36,7 @@ from engine.errors import ConfigError
 from engine.privacy.sealed_sqlite import (
     Connection,
     Error,
+    check_every_page,
     connect_plain,
     connect_sealed,
     could_be_sealed,
@@ -147,7 +148,10 @@ def check_kind(path: Path) -> None:
     if not path.is_file():
         raise ConfigError(f"{path}: no such recording")
     if not (is_plain_sqlite(path) or could_be_sealed(path)):
-        raise ConfigError(f"{path}: not a vest recording (vest run --record makes them)")
+        raise ConfigError(
+            f"{path}: not a vest recording, or one cut short (its size is not whole pages of "
+            "an encrypted database)"
+        )
 
 
 @dataclass(frozen=True)
@@ -188,11 +192,11 @@ def open_for_reading(path: Path, key: SiteKey | None) -> Opened:
             ) from None
     try:
         # one connection, used from the view's threads one query at a time (Recording locks)
-        connection = (
-            connect_sealed(path, key, read_only=True)
-            if key is not None and not plain
-            else connect_plain(path)
-        )
+        if key is not None and not plain:
+            connection = connect_sealed(path, key, read_only=True)
+            check_every_page(connection, path)  # tampering is named, never read as data
+        else:
+            connection = connect_plain(path)
         kinds = dict(connection.execute("SELECT name, type FROM sqlite_master").fetchall())
     except Error:
         raise ConfigError(f"{path}: not a vest recording (vest run --record makes them)") from None

@@ -1,0 +1,180 @@
+"""What a site holds is kept as long as it said and no longer, handed over or erased on a
+family's request, under a new key when the old one may have leaked, and every step of it
+is in an append-only audit trail."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from engine.cli import main
+from engine.errors import ConfigError
+from engine.privacy.sealed_sqlite import connect_sealed
+from engine.privacy.site import Site
+
+ROOT = Path(__file__).resolve().parents[2]
+DAY_S = 86_400.0
+
+
+class Calendar:
+    """A clock of seconds since the epoch that a test turns forward."""
+
+    def __init__(self, now: float) -> None:
+        self.t = now
+
+    def now(self) -> float:
+        return self.t
+
+
+@pytest.fixture
+def recorded(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> list[Path]:
+    """Two sessions of kid-17 (the guardian consented to speech as text), one of kid-4."""
+    monkeypatch.chdir(ROOT)
+    assert main(["data", "consent", "kid-17", "--given-by", "guardian", "--covers",
+                 "sensors,speech_text"]) == 0  # fmt: skip
+    made = []
+    for name, person in (("a", "kid-17"), ("b", "kid-17"), ("c", "kid-4")):
+        path = tmp_path / f"{name}.vest"
+        args = ["run", "--fast", "--speech", "text", "--duration", "4", "--record", str(path)]
+        assert main([*args, "--person", person]) == 0
+        made.append(path)
+    assert main(["report", str(made[0]), "-o", str(tmp_path / "a.html")]) == 0
+    capsys.readouterr()
+    return made
+
+
+def test_an_erasure_asks_then_leaves_nothing_naming_the_person_but_the_audit_trail(
+    recorded: list[Path], tmp_path: Path, site_data: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    exported = tmp_path / "kid-17-export"
+    assert main(["data", "export", "--person", "kid-17", "-o", str(exported)]) == 0
+    sessions = sorted((exported / "sessions").glob("*.json"))
+    assert len(sessions) == 2 and len(list((exported / "reports").glob("*.html"))) == 2
+    assert json.loads((exported / "consent.json").read_text())["given_by"] == "guardian"
+    assert json.loads(sessions[0].read_text())["meta"]
+    capsys.readouterr()
+    assert main(["data", "erase", "--person", "kid-17"]) == 2  # no terminal to ask on
+    assert "cannot be undone: add --yes to confirm" in capsys.readouterr().err
+    assert recorded[0].exists()
+    assert main(["data", "erase", "--person", "kid-17", "--yes"]) == 0
+    assert not recorded[0].exists() and not recorded[1].exists() and recorded[2].exists()
+    assert not (tmp_path / "a.html").exists() and not exported.exists()
+    assert "kid-17" not in (site_data / "consent.yaml").read_text()
+    capsys.readouterr()
+    assert main(["data", "list", "--json"]) == 0
+    assert [json.loads(line)["person"] for line in capsys.readouterr().out.splitlines()] == [
+        "kid-4"
+    ]
+    assert main(["data", "audit", "--person", "kid-17"]) == 0
+    assert capsys.readouterr().out.splitlines()[-1].endswith("erase kid-17: 4 files removed")
+
+
+def test_an_erasure_cut_off_half_way_finishes_on_the_next_run(
+    recorded: list[Path], site_data: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    site = Site.open(site_data, clock=Calendar(1e9), who="ana")
+    site.records.begin_erasing("kid-17", 1e9)  # marked, then the power went
+    recorded[0].unlink()  # one file removed before it
+    site.close()
+    assert main(["data", "list"]) == 0
+    captured = capsys.readouterr()
+    assert "finished erasing kid-17 (cut off earlier)" in captured.err
+    assert "kid-17" not in captured.out and not recorded[1].exists()
+
+
+def test_the_audit_trail_is_append_only_and_a_changed_line_is_found(
+    recorded: list[Path], site_data: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    assert main(["replay", str(recorded[1])]) == 0
+    capsys.readouterr()
+    assert main(["data", "audit", "--json"]) == 0
+    lines = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
+    actions = [(line["action"], line["person"]) for line in lines]
+    assert actions[:4] == [
+        ("consent", "kid-17"),
+        ("record", "kid-17"),
+        ("record", "kid-17"),
+        ("record", "kid-4"),
+    ]
+    assert ("replay", "kid-17") in actions and ("report written", "kid-17") in actions
+    site = Site.open(site_data, clock=Calendar(1e9), who="ana")
+    db = site.records._connection
+    with pytest.raises(Exception, match="append-only"):
+        db.execute("UPDATE audit SET who = 'nobody' WHERE seq = 2")
+    db.execute("DROP TRIGGER audit_is_not_changed")  # someone with the key, and SQL
+    db.execute("UPDATE audit SET who = 'nobody' WHERE seq = 2")
+    db.commit()
+    site.close()
+    assert main(["data", "audit"]) == 1
+    assert "line 2 and after were changed after they were written" in capsys.readouterr().err
+
+
+def test_sessions_older_than_the_site_keeps_them_are_purged(
+    recorded: list[Path], site_data: Path
+) -> None:
+    (site_data / "site.yaml").write_text("keep_sessions_days: 30\n")
+    started = Site.open(site_data, clock=Calendar(0), who="ana").records.sessions()[0].started
+    site = Site.open(site_data, clock=Calendar(started + 29 * DAY_S), who="ana")
+    assert site.purge() == []
+    site.clock = Calendar(started + 31 * DAY_S)
+    assert sorted(entry.path.name for entry in site.purge()) == ["a.vest", "b.vest", "c.vest"]
+    assert not any(path.exists() for path in recorded)
+    assert site.records.sessions() == []
+    assert [line.action for line in site.records.audit_lines()][-3:] == ["purge"] * 3
+    site.close()
+
+
+def test_a_site_setting_with_a_mistake_is_named(site_data: Path) -> None:
+    site_data.mkdir(parents=True)
+    (site_data / "site.yaml").write_text("keep_sesions_days: 30\n")
+    with pytest.raises(ConfigError, match=r"site.yaml:1:1: unknown site field 'keep_sesions_days'"):
+        Site.open(site_data, clock=Calendar(0), who="ana")
+
+
+def test_after_a_new_key_the_old_one_reads_nothing(
+    recorded: list[Path], site_data: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    old = (site_data / "site.key").read_text()
+    assert main(["data", "rekey"]) == 0
+    assert "4 files encrypted with a new key" in capsys.readouterr().out
+    assert (site_data / "site.key").read_text() != old
+    assert main(["replay", str(recorded[0])]) == 0
+    (site_data / "site.key").write_text(old)
+    with pytest.raises(ConfigError, match="cannot be read with this site's key"):
+        Site.open(site_data, clock=Calendar(0), who="ana")
+
+
+def test_a_rotation_cut_off_is_finished_by_running_it_again(
+    recorded: list[Path], site_data: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    site = Site.open(site_data, clock=Calendar(1e9), who="ana")
+    from engine.privacy.sealed_sqlite import rekey
+    from engine.privacy.site import site_key_in_rotation
+
+    new = site_key_in_rotation(site_data)
+    rekey(recorded[0], site.key, new)  # one recording done, then the power went
+    site.close()
+    assert main(["data", "list"]) == 0
+    assert "a key rotation was cut off" in capsys.readouterr().err
+    assert main(["data", "rekey"]) == 0
+    assert "3 files encrypted with a new key" in capsys.readouterr().out
+    for path in recorded:
+        assert main(["replay", str(path)]) == 0
+
+
+def test_a_recording_of_an_earlier_vest_is_read_and_can_be_sealed(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], the_site_key
+) -> None:
+    kept = tmp_path / "old.db"
+    kept.write_bytes((ROOT / "tests/recordings/unplug_touch.format1.db").read_bytes())
+    assert main(["replay", str(kept)]) == 0
+    assert "is not encrypted (recorded before vest sealed recordings)" in capsys.readouterr().err
+    assert main(["data", "seal", str(kept)]) == 0
+    assert not kept.read_bytes().startswith(b"SQLite format 3")
+    connect_sealed(kept, the_site_key, read_only=True).close()
+    assert main(["replay", str(kept), "--at", "4.5"]) == 0
+    assert "/devices/touch/ok = false" in capsys.readouterr().out
