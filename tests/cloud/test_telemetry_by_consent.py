@@ -1,0 +1,58 @@
+"""A robot tells the cloud a child's sensor readings only when their guardian consented
+to telemetry; the robot's own device states are sent either way (the operator sees a
+robot that works)."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from cloud.settings import Settings
+from engine.cli import main
+
+ROOT = Path(__file__).resolve().parents[2]
+SQUEEZES = """\
+duration_s: 2.5
+events:
+  - {at: 0.2, squeeze: {left_n: 9, right_n: 9, seconds: 2.0}}
+"""
+
+
+def sent_keys(tmp_path: Path, start_service: Callable[..., Any], person: str) -> set[str]:
+    """The telemetry keys the service holds after a short session of ``person``."""
+    running = start_service(Settings(db_url=f"sqlite:///{tmp_path / 'c.db'}"))
+    store = running.store
+    store.directory.add_operator("ana")
+    token = tmp_path / "robot.token"
+    token.write_text(store.directory.add_robot("hbs2", operator="ana") + "\n")
+    robot = store.directory.authenticate(token.read_text().strip())
+    scenario = tmp_path / "squeezes.yaml"
+    scenario.write_text(SQUEEZES)
+    args = ["run", "--trees", "trees/hug.yaml", "--scenario", str(scenario), "--speech", "text"]
+    args += ["--cloud", running.url, "--token-file", str(token), "--person", person]
+    assert main(args) == 0
+    return set(store.telemetry.latest(robot.id))
+
+
+@pytest.fixture(autouse=True)
+def here(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.chdir(ROOT)
+
+
+def test_without_consent_only_the_robot_s_devices_are_sent(
+    tmp_path: Path, start_service: Callable[..., Any], capsys: pytest.CaptureFixture[str]
+) -> None:
+    keys = sent_keys(tmp_path, start_service, "kid-17")
+    assert "kid-17: no consent record" in capsys.readouterr().err
+    assert keys and all(key.startswith("/devices/") for key in keys)
+
+
+def test_with_consent_to_telemetry_the_sensor_readings_are_sent(
+    tmp_path: Path, start_service: Callable[..., Any], consenting
+) -> None:
+    consenting("kid-17", "sensors", "cloud_telemetry")
+    keys = sent_keys(tmp_path, start_service, "kid-17")
+    assert "/sensors/force/left_n" in keys
