@@ -42,7 +42,7 @@ def test_commands_sent_and_canceled_are_audited_with_who_role_robot_and_address(
     clock.advance(1)
     cancel = f"{commands}/{sent.json()['id']}/cancel"
     assert requests.post(cancel, headers=ana, timeout=10).json()["state"] == "CANCELED"
-    entries = [e for e in directory.audit.since(1_800_000_060.0)]
+    entries = directory.audit.since(1_800_000_060.0)
     assert [(e.actor, e.role, e.action, e.robot, e.client, e.at_s) for e in entries] == [
         ("ana", "operator", "send", "hbs2", "127.0.0.1", 1_800_000_060.0),
         ("ana", "operator", "cancel", "hbs2", "127.0.0.1", 1_800_000_061.0),
@@ -93,9 +93,11 @@ def test_nothing_can_change_or_delete_an_entry_not_even_sql_by_hand(
     engine = sa.create_engine(engine_url(db_url))
     try:
         for statement in ("UPDATE audit_log SET actor = 'nobody'", "DELETE FROM audit_log"):
-            with pytest.raises(sa.exc.DatabaseError, match="the audit log is append-only"):
-                with engine.begin() as connection:
-                    connection.execute(sa.text(statement))
+            with (
+                pytest.raises(sa.exc.DatabaseError, match="the audit log is append-only"),
+                engine.begin() as connection,
+            ):
+                connection.execute(sa.text(statement))
     finally:
         engine.dispose()
     assert [e.actor for e in directory.audit.since()] == ["shell"]

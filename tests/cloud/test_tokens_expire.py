@@ -15,7 +15,7 @@ from cloud.services import CloudStore
 from cloud.settings import Settings
 from cloud.store.directory import Directory
 from engine.cli import main
-from engine.clock import RealClock, VirtualClock
+from engine.clock import EpochClock, VirtualClock
 from engine.errors import ConfigError
 from tests.cloud.test_api_contract import bearer
 
@@ -96,7 +96,7 @@ def test_rotate_on_the_command_line_prints_the_fresh_token_alone(
     assert main(["cloud", "rotate", "robot", "hbs2", "--db", db]) == 0
     fresh = capsys.readouterr().out
     assert fresh.count("\n") == 1 and len(fresh.strip()) == 43
-    store = CloudStore.open(Settings(db_url=db), RealClock())
+    store = CloudStore.open(Settings(db_url=db), EpochClock())
     try:
         assert store.directory.authenticate(old) is None
         robot = store.directory.authenticate(fresh.strip())
