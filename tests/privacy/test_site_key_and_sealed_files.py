@@ -15,9 +15,7 @@ from engine.privacy.site_data import check_apart, data_folder, site_key
 
 def test_the_data_folder_is_vest_data_else_the_user_s_own(tmp_path: Path) -> None:
     assert data_folder({"VEST_DATA": str(tmp_path / "clinic")}) == tmp_path / "clinic"
-    assert data_folder({"XDG_DATA_HOME": "/x/share", "HOME": "/home/ana"}) == Path(
-        "/x/share/vest"
-    )
+    assert data_folder({"XDG_DATA_HOME": "/x/share", "HOME": "/home/ana"}) == Path("/x/share/vest")
     assert data_folder({"HOME": "/home/ana"}) == Path("/home/ana/.local/share/vest")
 
 
