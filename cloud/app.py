@@ -49,7 +49,7 @@ def create_app(
 
     app = FastAPI(title="vest cloud", version="1", lifespan=lifespan)
     app.state.store = store
-    for router in (robots.router, commands.router, robot_side.router, events.router):
+    for router in (robots.me, robots.router, commands.router, robot_side.router, events.router):
         app.include_router(router, prefix=API, responses=ERRORS)
     add_page(app)
 

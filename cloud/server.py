@@ -4,6 +4,11 @@ Stopping a one-process service ends the operators' live streams and waiting long
 once (they reconnect to the next service) instead of holding the shutdown up. Several
 workers run under uvicorn's supervisor on one socket made here (uvicorn's own socket keeps
 Nagle's algorithm on: every request took ~45 ms more).
+
+``options`` are uvicorn's: ``ssl_certfile``/``ssl_keyfile`` to serve HTTPS on that socket
+(checked first by :func:`engine.web.tls.tls_options`), ``forwarded_allow_ips``: the
+addresses of proxies whose ``X-Forwarded-For``/``-Proto`` are believed (the audit log
+then names the real client).
 """
 
 from __future__ import annotations
@@ -58,19 +63,32 @@ def tune_garbage_collector() -> None:
     gc.set_threshold(20_000, 50, 1_000)
 
 
-def serve(settings: Settings, host: str, port: int, *, shared: bool = False) -> None:
+def serve(
+    settings: Settings,
+    host: str,
+    port: int,
+    *,
+    shared: bool = False,
+    options: dict[str, object] | None = None,
+) -> None:
     """Run one service process until SIGTERM or Ctrl-C."""
     sock = listening_socket(host, port, shared=shared, named=f"--host {host} --port {port}")
     from cloud.app import create_app
 
     if not shared:
-        _say_where(host, port, 1)
-    server = server_for(create_app(settings), log_level="info")
+        _say_where(host, port, 1, "ssl_certfile" in (options or {}))
+    server = server_for(create_app(settings), log_level="info", **(options or {}))
     tune_garbage_collector()
     server.run(sockets=[sock])
 
 
-def serve_workers(settings: Settings, host: str, port: int, workers: int) -> None:
+def serve_workers(
+    settings: Settings,
+    host: str,
+    port: int,
+    workers: int,
+    options: dict[str, object] | None = None,
+) -> None:
     """Run ``workers`` service processes on one port until SIGTERM or Ctrl-C.
 
     uvicorn's own supervisor (``Multiprocess``) starts them, checks they answer, and starts
@@ -81,13 +99,15 @@ def serve_workers(settings: Settings, host: str, port: int, workers: int) -> Non
     ``GRACE_S`` to finish."""
     sock = listening_socket(host, port, shared=True, named=f"--host {host} --port {port}")
     os.environ.update(settings.environment())
-    _say_where(host, port, workers)
+    options = options or {}
+    _say_where(host, port, workers, "ssl_certfile" in options)
     config = uvicorn.Config(
         "cloud.server:app_from_environment",
         factory=True,
         workers=workers,
         timeout_graceful_shutdown=GRACE_S,
         log_level="info",
+        **options,  # type: ignore[arg-type]
     )
     Multiprocess(config, sockets=[sock]).run()
 
@@ -132,7 +152,8 @@ def _close_first(signum: int, loop: asyncio.AbstractEventLoop, store: CloudStore
     signal.signal(signum, handler)
 
 
-def _say_where(host: str, port: int, workers: int) -> None:
+def _say_where(host: str, port: int, workers: int, tls: bool) -> None:
     shown = f"[{host}]" if ":" in host else host
     processes = "1 process" if workers == 1 else f"{workers} processes"
-    print(f"vest cloud: operators open http://{shown}:{port}/ ({processes})", file=sys.stderr)
+    scheme = "https" if tls else "http"
+    print(f"vest cloud: operators open {scheme}://{shown}:{port}/ ({processes})", file=sys.stderr)

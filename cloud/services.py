@@ -45,7 +45,14 @@ class CloudStore:
         )
         listener = PostgresListener(db.engine, doorbell, clock) if db.is_postgresql else None
         return cls(
-            settings, clock, db, Directory(db), ledger, Telemetry(db, clock), doorbell, listener
+            settings,
+            clock,
+            db,
+            Directory(db, clock),
+            ledger,
+            Telemetry(db, clock),
+            doorbell,
+            listener,
         )
 
     def begin_closing(self) -> None:

@@ -1,13 +1,16 @@
-"""Operators: send commands to a robot, follow them, cancel them."""
+"""People: follow a robot's commands; those whose role may, send and cancel them (each one
+written to the audit log)."""
 
 from __future__ import annotations
 
-from fastapi import APIRouter, HTTPException, Response, status
+import json
 
-from cloud.api.deps import CurrentOperator, StoreDep
+from fastapi import APIRouter, HTTPException, Request, Response, status
+
+from cloud.api.deps import Commander, CurrentOperator, StoreDep, actor
 from cloud.api.robots import granted
 from cloud.api.schemas import CommandCreate, CommandPublic
-from cloud.store.ledger import ConflictError
+from cloud.store.ledger import Command, ConflictError
 from engine.remote_commands import command_problem
 
 router = APIRouter(prefix="/robots/{robot}/commands", tags=["operator"])
@@ -15,7 +18,12 @@ router = APIRouter(prefix="/robots/{robot}/commands", tags=["operator"])
 
 @router.post("", status_code=status.HTTP_201_CREATED)
 def send_command(
-    robot: str, body: CommandCreate, store: StoreDep, operator: CurrentOperator, response: Response
+    robot: str,
+    body: CommandCreate,
+    store: StoreDep,
+    operator: Commander,
+    request: Request,
+    response: Response,
 ) -> CommandPublic:
     """QUEUED and committed before the 201; the same idempotency_key again: 200, the same
     command (409 if it named another). Arguments of built-in types are checked here as the
@@ -38,6 +46,10 @@ def send_command(
         raise HTTPException(status.HTTP_409_CONFLICT, str(error)) from None
     if not created:
         response.status_code = status.HTTP_200_OK
+    else:
+        store.directory.audit.record(
+            actor(operator, request), "send", robot=row.name, detail=_described(command)
+        )
     return CommandPublic.of(command, row.name)
 
 
@@ -61,7 +73,7 @@ def get_command(
 
 @router.post("/{command_id}/cancel")
 def cancel_command(
-    robot: str, command_id: str, store: StoreDep, operator: CurrentOperator
+    robot: str, command_id: str, store: StoreDep, operator: Commander, request: Request
 ) -> CommandPublic:
     """200 with the command, CANCELED (also when it already was); 409 naming how it ended
     when it finished first (a report or a timeout won); 404 for a command not there."""
@@ -72,4 +84,12 @@ def cancel_command(
         raise HTTPException(status.HTTP_409_CONFLICT, str(error)) from None
     if command is None:
         raise HTTPException(status.HTTP_404_NOT_FOUND, f"no command {command_id!r}")
+    store.directory.audit.record(
+        actor(operator, request), "cancel", robot=row.name, detail=_described(command)
+    )
     return CommandPublic.of(command, row.name)
+
+
+def _described(command: Command) -> str:
+    """A command as the audit log tells it: its type, id and arguments (cut to fit)."""
+    return f"{command.type} {command.id} {json.dumps(command.args, ensure_ascii=False)}"[:500]

@@ -6,7 +6,8 @@
 - ``robots``: every robot granted to the operator (name, online, last_seen_s), first and
   whenever one of them changes;
 - ``telemetry``: ``{"robot", "values": {key: {"value", "at_s"}}}`` with the keys whose
-  values came in since the last one (all of them first);
+  values came in since the last one (all of them first); never to a role that may not see
+  telemetry (a viewer);
 - ``command``: a command (as ``GET .../commands/{id}`` answers it) whenever its version
   grows; the newest 50 of each robot first.
 
@@ -14,7 +15,7 @@ The stream wakes at once when a robot's commands change (the same doorbell as th
 long-polls) and looks for new telemetry every ``TELEMETRY_EVERY_S``. A comment line every
 ``KEEPALIVE_S`` keeps proxies from closing an idle stream. It ends after ``STREAM_S`` (the
 page then opens a new one), when the service stops, and when the operator's token is
-revoked.
+revoked or expires. A role changed meanwhile is taken up within the token cache time.
 """
 
 from __future__ import annotations
@@ -29,6 +30,7 @@ from starlette.responses import Response
 from cloud.api.deps import CurrentOperator, StoreDep
 from cloud.api.robots import robot_public
 from cloud.api.schemas import CommandPublic
+from cloud.roles import Permission, may
 from cloud.services import CloudStore
 from cloud.store.directory import Principal
 from engine.web.sse import KEEPALIVE, KEEPALIVE_S, event_stream, frame
@@ -51,7 +53,8 @@ class OperatorView:
 
     def changes(self) -> list[str]:
         """The events to send now (server-sent event text, one string each)."""
-        rows = self.store.directory.robots_of(self.operator.id)
+        rows = self.store.directory.robots_of(self.operator)
+        sees_telemetry = may(self.operator.role, Permission.TELEMETRY)
         self.robot_ids = [row.id for row in rows]
         events: list[str] = []
         robots = [robot_public(self.store, row).model_dump() for row in rows]
@@ -65,6 +68,8 @@ class OperatorView:
                     events.append(
                         frame(CommandPublic.of(command, row.name).model_dump(), "command")
                     )
+            if not sees_telemetry:
+                continue
             fresh = {
                 key: reading
                 for key, reading in self.store.telemetry.latest(row.id).items()
@@ -92,9 +97,10 @@ async def _stream(request: Request, store: CloudStore, view: OperatorView) -> As
         store.clock.now() - started_s < STREAM_S
         and not store.closing.is_set()
         and not await request.is_disconnected()
-        # a token revoked meanwhile ends the stream (within the cache's 5 s)
-        and await run_in_threadpool(store.principals.authenticate, token) is not None
+        # a token revoked or expired meanwhile ends the stream (within the cache's 5 s)
+        and (person := await run_in_threadpool(store.principals.authenticate, token)) is not None
     ):
+        view.operator = person  # its role as it is now
         changes = await run_in_threadpool(view.changes)
         if changes:
             quiet_since_s = store.clock.now()

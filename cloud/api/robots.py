@@ -1,4 +1,5 @@
-"""Operators: their robots, and each robot's latest telemetry."""
+"""People: who they are, the robots they see, and each robot's latest telemetry (for the
+roles that may see it)."""
 
 from __future__ import annotations
 
@@ -6,8 +7,9 @@ from typing import Any
 
 from fastapi import APIRouter, HTTPException, status
 
-from cloud.api.deps import CurrentOperator, StoreDep
-from cloud.api.schemas import RobotPublic
+from cloud.api.deps import CurrentOperator, StoreDep, TelemetryReader
+from cloud.api.schemas import AccountPublic, RobotPublic
+from cloud.roles import Permission, may
 from cloud.services import CloudStore
 from cloud.store.tables import RobotRow
 from engine.remote_commands import command_catalogue
@@ -19,8 +21,8 @@ pushes telemetry every second and long-polls again as soon as one ends)."""
 
 
 def granted(store: StoreDep, operator: CurrentOperator, robot: str) -> RobotRow:
-    """The robot, or 404 whether it does not exist or is not this operator's."""
-    row = store.directory.granted_robot(operator.id, robot)
+    """The robot, or 404 whether it does not exist or is not this person's to see."""
+    row = store.directory.granted_robot(operator, robot)
     if row is None:
         raise HTTPException(status.HTTP_404_NOT_FOUND, f"no robot {robot!r}")
     return row
@@ -28,7 +30,7 @@ def granted(store: StoreDep, operator: CurrentOperator, robot: str) -> RobotRow:
 
 @router.get("")
 def list_robots(store: StoreDep, operator: CurrentOperator) -> list[RobotPublic]:
-    return [robot_public(store, row) for row in store.directory.robots_of(operator.id)]
+    return [robot_public(store, row) for row in store.directory.robots_of(operator)]
 
 
 def robot_public(store: CloudStore, row: RobotRow) -> RobotPublic:
@@ -51,6 +53,22 @@ def command_types(
 
 @router.get("/{robot}/telemetry")
 def robot_telemetry(
-    robot: str, store: StoreDep, operator: CurrentOperator
+    robot: str, store: StoreDep, operator: TelemetryReader
 ) -> dict[str, dict[str, Any]]:
     return store.telemetry.latest(granted(store, operator, robot).id)
+
+
+me = APIRouter(tags=["operator"])
+
+
+@me.get("/me")
+def who_am_i(operator: CurrentOperator) -> AccountPublic:
+    """The account behind the token: its role, what the role may do, and when the token
+    expires (the page shows commands read-only to a role that may not send them)."""
+    return AccountPublic(
+        name=operator.name,
+        role=operator.role or "",
+        can_command=may(operator.role, Permission.COMMAND),
+        sees_telemetry=may(operator.role, Permission.TELEMETRY),
+        expires_at_s=operator.expires_at_s,
+    )

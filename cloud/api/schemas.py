@@ -165,6 +165,17 @@ class RobotPublic(BaseModel):
     last_seen_s: float | None
 
 
+class AccountPublic(BaseModel):
+    """A person's account as they see it: ``expires_at_s`` in seconds since the epoch
+    (None: the token never expires)."""
+
+    name: str
+    role: str
+    can_command: bool
+    sees_telemetry: bool
+    expires_at_s: float | None
+
+
 class Problem(BaseModel):
     """One thing wrong with a request: the field (``body`` for the whole) and why."""
 
@@ -179,13 +190,14 @@ class Problems(BaseModel):
 
 
 class Refusal(BaseModel):
-    """A 401, 404, 409, 413 or 503: why, in words."""
+    """A 401, 403, 404, 409, 413 or 503: why, in words."""
 
     detail: str
 
 
 ERRORS: dict[int | str, dict[str, Any]] = {
-    401: {"model": Refusal, "description": "no token, or one that is unknown or revoked"},
+    401: {"model": Refusal, "description": "no token, or one unknown, revoked or expired"},
+    403: {"model": Refusal, "description": "the account's role may not do this (it is named)"},
     404: {"model": Refusal, "description": "nothing of that name this caller may see"},
     409: {"model": Refusal, "description": "it contradicts how the command already ended"},
     413: {"model": Refusal, "description": "the body is larger than the service takes"},

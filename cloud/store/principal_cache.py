@@ -2,7 +2,8 @@
 
 Every request carries a token, and looking it up costs the database one or two queries:
 more than the rest of a telemetry post. A token found valid is trusted for ``ttl_s``; a
-token revoked (by `vest cloud revoke`, in another process) stops working within that time.
+token revoked or rotated (by `vest cloud revoke`/`rotate`, in another process), or given
+another role, is taken up within that time; an expiry is checked on every request.
 Unknown tokens are never remembered, so guessing cannot fill the memory.
 """
 
@@ -37,19 +38,26 @@ class PrincipalCache:
         self._lock = threading.Lock()
 
     def remembered(self, token: str) -> Principal | None:
-        """The token's owner if it was found valid within ``ttl_s``; None means "ask
-        ``authenticate``" (no database is touched here: safe on the event loop)."""
+        """The token's owner (expired or not) if it was found within ``ttl_s``; None means
+        "ask ``identify``" (no database is touched here: safe on the event loop)."""
         with self._lock:  # TTLCache is not thread-safe on its own
             return self._known.get(digest(token))
 
     def authenticate(self, token: str, session: Session | None = None) -> Principal | None:
-        """The operator or robot whose token this is, or None (unknown or revoked); looked
-        up on ``session`` when one is given (see `Directory.authenticate`)."""
+        """The operator or robot whose token this is, or None (unknown, revoked or expired
+        now, by the clock); looked up on ``session`` when one is given (see
+        `Directory.authenticate`)."""
+        principal = self.identify(token, session)
+        return None if principal is None or principal.expired(self.clock.now()) else principal
+
+    def identify(self, token: str, session: Session | None = None) -> Principal | None:
+        """The token's owner, expired or not (the caller says which it is); None: unknown
+        or revoked."""
         remembered = self.remembered(token)
         if remembered is not None:
             return remembered
         key = digest(token)
-        principal = self.directory.authenticate(token, session)
+        principal = self.directory.holder(token, session)
         with self._lock:
             if principal is None:
                 self._known.pop(key, None)

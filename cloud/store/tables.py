@@ -22,12 +22,17 @@ class Table(DeclarativeBase):
 
 
 class OperatorRow(Table):
+    """A person's account (the table keeps its first name): its ``role`` (cloud/roles.py)
+    and when its token expires (``expires_at_s``, None: never)."""
+
     __tablename__ = "operators"
 
     id: Mapped[int] = mapped_column(Integer, primary_key=True)
     name: Mapped[str] = mapped_column(String(64), unique=True)
     token_digest: Mapped[str] = mapped_column(String(64), unique=True)
     revoked: Mapped[bool] = mapped_column(default=False)
+    role: Mapped[str] = mapped_column(String(16), default="operator", server_default="operator")
+    expires_at_s: Mapped[float | None] = mapped_column(Float, default=None)
 
 
 class RobotRow(Table):
@@ -38,6 +43,7 @@ class RobotRow(Table):
     token_digest: Mapped[str] = mapped_column(String(64), unique=True)
     revoked: Mapped[bool] = mapped_column(default=False)
     last_seen_s: Mapped[float | None] = mapped_column(Float, default=None)
+    expires_at_s: Mapped[float | None] = mapped_column(Float, default=None)
 
 
 class GrantRow(Table):
@@ -87,3 +93,21 @@ class TelemetryRow(Table):
     robot_id: Mapped[int] = mapped_column(ForeignKey("robots.id"), primary_key=True)
     readings: Mapped[dict[str, Any]] = mapped_column(JSON)
     at_s: Mapped[float] = mapped_column(Float)
+
+
+class AuditRow(Table):
+    """One thing a person did: sent or canceled a command, or changed an account. Only
+    ever added to (the database refuses UPDATE and DELETE on it: migration 0003).
+    ``actor`` and ``role`` are who did it and their role then; ``client`` the address it
+    came from (the real client's behind a trusted proxy; ``local`` for the command line)."""
+
+    __tablename__ = "audit_log"
+
+    id: Mapped[int] = mapped_column(Integer, primary_key=True)
+    at_s: Mapped[float] = mapped_column(Float, index=True)
+    actor: Mapped[str] = mapped_column(String(64))
+    role: Mapped[str] = mapped_column(String(16))
+    action: Mapped[str] = mapped_column(String(32))
+    robot: Mapped[str | None] = mapped_column(String(64), default=None)
+    detail: Mapped[str] = mapped_column(String(500), default="")
+    client: Mapped[str] = mapped_column(String(64), default="")

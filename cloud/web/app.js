@@ -1,5 +1,6 @@
-// The operator's page: log in with the operator token, see the robots granted to you,
-// their live sensor values, send commands and follow each one to its end.
+// The operator's page: log in with your token, see the robots granted to you, their live
+// sensor values (if your role may see them), send commands (if your role may) and follow
+// each one to its end.
 
 import { Api, ApiError } from "./api.js";
 import { buildArgs, readCommand, typeOptions } from "./forms.js";
@@ -10,6 +11,7 @@ const FINISHED = new Set(["SUCCEEDED", "FAILED", "TIMED_OUT", "CANCELED"]);
 
 const state = {
   api: null,
+  me: null, // {name, role, can_command, sees_telemetry, expires_at_s}
   robots: [],
   selected: null,
   commands: new Map(), // robot -> Map(id -> command)
@@ -40,11 +42,13 @@ function ago(seconds) {
 async function login(token) {
   const api = new Api(token);
   try {
+    state.me = await api.call("GET", "/me");
     state.robots = await api.call("GET", "/robots");
   } catch (error) {
     sessionStorage.removeItem(TOKEN_KEY);
+    const expired = error.message.includes("expired");
     $("#login-error").textContent =
-      error.status === 401 ? "That token is not valid (or it was revoked)." : error.message;
+      error.status === 401 && !expired ? "That token is not valid (or it was revoked)." : error.message;
     return;
   }
   sessionStorage.setItem(TOKEN_KEY, token);
@@ -53,6 +57,7 @@ async function login(token) {
   $("#console").hidden = false;
   $("#logout").hidden = false;
   $("#login-error").textContent = "";
+  showRole(state.me);
   renderRobots();
   if (state.robots.length) await select(state.robots[0].name);
   follow();
@@ -62,6 +67,18 @@ function logout() {
   sessionStorage.removeItem(TOKEN_KEY);
   if (state.stream) state.stream.abort();
   location.reload();
+}
+
+// What the role lets this person do: a role that may not command sees commands read-only,
+// one that may not see telemetry (a viewer) sees a sentence instead of sensor values.
+function showRole(me) {
+  $("#who").hidden = false;
+  $("#who").textContent = `${me.name} (${me.role})`;
+  for (const node of document.querySelectorAll(".role")) node.textContent = me.role;
+  $("#send").hidden = !me.can_command;
+  $("#read-only").hidden = me.can_command;
+  $("#sensors").hidden = !me.sees_telemetry;
+  $("#sensors-hidden").hidden = me.sees_telemetry;
 }
 
 // -- the live stream -------------------------------------------------------------------------
@@ -208,7 +225,7 @@ function renderCommands() {
       );
       row.dataset.command = c.id;
       row.dataset.state = c.state;
-      if (!FINISHED.has(c.state)) {
+      if (!FINISHED.has(c.state) && state.me.can_command) {
         const button = el("button", { type: "button", className: "cancel", textContent: "Cancel" });
         button.addEventListener("click", () => cancel(c));
         row.lastChild.append(button);

@@ -44,7 +44,7 @@ COMMANDS: tuple[tuple[str, str], ...] = (
     ("hear", "run the robot's hearing on WAV files (or the microphone) and show the answers"),
     ("say", "speak a text with the robot's voice (or write it to a WAV file)"),
     ("dialogs", "check that each dialog phrase is recognized, and as its own rule"),
-    ("cloud", "run the cloud service; add operators and robots, grant, revoke"),
+    ("cloud", "run the cloud service; add accounts and robots, roles, grants, tokens, audit"),
     ("gesture", "count fingers in pictures; record, generate, train and check a hand model"),
     ("replay", "show a recorded session at a moment (trees' statuses, the blackboard)"),
     ("report", "write a recorded session as a report for the therapist (HTML)"),

@@ -59,8 +59,8 @@ def db(db_url: str) -> Iterator[Database]:
 
 
 @pytest.fixture
-def directory(db: Database) -> Directory:
-    return Directory(db)
+def directory(db: Database, clock: VirtualClock) -> Directory:
+    return Directory(db, clock)
 
 
 @pytest.fixture

@@ -10,7 +10,7 @@ import pytest
 from cloud.services import CloudStore
 from cloud.settings import Settings
 from engine.cli import main
-from engine.clock import RealClock
+from engine.clock import EpochClock
 
 
 def test_an_admin_adds_an_operator_and_a_robot_and_scripts_capture_the_tokens(
@@ -21,14 +21,14 @@ def test_an_admin_adds_an_operator_and_a_robot_and_scripts_capture_the_tokens(
     operator_token = capsys.readouterr().out.strip()
     assert main(["cloud", "add-robot", "hbs2", "--operator", "ana", "--db", db]) == 0
     robot_token = capsys.readouterr().out.strip()
-    store = CloudStore.open(Settings(db_url=db), RealClock())
+    store = CloudStore.open(Settings(db_url=db), EpochClock())
     try:
         assert store.directory.authenticate(operator_token).name == "ana"  # type: ignore[union-attr]
         assert store.directory.authenticate(robot_token).name == "hbs2"  # type: ignore[union-attr]
     finally:
         store.close()
     assert main(["cloud", "revoke", "robot", "hbs2", "--db", db]) == 0
-    store = CloudStore.open(Settings(db_url=db), RealClock())
+    store = CloudStore.open(Settings(db_url=db), EpochClock())
     try:
         assert store.directory.authenticate(robot_token) is None
     finally:

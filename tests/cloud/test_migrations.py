@@ -18,6 +18,7 @@ from cloud.store.database import Database, alembic_config, engine_url
 from cloud.store.directory import Directory
 from cloud.store.tables import Table
 from cloud.store.telemetry import Telemetry
+from cloud.store.tokens import digest
 from engine.cli import main
 from engine.clock import VirtualClock
 
@@ -117,3 +118,29 @@ def test_commands_opening_a_new_sqlite_database_at_once_all_succeed(tmp_path: Pa
         for process in started:
             _, err = process.communicate(timeout=60)
             assert process.returncode == 0, err.decode()
+
+
+def test_accounts_made_before_roles_become_operators_whose_tokens_do_not_expire(
+    db_url: str, clock: VirtualClock
+) -> None:
+    engine = sa.create_engine(engine_url(db_url))
+    with engine.begin() as connection:  # a database made before roles and expiry
+        command.upgrade(alembic_config(connection), "0002")
+        connection.execute(
+            sa.text(
+                "INSERT INTO operators (id, name, token_digest, revoked)"
+                f" VALUES (1, 'ana', '{digest('old-token')}', false)"
+            )
+        )
+    db = Database(db_url)  # brought up to date on opening
+    try:
+        ana = Directory(db, clock).authenticate("old-token")
+        assert ana is not None and (ana.role, ana.expires_at_s) == ("operator", None)
+        Directory(db, clock).set_role("ana", "viewer")  # an entry in the new audit log
+    finally:
+        db.close()
+    with engine.begin() as connection:  # and back: the audit log (and its guard) go
+        command.downgrade(alembic_config(connection), "0002")
+        assert sa.inspect(connection).has_table("audit_log") is False
+        assert connection.execute(sa.text("SELECT name FROM operators")).scalars().all() == ["ana"]
+    engine.dispose()

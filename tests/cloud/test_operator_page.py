@@ -121,3 +121,49 @@ def test_the_page_fits_a_tablet_held_upright(browser: Browser, lab: dict[str, An
         assert box is not None and box["height"] >= 44  # a finger can hit it
     finally:
         context.close()
+
+
+@pytest.fixture
+def watchers(tmp_path: Path, start_service: Callable[..., Any]) -> dict[str, Any]:
+    """hbs2 (switched off) with a command ana queued and a force it last pushed; tess (a
+    therapist) and vic (a viewer) may see it."""
+    running = start_service(Settings(db_url=f"sqlite:///{tmp_path / 'c.db'}"))
+    store = running.store
+    ana = store.directory.add_operator("ana")
+    robot = store.directory.authenticate(store.directory.add_robot("hbs2", operator="ana"))
+    assert robot is not None
+    tokens = {
+        "tess": store.directory.add_operator("tess", role="therapist"),
+        "vic": store.directory.add_operator("vic", role="viewer"),
+    }
+    for person in tokens:
+        store.directory.grant(person, "hbs2")
+    store.ledger.submit(robot.id, "say", {"text": "Hello"})
+    store.telemetry.put(robot.id, {"/sensors/force/left_n": 3.5})
+    return {"url": running.url, "ana": ana, **tokens}
+
+
+def test_a_therapist_follows_commands_and_sensors_but_is_offered_no_command(
+    page: Page, watchers: dict[str, Any]
+) -> None:
+    log_in(page, watchers["url"], watchers["tess"])
+    expect(page.locator("#who")).to_have_text("tess (therapist)")
+    row = page.locator("#commands tbody tr").first
+    expect(row).to_have_attribute("data-state", "QUEUED")
+    expect(row.locator("button.cancel")).to_have_count(0)
+    expect(page.locator("#send")).to_be_hidden()
+    expect(page.locator("#read-only")).to_have_text(
+        "You can follow this robot's commands; your role, therapist, does not send or cancel them."
+    )
+    expect(page.locator('#telemetry tr[data-key="/sensors/force/left_n"]')).to_contain_text("3.5")
+
+
+def test_a_viewer_sees_commands_and_no_sensor_value(page: Page, watchers: dict[str, Any]) -> None:
+    log_in(page, watchers["url"], watchers["vic"])
+    expect(page.locator("#commands tbody tr").first).to_contain_text("Hello")
+    expect(page.locator("#send")).to_be_hidden()
+    expect(page.locator("#sensors")).to_be_hidden()
+    expect(page.locator("#sensors-hidden")).to_have_text(
+        "Sensor values are not shown to your role, viewer: they are a child's data."
+    )
+    assert "3.5" not in page.content()

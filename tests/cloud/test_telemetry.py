@@ -80,7 +80,7 @@ def test_last_seen_moves_forward_only_whichever_worker_writes_last(
     late.seen(hbs2)
     late.flush()
     early.flush()  # an older time, written after
-    stored = directory.robots_of(ana.id)[0].last_seen_s
+    stored = directory.robots_of(ana)[0].last_seen_s
     assert stored == 1005.0
     assert Telemetry(db, clock).last_seen(hbs2, stored) == 1005.0
 
