@@ -115,7 +115,10 @@ class Robot:
     of its own, so a test that does not read it never leaves the robot blocked on a full
     pipe)."""
 
-    def __init__(self, url: str, token_file: Path, scenario: Path, trees: list[str]) -> None:
+    def __init__(
+        self, url: str, token_file: Path, scenario: Path, trees: list[str], person: str = ""
+    ) -> None:
+        whose = ["--person", person] if person else []  # their consent decides the telemetry
         self.process = subprocess.Popen(
             [
                 *VEST,
@@ -131,6 +134,7 @@ class Robot:
                 "--token-file",
                 str(token_file),
                 "--json",
+                *whose,
             ],
             cwd=ROOT,
             stdout=subprocess.PIPE,
@@ -184,8 +188,10 @@ def start_robot() -> Iterator[Callable[..., Robot]]:
     """Starts `vest run --cloud` robots on the simulated vest (stopped after the test)."""
     robots: list[Robot] = []
 
-    def start(url: str, token_file: Path, scenario: Path, trees: list[str]) -> Robot:
-        robots.append(Robot(url, token_file, scenario, trees))
+    def start(
+        url: str, token_file: Path, scenario: Path, trees: list[str], person: str = ""
+    ) -> Robot:
+        robots.append(Robot(url, token_file, scenario, trees, person))
         return robots[-1]
 
     yield start

@@ -16,10 +16,14 @@ from cloud.settings import Settings
 
 @pytest.fixture
 def lab(
-    tmp_path: Path, start_service: Callable[..., Any], start_robot: Callable[..., Any]
+    tmp_path: Path,
+    start_service: Callable[..., Any],
+    start_robot: Callable[..., Any],
+    consenting: Callable[..., None],
 ) -> dict[str, Any]:
-    """A service with operator ana, robot hbs2 running on the simulated vest, and hbs3
-    switched off."""
+    """A service with operator ana, robot hbs2 running on the simulated vest in a session
+    of kid-9 (whose guardian consented to telemetry), and hbs3 switched off."""
+    consenting("kid-9", "sensors", "cloud_telemetry")
     running = start_service(Settings(db_url=f"sqlite:///{tmp_path / 'c.db'}", recheck_s=0.2))
     directory = running.store.directory
     token = directory.add_operator("ana")
@@ -32,7 +36,7 @@ def lab(
         "duration_s: 120\nevents:\n"
         "  - {at: 0.5, obstacle: {left_mm: 250, center_mm: 600, right_mm: 900, seconds: 100}}\n"
     )
-    start_robot(running.url, token_file, scenario, ["trees/iot_command.yaml"])
+    start_robot(running.url, token_file, scenario, ["trees/iot_command.yaml"], person="kid-9")
     return {"url": running.url, "token": token}
 
 
