@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import re
 import statistics
 import subprocess
@@ -50,11 +51,17 @@ def run(way: str, seconds: float, folder: Path) -> dict[str, float]:
     replaces an earlier session)."""
     args = [*VEST, "run", "--speech", "text", "--duration", str(seconds)]
     if way == "record":
-        args += ["--record", str(folder / f"bench-{len(list(folder.iterdir()))}.db")]
+        args += ["--record", str(folder / f"bench-{len(list(folder.iterdir()))}.vest")]
     if way == "view":
         args += ["--view", "--view-port", "0"]
+    site = {"VEST_DATA": str(folder.parent / "site")}  # a site of its own: its key, its index
     process = subprocess.Popen(
-        args, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
+        args,
+        cwd=ROOT,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env={**os.environ, **site},
     )
     counted, stop = [0], threading.Event()
     reader: threading.Thread | None = None
@@ -92,10 +99,12 @@ def main() -> None:
         args.seconds, args.rounds = 3.0, 1
     ways = ("plain", "record", "view")
     results: dict[str, list[dict[str, float]]] = {way: [] for way in ways}
-    with tempfile.TemporaryDirectory() as folder:
+    with tempfile.TemporaryDirectory() as scratch:
+        folder = Path(scratch) / "recordings"
+        folder.mkdir()
         for round_number in range(args.rounds):
             for way in ways:
-                results[way].append(run(way, args.seconds, Path(folder)))
+                results[way].append(run(way, args.seconds, folder))
                 print(f"round {round_number + 1} {way:7} {results[way][-1]}", flush=True)
     base = {key: statistics.median(r[key] for r in results["plain"]) for key in results["plain"][0]}
     print(f"\nworst tree over {args.rounds} rounds of {args.seconds:g} s (median of rounds)")
