@@ -8,7 +8,7 @@ one role; the service checks it on every endpoint (403 naming the role and what 
 | admin | every robot | sees, sends, cancels | sees |
 | operator | those granted to it | sees, sends, cancels | sees |
 | therapist | those granted to it | sees | sees |
-| viewer | those granted to it | sees | never (a child's data) |
+| viewer | those granted to it | sees (not their results) | never (a child's data) |
 """
 
 from __future__ import annotations

@@ -10,6 +10,7 @@ from fastapi import APIRouter, HTTPException, Request, Response, status
 from cloud.api.deps import Commander, CurrentOperator, StoreDep, actor
 from cloud.api.robots import granted
 from cloud.api.schemas import CommandCreate, CommandPublic
+from cloud.roles import Permission, may
 from cloud.store.ledger import Command, ConflictError
 from engine.remote_commands import command_problem
 
@@ -57,7 +58,8 @@ def send_command(
 def list_commands(robot: str, store: StoreDep, operator: CurrentOperator) -> list[CommandPublic]:
     """Newest first (the last 50)."""
     row = granted(store, operator, robot)
-    return [CommandPublic.of(c, row.name) for c in store.ledger.recent(row.id)]
+    sees = may(operator.role, Permission.TELEMETRY)
+    return [CommandPublic.of(c, row.name, with_result=sees) for c in store.ledger.recent(row.id)]
 
 
 @router.get("/{command_id}")
@@ -68,7 +70,7 @@ def get_command(
     command = store.ledger.get(row.id, command_id)
     if command is None:
         raise HTTPException(status.HTTP_404_NOT_FOUND, f"no command {command_id!r}")
-    return CommandPublic.of(command, row.name)
+    return CommandPublic.of(command, row.name, with_result=may(operator.role, Permission.TELEMETRY))
 
 
 @router.post("/{command_id}/cancel")

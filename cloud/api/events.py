@@ -66,7 +66,12 @@ class OperatorView:
                 if self._versions.get(command.id) != command.version:
                     self._versions[command.id] = command.version
                     events.append(
-                        frame(CommandPublic.of(command, row.name).model_dump(), "command")
+                        frame(
+                            CommandPublic.of(
+                                command, row.name, with_result=sees_telemetry
+                            ).model_dump(),
+                            "command",
+                        )
                     )
             if not sees_telemetry:
                 continue

@@ -71,12 +71,18 @@ class CommandPublic(BaseModel):
     state: CommandState
     version: int
     result: Any = None
+    result_hidden: bool = False
+    """The robot's result is not shown to this account's role (a result may carry sensor
+    values, which a viewer never sees)."""
     created_s: float
     updated_s: float
     deliveries: int
 
     @classmethod
-    def of(cls, command: Command, robot: str) -> CommandPublic:
+    def of(cls, command: Command, robot: str, *, with_result: bool = True) -> CommandPublic:
+        """``command`` as the API shows it; without its result for a role that may not
+        see sensor values (``with_result`` False)."""
+        hidden = not with_result and command.result is not None
         return cls(
             id=command.id,
             robot=robot,
@@ -84,7 +90,8 @@ class CommandPublic(BaseModel):
             args=command.args,
             state=command.state,
             version=command.version,
-            result=command.result,
+            result=None if hidden else command.result,
+            result_hidden=hidden,
             created_s=command.created_s,
             updated_s=command.updated_s,
             deliveries=command.deliveries,

@@ -220,7 +220,10 @@ function renderCommands() {
         el("td", { textContent: clock(c.created_s) }),
         el("td", {}, el("strong", { textContent: c.type }), " ", el("code", { textContent: shown(c.args) })),
         el("td", {}, el("span", { className: `state ${c.state}`, textContent: c.state })),
-        el("td", {}, el("pre", { textContent: c.result === null || c.result === undefined ? "" : shown(c.result) })),
+        el("td", {}, el("pre", {
+          textContent: c.result_hidden ? "(not shown to a viewer)"
+            : c.result === null || c.result === undefined ? "" : shown(c.result),
+        })),
         el("td"),
       );
       row.dataset.command = c.id;

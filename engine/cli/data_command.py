@@ -185,8 +185,12 @@ def _purge(site: Site, args: argparse.Namespace) -> int:
     days = site.settings.keep_sessions_days
     for entry in purged:
         print(f"purged {entry.path} ({entry.person or 'no person'}, {when(entry.started)})")
-    print(f"{len(purged)} sessions older than {days:g} days removed")
+    print(f"{_count(len(purged), 'session')} older than {days:g} days removed")
     return 0
+
+
+def _count(number: int, thing: str) -> str:
+    return f"{number} {thing}{'' if number == 1 else 's'}"
 
 
 def _number(text: str | None) -> float | None:
@@ -221,7 +225,11 @@ def _rekey(site: Site, args: argparse.Namespace) -> int:
     done, missing = site.rekey(drop_missing=args.drop_missing)
     for path in missing:
         tell(f"given up: {path} (not there; it cannot be read with the new key)")
-    print(f"{len(done)} files encrypted with a new key ({site.key.path})")
+    print(f"{_count(len(done), 'file')} encrypted with a new key ({site.key.path})")
+    tell(
+        f"back up the new key now ({site.key.path}): the old one is gone, and copies of "
+        "recordings made before (backups) can be read only with the old key's backup"
+    )
     return 0
 
 

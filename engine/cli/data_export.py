@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
 import sys
 from pathlib import Path
 from typing import Any
@@ -67,7 +66,13 @@ def export(site: Site, args: argparse.Namespace) -> int:
             page = report_html(recording)
         finally:
             recording.close()
-        write_file(folder / "reports" / f"{stem}.html", page.encode(), str(folder), "a report")
+        write_file(
+            folder / "reports" / f"{stem}.html",
+            page.encode(),
+            str(folder),
+            "a report",
+            private=True,
+        )
     consent = site.consent_of(person)
     _write(
         folder / "consent.json",
@@ -97,7 +102,7 @@ def export(site: Site, args: argparse.Namespace) -> int:
     _write(folder / "audit.json", [_audit_line(line) for line in lines])
     day = site.today().isoformat()
     text = README.format(person=person, day=day, consent=consent.describe())
-    write_file(folder / "README.txt", text.encode(), str(folder), "the export")
+    write_file(folder / "README.txt", text.encode(), str(folder), "the export", private=True)
     print(f"exported {len(sessions) - missing} sessions of {person} to {folder}")
     return 0
 
@@ -108,8 +113,7 @@ def _audit_line(line: Any) -> dict[str, Any]:
 
 def _write(path: Path, data: Any) -> None:
     text = json.dumps(data, indent=1, default=str, allow_nan=False)
-    write_file(path, text.encode("utf-8"), str(path), "the export")
-    os.chmod(path, 0o600)
+    write_file(path, text.encode("utf-8"), str(path), "the export", private=True)
 
 
 def erase(site: Site, args: argparse.Namespace) -> int:
@@ -125,10 +129,10 @@ def erase(site: Site, args: argparse.Namespace) -> int:
     erased = site.erase(person)
     for path in erased.already_gone:
         tell(f"already gone: {path}")
-    print(
-        f"erased {person}: {len(erased.removed)} files removed, their index entries and "
-        "consent record forgotten (one audit line kept)"
-    )
+    files = f"{len(erased.removed)} file{'' if len(erased.removed) == 1 else 's'}"
+    consent = " and consent record" if has_consent else ""
+    kept = "the audit keeps one line"
+    print(f"erased {person}: {files} removed, their index entries{consent} forgotten ({kept})")
     return 0
 
 

@@ -131,14 +131,15 @@ def writable_folder(folder: Path) -> None:
         raise ConfigError(f"{folder}: cannot write there ({error.strerror or error})") from None
 
 
-def write_file(path: Path, data: bytes, named_by: str, what: str) -> None:
+def write_file(path: Path, data: bytes, named_by: str, what: str, *, private: bool = False) -> None:
     """``data`` (``what``: "the report") into the regular file ``path`` (made, or
-    replaced); ConfigError naming it (``named_by``: as the person did, ``-o r.html``) when
-    it cannot be written, or is a folder, a FIFO or a device: opened without blocking, so a
-    FIFO with no reader refuses at once instead of hanging the command."""
+    replaced); readable by its owner alone when ``private`` (a person's data in the clear).
+    ConfigError naming it (``named_by``: as the person did, ``-o r.html``) when it cannot
+    be written, or is a folder, a FIFO or a device: opened without blocking, so a FIFO with
+    no reader refuses at once instead of hanging the command."""
     flags = os.O_WRONLY | os.O_CREAT | os.O_NONBLOCK | os.O_CLOEXEC
     try:
-        descriptor = os.open(path, flags, 0o644)
+        descriptor = os.open(path, flags, 0o600 if private else 0o644)
     except OSError as error:
         why = "is not a regular file (a FIFO)" if error.errno == errno.ENXIO else reason(error)
         raise ConfigError(f"{named_by}: cannot write {what} ({why})") from None
@@ -146,6 +147,8 @@ def write_file(path: Path, data: bytes, named_by: str, what: str) -> None:
         if not stat.S_ISREG(os.fstat(descriptor).st_mode):
             raise ConfigError(f"{named_by}: cannot write {what} (it is not a regular file)")
         os.set_blocking(descriptor, True)
+        if private:
+            os.fchmod(descriptor, 0o600)  # a file that was there keeps no wider mode
         os.ftruncate(descriptor, 0)
         view = memoryview(data)
         while view:

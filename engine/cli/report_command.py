@@ -52,9 +52,10 @@ def main(args: argparse.Namespace) -> int:
         page = report_html(recording)
         cut = recording.cut_short
         output = args.output or args.recording.with_suffix(".html")
-        write_file(output, page.encode("utf-8"), f"{output}", "the report")
+        write_file(output, page.encode("utf-8"), f"{output}", "the report", private=True)
         if site is not None:  # a report names the person in the clear: erased with them
-            site.output_written(output, site.person_of(args.recording), "report")
+            person = site.person_of(args.recording)
+            site.output_written(output, person, "report", source=args.recording)
     finally:
         recording.close()
         if site is not None:
@@ -85,11 +86,12 @@ def _progress(person: str, output: Path) -> int:
                 recording.close()
             site.audit("report", person, str(entry.path))
         page = progress_html(person, summaries, gone)
-        write_file(output, page.encode("utf-8"), f"{output}", "the report")
+        write_file(output, page.encode("utf-8"), f"{output}", "the report", private=True)
         site.output_written(output, person, "report")
     finally:
         site.close()
-    print(f"progress of {person} over {len(summaries)} sessions: {output}")
+    sessions = f"{len(summaries)} session{'' if len(summaries) == 1 else 's'}"
+    print(f"progress of {person} over {sessions}: {output}")
     for path in gone:
         tell(f"warning: {path}: not there any more; left out of the progress")
     return 0

@@ -115,6 +115,7 @@ def _why_unreadable(path: Path) -> str:
     if not could_be_sealed(path):
         return f"{path}: not an encrypted database (its size is not whole pages)"
     return (
-        f"{path}: cannot be read with this site's key: recorded at another site, or "
-        "changed or damaged since it was written"
+        f"{path}: cannot be read with this site's key: recorded at another site (or before "
+        "this site's key was changed with vest data rekey), or changed or damaged since it "
+        "was written"
     )

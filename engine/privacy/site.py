@@ -123,10 +123,16 @@ class Site:
     def session_ended(self, path: Path, length_s: float) -> None:
         self.records.end_session(path.resolve(), length_s)
 
-    def output_written(self, path: Path, person: str, kind: str) -> None:
-        """Notes a report or export written in the clear about ``person`` (erased with them)."""
-        self.records.add_output(path.resolve(), person, kind, self.clock.now())
-        self.audit(f"{kind} written", person, str(path.resolve()))
+    def output_written(
+        self, path: Path, person: str, kind: str, source: Path | None = None
+    ) -> None:
+        """Notes a report or export written in the clear about ``person`` (from the
+        recording ``source``, None for one about the person as a whole): removed when
+        that recording is purged, and when the person is erased."""
+        where = path.resolve()
+        origin = source.resolve() if source is not None else None
+        self.records.add_output(where, person, kind, self.clock.now(), origin)
+        self.audit(f"{kind} written", person, str(where))
 
     def person_of(self, recording: Path) -> str:
         """The pseudonym a recording belongs to ('' for none or one not in the index)."""
@@ -135,11 +141,14 @@ class Site:
 
     # -- retention ----------------------------------------------------------------------
     def purge(self) -> list[SessionEntry]:
-        """Removes every session older than the site keeps them (file and index entry,
-        each audited); returns them."""
+        """Removes every session older than the site keeps them (file, the reports written
+        from it, index entry; each audited); returns them."""
         oldest = self.clock.now() - self.settings.keep_sessions_days * DAY_S
         purged = [entry for entry in self.records.sessions() if entry.started < oldest]
         for entry in purged:
+            for output in self.records.outputs_from(entry.path):  # its reports go with it
+                _remove(output)
+                self.records.forget_output(output)
             _remove(entry.path)
             self.records.forget_session(entry.path)
             days = self.settings.keep_sessions_days
@@ -181,7 +190,7 @@ class Site:
         missing = [entry.path for entry in sessions if not entry.path.is_file()]
         if missing and not drop_missing:
             raise ConfigError(
-                f"{len(missing)} recordings are not where the index says ({missing[0]}...): "
+                f"{len(missing)} recording(s) not where the index says ({missing[0]}...): "
                 "put them back, or add --drop-missing to give them up (they could never be "
                 "read again)"
             )

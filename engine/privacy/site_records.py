@@ -4,8 +4,9 @@ data folder.
 - ``sessions``: every recording vest made here (its path, the pseudonym it belongs to or
   '' for none, when it started, how long it lasted in seconds, the profile, what consent
   let it keep), wherever the file was written;
-- ``outputs``: what was written from those sessions in the clear (reports, exports), so an
-  erasure finds them;
+- ``outputs``: what was written from those sessions in the clear (reports, exports), and
+  from which recording ('' for one about the person as a whole), so an erasure and the
+  purge of that recording find them;
 - ``erasing``: a person whose erasure began and has not finished (it finishes on the next
   run of any ``vest data`` command or ``vest run``);
 - ``audit``: who recorded, replayed, reported, exported, erased what and when. Append-only:
@@ -35,7 +36,8 @@ CREATE TABLE IF NOT EXISTS sessions (
     profile TEXT NOT NULL, kept TEXT NOT NULL
 );
 CREATE TABLE IF NOT EXISTS outputs (
-    path TEXT PRIMARY KEY, person TEXT NOT NULL, kind TEXT NOT NULL, made REAL NOT NULL
+    path TEXT PRIMARY KEY, person TEXT NOT NULL, kind TEXT NOT NULL, made REAL NOT NULL,
+    source TEXT NOT NULL
 );
 CREATE TABLE IF NOT EXISTS erasing (person TEXT PRIMARY KEY, since REAL NOT NULL);
 CREATE TABLE IF NOT EXISTS audit (
@@ -138,12 +140,25 @@ class SiteRecords:
         with self.transaction() as db:
             db.execute("DELETE FROM sessions WHERE path = ?", (str(path),))
 
-    def add_output(self, path: Path, person: str, kind: str, made: float) -> None:
+    def add_output(
+        self, path: Path, person: str, kind: str, made: float, source: Path | None
+    ) -> None:
         with self.transaction() as db:
             db.execute(
-                "INSERT OR REPLACE INTO outputs VALUES (?, ?, ?, ?)",
-                (str(path), person, kind, made),
+                "INSERT OR REPLACE INTO outputs VALUES (?, ?, ?, ?, ?)",
+                (str(path), person, kind, made, str(source) if source is not None else ""),
             )
+
+    def outputs_from(self, source: Path) -> list[Path]:
+        """What was written in the clear from the recording ``source``."""
+        rows = self._connection.execute(
+            "SELECT path FROM outputs WHERE source = ? ORDER BY made", (str(source),)
+        ).fetchall()
+        return [Path(path) for (path,) in rows]
+
+    def forget_output(self, path: Path) -> None:
+        with self.transaction() as db:
+            db.execute("DELETE FROM outputs WHERE path = ?", (str(path),))
 
     def outputs(self, person: str) -> list[tuple[Path, str]]:
         """What was written in the clear about ``person``: (path, kind: report or export)."""

@@ -49,7 +49,9 @@ class SessionSummary:
 
     @property
     def day(self) -> str:
-        return datetime.datetime.fromtimestamp(self.started, datetime.UTC).strftime("%Y-%m-%d")
+        """When it started, as a person reads it (UTC)."""
+        when = datetime.datetime.fromtimestamp(self.started, datetime.UTC)
+        return when.strftime("%Y-%m-%d %H:%M")
 
 
 def summarize(recording: Recording, started: float) -> SessionSummary:
@@ -91,6 +93,9 @@ def progress_html(person: str, sessions: list[SessionSummary], gone: list[Path])
         + (f" from {sessions[0].day} to {sessions[-1].day}" if sessions else "")
         + "</p>",
         f"<p>{html.escape(_in_words(sessions))}</p>",
+        "<p class='meta'>Counted: what the person did (touches, hugs, words, gestures), not "
+        "the therapist's presses or an operator's commands, which the session reports list "
+        "too.</p>",
     ]
     if gone:
         listed = ", ".join(html.escape(str(path)) for path in gone)

@@ -37,7 +37,12 @@ from engine.blackboard.catalogue import IOT_CANCELED, IOT_INBOX
 from engine.clock import Clock
 from engine.services.done_commands import DoneCommands
 from engine.services.jobs import ImmediateJob, Job
-from engine.services.telemetry import TelemetrySnapshot, json_safe
+from engine.services.telemetry import (
+    WITHHELD,
+    TelemetrySnapshot,
+    carries_sensor_values,
+    json_safe,
+)
 from engine.session.events import KeyChanged
 from engine.session.stream import SessionStream
 
@@ -138,6 +143,8 @@ class CloudLink:
         """Queue the report (it is sent, and retried, by the reporter); done at once. A
         command that did not come from the cloud (a scenario's, say) is not reported there."""
         report = {"status": status.upper(), "result": json_safe(result)}
+        if not self.telemetry.sensors_allowed and carries_sensor_values(result):
+            report = {"status": "FAILED", "result": {"error": WITHHELD}}  # consent: no sensors
         with self._carrying_out:
             if command_id not in self._from_cloud:
                 log.debug("command %s did not come from the cloud; not reported there", command_id)

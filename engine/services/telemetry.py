@@ -46,6 +46,10 @@ class TelemetrySnapshot:
         """The keys sent: sensors and devices, or devices alone when the person did not
         consent to telemetry (:meth:`devices_only`)."""
 
+    @property
+    def sensors_allowed(self) -> bool:
+        return SENSORS_PREFIX in self.prefixes
+
     def devices_only(self) -> None:
         """From now on only the robot's own device keys are sent, never a sensor reading."""
         with self._lock:
@@ -61,3 +65,19 @@ class TelemetrySnapshot:
     def take(self) -> dict[str, Any]:
         with self._lock:
             return dict(self._values)
+
+
+WITHHELD = "not sent: the person's consent does not cover sensor readings sent to the cloud"
+"""A command's result that carries sensor values, when the person did not consent."""
+
+
+def carries_sensor_values(value: Any) -> bool:
+    """Whether ``value`` (a command's result) holds a sensor or camera key's value."""
+    if isinstance(value, dict):
+        return any(
+            str(key).startswith((SENSORS_PREFIX, "/vision/")) or carries_sensor_values(item)
+            for key, item in value.items()
+        )
+    if isinstance(value, list | tuple):
+        return any(carries_sensor_values(item) for item in value)
+    return False

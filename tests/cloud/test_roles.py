@@ -147,3 +147,20 @@ def test_a_role_changed_by_the_admin_holds_within_the_token_cache_time(team: Tea
     team.store.directory.set_role("vic", "viewer")
     team.clock.advance(5.1)
     assert team.get("vic", "/robots/hbs2/telemetry").status_code == 403
+
+
+def test_a_viewer_sees_a_command_but_not_the_sensor_values_it_brought_back(team: Team) -> None:
+    sent = team.post("ana", "/robots/hbs2/commands", {"type": "read", "args": {"sensor": "force"}})
+    command = sent.json()["id"]
+    assert team.get("hbs2", "/robot/commands/next?wait_s=0").status_code == 200
+    values = {"/sensors/force/left_n": 4.0}
+    result = {"status": "SUCCEEDED", "result": values}
+    assert team.post("hbs2", f"/robot/commands/{command}/result", result).status_code == 200
+    as_therapist = team.get("tess", f"/robots/hbs2/commands/{command}").json()
+    assert as_therapist["result"] == values and not as_therapist["result_hidden"]
+    for shown in (
+        team.get("vic", f"/robots/hbs2/commands/{command}").json(),
+        team.get("vic", "/robots/hbs2/commands").json()[0],
+    ):
+        assert shown["state"] == "SUCCEEDED" and shown["result"] is None
+        assert shown["result_hidden"]

@@ -49,7 +49,15 @@ def test_without_consent_the_words_are_not_kept_but_the_robot_still_answers(
     keys = {key for (key,) in db.execute("SELECT key FROM blackboard")}
     world = [d for (d,) in db.execute("SELECT description FROM world WHERE kind = 'hear'")]
     left_out = db.execute("SELECT value FROM meta WHERE key = 'left_out'").fetchone()[0]
+    everything = " ".join(  # every value of every row of every table
+        str(value)
+        for (table,) in db.execute("SELECT name FROM sqlite_master WHERE type = 'table'")
+        for row in db.execute(f"SELECT * FROM {table}")
+        for value in row
+    )
     db.close()
+    for word in ("Lina", "dogs", "what's your name"):  # not in a node's feedback either
+        assert word.lower() not in everything.lower(), word
     assert "/speech/heard" not in keys and "/sensors/force/left_n" in keys
     assert world and all("Lina" not in d and "words not kept" in d for d in world)
     assert left_out == "speech as text, audio, camera frames, telemetry to the cloud"

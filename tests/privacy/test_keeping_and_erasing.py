@@ -120,9 +120,11 @@ def test_sessions_older_than_the_site_keeps_them_are_purged(
     started = Site.open(site_data, clock=Calendar(0), who="ana").records.sessions()[0].started
     site = Site.open(site_data, clock=Calendar(started + 29 * DAY_S), who="ana")
     assert site.purge() == []
+    report = recorded[0].with_suffix(".html")  # a.vest's report, in the clear
+    assert report.exists() and report.stat().st_mode & 0o077 == 0  # its owner's alone
     site.clock = Calendar(started + 31 * DAY_S)
     assert sorted(entry.path.name for entry in site.purge()) == ["a.vest", "b.vest", "c.vest"]
-    assert not any(path.exists() for path in recorded)
+    assert not any(path.exists() for path in recorded) and not report.exists()
     assert site.records.sessions() == []
     assert [line.action for line in site.records.audit_lines()][-3:] == ["purge"] * 3
     site.close()
