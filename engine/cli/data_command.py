@@ -19,17 +19,19 @@ from __future__ import annotations
 import argparse
 import datetime
 import json
+import math
 import os
 import sys
 from pathlib import Path
 
 from engine.cli.data_export import erase, export
 from engine.cli.output import tell
-from engine.cli.site_access import PSEUDONYM, open_site, pseudonym
+from engine.cli.site_access import open_site, pseudonym
 from engine.errors import ConfigError, UsageError
-from engine.privacy.consent import CAPTURES, CONSENT_FILE, ConsentBook
+from engine.privacy.consent import CAPTURES, CONSENT_FILE, PSEUDONYM, ROLE, ConsentBook
 from engine.privacy.sealed_sqlite import is_plain_sqlite, seal_copy
 from engine.privacy.site import Site
+from engine.privacy.site_data import check_apart
 from engine.recording.replay import Recording
 
 
@@ -103,8 +105,12 @@ def main(args: argparse.Namespace) -> int:
 
 
 def when(at: float) -> str:
-    """A stored time (seconds since the epoch) as a person reads it, UTC."""
-    return datetime.datetime.fromtimestamp(at, datetime.UTC).strftime("%Y-%m-%d %H:%M UTC")
+    """A stored time (seconds since the epoch) as a person reads it, UTC ('?' for one no
+    calendar has)."""
+    try:
+        return datetime.datetime.fromtimestamp(at, datetime.UTC).strftime("%Y-%m-%d %H:%M UTC")
+    except (OverflowError, OSError, ValueError):
+        return "?"
 
 
 def _list(site: Site, args: argparse.Namespace) -> int:
@@ -154,7 +160,7 @@ def _consent(site: Site, args: argparse.Namespace) -> int:
 def _add_consent(site: Site, args: argparse.Namespace) -> int:
     if args.person is None or args.given_by is None or args.covers is None:
         raise UsageError("vest data consent PERSON --given-by ROLE --covers LIST: all three")
-    if not PSEUDONYM.fullmatch(args.given_by):
+    if not ROLE.fullmatch(args.given_by):
         raise UsageError(f"--given-by {args.given_by!r}: a role (guardian, parent), never a name")
     path = site.folder / CONSENT_FILE
     if args.person in site.consents.records:
@@ -194,10 +200,12 @@ def _count(number: int, thing: str) -> str:
 
 
 def _number(text: str | None) -> float | None:
+    """A meta value as a finite number, else None."""
     try:
-        return float(text) if text is not None else None
+        value = float(text) if text is not None else None
     except ValueError:
         return None
+    return value if value is not None and math.isfinite(value) else None
 
 
 def _audit(site: Site, args: argparse.Namespace) -> int:
@@ -212,6 +220,12 @@ def _audit(site: Site, args: argparse.Namespace) -> int:
         else:
             person = f" {line.person}" if line.person else ""
             print(f"{line.seq:>5}  {when(line.at)}  {line.who}  {line.action}{person}: {line.what}")
+    if lines and args.person is None and not args.json:
+        head = lines[-1]
+        print(
+            f"{len(lines)} lines; the last one's chain is {head.chain[:16]}: kept elsewhere, "
+            "it shows whether lines were later removed from the end"
+        )
     if broken is not None:
         tell(
             f"vest data audit: line {broken.seq} and after were changed after they were "
@@ -235,8 +249,11 @@ def _rekey(site: Site, args: argparse.Namespace) -> int:
 
 def _seal(site: Site, args: argparse.Namespace) -> int:
     for path in args.files:
+        if path.is_symlink():  # sealing the link would leave the file it names in the clear
+            raise ConfigError(f"{path}: a link; name the file itself ({path.resolve()})")
         if not path.is_file() or not is_plain_sqlite(path):
             raise ConfigError(f"{path}: not a plain recording (sealed already, or not one)")
+        check_apart(path, site.key)
         Recording.open(path, None).close()  # a recording, not any SQLite file
         sealing = path.with_name(path.name + ".sealing")
         sealing.unlink(missing_ok=True)
@@ -246,11 +263,20 @@ def _seal(site: Site, args: argparse.Namespace) -> int:
         recording.close()
         os.replace(sealing, path)
         person = meta.get("person", "")
+        if person and not PSEUDONYM.fullmatch(person):
+            tell(
+                f"warning: {path}: names its person {person!r}, not a pseudonym; listed as no one's"
+            )
+            person = ""
         if site.records.session_at(path.resolve()) is None:  # listed, purged, erased as any
-            started = _number(meta.get("started")) or site.clock.now()
+            now = site.clock.now()
+            started = _number(meta.get("started"))
+            if started is None or not 0 <= started <= now:  # purged from today on, not never
+                tell(f"warning: {path}: no start time it could have had; listed as of now")
+                started = now
             kept = tuple(name for name in meta.get("kept", "").split(",") if name)
             site.records.add_session(path.resolve(), person, started, meta.get("profile", ""), kept)
-            if (length := _number(meta.get("duration_s"))) is not None:
+            if (length := _number(meta.get("duration_s"))) is not None and length >= 0:
                 site.session_ended(path, length)
         site.audit("seal", person, str(path.resolve()))
         print(f"sealed {path}")

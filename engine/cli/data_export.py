@@ -60,6 +60,7 @@ def export(site: Site, args: argparse.Namespace) -> int:
         stem = f"{number:03d}-{entry.path.stem}"
         recording = Recording.open(entry.path, site.key)
         try:
+            site.check_belongs(entry.path, recording.meta.get("person", ""))
             data: dict[str, Any] = {"file": str(entry.path)}
             data |= {name: recording.table(name) for name in (*TABLES, "events")}
             _write(folder / "sessions" / f"{stem}.json", data)

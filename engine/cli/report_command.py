@@ -15,10 +15,11 @@ from pathlib import Path
 
 from engine.cli.output import tell, write_file
 from engine.cli.site_access import open_recording, open_site, pseudonym
-from engine.errors import UsageError
+from engine.errors import ConfigError, UsageError
+from engine.privacy.site import Site
 from engine.recording.progress import SessionSummary, progress_html, summarize
 from engine.recording.replay import Recording
-from engine.recording.report import report_html
+from engine.recording.report import REPORT_HEAD, report_html
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -49,9 +50,10 @@ def main(args: argparse.Namespace) -> int:
         return _progress(args.person, args.output or Path(f"{args.person}-progress.html"))
     recording, site = open_recording(args.recording, "report")
     try:
+        output = args.output or args.recording.with_suffix(".html")
+        check_replaceable(output, site)
         page = report_html(recording)
         cut = recording.cut_short
-        output = args.output or args.recording.with_suffix(".html")
         write_file(output, page.encode("utf-8"), f"{output}", "the report", private=True)
         if site is not None:  # a report names the person in the clear: erased with them
             person = site.person_of(args.recording)
@@ -67,9 +69,30 @@ def main(args: argparse.Namespace) -> int:
     return 0
 
 
+def check_replaceable(output: Path, site: Site | None) -> None:
+    """ConfigError when ``output`` holds something a report would replace that is not a
+    report vest wrote (a recording, someone's notes): never lost to a mistyped -o."""
+    if not output.is_file():  # nothing there, or what writing it refuses by name (a FIFO)
+        return
+    if site is not None and site.records.is_output(output.resolve()):
+        return
+    try:
+        with open(output, "rb") as file:
+            head = file.read(200)
+    except OSError:
+        head = b""
+    if head.startswith(REPORT_HEAD.encode()):
+        return
+    raise ConfigError(
+        f"-o {output}: holds something else than a report, which the report would replace; "
+        "name another file"
+    )
+
+
 def _progress(person: str, output: Path) -> int:
     site = open_site(create=False)
     try:
+        check_replaceable(output, site)
         entries = site.records.sessions(person)
         if not entries:
             raise UsageError(f"the site holds no session of {person} (vest data list)")
@@ -81,6 +104,7 @@ def _progress(person: str, output: Path) -> int:
                 continue
             recording = Recording.open(entry.path, site.key)
             try:
+                site.check_belongs(entry.path, recording.meta.get("person", ""))
                 summaries.append(summarize(recording, entry.started))
             finally:
                 recording.close()

@@ -6,19 +6,17 @@ from __future__ import annotations
 import argparse
 import getpass
 import os
-import re
 from pathlib import Path
 
 from engine.cli.output import tell
 from engine.clock import EpochClock
 from engine.errors import ConfigError
+from engine.privacy.consent import PSEUDONYM
 from engine.privacy.sealed_sqlite import is_plain_sqlite
 from engine.privacy.site import Site
 from engine.privacy.site_data import data_folder
 from engine.recording.replay import Recording
 from engine.recording.session_file import check_kind
-
-PSEUDONYM = re.compile(r"[A-Za-z0-9][A-Za-z0-9._-]{0,39}")
 
 
 def pseudonym(text: str) -> str:
@@ -74,5 +72,11 @@ def open_recording(path: Path, action: str) -> tuple[Recording, Site | None]:
             f"vest data seal {path} encrypts it"
         )
     if site is not None:
+        try:
+            site.check_belongs(path, recording.meta.get("person", ""))
+        except ConfigError:
+            recording.close()
+            site.close()
+            raise
         site.audit(action, site.person_of(path), str(path.resolve()))
     return recording, site

@@ -14,6 +14,7 @@ them in reverse.
 
 from __future__ import annotations
 
+import logging
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -21,8 +22,10 @@ from pathlib import Path
 from engine.buttons.button_file import ButtonBoard
 from engine.buttons.wizard import Wizard
 from engine.clock import Clock
+from engine.errors import ConfigError
 from engine.hardware.config import RobotConfig
 from engine.privacy.consent import Consent, without_record
+from engine.privacy.sealed_sqlite import Error as SealedError
 from engine.privacy.site import Site
 from engine.recording.recorder import SessionRecorder
 from engine.robot_io.robot_speech import RobotSpeech
@@ -37,6 +40,8 @@ from engine.session.events import WorldEvent
 from engine.session.stream import SessionStream
 from engine.view.hub import ViewHub
 from engine.view.server import LiveSource, ViewServer
+
+log = logging.getLogger(__name__)
 
 
 @dataclass(frozen=True)
@@ -162,8 +167,12 @@ def _around(assembled: AssembledRobot, plan: SessionPlan) -> RunningSession:
 
         def close_recording() -> None:
             recorder.close()
-            if recorder.length_s is not None:
+            if recorder.length_s is None:
+                return
+            try:
                 record.site.session_ended(record.path, recorder.length_s)
+            except (ConfigError, SealedError) as error:  # the recording itself is whole
+                log.error("the site's index did not take the session's length: %s", error)
 
         lifecycle.add("recording", stop=close_recording)  # closed even if it never starts
         recorder.describe(

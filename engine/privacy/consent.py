@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import datetime
 import os
+import re
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -30,6 +31,11 @@ from engine.files.yaml_source import load_yaml
 from engine.files.yaml_values import YList, YMap, YScalar, YValue
 from engine.values.param_problems import did_you_mean
 
+PSEUDONYM = re.compile(r"[A-Za-z0-9][A-Za-z0-9._-]{0,39}")
+"""A pseudonym: 1..40 letters, digits, '-', '_' or '.', starting with a letter or digit
+(kid-17): never a name, which has a space."""
+ROLE = re.compile(r"[A-Za-z][A-Za-z-]{0,39}")
+"""Who gave consent, as a role: guardian, parent, self, legal-guardian."""
 CONSENT_FILE = "consent.yaml"
 CAPTURES: dict[str, str] = {
     "sensors": "sensor readings",
@@ -150,6 +156,9 @@ def _mark(value: YValue) -> Mark:
 
 
 def _record(person: str, entry: YValue, where: Mark, problems: Problems) -> Consent | None:
+    if not PSEUDONYM.fullmatch(person):
+        problems.add(where, f"{person!r} is not a pseudonym", "e.g. kid-17: never a name")
+        return None
     if not isinstance(entry, YMap):
         problems.add(_mark(entry), f"{person}: a consent record is a mapping", ", ".join(FIELDS))
         return None
@@ -159,9 +168,14 @@ def _record(person: str, entry: YValue, where: Mark, problems: Problems) -> Cons
             problems.add(where, f"{person}: no {needed!r}", "fields: " + ", ".join(FIELDS))
     given_by = entry.get("given_by")
     if given_by is not None and not (
-        isinstance(given_by, YScalar) and isinstance(given_by.value, str) and given_by.value
+        isinstance(given_by, YScalar)
+        and isinstance(given_by.value, str)
+        and ROLE.fullmatch(given_by.value)
     ):
-        problems.add(_mark(given_by), "given_by: who gave consent, as a role (e.g. guardian)")
+        problems.add(
+            _mark(given_by),
+            "given_by: who gave consent, as a role (guardian, parent), never a name",
+        )
     given_on = _day(entry.get("given_on"), "given_on", problems)
     until = _day(entry.get("until"), "until", problems)
     covers = _covers(entry.get("covers"), problems)

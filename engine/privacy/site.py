@@ -12,9 +12,10 @@ Times are seconds since the epoch (UTC) from the injected clock (an
 
 from __future__ import annotations
 
+import contextlib
 import datetime
+import fcntl
 import os
-import shutil
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -23,7 +24,7 @@ from engine.errors import ConfigError
 from engine.files.problems import Problems
 from engine.files.yaml_source import load_yaml
 from engine.files.yaml_values import YMap, YScalar
-from engine.privacy.consent import Consent, ConsentBook
+from engine.privacy.consent import PSEUDONYM, Consent, ConsentBook
 from engine.privacy.sealed_sqlite import connect_sealed, rekey
 from engine.privacy.site_data import KEY_FILE, SiteKey, make_key_file, read_key_file, site_key
 from engine.privacy.site_records import RECORDS_FILE, SessionEntry, SiteRecords
@@ -81,6 +82,7 @@ class Site:
 
     def __init__(self, folder: Path, key: SiteKey, clock: Clock, who: str) -> None:
         self.folder, self.key, self.clock, self.who = folder, key, clock, who
+        _owner_only(folder)
         self.settings = SiteSettings.load(folder)
         self.consents = ConsentBook.load(folder)
         self.rotation_cut_off = False
@@ -94,6 +96,7 @@ class Site:
                 self.key = SiteKey(new.key, folder / KEY_FILE)
             else:
                 self.rotation_cut_off = True
+        self._lock = _SiteLock(folder)
         self.records = SiteRecords(folder, self.key)
 
     @classmethod
@@ -103,6 +106,7 @@ class Site:
 
     def close(self) -> None:
         self.records.close()
+        self._lock.release()
 
     # -- sessions -----------------------------------------------------------------------
     def today(self) -> datetime.date:
@@ -133,6 +137,20 @@ class Site:
         origin = source.resolve() if source is not None else None
         self.records.add_output(where, person, kind, self.clock.now(), origin)
         self.audit(f"{kind} written", person, str(where))
+
+    def check_belongs(self, recording: Path, person_in_file: str) -> None:
+        """ConfigError when the index lists ``recording`` as another person's than the
+        file says it is (a recording copied over another)."""
+        entry = self.records.session_at(recording.resolve())
+        if not PSEUDONYM.fullmatch(person_in_file):  # earlier vests took any name: no one
+            person_in_file = ""
+        if entry is not None and entry.person != person_in_file:
+            listed = entry.person or "no one"
+            said = person_in_file or "no one"
+            raise ConfigError(
+                f"{recording}: holds a session of {said}, but the site's index lists this file "
+                f"as {listed}'s (a recording copied over another?); not read"
+            )
 
     def person_of(self, recording: Path) -> str:
         """The pseudonym a recording belongs to ('' for none or one not in the index)."""
@@ -194,6 +212,7 @@ class Site:
                 "put them back, or add --drop-missing to give them up (they could never be "
                 "read again)"
             )
+        self._lock.alone()  # no other vest reads or records with the old key meanwhile
         new = site_key_in_rotation(self.folder)
         done: list[Path] = []
         self.records.close()
@@ -210,7 +229,35 @@ class Site:
             self.records.forget_session(path)
             self.audit("rekey", "", f"{path}: missing, given up")
         self.audit("rekey", "", f"{len(done)} files on a new key")
+        self._lock.shared()
         return done, missing
+
+
+class _SiteLock:
+    """Every vest using a site holds its lock shared (``site.lock``, released when the
+    process ends, however it ends); rotating the key needs it alone: never while a session
+    is being recorded or a recording read with the old key."""
+
+    def __init__(self, folder: Path) -> None:
+        self.path = folder / "site.lock"
+        self._file = open(self.path, "a+b")  # noqa: SIM115 - held for the site's lifetime
+        os.chmod(self.path, 0o600)
+        fcntl.flock(self._file, fcntl.LOCK_SH)
+
+    def alone(self) -> None:
+        try:
+            fcntl.flock(self._file, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            raise ConfigError(
+                f"{self.path.parent}: another vest is using this site now (a session being "
+                "recorded, a replay or a report); run vest data rekey once it has ended"
+            ) from None
+
+    def shared(self) -> None:
+        fcntl.flock(self._file, fcntl.LOCK_SH)
+
+    def release(self) -> None:
+        self._file.close()
 
 
 def site_key_in_rotation(folder: Path) -> SiteKey:
@@ -222,6 +269,21 @@ def site_key_in_rotation(folder: Path) -> SiteKey:
         return read_key_file(path)
 
 
+def _owner_only(folder: Path) -> None:
+    """The data folder and the files a person writes in it become their owner's alone (a
+    folder made by hand with 0755, a consent.yaml saved 0644)."""
+    for path, mode in (
+        (folder, 0o700),
+        (folder / "consent.yaml", 0o600),
+        (folder / SETTINGS_FILE, 0o600),
+    ):
+        try:
+            if path.exists() and path.stat().st_mode & 0o077 and path.stat().st_uid == os.getuid():
+                path.chmod(mode)
+        except OSError:
+            continue  # another user's: reading it says what is wrong
+
+
 def _reads_with(path: Path, key: SiteKey) -> bool:
     try:
         connect_sealed(path, key, read_only=True).close()
@@ -230,10 +292,28 @@ def _reads_with(path: Path, key: SiteKey) -> bool:
     return True
 
 
+EXPORT_FILES = (
+    "README.txt",
+    "consent.json",
+    "index.json",
+    "audit.json",
+    "sessions/*.json",
+    "reports/*.html",
+)
+"""What ``vest data export`` writes into its folder (an erasure removes these, and the
+folder when nothing else is left in it)."""
+
+
 def _remove(path: Path) -> bool:
-    """Removes a file (and its SQLite journal) or a folder; False when it was not there."""
+    """Removes a file (and its SQLite journal), or what an export wrote in a folder (the
+    folder too when nothing else is in it); False when it was not there."""
     if path.is_dir() and not path.is_symlink():
-        shutil.rmtree(path)
+        for pattern in EXPORT_FILES:
+            for written in path.glob(pattern):
+                written.unlink(missing_ok=True)
+        for folder in (path / "sessions", path / "reports", path):
+            with contextlib.suppress(OSError):  # not empty: what someone else put there
+                folder.rmdir()
         return True
     journal = path.with_name(path.name + "-journal")
     journal.unlink(missing_ok=True)

@@ -106,9 +106,9 @@ def make_key_file(path: Path) -> SiteKey:
 
 
 def check_apart(recording: Path, key: SiteKey) -> None:
-    """A recording is never written into the folder that holds the key (a copy of one
-    would carry the other)."""
-    if recording.resolve().parent == key.path.resolve().parent:
+    """A recording is never written into the folder that holds the key, nor below it (a
+    copy of one would carry the other)."""
+    if recording.resolve().is_relative_to(key.path.resolve().parent):
         raise ConfigError(
-            f"{recording}: is in the site's data folder, beside its key; record elsewhere"
+            f"{recording}: is in the site's data folder, with its key; record elsewhere"
         )

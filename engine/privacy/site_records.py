@@ -50,6 +50,7 @@ CREATE TRIGGER IF NOT EXISTS audit_is_not_deleted BEFORE DELETE ON audit
 BEGIN SELECT RAISE(ABORT, 'the audit trail is append-only'); END;
 """
 FIRST_LINK = "0" * 64
+SCHEMA_VERSION = 1
 
 
 @dataclass(frozen=True)
@@ -75,6 +76,7 @@ class AuditLine:
     action: str
     person: str
     what: str
+    chain: str
     intact: bool
 
 
@@ -88,7 +90,19 @@ class SiteRecords:
         self._connection.execute("PRAGMA busy_timeout = 10000")  # another vest writing
         self._connection.execute("PRAGMA secure_delete = ON")  # an erased row is overwritten
         self._connection.executescript(SCHEMA)
+        self._upgrade()
         self._connection.commit()
+
+    def _upgrade(self) -> None:
+        """Brings a site.db of an earlier vest up to this schema (``PRAGMA user_version``)."""
+        version = self._connection.execute("PRAGMA user_version").fetchone()[0]
+        if version < 1:
+            columns = {row[1] for row in self._connection.execute("PRAGMA table_info(outputs)")}
+            if "source" not in columns:  # before reports were tied to their recording
+                self._connection.execute(
+                    "ALTER TABLE outputs ADD COLUMN source TEXT NOT NULL DEFAULT ''"
+                )
+            self._connection.execute(f"PRAGMA user_version = {SCHEMA_VERSION}")
 
     def close(self) -> None:
         self._connection.close()
@@ -148,6 +162,13 @@ class SiteRecords:
                 "INSERT OR REPLACE INTO outputs VALUES (?, ?, ?, ?, ?)",
                 (str(path), person, kind, made, str(source) if source is not None else ""),
             )
+
+    def is_output(self, path: Path) -> bool:
+        """Whether vest wrote ``path`` (a report, an export) for this site."""
+        row = self._connection.execute(
+            "SELECT 1 FROM outputs WHERE path = ?", (str(path),)
+        ).fetchone()
+        return row is not None
 
     def outputs_from(self, source: Path) -> list[Path]:
         """What was written in the clear from the recording ``source``."""
@@ -216,7 +237,7 @@ class SiteRecords:
             "SELECT seq, at, who, action, person, what, chain FROM audit ORDER BY seq"
         ).fetchall():
             intact = intact and chain == _link(previous, at, who, action, person, what)
-            lines.append(AuditLine(seq, at, who, action, person, what, intact))
+            lines.append(AuditLine(seq, at, who, action, person, what, chain, intact))
             previous = chain
         return lines
 

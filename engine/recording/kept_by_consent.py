@@ -3,12 +3,14 @@
 The robot hears and sees everything it answers; the recording keeps only what was
 consented to:
 
-- ``sensors``: the ``/sensors/`` and ``/vision/`` keys, and what the scenario did to the
-  vest (touches, squeezes...); without it none of these is kept;
+- ``sensors``: the ``/sensors/`` and ``/vision/`` keys, what the scenario did to the vest
+  (touches, squeezes...), and the nodes' feedback messages (which tell what a node saw:
+  "a pat on middle_back", "event 1: 5" fingers); without it none of these is kept;
 - ``speech_text``: ``/speech/heard``, what a dialog did not understand, what the scenario
-  said; without it the fact that someone spoke is kept, never the words: what was heard
-  is also cut out of every other text the session tells (a node's feedback, "no rule
-  matches '...'", an action's arguments that echo it), since the robot heard it first.
+  said; without it the fact that someone spoke is kept, never the words: each utterance
+  heard is also cut out of every free text the session tells (a node's feedback, "no rule
+  matches '...'", an action's arguments that echo it, a tree's ``/vars/``), as written,
+  quoted or escaped, where it stands as words of its own (never out of a name or a key).
 
 The robot's own actions (what it said and did, and how each ended), its trees' statuses,
 turns, safety decisions and presses are always kept: they are the robot's account, not the
@@ -23,12 +25,13 @@ import json
 import re
 from typing import Any
 
-from engine.blackboard.catalogue import SENSORS_PREFIX, SPEECH_HEARD
+from engine.blackboard.catalogue import SENSORS_PREFIX, SPEECH_HEARD, VARIABLES_PREFIX
 from engine.blackboard.events import EventLog
 from engine.privacy.consent import CAPTURES, Consent
 from engine.session.events import (
     Heard,
     KeyChanged,
+    NodeStatus,
     NotUnderstood,
     SessionEvent,
     WorldEvent,
@@ -36,6 +39,12 @@ from engine.session.events import (
 
 VISION_PREFIX = "/vision/"
 WORDS_NOT_KEPT = "(words not kept: no consent for speech as text)"
+FREE_TEXT = ("feedback", "args", "why", "what", "text")
+"""The fields of a session event that hold free text (never a name or a key)."""
+FREE_TEXT_OF_KEYS = ("value", "text")
+"""Of a blackboard change, the value (of a tree's own ``/vars/`` key only)."""
+_START, _END = r"(?<!\w)(?:", r")(?!\w)"
+"""An utterance is cut where it stands as words of its own, not inside another word."""
 
 
 class KeptByConsent:
@@ -86,26 +95,39 @@ class KeptByConsent:
             heard = event.text
         elif isinstance(event, WorldEvent) and event.scenario_event == "hear":
             heard = event.value.get("text") if isinstance(event.value, dict) else None
-        if not isinstance(heard, str) or len(heard.strip()) < 2 or heard in self._phrases:
+        if not isinstance(heard, str) or not heard.strip() or heard in self._phrases:
             return
         self._phrases.add(heard)
-        forms = sorted({heard, json.dumps(heard)[1:-1]}, key=len, reverse=True)  # and as JSON
-        alternatives = "|".join(re.escape(form) for form in forms)
+        forms: set[str] = set()
+        for phrase in {heard, heard.strip()}:  # as said, quoted (repr) and in JSON
+            forms |= {phrase, repr(phrase)[1:-1], json.dumps(phrase)[1:-1]}
+            forms.add(json.dumps(phrase, ensure_ascii=False)[1:-1])
+        alternatives = "|".join(re.escape(f) for f in sorted(forms - {""}, key=len, reverse=True))
         if self._heard is not None:
-            alternatives = f"{self._heard.pattern}|{alternatives}"
-        self._heard = re.compile(alternatives, re.IGNORECASE)
+            alternatives = f"{self._heard.pattern[len(_START) : -len(_END)]}|{alternatives}"
+        self._heard = re.compile(f"{_START}{alternatives}{_END}", re.IGNORECASE)
 
     def _without_words(self, event: SessionEvent) -> SessionEvent:
-        """``event`` with every phrase heard so far cut out of its texts."""
+        """``event`` with its free texts cleared of what may not be kept: every phrase
+        heard so far (without consent to speech as text), every node's feedback (without
+        consent to sensor readings)."""
+        if isinstance(event, NodeStatus) and not self._sensors and event.feedback:
+            event = dataclasses.replace(event, feedback="")
         pattern = self._heard
-        if pattern is None or not dataclasses.is_dataclass(event):
+        if pattern is None:
             return event
+        fields: tuple[str, ...]
+        if isinstance(event, KeyChanged):
+            fields = FREE_TEXT_OF_KEYS if event.key.startswith(VARIABLES_PREFIX) else ()
+        else:
+            fields = FREE_TEXT
         changes: dict[str, Any] = {}
-        for field in dataclasses.fields(event):
-            value = getattr(event, field.name)
-            cut = _cut(value, pattern)
-            if cut is not value:
-                changes[field.name] = cut
+        for name in fields:
+            if hasattr(event, name):
+                value = getattr(event, name)
+                cut = _cut(value, pattern)
+                if cut is not value:
+                    changes[name] = cut
         return dataclasses.replace(event, **changes) if changes else event
 
 

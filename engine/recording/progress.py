@@ -18,7 +18,7 @@ from pathlib import Path
 
 from engine.recording.moments import not_understood, person_moments
 from engine.recording.replay import Recording
-from engine.recording.report import STYLE
+from engine.recording.report import REPORT_HEAD, STYLE
 from engine.recording.report_plots import per_session_plot
 
 THE_PERSON = "the person"
@@ -85,7 +85,7 @@ def progress_html(person: str, sessions: list[SessionSummary], gone: list[Path])
     name = html.escape(person)
     labels = [f"{n}: {s.day}" for n, s in enumerate(sessions, 1)]
     parts = [
-        '<!doctype html>\n<html lang="en"><head><meta charset="utf-8">',
+        REPORT_HEAD,
         f"<title>Progress: {name}</title>",
         f"<style>{STYLE(encoding='utf-8')}</style></head><body>",
         f"<h1>Progress of {name}</h1>",

@@ -134,6 +134,8 @@ def _started(epoch: str | None) -> str:
     return stamp.strftime("%d %B %Y, %H:%M UTC")
 
 
+REPORT_HEAD = '<!doctype html>\n<html lang="en"><head><meta charset="utf-8">'
+"""How every report vest writes begins (a file that does may be written over)."""
 STYLE = (Path(__file__).resolve().parent / "report.css").read_text
 """The report's style sheet, read when a report is written (it goes inside the page)."""
 
@@ -219,7 +221,7 @@ def report_html(recording: Recording) -> str:
     when = html.escape(_started(meta.get("started")))
     return "\n".join(
         [
-            '<!doctype html>\n<html lang="en"><head><meta charset="utf-8">',
+            REPORT_HEAD,
             f"<title>Session report: {recorded}</title>",
             f"<style>{STYLE(encoding='utf-8')}</style></head><body>",
             "<h1>Session report</h1>",

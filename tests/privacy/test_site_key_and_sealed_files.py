@@ -81,6 +81,6 @@ def test_another_site_s_key_a_plain_file_or_a_changed_byte_is_named(tmp_path: Pa
 
 def test_a_recording_is_never_kept_beside_the_key(tmp_path: Path) -> None:
     key = site_key(tmp_path / "clinic", create=True)
-    with pytest.raises(ConfigError, match="beside its key; record elsewhere"):
+    with pytest.raises(ConfigError, match="with its key; record elsewhere"):
         check_apart(tmp_path / "clinic" / "s.vest", key)
     check_apart(tmp_path / "s.vest", key)
