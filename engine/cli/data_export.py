@@ -44,6 +44,13 @@ def export(site: Site, args: argparse.Namespace) -> int:
         raise ConfigError(f"-o {folder}: is there already; name a new folder")
     if not sessions and site.consents.records.get(person) is None:
         raise ConfigError(f"the site holds nothing about {person} ({site.folder})")
+    for entry in sessions:  # every file is the person's, before anything is written
+        if entry.path.is_file():
+            recording = Recording.open(entry.path, site.key)
+            try:
+                site.check_belongs(entry.path, recording.meta.get("person", ""))
+            finally:
+                recording.close()
     try:
         (folder / "sessions").mkdir(mode=0o700, parents=True, exist_ok=True)
         (folder / "reports").mkdir(mode=0o700, exist_ok=True)
@@ -60,7 +67,6 @@ def export(site: Site, args: argparse.Namespace) -> int:
         stem = f"{number:03d}-{entry.path.stem}"
         recording = Recording.open(entry.path, site.key)
         try:
-            site.check_belongs(entry.path, recording.meta.get("person", ""))
             data: dict[str, Any] = {"file": str(entry.path)}
             data |= {name: recording.table(name) for name in (*TABLES, "events")}
             _write(folder / "sessions" / f"{stem}.json", data)

@@ -122,8 +122,9 @@ class KeptByConsent:
         else:
             fields = FREE_TEXT
         changes: dict[str, Any] = {}
+        present = {field.name for field in dataclasses.fields(event)}  # not a property
         for name in fields:
-            if hasattr(event, name):
+            if name in present:
                 value = getattr(event, name)
                 cut = _cut(value, pattern)
                 if cut is not value:

@@ -119,9 +119,14 @@ def test_a_recording_copied_over_another_person_s_is_not_read_as_theirs(
     mine = record(tmp_path, "y.vest", "kid-y")
     shutil.copy(theirs, mine)
     capsys.readouterr()
-    for command in (["replay", str(mine)], ["data", "export", "--person", "kid-y"]):
+    exported = tmp_path / "kid-y-export"
+    for command in (
+        ["replay", str(mine)],
+        ["data", "export", "--person", "kid-y", "-o", str(exported)],
+    ):
         assert main(command) == 1
         assert "holds a session of kid-x, but the site's index lists" in capsys.readouterr().err
+    assert not exported.exists()
 
 
 def test_a_site_db_of_an_earlier_vest_is_brought_up_to_date(
@@ -202,3 +207,17 @@ def test_consent_yaml_takes_pseudonyms_and_roles_never_names(
         0o700,
         0o600,
     )
+
+
+def test_without_consent_every_event_of_a_busy_session_is_still_recorded(
+    here: None, tmp_path: Path, caplog: pytest.LogCaptureFixture, the_site_key: SiteKey
+) -> None:
+    """Turns (a tree waiting for the speaker, yielding it) after words were heard: the
+    recording loses none of them when words are cut out of it (a reader that fails is
+    logged, and its events lost)."""
+    path = record(tmp_path, "busy.vest", "kid-7")
+    assert "failed on" not in caplog.text
+    db = connect_sealed(path, the_site_key, read_only=True)
+    turns = db.execute("SELECT count(*) FROM events WHERE kind = 'turn'").fetchone()[0]
+    db.close()
+    assert turns > 0
