@@ -48,6 +48,8 @@ COMMANDS: tuple[tuple[str, str], ...] = (
     ("gesture", "count fingers in pictures; record, generate, train and check a hand model"),
     ("replay", "show a recorded session at a moment (trees' statuses, the blackboard)"),
     ("report", "write a recorded session as a report for the therapist (HTML)"),
+    ("export", "write a tree as BehaviorTree.CPP v4 XML (Groot2)"),
+    ("import", "turn a BehaviorTree.CPP v4 XML tree into our YAML"),
     ("data", "the site's data: sessions by person, consent, export, erase, purge, audit, key"),
 )
 """Each command and what it does, in the order ``vest --help`` lists them; the command's

@@ -12,9 +12,10 @@ from pathlib import Path
 
 from engine.cli.output import write_file
 from engine.dialogs.library import DialogLibrary, find_dialogs_folder
+from engine.loader.tree_definition import TreeDefinition
 from engine.loader.tree_drawing import ascii_tree, dot_source
 from engine.loader.tree_file import TreeLoader
-from engine.nodes.registry import default_registry
+from engine.nodes.registry import NodeRegistry, default_registry
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -34,18 +35,24 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
 
 
-def main(args: argparse.Namespace) -> int:
+def load_tree(tree: Path, profile_name: str | None) -> tuple[TreeDefinition, NodeRegistry]:
+    """The tree file ``tree`` checked as ``vest run`` checks it (its dialogs, the profile
+    by name or path), and the registry of node types it was checked against."""
     from engine.cli.run_inputs import resolve_profile
     from engine.loader.substitution import load_profile
 
     registry = default_registry()
     catalogue = registry.catalogue()
-    folder = find_dialogs_folder(args.tree)
+    folder = find_dialogs_folder(tree)
     dialogs = DialogLibrary.from_folder(folder, catalogue) if folder else None
-    profile_path = resolve_profile(args.profile, [args.tree])  # by name or path, as vest run
+    profile_path = resolve_profile(profile_name, [tree])  # by name or path, as vest run
     profile = load_profile(profile_path) if profile_path else None
     loader = TreeLoader(registry, catalogue, dialogs=dialogs, profile=profile)
-    definition = loader.load(args.tree)
+    return loader.load(tree), registry
+
+
+def main(args: argparse.Namespace) -> int:
+    definition, _ = load_tree(args.tree, args.profile)
     if args.format in ("ascii", "dot"):
         text = ascii_tree(definition) if args.format == "ascii" else dot_source(definition)
         if args.output:

@@ -1,0 +1,53 @@
+"""Turn a BehaviorTree.CPP v4 XML tree into our YAML, when it uses what vest has (docs/
+interop.md): BehaviorTree.CPP's nodes that mean what ours mean, our own node types, and
+SubTrees (written in place). What has no counterpart is named with its line and column;
+the YAML is checked as vest validate checks it before it is written.
+
+  vest import hug.xml -o trees/hug.yaml
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import tempfile
+from pathlib import Path
+
+from engine.cli.output import write_file
+from engine.cli.render_command import load_tree
+from engine.errors import ConfigError
+from engine.files.yaml_source import read_text
+from engine.interop.btcpp_import import tree_yaml
+from engine.nodes.registry import default_registry
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("xml", type=Path, metavar="FILE.xml")
+    parser.add_argument(
+        "-o",
+        "--output",
+        type=Path,
+        default=None,
+        metavar="TREE.yaml",
+        help="file to write, never over one that is there (default: standard output)",
+    )
+
+
+def main(args: argparse.Namespace) -> int:
+    if args.output is not None and (args.output.exists() or args.output.is_symlink()):
+        raise ConfigError(f"-o {args.output}: is there already; name a new file")
+    text = read_text(args.xml, str(args.xml))
+    yaml_text = tree_yaml(text, str(args.xml), default_registry())
+    check_folder = args.output.parent if args.output is not None else Path(".")
+    with tempfile.TemporaryDirectory(
+        dir=check_folder if check_folder.is_dir() else None
+    ) as scratch:
+        checked = Path(scratch) / (args.xml.stem + ".yaml")
+        checked.write_text(yaml_text, encoding="utf-8")
+        load_tree(checked, None)  # the same checks as vest validate, beside its dialogs
+    if args.output is None:
+        sys.stdout.write(yaml_text)
+        return 0
+    write_file(args.output, yaml_text.encode("utf-8"), f"-o {args.output}", "the tree")
+    print(f"{args.output}: from {args.xml}")
+    return 0

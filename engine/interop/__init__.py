@@ -1,0 +1,1 @@
+"""Other tools' formats: BehaviorTree.CPP's XML (Groot2), its FileLogger2 logs, MCAP."""
