@@ -171,6 +171,7 @@ EXTRAS = {
         "starlette",
         "uvicorn",
         "sqlcipher3",
+        "mcap",
     ),
     "cloud": (
         "sqlalchemy",

@@ -17,7 +17,7 @@ from engine.cli.output import tell
 from engine.cli.site_access import open_recording
 from engine.cli.view_options import add_view_arguments, start_view
 from engine.clock import RealClock
-from engine.errors import UsageError
+from engine.errors import ConfigError, UsageError
 from engine.recording.replay import Recording, moment
 from engine.view.replay_source import ReplaySource
 
@@ -37,6 +37,15 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--at", type=_seconds, default=None, metavar="SECONDS", help="the moment to show"
     )
+    parser.add_argument(
+        "--to",
+        choices=("mcap", "btlog"),
+        default=None,
+        help="write the session for another tool: mcap (Foxglove, Lichtblick) or btlog "
+        "(BehaviorTree.CPP's FileLogger2, which Groot2 replays; one tree: --tree)",
+    )
+    parser.add_argument("-o", "--output", type=Path, default=None, metavar="FILE")
+    parser.add_argument("--tree", default=None, metavar="NAME", help="the tree, for --to btlog")
     add_view_arguments(parser)
 
 
@@ -59,6 +68,8 @@ def main(args: argparse.Namespace) -> int:
         site.close()
     try:
         duration = recording.duration_s
+        if args.to is not None:
+            return _converted(recording, args)
         if args.view:
             return _serve(recording, args)
         if args.at is None:
@@ -80,6 +91,34 @@ def main(args: argparse.Namespace) -> int:
         return _whole(recording)
     finally:
         recording.close()
+
+
+def _converted(recording: Recording, args: argparse.Namespace) -> int:
+    from engine.interop.session_formats import write_session
+    from engine.nodes.registry import default_registry
+
+    suffix = ".mcap" if args.to == "mcap" else ".btlog"
+    output: Path = args.output or args.recording.with_suffix(suffix)
+    if output.suffix != suffix:
+        raise UsageError(f"-o {output}: a {args.to} file ends in {suffix}")
+    if output.exists() or output.is_symlink():
+        raise ConfigError(f"-o {output}: is there already; name a new file")
+    tree = args.tree
+    names = list(dict.fromkeys(t.name for t in recording.trees))
+    if args.to == "btlog":
+        if tree is None and len(names) != 1:
+            raise UsageError(f"--to btlog holds one tree: add --tree, one of {', '.join(names)}")
+        tree = tree or names[0]
+        if tree not in names:
+            raise UsageError(f"--tree {tree}: not in this session; one of {', '.join(names)}")
+    try:
+        tags = {"composite": "Control"}
+        kinds = {t.name: tags.get(t.kind, t.kind.title()) for t in default_registry()}
+        tell(write_session(recording, args.to, output, tree, kinds))
+    except OSError as error:
+        output.unlink(missing_ok=True)
+        raise ConfigError(f"-o {output}: cannot write it ({error.strerror or error})") from None
+    return _whole(recording)
 
 
 def _whole(recording: Recording) -> int:
