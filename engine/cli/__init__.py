@@ -173,6 +173,7 @@ EXTRAS = {
         "sqlcipher3",
         "mcap",
     ),
+    "foxglove": ("foxglove",),
     "cloud": (
         "sqlalchemy",
         "alembic",

@@ -24,6 +24,7 @@ import argparse
 import math
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
 from urllib.parse import urlsplit
 
 from engine.cli.output import shown, tell
@@ -55,6 +56,9 @@ from engine.services.interfaces import Speech
 from engine.services.simulated import simulated_services
 from engine.session.sentences import TOLD_KINDS
 from engine.view.server import ViewServer
+
+if TYPE_CHECKING:
+    from engine.interop.foxglove_live import FoxgloveLive
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -148,6 +152,16 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "them (vest data list)",
     )
     parser.add_argument(
+        "--foxglove",
+        type=_port,
+        nargs="?",
+        const=8765,
+        default=None,
+        metavar="PORT",
+        help="serve the live session to Foxglove or Lichtblick on 127.0.0.1:PORT (default "
+        "8765; 0: any free port); needs pip install 'vest-engine[foxglove]'",
+    )
+    parser.add_argument(
         "--hardware",
         type=Path,
         default=DEFAULT_HARDWARE,
@@ -159,6 +173,16 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def _profile_name(behaviors: Behaviors) -> str:
     profile = behaviors.loader.profile
     return "" if profile is None else str(profile.path or profile.name)
+
+
+def _tell_foxglove(live: FoxgloveLive) -> None:
+    tell(f"foxglove: {live.url} (in Foxglove: Open connection, Foxglove WebSocket)")
+
+
+def _port(text: str) -> int:
+    if not text.isdigit() or int(text) > 65535:
+        raise argparse.ArgumentTypeError(f"a port 0..65535, got {text!r}")
+    return int(text)
 
 
 def _positive_seconds(text: str) -> float:
@@ -306,6 +330,8 @@ def _run_for_site(
                 "started": f"{EpochClock().now():.3f}",
             },
             reload=not args.fast,
+            foxglove_port=args.foxglove,
+            on_foxglove_up=_tell_foxglove,
         )
     )
     assembled = running.assembled

@@ -18,6 +18,7 @@ import logging
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from engine.buttons.button_file import ButtonBoard
 from engine.buttons.wizard import Wizard
@@ -40,6 +41,9 @@ from engine.session.events import WorldEvent
 from engine.session.stream import SessionStream
 from engine.view.hub import ViewHub
 from engine.view.server import LiveSource, ViewServer
+
+if TYPE_CHECKING:
+    from engine.interop.foxglove_live import FoxgloveLive
 
 log = logging.getLogger(__name__)
 
@@ -85,6 +89,10 @@ class SessionPlan:
     """What the person (``consent.person``; '' for none) agreed may be kept and sent: what
     is recorded, and whether sensor readings go to the cloud as telemetry."""
     reload: bool = False
+    foxglove_port: int | None = None
+    """Serve the session to Foxglove and Lichtblick on this loopback port (0: any free one)."""
+    on_foxglove_up: Callable[[FoxgloveLive], None] | None = None
+    """Told once Foxglove's server listens (to say its address)."""
 
 
 @dataclass
@@ -96,6 +104,8 @@ class RunningSession:
     wizard: Wizard | None = None
     view: ViewServer | None = None
     recorder: SessionRecorder | None = None
+    foxglove: FoxgloveLive | None = None
+    """Foxglove's live server, when asked for (its URL for the terminal)."""
 
     def run(self, until_s: float) -> None:
         """Start every part in order, then tick the trees until ``until_s`` (clock
@@ -186,6 +196,21 @@ def _around(assembled: AssembledRobot, plan: SessionPlan) -> RunningSession:
             record.path, consent.person, plan.facts.get("profile", ""), tuple(consent.covers)
         )
         session.subscribe(recorder)
+    if plan.foxglove_port is not None:
+        from engine.interop.foxglove_live import FoxgloveLive  # the foxglove extra
+
+        started = float(plan.facts.get("started", "0") or 0)  # seconds since the epoch
+        live = FoxgloveLive("127.0.0.1", plan.foxglove_port, plan.clock, started - start_s)
+        running.foxglove = live
+        on_up = plan.on_foxglove_up
+
+        def start_live() -> None:
+            live.start()
+            if on_up is not None:
+                on_up(live)
+
+        lifecycle.add("foxglove", start=start_live, stop=live.stop)
+        session.subscribe(live)
     player = ScenarioPlayer(
         plan.scenario, assembled.world, start_s=start_s, on_event=_world_events(session)
     )

@@ -1,0 +1,157 @@
+"""The live session for Foxglove and Lichtblick (``vest run --foxglove [PORT]``), through
+Foxglove's own SDK (``foxglove-sdk``, MIT): its WebSocket server, on loopback only (it has
+no token of its own: from another machine, an SSH tunnel), the same topics and JSON
+schemas as ``vest replay --to mcap`` (:mod:`engine.interop.session_formats`), so a layout
+made on a recording works live and the other way round.
+
+A session reader: the scheduler's thread only puts each event on a bounded queue (never
+waits: a full queue drops and counts, as the recorder does); a thread beside it hands the
+events to the SDK, which sends them to the connected clients.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import logging
+import queue
+import threading
+from typing import Any
+
+import foxglove
+
+from engine.clock import Clock
+from engine.errors import ConfigError
+from engine.interop.session_formats import SCHEMAS
+from engine.recording.recorder import KEPT_AS_EVENTS
+from engine.services.telemetry import json_safe
+from engine.session.events import (
+    ActionEnded,
+    ActionStarted,
+    KeyChanged,
+    NodeStatus,
+    SessionEvent,
+    TreeStarted,
+    WorldEvent,
+)
+from engine.web.guard import is_loopback
+
+log = logging.getLogger(__name__)
+CAPACITY = 50_000
+"""Events the queue holds before it drops (seconds of the busiest session)."""
+
+
+def live_message(
+    event: SessionEvent, paths: dict[tuple[str, int, int], tuple[str, str]]
+) -> tuple[str, str, dict[str, Any]] | None:
+    """(topic, schema, message) of a session event, as the MCAP export writes it; None for
+    what it does not carry."""
+    if isinstance(event, NodeStatus):
+        path, kind = paths.get((event.tree, event.version, event.node), ("", ""))
+        message = {
+            "tree": event.tree,
+            "version": event.version,
+            "tick": event.tick,
+            "node": event.node,
+            "path": path,
+            "type": kind,
+            "status": event.status,
+            "feedback": event.feedback,
+        }
+        return f"/vest/trees/{event.tree}/status", "vest.NodeStatus", message
+    if isinstance(event, KeyChanged):
+        message = {"key": event.key, "value": json_safe(event.value), "event": event.event}
+        return "/vest/blackboard", "vest.KeyChange", message
+    if isinstance(event, ActionStarted):
+        message = {"tree": event.tree, "action": event.action, "args": json_safe(event.args)}
+        return "/vest/actions", "vest.Action", message | {"outcome": None, "why": None}
+    if isinstance(event, ActionEnded):
+        message = {"tree": event.tree, "action": event.action, "args": json_safe(event.args)}
+        ended = {"outcome": event.outcome, "why": event.why or None}
+        return "/vest/actions/outcome", "vest.Action", message | ended
+    if isinstance(event, WorldEvent):
+        message = {"kind": event.scenario_event, "description": event.description}
+        return "/vest/world", "vest.WorldEvent", message
+    if event.kind in KEPT_AS_EVENTS:
+        data = {k: json_safe(v) for k, v in vars_of(event).items() if k not in ("t_s", "tree")}
+        message = {"kind": event.kind, "tree": str(getattr(event, "tree", "")), "data": data}
+        return "/vest/events", "vest.SessionEvent", message
+    return None
+
+
+def vars_of(event: SessionEvent) -> dict[str, Any]:
+    return {field.name: getattr(event, field.name) for field in dataclasses.fields(event)}
+
+
+class FoxgloveLive:
+    """Serves the session on ``host:port`` (loopback; port 0: any free one) to Foxglove
+    and Lichtblick; times are the clock's (``epoch_offset_s`` turns them into seconds since
+    the epoch)."""
+
+    def __init__(self, host: str, port: int, clock: Clock, epoch_offset_s: float) -> None:
+        if not is_loopback(host):
+            raise ConfigError(
+                f"--foxglove on {host}: Foxglove's server has no token, so vest serves it on "
+                "this machine only (127.0.0.1); from another, use an SSH tunnel "
+                "(ssh -L 8765:127.0.0.1:8765 robot)"
+            )
+        self.host, self.port, self.clock = host, port, clock
+        self.epoch_offset_s = epoch_offset_s
+        self.dropped = 0
+        self._context = foxglove.Context()  # this session's channels alone, no global one
+        self._server: Any = None
+        self._channels: dict[str, foxglove.Channel] = {}
+        self._paths: dict[tuple[str, int, int], tuple[str, str]] = {}
+        self._queue: queue.Queue[SessionEvent | None] = queue.Queue(maxsize=CAPACITY)
+        self._thread = threading.Thread(target=self._send, name="foxglove", daemon=True)
+
+    def start(self) -> None:
+        """Listens (ConfigError when the port is taken) and starts handing events over."""
+        try:
+            self._server = foxglove.start_server(
+                name="vest", host=self.host, port=self.port, context=self._context
+            )
+        except RuntimeError as error:
+            raise ConfigError(f"--foxglove {self.port}: cannot listen there ({error})") from None
+        self.port = int(self._server.port)
+        self._thread.start()
+
+    @property
+    def url(self) -> str:
+        return f"ws://{self.host}:{self.port}"
+
+    def on_event(self, event: SessionEvent) -> None:
+        """The scheduler's thread: queued, never waited for."""
+        try:
+            self._queue.put_nowait(event)
+        except queue.Full:
+            self.dropped += 1
+
+    def stop(self) -> None:
+        if self._thread.is_alive():
+            self._queue.put(None)
+            self._thread.join()
+        if self._server is not None:
+            self._server.stop()
+            self._server = None
+        if self.dropped:
+            log.warning("foxglove: %d events were dropped (no client kept up)", self.dropped)
+
+    def _send(self) -> None:
+        while (event := self._queue.get()) is not None:
+            if isinstance(event, TreeStarted):
+                for node in event.nodes:
+                    self._paths[(event.tree, event.version, node.index)] = (node.path, node.type)
+                continue
+            found = live_message(event, self._paths)
+            if found is None:
+                continue
+            topic, schema, message = found
+            channel = self._channels.get(topic)
+            if channel is None:
+                channel = foxglove.Channel(topic, schema=SCHEMAS[schema], context=self._context)
+                self._channels[topic] = channel
+            at_ns = round((event.t_s + self.epoch_offset_s) * 1e9)
+            try:
+                channel.log(message, log_time=at_ns)
+            except Exception as error:  # a value the SDK cannot carry: the rest goes on
+                log.warning("foxglove: %s not sent (%s)", topic, error)
