@@ -1,9 +1,10 @@
 """What watching and recording cost the robot: tick lateness and tick time with the live
-view (a page connected and reading every change) and with a recording, against the same
-run with neither, in one run.
+view (a page connected and reading every change), with Foxglove's live server (a client
+subscribed to every topic, reading every message) and with a recording, against the same
+run with none of them, in one run.
 
 Run: ``.venv/bin/python bench/bench_view.py`` (``--seconds S``, ``--rounds N``); about
-2 minutes with the defaults (3 ways x 2 rounds x 20 s).
+3 minutes with the defaults (4 ways x 2 rounds x 20 s).
 
 Each run is ``vest run --speech text`` on the demo scenario in real time (every tree of
 trees/, the simulated vest with its poller threads), ``--duration S``; the ways are
@@ -46,6 +47,31 @@ def read_changes(address: str, counted: list[int], stop: threading.Event) -> Non
                 counted[0] += 1
 
 
+def read_foxglove(address: str, counted: list[int], stop: threading.Event) -> None:
+    """Foxglove: subscribes to every channel as it is advertised and reads every message."""
+    from websockets.sync.client import connect
+
+    with connect(address, subprotocols=["foxglove.sdk.v1"], open_timeout=10) as client:
+        subscribed: set[int] = set()
+        while not stop.is_set():
+            try:
+                frame = client.recv(timeout=1)
+            except TimeoutError:
+                continue
+            except Exception:  # the run ended and closed the server
+                return
+            if isinstance(frame, bytes):
+                json.loads(frame[13:])  # opcode, subscription, time, then the message
+                counted[0] += 1
+                continue
+            message = json.loads(frame)
+            if message.get("op") == "advertise":
+                new = [c["id"] for c in message["channels"] if c["id"] not in subscribed]
+                subscribed.update(new)
+                wanted = [{"id": channel, "channelId": channel} for channel in new]
+                client.send(json.dumps({"op": "subscribe", "subscriptions": wanted}))
+
+
 def run(way: str, seconds: float, folder: Path) -> dict[str, float]:
     """One run of ``way``; a recording goes to a new file in ``folder`` (vest never
     replaces an earlier session)."""
@@ -54,6 +80,8 @@ def run(way: str, seconds: float, folder: Path) -> dict[str, float]:
         args += ["--record", str(folder / f"bench-{len(list(folder.iterdir()))}.vest")]
     if way == "view":
         args += ["--view", "--view-port", "0"]
+    if way == "foxglove":
+        args += ["--foxglove", "0"]
     site = {"VEST_DATA": str(folder.parent / "site")}  # a site of its own: its key, its index
     process = subprocess.Popen(
         args,
@@ -65,14 +93,15 @@ def run(way: str, seconds: float, folder: Path) -> dict[str, float]:
     )
     counted, stop = [0], threading.Event()
     reader: threading.Thread | None = None
-    if way == "view":
+    if way in ("view", "foxglove"):
         assert process.stderr is not None
+        prefix, target = (
+            ("view: ", read_changes) if way == "view" else ("foxglove: ", read_foxglove)
+        )
         for line in process.stderr:
-            if line.startswith("view: "):
-                address = line.removeprefix("view: ").strip()
-                reader = threading.Thread(
-                    target=read_changes, args=(address, counted, stop), daemon=True
-                )
+            if line.startswith(prefix):
+                address = line.removeprefix(prefix).split()[0]
+                reader = threading.Thread(target=target, args=(address, counted, stop), daemon=True)
                 reader.start()
                 break
     out, err = process.communicate(timeout=seconds + 120)
@@ -97,7 +126,7 @@ def main() -> None:
     args = parser.parse_args()
     if args.quick:
         args.seconds, args.rounds = 3.0, 1
-    ways = ("plain", "record", "view")
+    ways = ("plain", "record", "view", "foxglove")
     results: dict[str, list[dict[str, float]]] = {way: [] for way in ways}
     with tempfile.TemporaryDirectory() as scratch:
         folder = Path(scratch) / "recordings"
