@@ -9,6 +9,7 @@ the YAML is checked as vest validate checks it before it is written.
 from __future__ import annotations
 
 import argparse
+import re
 import sys
 import tempfile
 from pathlib import Path
@@ -16,6 +17,7 @@ from pathlib import Path
 from engine.cli.output import write_file
 from engine.cli.render_command import load_tree
 from engine.errors import ConfigError
+from engine.files.problems import LoadError
 from engine.files.yaml_source import read_text
 from engine.interop.btcpp_import import tree_yaml
 from engine.nodes.registry import default_registry
@@ -38,13 +40,15 @@ def main(args: argparse.Namespace) -> int:
         raise ConfigError(f"-o {args.output}: is there already; name a new file")
     text = read_text(args.xml, str(args.xml))
     yaml_text = tree_yaml(text, str(args.xml), default_registry())
-    check_folder = args.output.parent if args.output is not None else Path(".")
-    with tempfile.TemporaryDirectory(
-        dir=check_folder if check_folder.is_dir() else None
-    ) as scratch:
-        checked = Path(scratch) / (args.xml.stem + ".yaml")
+    near = args.output if args.output is not None else Path("tree.yaml")  # its dialogs
+    with tempfile.TemporaryDirectory() as scratch:
+        checked = Path(scratch) / "imported.yaml"
         checked.write_text(yaml_text, encoding="utf-8")
-        load_tree(checked, None)  # the same checks as vest validate, beside its dialogs
+        try:
+            load_tree(checked, None, near=near)  # the same checks as vest validate
+        except LoadError as error:  # the YAML is not written
+            shown = re.sub(r"\S*imported\.yaml", f"({args.xml} as YAML)", str(error))
+            raise ConfigError(f"the tree imported does not pass vest validate:\n{shown}") from None
     if args.output is None:
         sys.stdout.write(yaml_text)
         return 0

@@ -35,15 +35,18 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
 
 
-def load_tree(tree: Path, profile_name: str | None) -> tuple[TreeDefinition, NodeRegistry]:
-    """The tree file ``tree`` checked as ``vest run`` checks it (its dialogs, the profile
-    by name or path), and the registry of node types it was checked against."""
+def load_tree(
+    tree: Path, profile_name: str | None, *, near: Path | None = None
+) -> tuple[TreeDefinition, NodeRegistry]:
+    """The tree file ``tree`` checked as ``vest run`` checks it (the dialogs beside it, or
+    beside ``near``; the profile by name or path), and the registry of node types it was
+    checked against."""
     from engine.cli.run_inputs import resolve_profile
     from engine.loader.substitution import load_profile
 
     registry = default_registry()
     catalogue = registry.catalogue()
-    folder = find_dialogs_folder(tree)
+    folder = find_dialogs_folder(near or tree)
     dialogs = DialogLibrary.from_folder(folder, catalogue) if folder else None
     profile_path = resolve_profile(profile_name, [tree])  # by name or path, as vest run
     profile = load_profile(profile_path) if profile_path else None

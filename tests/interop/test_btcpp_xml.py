@@ -144,3 +144,18 @@ def test_a_bt_cpp_tree_using_what_vest_has_becomes_yaml_with_where_it_came_from(
     assert "# imported by vest from" in text and "# SubTree wave (line 4)" in text
     assert "rate_hz: 10.0   # BehaviorTree.CPP trees have no rate of their own" in text
     assert "- Timeout:\n        seconds: 1.5\n        child:\n          Say: {text: Hello!" in text
+
+
+def test_an_imported_tree_that_vest_validate_refuses_is_not_written(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    theirs = tmp_path / "t.xml"
+    theirs.write_text(
+        '<root BTCPP_format="4">\n  <BehaviorTree ID="t"><Check key="/nope/x" above="1"/>'
+        "</BehaviorTree>\n</root>\n"
+    )
+    out = tmp_path / "t.yaml"
+    assert main(["import", str(theirs), "-o", str(out)]) == 1
+    err = capsys.readouterr().err
+    assert "does not pass vest validate" in err and "unknown blackboard key '/nope/x'" in err
+    assert f"({theirs} as YAML):" in err and not out.exists()
