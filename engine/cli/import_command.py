@@ -14,7 +14,7 @@ import sys
 import tempfile
 from pathlib import Path
 
-from engine.cli.output import write_file
+from engine.cli.output import tell, write_file
 from engine.cli.render_command import load_tree
 from engine.errors import ConfigError
 from engine.files.problems import LoadError
@@ -39,7 +39,9 @@ def main(args: argparse.Namespace) -> int:
     if args.output is not None and (args.output.exists() or args.output.is_symlink()):
         raise ConfigError(f"-o {args.output}: is there already; name a new file")
     text = read_text(args.xml, str(args.xml))
-    yaml_text = tree_yaml(text, str(args.xml), default_registry())
+    yaml_text, notes = tree_yaml(text, str(args.xml), default_registry())
+    for note in notes:
+        tell(f"warning: {note}")
     near = args.output if args.output is not None else Path("tree.yaml")  # its dialogs
     with tempfile.TemporaryDirectory() as scratch:
         checked = Path(scratch) / "imported.yaml"

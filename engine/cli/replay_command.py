@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import os
 from pathlib import Path
 
 from engine.buttons.button_file import BUTTONS_TREE
@@ -18,6 +19,7 @@ from engine.cli.site_access import open_recording
 from engine.cli.view_options import add_view_arguments, start_view
 from engine.clock import RealClock
 from engine.errors import ConfigError, UsageError
+from engine.privacy.site import Site
 from engine.recording.replay import Recording, moment
 from engine.view.replay_source import ReplaySource
 
@@ -64,12 +66,16 @@ def _serve(recording: Recording, args: argparse.Namespace) -> int:
 
 def main(args: argparse.Namespace) -> int:
     recording, site = open_recording(args.recording, "replay")
-    if site is not None:
-        site.close()
+    try:
+        if args.to is not None:
+            return _converted(recording, site, args)
+    finally:
+        if site is not None:
+            site.close()
+        if args.to is not None:
+            recording.close()
     try:
         duration = recording.duration_s
-        if args.to is not None:
-            return _converted(recording, args)
         if args.view:
             return _serve(recording, args)
         if args.at is None:
@@ -93,7 +99,9 @@ def main(args: argparse.Namespace) -> int:
         recording.close()
 
 
-def _converted(recording: Recording, args: argparse.Namespace) -> int:
+def _converted(recording: Recording, site: Site | None, args: argparse.Namespace) -> int:
+    """The session written for another tool: a copy in the clear, its owner's alone, listed
+    with the site (purged and erased with its recording)."""
     from engine.interop.session_formats import write_session
     from engine.nodes.registry import default_registry
 
@@ -101,8 +109,6 @@ def _converted(recording: Recording, args: argparse.Namespace) -> int:
     output: Path = args.output or args.recording.with_suffix(suffix)
     if output.suffix != suffix:
         raise UsageError(f"-o {output}: a {args.to} file ends in {suffix}")
-    if output.exists() or output.is_symlink():
-        raise ConfigError(f"-o {output}: is there already; name a new file")
     tree = args.tree
     names = list(dict.fromkeys(t.name for t in recording.trees))
     if args.to == "btlog":
@@ -111,13 +117,24 @@ def _converted(recording: Recording, args: argparse.Namespace) -> int:
         tree = tree or names[0]
         if tree not in names:
             raise UsageError(f"--tree {tree}: not in this session; one of {', '.join(names)}")
+    tags = {"composite": "Control"}
+    kinds = {t.name: tags.get(t.kind, t.kind.title()) for t in default_registry()}
     try:
-        tags = {"composite": "Control"}
-        kinds = {t.name: tags.get(t.kind, t.kind.title()) for t in default_registry()}
-        tell(write_session(recording, args.to, output, tree, kinds))
+        descriptor = os.open(output, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
+    except FileExistsError:
+        raise ConfigError(f"-o {output}: is there already; name a new file") from None
     except OSError as error:
-        output.unlink(missing_ok=True)
         raise ConfigError(f"-o {output}: cannot write it ({error.strerror or error})") from None
+    try:
+        with os.fdopen(descriptor, "wb") as out:
+            said = write_session(recording, args.to, out, tree, kinds)
+    except OSError as error:
+        output.unlink(missing_ok=True)  # ours: made a moment ago
+        raise ConfigError(f"-o {output}: cannot write it ({error.strerror or error})") from None
+    if site is not None:
+        person = site.person_of(args.recording)
+        site.output_written(output, person, args.to, source=args.recording)
+    tell(f"{output}: {said}")
     return _whole(recording)
 
 

@@ -155,11 +155,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--foxglove",
         type=_port,
         nargs="?",
-        const=8765,
+        const=8766,
         default=None,
         metavar="PORT",
-        help="serve the live session to Foxglove or Lichtblick on 127.0.0.1:PORT (default "
-        "8765; 0: any free port); needs pip install 'vest-engine[foxglove]'",
+        help="serve the live session to Foxglove (its WebSocket, protocol foxglove.sdk.v1) on "
+        "127.0.0.1:PORT (default 8766, beside the view's 8765; 0: any free port); needs "
+        "pip install 'vest-engine[foxglove]'",
     )
     parser.add_argument(
         "--hardware",

@@ -11,6 +11,8 @@ synchronise: false) is written as our own node type, declared with its ports in 
 ``TreeNodesModel`` (all of our leaves, so Groot2's palette has them). A subtree is a
 ``SubTree``; its parameters are already filled in (BehaviorTree.CPP has none), so each
 differently filled use is a BehaviorTree of its own (``finger_round``, ``finger_round_2``).
+The tree's rate, priority and turn settings are the main BehaviorTree's ``_vest_settings``
+attribute (JSON), which BehaviorTree.CPP ignores and ``vest import`` reads.
 
 A port's value is its text: numbers as written (``3.0``), true/false, and lists as
 ``json:[...]`` (BehaviorTree.CPP v4's prefix for JSON). Defaults are left out.
@@ -30,6 +32,8 @@ from engine.nodes.spec import NodeType
 from engine.values.templates import CompiledTemplate
 
 BTCPP_FORMAT = "4"
+SETTINGS_ATTRIBUTE = "_vest_settings"
+"""The main BehaviorTree's attribute holding the tree's rate, priority and turns (JSON)."""
 _MODEL_TAGS = {"action": "Action", "condition": "Condition", "decorator": "Decorator"}
 _MODEL_TAGS["composite"] = "Control"
 
@@ -159,16 +163,17 @@ def btcpp_xml(definition: TreeDefinition, registry: NodeRegistry) -> str:
         "when_interrupted": definition.when_interrupted,
         "description": definition.description.strip(),
     }
-    text = json.dumps(settings, ensure_ascii=False).replace("--", "-\\u002d")  # XML comment
-    comment = f"    <!-- vest settings: {text} -->\n"
-    writer.trees[definition.name] = comment + writer.element(definition.root, 2, top=True)
+    writer.trees[definition.name] = writer.element(definition.root, 2, top=True)
     parts = [
         '<?xml version="1.0" encoding="UTF-8"?>\n',
         f'<root BTCPP_format="{BTCPP_FORMAT}" main_tree_to_execute={quoteattr(definition.name)}>\n',
         f"  <!-- {_comment(definition)} -->\n",
     ]
     for tree_id, body in writer.trees.items():
-        parts.append(f"  <BehaviorTree ID={quoteattr(tree_id)}>\n{body}  </BehaviorTree>\n")
+        kept = ""  # BehaviorTree.CPP ignores an attribute of a BehaviorTree it does not know
+        if tree_id == definition.name:
+            kept = f" {SETTINGS_ATTRIBUTE}={quoteattr(json.dumps(settings, ensure_ascii=False))}"
+        parts.append(f"  <BehaviorTree ID={quoteattr(tree_id)}{kept}>\n{body}  </BehaviorTree>\n")
     parts.append("  <TreeNodesModel>\n")
     parts.extend(model_entries(registry))
     parts.append("  </TreeNodesModel>\n</root>\n")

@@ -20,16 +20,19 @@ from typing import Any
 import yaml
 
 from engine.files.problems import LoadError, Mark, Problem, Problems
-from engine.interop.btcpp_export import BTCPP_BUILTINS, own_id
+from engine.interop.btcpp_export import BTCPP_BUILTINS, SETTINGS_ATTRIBUTE, own_id
 from engine.nodes.registry import NodeRegistry
 from engine.nodes.spec import NodeType
 from engine.values.param_problems import did_you_mean
 from engine.values.params import Boolean, Integer, ListOf, Number
+from engine.values.templates import Template
 
-VEST_SETTINGS = re.compile(r"^\s*vest settings: (\{.*\})\s*$", re.S)
-"""The comment our export writes in the main BehaviorTree: its rate, priority, turns."""
 SETTINGS = ("rate_hz", "priority", "wait_for_turn_s", "when_interrupted", "description")
 DEFAULT_RATE_HZ = 10.0
+GENERIC_TAGS = frozenset({"Action", "Condition", "Decorator", "Control"})
+"""BehaviorTree.CPP's explicit form of a node: ``<Action ID="Say"/>``."""
+METADATA = ("_description", "_uid", "_fullpath", "_autoremap")
+"""Attributes Groot2 and BehaviorTree.CPP keep about a node, not what it does."""
 COMMENT = "#"
 """A node's note, written as a YAML comment after it (where an inlined subtree came from)."""
 MAX_ELEMENTS = 10_000
@@ -41,7 +44,6 @@ class Element:
     attributes: dict[str, str]
     mark: Mark
     children: list[Element] = field(default_factory=list)
-    comments: list[str] = field(default_factory=list)
 
 
 def parse_xml(text: str, name: str) -> Element:
@@ -64,13 +66,8 @@ def parse_xml(text: str, name: str) -> Element:
     def end(tag: str) -> None:
         stack.pop()
 
-    def comment(text: str) -> None:
-        if stack:
-            stack[-1].comments.append(text)
-
     parser.StartElementHandler = start
     parser.EndElementHandler = end
-    parser.CommentHandler = comment
     try:
         parser.Parse(text, True)
     except xml.parsers.expat.ExpatError as error:
@@ -93,7 +90,12 @@ class _Importer:
         """Our YAML node (``{Type: ...}``) for ``element``; None (a problem noted) when it
         has no counterpart."""
         tag, attrs = element.tag, dict(element.attributes)
+        if tag in GENERIC_TAGS and "ID" in attrs:  # <Action ID="Say" .../>, as Groot2 writes
+            tag = attrs.pop("ID")
+            element = Element(tag, attrs, element.mark, element.children)
         name = attrs.pop("name", None)
+        for attribute in METADATA:
+            attrs.pop(attribute, None)
         for attribute in sorted(attrs):
             if attribute.startswith("_"):
                 self.problems.add(
@@ -215,11 +217,13 @@ class _Importer:
                 hint = did_you_mean(port, [p.name for p in node_type.params])
                 self.problems.add(element.mark, f"<{element.tag}> has no port {port!r}", hint)
                 continue
-            if re.fullmatch(r"\{[^{}]*\}", text.strip()):
+            remapped = re.fullmatch(r"\{[^{}]*\}", text.strip())
+            if remapped and not isinstance(param.type, Template):  # in a text: our {key}
                 self.problems.add(
                     element.mark,
                     f"<{element.tag}> {port}={text!r}: blackboard remapping, which vest lacks",
-                    "name the key itself (vest's nodes read keys by name: key=/vars/x)",
+                    "vest's nodes name a key in a key port (key: /vars/x), or fill {/vars/x} "
+                    "in a text",
                 )
                 continue
             args[port] = _value(text, param.type)
@@ -277,9 +281,10 @@ def _value(text: str, param_type: Any) -> Any:
     return text
 
 
-def tree_yaml(text: str, name: str, registry: NodeRegistry) -> str:
+def tree_yaml(text: str, name: str, registry: NodeRegistry) -> tuple[str, list[str]]:
     """The BehaviorTree.CPP v4 XML ``text`` (``name`` is its file, for messages) as our
-    tree YAML; LoadError naming each element or port vest has no counterpart for."""
+    tree YAML, and what the person should know of it; LoadError naming each element or
+    port vest has no counterpart for."""
     document = parse_xml(text, name)
     if document.tag != "root":
         raise LoadError([Problem(document.mark, f"<{document.tag}>: not a BehaviorTree.CPP file")])
@@ -301,7 +306,7 @@ def tree_yaml(text: str, name: str, registry: NodeRegistry) -> str:
     assert root is not None
     settings = _settings(trees[main_id])
     head = [
-        f"# imported by vest from {name} (BehaviorTree {main_id!r}); check it with vest validate",
+        f"# imported by vest from {name} (BehaviorTree {main_id!r})",
         f"name: {_scalar(main_id)}",
         f"rate_hz: {_scalar(settings.get('rate_hz', DEFAULT_RATE_HZ))}",
     ]
@@ -313,23 +318,22 @@ def tree_yaml(text: str, name: str, registry: NodeRegistry) -> str:
     if settings.get("description"):
         folded = textwrap.wrap(str(settings["description"]), 86, break_on_hyphens=False)
         head += ["description: >", *(f"  {line}" for line in folded)]
-    return "\n".join([*head, "root:", *_block(root, 1)]) + "\n"
+    notes = []
+    if "rate_hz" not in settings:
+        notes.append(
+            f"{name}: no vest settings ({SETTINGS_ATTRIBUTE}: a tool dropped them, or the tree "
+            f"was not made by vest): rate {DEFAULT_RATE_HZ:g} Hz, priority 0; set them in the YAML"
+        )
+    return "\n".join([*head, "root:", *_block(root, 1)]) + "\n", notes
 
 
 def _settings(tree: Element) -> dict[str, Any]:
-    for comment in tree.comments:
-        found = VEST_SETTINGS.match(comment)
-        if found:
-            try:
-                loaded = json.loads(found.group(1))
-            except ValueError:
-                return {}
-            return (
-                {k: v for k, v in loaded.items() if k in SETTINGS}
-                if isinstance(loaded, dict)
-                else {}
-            )
-    return {}
+    """What our export kept of the tree's settings (``_vest_settings``), else nothing."""
+    try:
+        loaded = json.loads(tree.attributes.get(SETTINGS_ATTRIBUTE, "{}"))
+    except ValueError:
+        return {}
+    return {k: v for k, v in loaded.items() if k in SETTINGS} if isinstance(loaded, dict) else {}
 
 
 def _scalar(value: Any) -> str:

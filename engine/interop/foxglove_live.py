@@ -12,6 +12,7 @@ events to the SDK, which sends them to the connected clients.
 from __future__ import annotations
 
 import dataclasses
+import json
 import logging
 import queue
 import threading
@@ -148,7 +149,12 @@ class FoxgloveLive:
             topic, schema, message = found
             channel = self._channels.get(topic)
             if channel is None:
-                channel = foxglove.Channel(topic, schema=SCHEMAS[schema], context=self._context)
+                named = foxglove.Schema(  # named as in the MCAP export: one layout for both
+                    name=schema, encoding="jsonschema", data=json.dumps(SCHEMAS[schema]).encode()
+                )
+                channel = foxglove.Channel(
+                    topic, schema=named, message_encoding="json", context=self._context
+                )
                 self._channels[topic] = channel
             at_ns = round((event.t_s + self.epoch_offset_s) * 1e9)
             try:

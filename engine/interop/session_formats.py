@@ -19,12 +19,12 @@ from __future__ import annotations
 import json
 import struct
 from collections.abc import Iterator, Mapping
-from pathlib import Path
 from typing import Any, BinaryIO
 
 from mcap.writer import Writer
 
-from engine.recording.replay import RecordedTree, Recording
+from engine.interop.btcpp_export import BTCPP_BUILTINS
+from engine.recording.replay import RecordedNode, RecordedTree, Recording
 
 MAGIC = b"BTCPP4-FileLogger2"
 PROTOCOL = 1
@@ -54,7 +54,7 @@ def btlog_tree_xml(tree: RecordedTree, kinds: Mapping[str, str]) -> tuple[str, d
             lines.append(f"{'  ' * (depth + 2)}</{tag}>")
         uid = len(uids) + 1
         uids[node.index] = uid
-        tag = _tag(node.type)
+        tag = _tag(node)
         following = nodes[position + 1] if position + 1 < len(nodes) else None
         has_children = following is not None and following.depth == node.depth + 1
         attributes = f' name="{_escape(node.label)}" _uid="{uid}"'
@@ -78,26 +78,31 @@ def btlog_tree_xml(tree: RecordedTree, kinds: Mapping[str, str]) -> tuple[str, d
 
 
 def _model(tree: RecordedTree, kinds: Mapping[str, str]) -> str:
-    ours = sorted({node.type for node in tree.nodes} - _THEIRS)
+    ours = {_tag(node): node.type for node in tree.nodes if _tag(node) not in BTCPP_BUILTINS}
     return "".join(
-        f'    <{kinds.get(kind, "Action")} ID="{_escape(_tag(kind))}"/>\n' for kind in ours
+        f'    <{kinds.get(kind, "Action")} ID="{_escape(tag)}"/>\n'
+        for tag, kind in sorted(ours.items())
     )
 
 
-_THEIRS = frozenset(
-    {"Sequence", "Selector", "Parallel", "Inverter", "ForceSuccess", "Repeat", "Retry", "Timeout"}
-)
-"""Our node types written as BehaviorTree.CPP's own (Groot2 knows them)."""
-
-
-def _tag(node_type: str) -> str:
-    """The element a recorded node is written as: BehaviorTree.CPP's own name where one
-    means the same (without the settings, which a recording keeps only in its label)."""
-    return {
-        "Selector": "ReactiveFallback",
-        "Parallel": "ParallelAll",
-        "Retry": "RetryUntilSuccessful",
-    }.get(node_type, node_type)
+def _tag(node: RecordedNode) -> str:
+    """The element a recorded node is written as, as ``vest export`` writes it: its
+    settings read from its label (``Selector memory=True`` is a ``Fallback``)."""
+    settings = dict(part.split("=", 1) for part in node.label.split() if "=" in part)
+    kind = node.type
+    if kind == "Sequence":
+        return "ReactiveSequence" if settings.get("memory") == "False" else "Sequence"
+    if kind == "Selector":
+        return "Fallback" if settings.get("memory") == "True" else "ReactiveFallback"
+    if kind == "Parallel":
+        if settings.get("synchronise") == "False":
+            return "VestParallel"
+        return "Parallel" if settings.get("succeed_when") == "one" else "ParallelAll"
+    if kind == "Retry":
+        return "RetryUntilSuccessful"
+    if kind == "OneShot" and settings.get("after") == "completion":
+        return "RunOnce"
+    return kind
 
 
 def _escape(text: str) -> str:
@@ -232,14 +237,13 @@ def write_mcap(recording: Recording, out: BinaryIO) -> dict[str, int]:
 
 
 def write_session(
-    recording: Recording, kind: str, path: Path, tree: str | None, kinds: Mapping[str, str]
+    recording: Recording, kind: str, out: BinaryIO, tree: str | None, kinds: Mapping[str, str]
 ) -> str:
-    """Writes the session as ``kind`` (mcap or btlog) to ``path``; a line saying what.
-    ``kinds``: our node types' kinds, as :func:`btlog_tree_xml` takes them."""
-    with open(path, "wb") as out:
-        if kind == "mcap":
-            counts = write_mcap(recording, out)
-            return f"{path}: {sum(counts.values())} messages on {len(counts)} topics (MCAP)"
-        assert tree is not None
-        written = write_btlog(recording, tree, kinds, out)
-        return f"{path}: {tree}, {written} status changes (BehaviorTree.CPP FileLogger2)"
+    """Writes the session as ``kind`` (mcap or btlog) into ``out``; what it wrote, in
+    words. ``kinds``: our node types' kinds, as :func:`btlog_tree_xml` takes them."""
+    if kind == "mcap":
+        counts = write_mcap(recording, out)
+        return f"{sum(counts.values())} messages on {len(counts)} topics (MCAP)"
+    assert tree is not None
+    written = write_btlog(recording, tree, kinds, out)
+    return f"{tree}, {written} status changes (BehaviorTree.CPP FileLogger2)"

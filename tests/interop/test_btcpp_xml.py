@@ -101,7 +101,7 @@ def test_what_vest_has_no_counterpart_for_is_named_with_its_place(
         '  <BehaviorTree ID="T">\n'
         "    <Sequence>\n"
         '      <Script code="x := 1"/>\n'
-        '      <Say text="{greeting}"/>\n'
+        '      <Check key="{target}" above="1"/>\n'
         '      <SubTree ID="Sub" target="{pose}"/>\n'
         '      <Say text="hi" _skipIf="x == 1"/>\n'
         '      <ParallelAll max_failures="2"><Say text="a"/></ParallelAll>\n'
@@ -114,7 +114,7 @@ def test_what_vest_has_no_counterpart_for_is_named_with_its_place(
     err = capsys.readouterr().err
     for expected in (
         r'theirs.xml:4:7: <Script code="x := 1">: vest has no node that means the same',
-        r"theirs.xml:5:7: <Say> text='\{greeting\}': blackboard remapping, which vest lacks",
+        r"theirs.xml:5:7: <Check> key='\{target\}': blackboard remapping, which vest lacks",
         r"theirs.xml:6:7: <SubTree ID='Sub'> port target: vest's subtrees take no ports",
         r"theirs.xml:7:7: <Say> _skipIf: vest has no pre/post conditions",
         r'theirs.xml:8:7: <ParallelAll max_failures="2">: vest has no node that means the same',
@@ -159,3 +159,21 @@ def test_an_imported_tree_that_vest_validate_refuses_is_not_written(
     err = capsys.readouterr().err
     assert "does not pass vest validate" in err and "unknown blackboard key '/nope/x'" in err
     assert f"({theirs} as YAML):" in err and not out.exists()
+
+
+def test_a_text_that_fills_in_a_key_and_the_explicit_form_of_a_node_come_through(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.chdir(ROOT)
+    theirs = tmp_path / "pad.xml"
+    theirs.write_text(
+        '<root BTCPP_format="4">\n  <BehaviorTree ID="pad">\n    <Sequence>\n'
+        '      <Action ID="OnTouch" _description="as Groot2 writes it"/>\n'
+        '      <Say text="You touched {/sensors/touch/touched}"/>\n'
+        "    </Sequence>\n  </BehaviorTree>\n</root>\n"
+    )
+    assert main(["import", str(theirs)]) == 0
+    captured = capsys.readouterr()
+    assert "- OnTouch: {}" in captured.out
+    assert "Say: {text: 'You touched {/sensors/touch/touched}'}" in captured.out
+    assert "no vest settings (_vest_settings" in captured.err  # not made by vest: said

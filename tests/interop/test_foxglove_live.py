@@ -39,6 +39,7 @@ def test_the_robot_s_actions_reach_a_foxglove_client_as_they_happen() -> None:
         assert url.startswith("ws://127.0.0.1:")
         channels: dict[str, int] = {}
         subscribed = False
+        names: dict[str, str] = {}
         with connect(url, subprotocols=[PROTOCOL], open_timeout=10) as client:
             first = json.loads(client.recv(timeout=10))
             assert first["op"] == "serverInfo" and first["name"] == "vest"
@@ -51,6 +52,7 @@ def test_the_robot_s_actions_reach_a_foxglove_client_as_they_happen() -> None:
                     continue
                 for channel in message["channels"]:
                     channels[channel["topic"]] = channel["id"]
+                    names[channel["topic"]] = channel["schemaName"]
                     assert (
                         channel["encoding"] == "json" and channel["schemaEncoding"] == "jsonschema"
                     )
@@ -63,6 +65,7 @@ def test_the_robot_s_actions_reach_a_foxglove_client_as_they_happen() -> None:
         assert (opcode, subscription_id) == (1, 1)
         assert {"tree", "action", "args"} <= set(action)
         assert "/vest/trees/hug/status" in channels and "/vest/blackboard" in channels
+        assert names["/vest/actions"] == "vest.Action"  # as the MCAP export names it
     finally:
         robot.wait(timeout=60)
     assert robot.returncode == 0

@@ -32,7 +32,7 @@ def demo(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys, consenting) ->
 
 
 def test_the_session_as_mcap_has_a_topic_per_tree_and_one_each_for_the_rest(
-    demo: Path, tmp_path: Path, the_site_key: SiteKey
+    demo: Path, tmp_path: Path, the_site_key: SiteKey, capsys: pytest.CaptureFixture[str]
 ) -> None:
     out = tmp_path / "demo.mcap"
     assert main(["replay", str(demo), "--to", "mcap", "-o", str(out)]) == 0
@@ -67,6 +67,9 @@ def test_the_session_as_mcap_has_a_topic_per_tree_and_one_each_for_the_rest(
     started_ns = float(recording.meta["started"]) * 1e9
     assert abs(times[0] - started_ns) < 40e9  # the session's own times, since the epoch
     recording.close()
+    assert out.stat().st_mode & 0o077 == 0  # a copy in the clear: its owner's alone
+    assert main(["data", "audit", "--person", "kid-17"]) == 0  # and the site knows of it
+    assert f"mcap written kid-17: {out}" in capsys.readouterr().out
 
 
 def read_btlog(path: Path) -> tuple[ET.Element, int, list[tuple[int, int, int]]]:
@@ -97,6 +100,11 @@ def test_one_tree_of_the_session_as_a_groot2_log(
     uids = {int(e.attrib["_uid"]): e for e in xml.iter() if "_uid" in e.attrib}
     assert sorted(uids) == list(range(1, len(uids) + 1))  # depth-first from 1
     assert uids[1].tag == "Sequence" and xml.find("TreeNodesModel/Action[@ID='Say']") is not None
+    game = tmp_path / "game.btlog"
+    args = ["replay", str(demo), "--to", "btlog", "--tree", "finger_game", "-o", str(game)]
+    assert main(args) == 0
+    tags = {e.tag for e in read_btlog(game)[0].iter()}
+    assert "Fallback" in tags and "ReactiveFallback" not in tags  # as vest export writes it
     recording = Recording.open(demo, the_site_key)
     hug = [row for row in recording.table("statuses") if row["tree"] == "hug"]
     assert len(records) == len(hug) > 0
