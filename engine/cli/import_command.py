@@ -9,12 +9,13 @@ the YAML is checked as vest validate checks it before it is written.
 from __future__ import annotations
 
 import argparse
+import os
 import re
 import sys
 import tempfile
 from pathlib import Path
 
-from engine.cli.output import tell, write_file
+from engine.cli.output import tell
 from engine.cli.render_command import load_tree
 from engine.errors import ConfigError
 from engine.files.problems import LoadError
@@ -54,6 +55,15 @@ def main(args: argparse.Namespace) -> int:
     if args.output is None:
         sys.stdout.write(yaml_text)
         return 0
-    write_file(args.output, yaml_text.encode("utf-8"), f"-o {args.output}", "the tree")
+    try:  # O_EXCL: a file made there meanwhile is never written over
+        descriptor = os.open(args.output, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o644)
+    except FileExistsError:
+        raise ConfigError(f"-o {args.output}: is there already; name a new file") from None
+    except OSError as error:
+        raise ConfigError(
+            f"-o {args.output}: cannot write it ({error.strerror or error})"
+        ) from None
+    with os.fdopen(descriptor, "w", encoding="utf-8") as out:
+        out.write(yaml_text)
     print(f"{args.output}: from {args.xml}")
     return 0

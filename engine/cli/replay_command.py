@@ -109,12 +109,16 @@ def _converted(recording: Recording, site: Site | None, args: argparse.Namespace
     output: Path = args.output or args.recording.with_suffix(suffix)
     if output.suffix != suffix:
         raise UsageError(f"-o {output}: a {args.to} file ends in {suffix}")
+    if args.at is not None or args.view:
+        raise UsageError("--to writes a file: without --at and --view")
+    if args.tree is not None and args.to != "btlog":
+        raise UsageError("--tree picks the tree of a btlog; an MCAP holds them all")
     tree = args.tree
     names = list(dict.fromkeys(t.name for t in recording.trees))
     if args.to == "btlog":
         if tree is None and len(names) != 1:
             raise UsageError(f"--to btlog holds one tree: add --tree, one of {', '.join(names)}")
-        tree = tree or names[0]
+        tree = names[0] if tree is None else tree
         if tree not in names:
             raise UsageError(f"--tree {tree}: not in this session; one of {', '.join(names)}")
     tags = {"composite": "Control"}
@@ -131,6 +135,12 @@ def _converted(recording: Recording, site: Site | None, args: argparse.Namespace
     except OSError as error:
         output.unlink(missing_ok=True)  # ours: made a moment ago
         raise ConfigError(f"-o {output}: cannot write it ({error.strerror or error})") from None
+    except (ValueError, OverflowError) as error:  # NaN, a time no calendar has
+        output.unlink(missing_ok=True)
+        raise ConfigError(f"{args.recording}: a damaged recording ({error})") from None
+    except BaseException:  # a damaged recording named, Ctrl-C: no half-written file
+        output.unlink(missing_ok=True)
+        raise
     if site is not None:
         person = site.person_of(args.recording)
         site.output_written(output, person, args.to, source=args.recording)

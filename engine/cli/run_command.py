@@ -181,7 +181,7 @@ def _tell_foxglove(live: FoxgloveLive) -> None:
 
 
 def _port(text: str) -> int:
-    if not text.isdigit() or int(text) > 65535:
+    if not (text.isascii() and text.isdigit() and len(text) <= 5) or int(text) > 65535:
         raise argparse.ArgumentTypeError(f"a port 0..65535, got {text!r}")
     return int(text)
 

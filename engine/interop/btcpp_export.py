@@ -21,6 +21,7 @@ A port's value is its text: numbers as written (``3.0``), true/false, and lists 
 from __future__ import annotations
 
 import json
+import re
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 from typing import Any
@@ -39,9 +40,13 @@ _MODEL_TAGS["composite"] = "Control"
 
 
 def port_text(value: Any) -> str:
-    """A parameter's value as BehaviorTree.CPP reads a port: text."""
+    """A parameter's value as BehaviorTree.CPP reads a port: text. A text that would read
+    back as another kind of value (``"true"``, ``"7"``) or holds a character XML cannot
+    carry is written as JSON (``json:"7"``), so ``vest import`` gives back the same."""
     if isinstance(value, CompiledTemplate):
-        return value.source
+        return _text_port(value.source)
+    if isinstance(value, str):
+        return _text_port(value)
     if isinstance(value, bool):
         return "true" if value else "false"
     if isinstance(value, list | tuple | dict):
@@ -69,11 +74,33 @@ def btcpp_node(node: NodeDefinition) -> tuple[str, dict[str, str]]:
         return "Repeat", {"num_cycles": str(args["times"])}
     if kind == "Retry":
         return "RetryUntilSuccessful", {"num_attempts": str(args["times"])}
-    if kind == "Timeout":
+    if kind == "Timeout" and _whole_msec(float(args["seconds"])):
         return "Timeout", {"msec": str(round(float(args["seconds"]) * 1000))}
     if kind == "OneShot" and args.get("after") == "completion":
         return "RunOnce", {"then_skip": "false"}
     return own_id(node.type), own_ports(node)
+
+
+def _whole_msec(seconds: float) -> bool:
+    """Whether BehaviorTree.CPP's ``msec`` carries ``seconds`` exactly (else: our own)."""
+    msec = seconds * 1000
+    return msec >= 1 and abs(msec - round(msec)) < 1e-6
+
+
+LOOKS_TYPED = re.compile(r"true|false|-?(0|[1-9][0-9]*)(\.[0-9]+)?([eE][+-]?[0-9]+)?|json:.*", re.S)
+NOT_XML = re.compile("[\x00-\x08\x0b\x0c\x0e-\x1f\ufffe\uffff\ud800-\udfff]")
+"""Characters XML 1.0 cannot carry, even escaped."""
+
+
+def _text_port(text: str) -> str:
+    if LOOKS_TYPED.fullmatch(text) or NOT_XML.search(text):
+        return "json:" + json.dumps(text, ensure_ascii=False).replace("\u2028", "\\u2028")
+    return text
+
+
+def xml_safe(text: str) -> str:
+    """``text`` with what XML cannot carry replaced (a name, a label, a comment)."""
+    return NOT_XML.sub("\ufffd", text)
 
 
 def own_id(node_type: NodeType) -> str:
@@ -138,7 +165,7 @@ class _Writer:
         tag, ports = btcpp_node(node)
         attributes = "".join(f" {name}={quoteattr(text)}" for name, text in ports.items())
         if node.name != node.type.name:
-            attributes = f" name={quoteattr(node.name)}" + attributes
+            attributes = f" name={quoteattr(xml_safe(node.name))}" + attributes
         if not node.children:
             return f"{indent}<{tag}{attributes}/>\n"
         inner = "".join(self.element(child, depth + 1) for child in node.children)
@@ -181,11 +208,10 @@ def btcpp_xml(definition: TreeDefinition, registry: NodeRegistry) -> str:
 
 
 def _comment(definition: TreeDefinition) -> str:
-    text = (
-        f"exported by vest from {definition.path.name} ({definition.rate_hz:g} Hz, priority "
-        f"{definition.priority}); vest import turns it back into YAML"
-    )
-    return text.replace("--", "- -")
+    text = xml_safe(f"exported by vest from {definition.path.name}; vest import reads it back")
+    while "--" in text:  # a comment cannot hold two dashes
+        text = text.replace("--", "- -")
+    return text.rstrip("-")
 
 
 def model_entries(registry: Iterable[NodeType]) -> list[str]:

@@ -12,7 +12,6 @@ from __future__ import annotations
 import json
 import math
 import re
-import textwrap
 import xml.parsers.expat
 from dataclasses import dataclass, field
 from typing import Any
@@ -29,6 +28,9 @@ from engine.values.templates import Template
 
 SETTINGS = ("rate_hz", "priority", "wait_for_turn_s", "when_interrupted", "description")
 DEFAULT_RATE_HZ = 10.0
+MAX_NODES = 5000
+MAX_DEPTH = 200
+JSON_NUMBER = re.compile(r"-?(0|[1-9][0-9]*)(\.[0-9]+)?([eE][+-]?[0-9]+)?")
 GENERIC_TAGS = frozenset({"Action", "Condition", "Decorator", "Control"})
 """BehaviorTree.CPP's explicit form of a node: ``<Action ID="Say"/>``."""
 METADATA = ("_description", "_uid", "_fullpath", "_autoremap")
@@ -85,10 +87,22 @@ class _Importer:
     trees: dict[str, Element]
     problems: Problems = field(default_factory=Problems)
     opening: list[str] = field(default_factory=list)
+    expanded: int = 0
+    """Nodes made so far (SubTrees written in place: a small file can expand to millions)."""
+    too_big: bool = False
 
-    def node(self, element: Element) -> dict[str, Any] | None:
+    def node(self, element: Element, depth: int = 0) -> dict[str, Any] | None:
         """Our YAML node (``{Type: ...}``) for ``element``; None (a problem noted) when it
         has no counterpart."""
+        self.expanded += 1
+        if self.expanded > MAX_NODES or depth > MAX_DEPTH:
+            if not self.too_big:
+                why = f"deeper than {MAX_DEPTH}" if depth > MAX_DEPTH else f"over {MAX_NODES}"
+                self.problems.add(
+                    element.mark, f"the tree, SubTrees written in place, is {why} nodes"
+                )
+                self.too_big = True
+            return None
         tag, attrs = element.tag, dict(element.attributes)
         if tag in GENERIC_TAGS and "ID" in attrs:  # <Action ID="Say" .../>, as Groot2 writes
             tag = attrs.pop("ID")
@@ -105,8 +119,8 @@ class _Importer:
                 )
                 return None
         if tag == "SubTree":
-            return self.subtree(element, attrs)
-        children = [self.node(child) for child in element.children]
+            return self.subtree(element, attrs, depth, name)
+        children = [self.node(child, depth + 1) for child in element.children]
         if any(child is None for child in children):
             return None
         kept = [child for child in children if child is not None]
@@ -121,7 +135,9 @@ class _Importer:
             mapped = {kind: {"name": name, **_as_options(body)}}
         return mapped
 
-    def subtree(self, element: Element, attrs: dict[str, str]) -> dict[str, Any] | None:
+    def subtree(
+        self, element: Element, attrs: dict[str, str], depth: int, name: str | None
+    ) -> dict[str, Any] | None:
         tree_id = attrs.pop("ID", "")
         if attrs:
             port = sorted(attrs)[0]
@@ -141,18 +157,23 @@ class _Importer:
             return None
         self.opening.append(tree_id)
         try:
-            inlined = self.tree_root(body)
+            inlined = self.tree_root(body, depth + 1)
         finally:
             self.opening.pop()
         if inlined is None:
             return None
-        return {COMMENT: f"SubTree {tree_id} (line {element.mark.line})", **inlined}
+        shown = json.dumps(tree_id, ensure_ascii=True)  # one line, whatever the ID holds
+        if name is not None:  # the SubTree's own name goes to the node in its place
+            inner = {k: v for k, v in inlined.items() if k != COMMENT}
+            ((kind, body),) = inner.items()
+            inlined = {kind: {"name": name, **_as_options(body)}}
+        return {COMMENT: f"SubTree {shown} (line {element.mark.line})", **inlined}
 
-    def tree_root(self, tree: Element) -> dict[str, Any] | None:
+    def tree_root(self, tree: Element, depth: int = 0) -> dict[str, Any] | None:
         if len(tree.children) != 1:
             self.problems.add(tree.mark, "a BehaviorTree holds exactly one root node")
             return None
-        return self.node(tree.children[0])
+        return self.node(tree.children[0], depth)
 
     def theirs(
         self, element: Element, attrs: dict[str, str], children: list[dict[str, Any]]
@@ -234,6 +255,9 @@ class _Importer:
                 self.problems.add(element.mark, f"<{element.tag}> takes one child")
                 return None
             return {node_type.name: {**args, "child": children[0]}}
+        if children:
+            self.problems.add(element.mark, f"<{element.tag}> takes no children (it is a leaf)")
+            return None
         return {node_type.name: args}
 
     def node_type(self, tag: str) -> NodeType | None:
@@ -272,12 +296,12 @@ def _value(text: str, param_type: Any) -> Any:
         return number if math.isfinite(number) else text
     if isinstance(param_type, ListOf):
         return [item for item in text.split(";") if item]
-    if type(param_type).__name__ in ("Scalar", "AnyValue"):
-        try:
-            loaded = yaml.safe_load(text)
-        except yaml.YAMLError:
-            return text
-        return loaded if isinstance(loaded, str | int | float | bool) else text
+    if type(param_type).__name__ in ("Scalar", "AnyValue"):  # as vest export writes them
+        if text in ("true", "false"):
+            return text == "true"
+        if JSON_NUMBER.fullmatch(text):
+            number = json.loads(text)
+            return number if math.isfinite(number) else text
     return text
 
 
@@ -293,7 +317,12 @@ def tree_yaml(text: str, name: str, registry: NodeRegistry) -> tuple[str, list[s
         hint = "BehaviorTree.CPP 3's XML: convert it with its own tool first" if version else None
         found = f"BTCPP_format={version!r}" if version else "no BTCPP_format"
         raise LoadError([Problem(document.mark, f"{found}: vest reads version 4", hint)])
-    trees = {t.attributes.get("ID", ""): t for t in document.children if t.tag == "BehaviorTree"}
+    trees: dict[str, Element] = {}
+    for tree in (t for t in document.children if t.tag == "BehaviorTree"):
+        tree_id = tree.attributes.get("ID", "")
+        if tree_id in trees:
+            raise LoadError([Problem(tree.mark, f"a second BehaviorTree with ID {tree_id!r}")])
+        trees[tree_id] = tree
     if not trees:
         raise LoadError([Problem(document.mark, "no <BehaviorTree> in it")])
     main_id = document.attributes.get("main_tree_to_execute") or next(iter(trees))
@@ -316,8 +345,7 @@ def tree_yaml(text: str, name: str, registry: NodeRegistry) -> tuple[str, list[s
         if settings.get(key, default) != default:
             head.append(f"{key}: {_scalar(settings[key])}")
     if settings.get("description"):
-        folded = textwrap.wrap(str(settings["description"]), 86, break_on_hyphens=False)
-        head += ["description: >", *(f"  {line}" for line in folded)]
+        head.append(f"description: {_scalar(str(settings['description']))}")
     notes = []
     if "rate_hz" not in settings:
         notes.append(

@@ -17,14 +17,16 @@
 from __future__ import annotations
 
 import json
+import math
 import struct
 from collections.abc import Iterator, Mapping
 from typing import Any, BinaryIO
 
 from mcap.writer import Writer
 
-from engine.interop.btcpp_export import BTCPP_BUILTINS
+from engine.interop.btcpp_export import BTCPP_BUILTINS, xml_safe
 from engine.recording.replay import RecordedNode, RecordedTree, Recording
+from engine.services.telemetry import json_safe
 
 MAGIC = b"BTCPP4-FileLogger2"
 PROTOCOL = 1
@@ -32,10 +34,12 @@ STATUS_CODES = {"INVALID": 0, "IDLE": 0, "RUNNING": 1, "SUCCESS": 2, "FAILURE": 
 
 
 def _epoch_s(recording: Recording) -> float:
+    """When the session started, seconds since the epoch (0 when the file cannot say)."""
     try:
-        return float(recording.meta.get("started", "0"))
+        started = float(recording.meta.get("started", "0"))
     except ValueError:
         return 0.0
+    return started if math.isfinite(started) and 0 <= started < 1e11 else 0.0
 
 
 # -- btlog ----------------------------------------------------------------------------------
@@ -106,6 +110,7 @@ def _tag(node: RecordedNode) -> str:
 
 
 def _escape(text: str) -> str:
+    text = xml_safe(text)
     return (
         text.replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;").replace('"', "&quot;")
     )
@@ -130,7 +135,9 @@ def write_btlog(
         code = STATUS_CODES.get(str(row["status"]))
         if uid is None or code is None:
             continue
-        since_us = max(0, round(float(row["at_s"]) * 1e6))
+        since_us = round(float(row["at_s"]) * 1e6)
+        if not 0 <= since_us < 2**48:  # 6 bytes: a damaged time
+            raise ValueError(f"a status at {row['at_s']!r} s")
         out.write(since_us.to_bytes(6, "little") + struct.pack("<HB", uid, code))
         written += 1
     return written
@@ -226,10 +233,12 @@ def write_mcap(recording: Recording, out: BinaryIO) -> dict[str, int]:
     start_ns = round(_epoch_s(recording) * 1e9)
     messages = sorted(_messages(recording), key=lambda m: m[2])  # time order, stable
     for topic, schema, at_s, message in messages:
+        if not (math.isfinite(float(at_s)) and 0 <= float(at_s) < 1e9):
+            raise ValueError(f"{topic} at {at_s!r} s")
         if topic not in channels:
             channels[topic] = writer.register_channel(topic, "json", schema_ids[schema])
         at_ns = start_ns + round(float(at_s) * 1e9)
-        data = json.dumps(message, default=str, allow_nan=False).encode()
+        data = json.dumps(json_safe(message), allow_nan=False).encode()  # NaN: null
         writer.add_message(channels[topic], at_ns, data, at_ns, counts.get(topic, 0))
         counts[topic] = counts.get(topic, 0) + 1
     writer.finish()  # type: ignore[no-untyped-call]

@@ -141,7 +141,7 @@ def test_a_bt_cpp_tree_using_what_vest_has_becomes_yaml_with_where_it_came_from(
     )
     assert main(["import", str(theirs)]) == 0
     text = capsys.readouterr().out
-    assert "# imported by vest from" in text and "# SubTree wave (line 4)" in text
+    assert "# imported by vest from" in text and '# SubTree "wave" (line 4)' in text
     assert "rate_hz: 10.0   # BehaviorTree.CPP trees have no rate of their own" in text
     assert "- Timeout:\n        seconds: 1.5\n        child:\n          Say: {text: Hello!" in text
 
