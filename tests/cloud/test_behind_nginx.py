@@ -17,7 +17,7 @@ import pytest
 import requests
 
 from cloud.settings import Settings
-from tests.cloud.conftest import ROOT
+from tests.cloud.conftest import ROOT, self_signed
 
 NGINX = shutil.which("nginx") or "/usr/sbin/nginx"
 DOCS_BLOCK = re.compile(r"```nginx\n(.*?)```", re.S)
@@ -53,13 +53,7 @@ def proxy(
     running = start_service(Settings(db_url=f"sqlite:///{tmp_path / 'c.db'}"))
     token = running.store.directory.add_operator("ana")
     running.store.directory.add_robot("hbs2", operator="ana")
-    cert, key = tmp_path / "cert.pem", tmp_path / "key.pem"
-    subprocess.run(
-        ["openssl", "req", "-x509", "-newkey", "ec", "-pkeyopt", "ec_paramgen_curve:P-256",
-         "-nodes", "-keyout", str(key), "-out", str(cert), "-days", "1",
-         "-subj", "/CN=127.0.0.1", "-addext", "subjectAltName=IP:127.0.0.1"],
-        check=True, capture_output=True,
-    )  # fmt: skip
+    cert, key = self_signed(tmp_path)
     port = free_port()
     server = placed(
         docs_server_block(),

@@ -13,19 +13,10 @@ from engine.cli import main
 from engine.errors import ConfigError
 from engine.privacy.sealed_sqlite import connect_sealed
 from engine.privacy.site import Site
+from tests.privacy.conftest import Calendar
 
 ROOT = Path(__file__).resolve().parents[2]
 DAY_S = 86_400.0
-
-
-class Calendar:
-    """A clock of seconds since the epoch that a test turns forward."""
-
-    def __init__(self, now: float) -> None:
-        self.t = now
-
-    def now(self) -> float:
-        return self.t
 
 
 @pytest.fixture

@@ -17,6 +17,7 @@ from engine.cli import main
 from engine.privacy.sealed_sqlite import connect_sealed
 from engine.privacy.site import Site
 from engine.privacy.site_data import SiteKey
+from tests.privacy.conftest import Calendar
 
 ROOT = Path(__file__).resolve().parents[2]
 TRICKY = """\
@@ -28,14 +29,6 @@ events:
   - {at: 3.0, hear: 'mum said "SECRETDQ is coming" and it''s today'}
   - {at: 4.0, hear: 'Zoë naïve\\path SECRETZ'}
 """
-
-
-class Calendar:
-    def __init__(self, now: float) -> None:
-        self.t = now
-
-    def now(self) -> float:
-        return self.t
 
 
 @pytest.fixture
