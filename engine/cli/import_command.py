@@ -15,7 +15,7 @@ import sys
 import tempfile
 from pathlib import Path
 
-from engine.cli.output import tell
+from engine.cli.output import new_file, tell
 from engine.cli.render_command import load_tree
 from engine.errors import ConfigError
 from engine.files.problems import LoadError
@@ -55,14 +55,7 @@ def main(args: argparse.Namespace) -> int:
     if args.output is None:
         sys.stdout.write(yaml_text)
         return 0
-    try:  # O_EXCL: a file made there meanwhile is never written over
-        descriptor = os.open(args.output, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o644)
-    except FileExistsError:
-        raise ConfigError(f"-o {args.output}: is there already; name a new file") from None
-    except OSError as error:
-        raise ConfigError(
-            f"-o {args.output}: cannot write it ({error.strerror or error})"
-        ) from None
+    descriptor = new_file(args.output, f"-o {args.output}")  # made meanwhile: not over it
     with os.fdopen(descriptor, "w", encoding="utf-8") as out:
         out.write(yaml_text)
     print(f"{args.output}: from {args.xml}")

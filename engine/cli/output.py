@@ -131,6 +131,18 @@ def writable_folder(folder: Path) -> None:
         raise ConfigError(f"{folder}: cannot write there ({error.strerror or error})") from None
 
 
+def new_file(path: Path, named_by: str, *, private: bool = False) -> int:
+    """A file descriptor of ``path``, made now for writing (O_EXCL: never a file that is
+    there, not even one made a moment ago); owner-only when ``private``. ConfigError naming
+    it (``named_by``: ``-o out.mcap``) when it is there or cannot be made."""
+    try:
+        return os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600 if private else 0o644)
+    except FileExistsError:
+        raise ConfigError(f"{named_by}: is there already; name a new file") from None
+    except OSError as error:
+        raise ConfigError(f"{named_by}: cannot write it ({reason(error)})") from None
+
+
 def write_file(path: Path, data: bytes, named_by: str, what: str, *, private: bool = False) -> None:
     """``data`` (``what``: "the report") into the regular file ``path`` (made, or
     replaced); readable by its owner alone when ``private`` (a person's data in the clear).

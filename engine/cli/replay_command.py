@@ -14,7 +14,7 @@ import os
 from pathlib import Path
 
 from engine.buttons.button_file import BUTTONS_TREE
-from engine.cli.output import tell
+from engine.cli.output import new_file, tell
 from engine.cli.site_access import open_recording
 from engine.cli.view_options import add_view_arguments, start_view
 from engine.clock import RealClock
@@ -123,12 +123,7 @@ def _converted(recording: Recording, site: Site | None, args: argparse.Namespace
             raise UsageError(f"--tree {tree}: not in this session; one of {', '.join(names)}")
     tags = {"composite": "Control"}
     kinds = {t.name: tags.get(t.kind, t.kind.title()) for t in default_registry()}
-    try:
-        descriptor = os.open(output, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
-    except FileExistsError:
-        raise ConfigError(f"-o {output}: is there already; name a new file") from None
-    except OSError as error:
-        raise ConfigError(f"-o {output}: cannot write it ({error.strerror or error})") from None
+    descriptor = new_file(output, f"-o {output}", private=True)
     try:
         with os.fdopen(descriptor, "wb") as out:
             said = write_session(recording, args.to, out, tree, kinds)

@@ -18,7 +18,7 @@ import logging
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, TypeVar
 
 from engine.buttons.button_file import ButtonBoard
 from engine.buttons.wizard import Wizard
@@ -46,6 +46,7 @@ if TYPE_CHECKING:
     from engine.interop.foxglove_live import FoxgloveLive
 
 log = logging.getLogger(__name__)
+Part = TypeVar("Part")
 
 
 @dataclass(frozen=True)
@@ -162,14 +163,7 @@ def _around(assembled: AssembledRobot, plan: SessionPlan) -> RunningSession:
             wizard=running.wizard,
         )
         running.view = view
-        on_view_up = plan.on_view_up
-
-        def start_view() -> None:
-            view.start()
-            if on_view_up is not None:
-                on_view_up(view)
-
-        lifecycle.add("view", start=start_view, stop=view.stop)
+        lifecycle.add("view", start=_telling(view.start, view, plan.on_view_up), stop=view.stop)
     if plan.record is not None:
         record, consent = plan.record, plan.consent
         recorder = SessionRecorder(record.path, plan.clock, record.site.key, consent)
@@ -202,13 +196,7 @@ def _around(assembled: AssembledRobot, plan: SessionPlan) -> RunningSession:
         started = float(plan.facts.get("started", "0") or 0)  # seconds since the epoch
         live = FoxgloveLive("127.0.0.1", plan.foxglove_port, plan.clock, started - start_s)
         running.foxglove = live
-        on_up = plan.on_foxglove_up
-
-        def start_live() -> None:
-            live.start()
-            if on_up is not None:
-                on_up(live)
-
+        start_live = _telling(live.start, live, plan.on_foxglove_up)
         lifecycle.add("foxglove", start=start_live, stop=live.stop)
         session.subscribe(live)
     player = ScenarioPlayer(
@@ -240,6 +228,20 @@ def _around(assembled: AssembledRobot, plan: SessionPlan) -> RunningSession:
 
         lifecycle.add("cloud link", start=start_link, stop=link.stop)
     return running
+
+
+def _telling(
+    start: Callable[[], None], part: Part, told: Callable[[Part], None] | None
+) -> Callable[[], None]:
+    """``start``, then ``told(part)`` once it is up (a server's address, said when it
+    serves: a page opened then misses nothing)."""
+
+    def start_and_tell() -> None:
+        start()
+        if told is not None:
+            told(part)
+
+    return start_and_tell
 
 
 def _nothing() -> None:

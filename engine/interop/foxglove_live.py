@@ -4,9 +4,10 @@ no token of its own: from another machine, an SSH tunnel), the same topics and J
 schemas as ``vest replay --to mcap`` (:mod:`engine.interop.session_formats`), so a layout
 made on a recording works live and the other way round.
 
-A session reader: the scheduler's thread only puts each event on a bounded queue (never
-waits: a full queue drops and counts, as the recorder does); a thread beside it hands the
-events to the SDK, which sends them to the connected clients.
+A session reader: the scheduler's thread only hands each event over
+(:class:`~engine.session.handoff.Handoff`, as the recorder does: never waited for, a full
+queue drops and counts); a thread beside it gives them to the SDK, which sends them to the
+connected clients.
 """
 
 from __future__ import annotations
@@ -14,8 +15,6 @@ from __future__ import annotations
 import dataclasses
 import json
 import logging
-import queue
-import threading
 from typing import Any
 
 import foxglove
@@ -34,6 +33,7 @@ from engine.session.events import (
     TreeStarted,
     WorldEvent,
 )
+from engine.session.handoff import Handoff
 from engine.web.guard import is_loopback
 
 log = logging.getLogger(__name__)
@@ -97,13 +97,11 @@ class FoxgloveLive:
             )
         self.host, self.port, self.clock = host, port, clock
         self.epoch_offset_s = epoch_offset_s
-        self.dropped = 0
         self._context = foxglove.Context()  # this session's channels alone, no global one
         self._server: Any = None
         self._channels: dict[str, foxglove.Channel] = {}
         self._paths: dict[tuple[str, int, int], tuple[str, str]] = {}
-        self._queue: queue.Queue[SessionEvent | None] = queue.Queue(maxsize=CAPACITY)
-        self._thread = threading.Thread(target=self._send, name="foxglove", daemon=True)
+        self._handoff = Handoff("foxglove", self._send, capacity=CAPACITY)
 
     def start(self) -> None:
         """Listens (ConfigError when the port is taken) and starts handing events over."""
@@ -114,7 +112,7 @@ class FoxgloveLive:
         except RuntimeError as error:
             raise ConfigError(f"--foxglove {self.port}: cannot listen there ({error})") from None
         self.port = int(self._server.port)
-        self._thread.start()
+        self._handoff.start()
 
     @property
     def url(self) -> str:
@@ -122,42 +120,42 @@ class FoxgloveLive:
 
     def on_event(self, event: SessionEvent) -> None:
         """The scheduler's thread: queued, never waited for."""
-        try:
-            self._queue.put_nowait(event)
-        except queue.Full:
-            self.dropped += 1
+        self._handoff.put(event)
 
     def stop(self) -> None:
-        if self._thread.is_alive():
-            self._queue.put(None)
-            self._thread.join()
+        self._handoff.close()
         if self._server is not None:
             self._server.stop()
             self._server = None
-        if self.dropped:
-            log.warning("foxglove: %d events were dropped (no client kept up)", self.dropped)
+        if self._handoff.dropped:
+            log.warning("foxglove: %d events were dropped", self._handoff.dropped)
 
-    def _send(self) -> None:
-        while (event := self._queue.get()) is not None:
-            if isinstance(event, TreeStarted):
-                for node in event.nodes:
-                    self._paths[(event.tree, event.version, node.index)] = (node.path, node.type)
-                continue
-            found = live_message(event, self._paths)
-            if found is None:
-                continue
-            topic, schema, message = found
-            channel = self._channels.get(topic)
-            if channel is None:
-                named = foxglove.Schema(  # named as in the MCAP export: one layout for both
-                    name=schema, encoding="jsonschema", data=json.dumps(SCHEMAS[schema]).encode()
-                )
-                channel = foxglove.Channel(
-                    topic, schema=named, message_encoding="json", context=self._context
-                )
-                self._channels[topic] = channel
-            at_ns = round((event.t_s + self.epoch_offset_s) * 1e9)
-            try:
-                channel.log(message, log_time=at_ns)
-            except Exception as error:  # a value the SDK cannot carry: the rest goes on
-                log.warning("foxglove: %s not sent (%s)", topic, error)
+    def _send(self, events: list[SessionEvent]) -> bool:
+        for event in events:
+            self._log(event)
+        return True
+
+    def _log(self, event: SessionEvent) -> None:
+        """One event to its channel (made, with its MCAP schema's name, on first use)."""
+        if isinstance(event, TreeStarted):
+            for node in event.nodes:
+                self._paths[(event.tree, event.version, node.index)] = (node.path, node.type)
+            return
+        found = live_message(event, self._paths)
+        if found is None:
+            return
+        topic, schema, message = found
+        channel = self._channels.get(topic)
+        if channel is None:
+            named = foxglove.Schema(  # named as in the MCAP export: one layout for both
+                name=schema, encoding="jsonschema", data=json.dumps(SCHEMAS[schema]).encode()
+            )
+            channel = foxglove.Channel(
+                topic, schema=named, message_encoding="json", context=self._context
+            )
+            self._channels[topic] = channel
+        at_ns = round((event.t_s + self.epoch_offset_s) * 1e9)
+        try:
+            channel.log(message, log_time=at_ns)
+        except Exception as error:  # a value the SDK cannot carry: the rest goes on
+            log.warning("foxglove: %s not sent (%s)", topic, error)

@@ -147,8 +147,15 @@ class SiteRecords:
         ]
 
     def session_at(self, path: Path) -> SessionEntry | None:
-        found = [entry for entry in self.sessions() if entry.path == path]
-        return found[0] if found else None
+        """The index's entry of the recording at ``path`` (resolved), or None."""
+        row = self._connection.execute(
+            "SELECT path, person, started, length_s, profile, kept FROM sessions WHERE path = ?",
+            (str(path),),
+        ).fetchone()
+        if row is None:
+            return None
+        where, person, started, length, profile, kept = row
+        return SessionEntry(Path(where), person, started, length, profile, tuple(json.loads(kept)))
 
     def forget_session(self, path: Path) -> None:
         with self.transaction() as db:

@@ -57,6 +57,7 @@ class KeptByConsent:
         self._heard: re.Pattern[str] | None = None
         """What was heard so far (without consent to keep it), to cut out of any text."""
         self._phrases: set[str] = set()
+        self._fields: dict[type, frozenset[str]] = {}
 
     def kept(self, event: SessionEvent) -> SessionEvent | None:
         if not self._words:
@@ -122,7 +123,10 @@ class KeptByConsent:
         else:
             fields = FREE_TEXT
         changes: dict[str, Any] = {}
-        present = {field.name for field in dataclasses.fields(event)}  # not a property
+        present = self._fields.get(type(event))
+        if present is None:  # its fields, not a property (a turn's text); once a kind
+            present = frozenset(field.name for field in dataclasses.fields(event))
+            self._fields[type(event)] = present
         for name in fields:
             if name in present:
                 value = getattr(event, name)

@@ -17,8 +17,6 @@ import dataclasses
 import hashlib
 import json
 import logging
-import queue
-import threading
 from pathlib import Path
 from typing import Any
 
@@ -37,6 +35,7 @@ from engine.session.events import (
     TreeStarted,
     WorldEvent,
 )
+from engine.session.handoff import Handoff
 
 log = logging.getLogger(__name__)
 CAPACITY = 200_000
@@ -65,8 +64,6 @@ class SessionRecorder:
         self.path = path
         self.clock = clock
         self.start_s = clock.now()
-        self.dropped = 0
-        self._broken = False
         self.keeps = KeptByConsent(consent)
         self._connection: Any = create(path, key)
         self._seq = 0  # the order of the session's events across tables
@@ -74,9 +71,13 @@ class SessionRecorder:
         """How long the session lasted (seconds), once closed."""
         self.stopped_why: str | None = None
         """Why the recording stopped before the session ended (a full disk), or None."""
-        self._queue: queue.Queue[Row | None] = queue.Queue(maxsize=capacity)
-        self._thread = threading.Thread(target=self._write, name="recorder", daemon=True)
-        self._thread.start()
+        self._handoff = Handoff("recorder", self._write, capacity=capacity)
+        self._handoff.start()
+
+    @property
+    def dropped(self) -> int:
+        """Changes lost because the disk fell behind (never waited for)."""
+        return self._handoff.dropped
 
     # -- what the session is ------------------------------------------------------------
     def describe(self, **facts: str) -> None:
@@ -206,37 +207,22 @@ class SessionRecorder:
             )
 
     def _note(self, sql: str, row: tuple[Any, ...]) -> None:
-        if self._broken:
-            return
-        try:
-            self._queue.put_nowait((sql, row))
-        except queue.Full:
-            self.dropped += 1
+        self._handoff.put((sql, row))
 
     # -- the writer thread ----------------------------------------------------------------
-    def _write(self) -> None:
+    def _write(self, batch: list[Row]) -> bool:
+        """One batch, one commit; False (no more) when the disk refuses."""
         connection = self._connection
         assert connection is not None
-        stopping = False
-        while not stopping:
-            batch = [self._queue.get()]
-            while len(batch) < 5000:  # everything already waiting, then one commit
-                try:
-                    batch.append(self._queue.get_nowait())
-                except queue.Empty:
-                    break
-            try:
-                for item in batch:
-                    if item is None:
-                        stopping = True
-                        continue
-                    connection.execute(*item)
-                connection.commit()
-            except Error as error:  # a full disk: the robot goes on, the record stops
-                log.error("recording %s stopped: %s", self.path, error)
-                self.stopped_why = str(error)
-                self._broken = True
-                return
+        try:
+            for item in batch:
+                connection.execute(*item)
+            connection.commit()
+        except Error as error:  # a full disk: the robot goes on, the record stops
+            log.error("recording %s stopped: %s", self.path, error)
+            self.stopped_why = str(error)
+            return False
+        return True
 
     def close(self) -> None:
         """Write what is still queued, how long the session was and what was lost."""
@@ -244,9 +230,7 @@ class SessionRecorder:
             return
         self.length_s = self._at(self.clock.now())
         self.describe(duration_s=f"{self.length_s:.3f}", dropped=str(self.dropped))
-        if not self._broken:  # a writer that stopped reads no more: nothing to wait for
-            self._queue.put(None)
-            self._thread.join()
+        self._handoff.close()  # what is queued is written (unless the writer stopped)
         self._connection.close()
         self._connection = None
         if self.dropped:
