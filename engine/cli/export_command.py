@@ -12,7 +12,7 @@ import sys
 from pathlib import Path
 
 from engine.cli.output import write_file
-from engine.cli.render_command import load_tree
+from engine.cli.run_inputs import load_tree
 from engine.interop.btcpp_export import btcpp_xml
 
 

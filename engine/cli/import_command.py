@@ -16,7 +16,7 @@ import tempfile
 from pathlib import Path
 
 from engine.cli.output import new_file, tell
-from engine.cli.render_command import load_tree
+from engine.cli.run_inputs import load_tree
 from engine.errors import ConfigError
 from engine.files.problems import LoadError
 from engine.files.yaml_source import read_text

@@ -11,11 +11,8 @@ import sys
 from pathlib import Path
 
 from engine.cli.output import write_file
-from engine.dialogs.library import DialogLibrary, find_dialogs_folder
-from engine.loader.tree_definition import TreeDefinition
+from engine.cli.run_inputs import load_tree
 from engine.loader.tree_drawing import ascii_tree, dot_source
-from engine.loader.tree_file import TreeLoader
-from engine.nodes.registry import NodeRegistry, default_registry
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -33,25 +30,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         default=None,
         help="a profile file, or a name in trees/profiles/ (child, adult)",
     )
-
-
-def load_tree(
-    tree: Path, profile_name: str | None, *, near: Path | None = None
-) -> tuple[TreeDefinition, NodeRegistry]:
-    """The tree file ``tree`` checked as ``vest run`` checks it (the dialogs beside it, or
-    beside ``near``; the profile by name or path), and the registry of node types it was
-    checked against."""
-    from engine.cli.run_inputs import resolve_profile
-    from engine.loader.substitution import load_profile
-
-    registry = default_registry()
-    catalogue = registry.catalogue()
-    folder = find_dialogs_folder(near or tree)
-    dialogs = DialogLibrary.from_folder(folder, catalogue) if folder else None
-    profile_path = resolve_profile(profile_name, [tree])  # by name or path, as vest run
-    profile = load_profile(profile_path) if profile_path else None
-    loader = TreeLoader(registry, catalogue, dialogs=dialogs, profile=profile)
-    return loader.load(tree), registry
 
 
 def main(args: argparse.Namespace) -> int:

@@ -17,11 +17,13 @@ from pathlib import Path
 from engine.blackboard.catalogue import KeyCatalogue, KeySpec, default_catalogue
 from engine.buttons.button_file import BUTTONS_TREE, ButtonBoard, load_buttons
 from engine.cli.robot_checks import check_on_robot, check_scenario_events, list_lengths
+from engine.dialogs.library import DialogLibrary, find_dialogs_folder
 from engine.errors import ConfigError
 from engine.files.problems import LoadError, Problem, Problems
 from engine.hardware.config import CAMERA_NAME, RobotConfig
 from engine.hardware.config_file import load_robot_config
 from engine.loader.tree_checks import variable_problems
+from engine.loader.tree_definition import TreeDefinition
 from engine.loader.tree_file import TreeLoader
 from engine.nodes.registry import NodeRegistry, default_registry
 from engine.runtime.robot import Behaviors, load_behaviors
@@ -282,3 +284,21 @@ def default_scenario(path: Path | None, *, simulated: bool) -> Scenario:
     if simulated:
         return load_scenario(found(DEFAULT_SCENARIO))
     return Scenario(duration_s=float("inf"), events=(), path=Path("(no scenario)"))
+
+
+def load_tree(
+    tree: Path, profile_name: str | None, *, near: Path | None = None
+) -> tuple[TreeDefinition, NodeRegistry]:
+    """The tree file ``tree`` checked as ``vest run`` checks it (the dialogs beside it, or
+    beside ``near``; the profile by name or path), and the registry of node types it was
+    checked against."""
+    from engine.loader.substitution import load_profile
+
+    registry = default_registry()
+    catalogue = registry.catalogue()
+    folder = find_dialogs_folder(near or tree)
+    dialogs = DialogLibrary.from_folder(folder, catalogue) if folder else None
+    profile_path = resolve_profile(profile_name, [tree])  # by name or path, as vest run
+    profile = load_profile(profile_path) if profile_path else None
+    loader = TreeLoader(registry, catalogue, dialogs=dialogs, profile=profile)
+    return loader.load(tree), registry

@@ -14,7 +14,7 @@ import behaviortreepy as btcpp
 import pytest
 
 from engine.cli import main
-from engine.cli.render_command import load_tree
+from engine.cli.run_inputs import load_tree
 from engine.interop.btcpp_export import btcpp_xml
 
 ROOT = Path(__file__).resolve().parents[2]
