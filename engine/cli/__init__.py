@@ -174,6 +174,7 @@ EXTRAS = {
         "mcap",
     ),
     "foxglove": ("foxglove",),
+    "ros2": ("zenoh", "rosbags"),
     "cloud": (
         "sqlalchemy",
         "alembic",

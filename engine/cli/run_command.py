@@ -24,9 +24,9 @@ import argparse
 import math
 import sys
 from pathlib import Path
-from typing import TYPE_CHECKING
 from urllib.parse import urlsplit
 
+from engine.cli.interop_options import add_interop_arguments, ros2_plan, tell_foxglove, tell_ros2
 from engine.cli.output import shown, tell
 from engine.cli.run_inputs import (
     DEFAULT_HARDWARE,
@@ -56,9 +56,6 @@ from engine.services.interfaces import Speech
 from engine.services.simulated import simulated_services
 from engine.session.sentences import TOLD_KINDS
 from engine.view.server import ViewServer
-
-if TYPE_CHECKING:
-    from engine.interop.foxglove_live import FoxgloveLive
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -151,17 +148,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "record decides what is recorded and sent to the cloud; the session is listed under "
         "them (vest data list)",
     )
-    parser.add_argument(
-        "--foxglove",
-        type=_port,
-        nargs="?",
-        const=8766,
-        default=None,
-        metavar="PORT",
-        help="serve the live session to Foxglove (its WebSocket, protocol foxglove.sdk.v1) on "
-        "127.0.0.1:PORT (default 8766, beside the view's 8765; 0: any free port); needs "
-        "pip install 'vest-engine[foxglove]'",
-    )
+    add_interop_arguments(parser)
     parser.add_argument(
         "--hardware",
         type=Path,
@@ -174,16 +161,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def _profile_name(behaviors: Behaviors) -> str:
     profile = behaviors.loader.profile
     return "" if profile is None else str(profile.path or profile.name)
-
-
-def _tell_foxglove(live: FoxgloveLive) -> None:
-    tell(f"foxglove: {live.url} (in Foxglove: Open connection, Foxglove WebSocket)")
-
-
-def _port(text: str) -> int:
-    if not (text.isascii() and text.isdigit() and len(text) <= 5) or int(text) > 65535:
-        raise argparse.ArgumentTypeError(f"a port 0..65535, got {text!r}")
-    return int(text)
 
 
 def _positive_seconds(text: str) -> float:
@@ -276,7 +253,8 @@ def _run_for_site(
     consent = site.consent_of(args.person or "")
     if args.record is not None:
         check_new(args.record, site.key)  # before anything starts: never over a session
-    if args.record is not None or args.cloud is not None:
+    ros2 = ros2_plan(args)
+    if args.record is not None or args.cloud is not None or ros2 is not None:
         tell(f"privacy: {consent.describe()}")
     link = _cloud_link(args)
     clock: Clock = VirtualClock() if args.fast else RealClock()
@@ -332,7 +310,9 @@ def _run_for_site(
             },
             reload=not args.fast,
             foxglove_port=args.foxglove,
-            on_foxglove_up=_tell_foxglove,
+            on_foxglove_up=tell_foxglove,
+            ros2=ros2,
+            on_ros2_up=tell_ros2,
         )
     )
     assembled = running.assembled

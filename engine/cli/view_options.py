@@ -14,8 +14,9 @@ from engine.web.guard import is_loopback
 DEFAULT_PORT = 8765
 
 
-def _port(text: str) -> int:
-    if not text.isdigit() or not 0 <= int(text) <= 65535:
+def port_number(text: str) -> int:
+    """A port option's value (0: any free one)."""
+    if not (text.isascii() and text.isdigit() and len(text) <= 5) or int(text) > 65535:
         raise argparse.ArgumentTypeError(
             f"must be a port number 0..65535 (0: any free), got {text!r}"
         )
@@ -27,7 +28,11 @@ def add_view_arguments(parser: argparse.ArgumentParser) -> None:
         "--view", action="store_true", help="show the trees live in a browser (prints the address)"
     )
     parser.add_argument(
-        "--view-port", type=_port, default=DEFAULT_PORT, metavar="P", help=f"default {DEFAULT_PORT}"
+        "--view-port",
+        type=port_number,
+        default=DEFAULT_PORT,
+        metavar="P",
+        help=f"default {DEFAULT_PORT}",
     )
     parser.add_argument(
         "--view-host",

@@ -44,6 +44,7 @@ from engine.view.server import LiveSource, ViewServer
 
 if TYPE_CHECKING:
     from engine.interop.foxglove_live import FoxgloveLive
+    from engine.interop.ros2_bridge import Ros2Bridge
 
 log = logging.getLogger(__name__)
 Part = TypeVar("Part")
@@ -64,6 +65,17 @@ class RecordPlan:
 
     path: Path
     site: Site
+
+
+@dataclass(frozen=True)
+class Ros2Plan:
+    """Where the ROS 2 graph is: its Zenoh router (rmw_zenoh's ``tcp/127.0.0.1:7447``), or
+    a Zenoh config file in its place; the ROS domain; whether commands are taken from it."""
+
+    router: str = "tcp/127.0.0.1:7447"
+    domain: int = 0
+    commands: bool = False
+    config_file: str | None = None
 
 
 @dataclass
@@ -94,6 +106,10 @@ class SessionPlan:
     """Serve the session to Foxglove and Lichtblick on this loopback port (0: any free one)."""
     on_foxglove_up: Callable[[FoxgloveLive], None] | None = None
     """Told once Foxglove's server listens (to say its address)."""
+    ros2: Ros2Plan | None = None
+    """Join this ROS 2 graph (publish the session; take commands when it says so)."""
+    on_ros2_up: Callable[[Ros2Bridge], None] | None = None
+    """Told once the robot is on the graph."""
 
 
 @dataclass
@@ -107,6 +123,8 @@ class RunningSession:
     recorder: SessionRecorder | None = None
     foxglove: FoxgloveLive | None = None
     """Foxglove's live server, when asked for (its URL for the terminal)."""
+    ros2: Ros2Bridge | None = None
+    """The robot's node on a ROS 2 graph, when asked for."""
 
     def run(self, until_s: float) -> None:
         """Start every part in order, then tick the trees until ``until_s`` (clock
@@ -199,6 +217,22 @@ def _around(assembled: AssembledRobot, plan: SessionPlan) -> RunningSession:
         start_live = _telling(live.start, live, plan.on_foxglove_up)
         lifecycle.add("foxglove", start=start_live, stop=live.stop)
         session.subscribe(live)
+    if plan.ros2 is not None:
+        from engine.interop.ros2_bridge import Ros2Bridge  # the ros2 extra
+
+        started = float(plan.facts.get("started", "0") or 0)
+        bridge = Ros2Bridge(
+            plan.ros2, plan.clock, started - start_s, plan.consent, assembled.blackboard.catalogue
+        )
+        running.ros2 = bridge
+
+        def start_bridge() -> None:
+            bridge.start(assembled.blackboard)
+
+        lifecycle.add(
+            "ros2", start=_telling(start_bridge, bridge, plan.on_ros2_up), stop=bridge.stop
+        )
+        session.subscribe(bridge)
     player = ScenarioPlayer(
         plan.scenario, assembled.world, start_s=start_s, on_event=_world_events(session)
     )

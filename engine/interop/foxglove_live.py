@@ -12,7 +12,6 @@ connected clients.
 
 from __future__ import annotations
 
-import dataclasses
 import json
 import logging
 from typing import Any
@@ -22,65 +21,14 @@ import foxglove
 from engine.clock import Clock
 from engine.errors import ConfigError
 from engine.interop.session_formats import SCHEMAS
-from engine.recording.recorder import KEPT_AS_EVENTS
-from engine.services.telemetry import json_safe
-from engine.session.events import (
-    ActionEnded,
-    ActionStarted,
-    KeyChanged,
-    NodeStatus,
-    SessionEvent,
-    TreeStarted,
-    WorldEvent,
-)
+from engine.interop.session_topics import NodePaths, live_message
+from engine.session.events import SessionEvent, TreeStarted
 from engine.session.handoff import Handoff
 from engine.web.guard import is_loopback
 
 log = logging.getLogger(__name__)
 CAPACITY = 50_000
 """Events the queue holds before it drops (seconds of the busiest session)."""
-
-
-def live_message(
-    event: SessionEvent, paths: dict[tuple[str, int, int], tuple[str, str]]
-) -> tuple[str, str, dict[str, Any]] | None:
-    """(topic, schema, message) of a session event, as the MCAP export writes it; None for
-    what it does not carry."""
-    if isinstance(event, NodeStatus):
-        path, kind = paths.get((event.tree, event.version, event.node), ("", ""))
-        message = {
-            "tree": event.tree,
-            "version": event.version,
-            "tick": event.tick,
-            "node": event.node,
-            "path": path,
-            "type": kind,
-            "status": event.status,
-            "feedback": event.feedback,
-        }
-        return f"/vest/trees/{event.tree}/status", "vest.NodeStatus", message
-    if isinstance(event, KeyChanged):
-        message = {"key": event.key, "value": json_safe(event.value), "event": event.event}
-        return "/vest/blackboard", "vest.KeyChange", message
-    if isinstance(event, ActionStarted):
-        message = {"tree": event.tree, "action": event.action, "args": json_safe(event.args)}
-        return "/vest/actions", "vest.Action", message | {"outcome": None, "why": None}
-    if isinstance(event, ActionEnded):
-        message = {"tree": event.tree, "action": event.action, "args": json_safe(event.args)}
-        ended = {"outcome": event.outcome, "why": event.why or None}
-        return "/vest/actions/outcome", "vest.Action", message | ended
-    if isinstance(event, WorldEvent):
-        message = {"kind": event.scenario_event, "description": event.description}
-        return "/vest/world", "vest.WorldEvent", message
-    if event.kind in KEPT_AS_EVENTS:
-        data = {k: json_safe(v) for k, v in vars_of(event).items() if k not in ("t_s", "tree")}
-        message = {"kind": event.kind, "tree": str(getattr(event, "tree", "")), "data": data}
-        return "/vest/events", "vest.SessionEvent", message
-    return None
-
-
-def vars_of(event: SessionEvent) -> dict[str, Any]:
-    return {field.name: getattr(event, field.name) for field in dataclasses.fields(event)}
 
 
 class FoxgloveLive:
@@ -100,7 +48,7 @@ class FoxgloveLive:
         self._context = foxglove.Context()  # this session's channels alone, no global one
         self._server: Any = None
         self._channels: dict[str, foxglove.Channel] = {}
-        self._paths: dict[tuple[str, int, int], tuple[str, str]] = {}
+        self._paths: NodePaths = {}
         self._handoff = Handoff("foxglove", self._send, capacity=CAPACITY)
 
     def start(self) -> None:

@@ -1,0 +1,77 @@
+"""The options of `vest run` that open the session to other tools: Foxglove and Lichtblick
+(``--foxglove``) and a ROS 2 graph (``--ros2``, ``--ros2-commands``)."""
+
+from __future__ import annotations
+
+import argparse
+import os
+from typing import TYPE_CHECKING
+
+from engine.cli.output import tell
+from engine.cli.view_options import port_number
+from engine.composition.session_root import Ros2Plan
+from engine.errors import UsageError
+
+if TYPE_CHECKING:
+    from engine.interop.foxglove_live import FoxgloveLive
+    from engine.interop.ros2_bridge import Ros2Bridge
+
+ROUTER = "tcp/127.0.0.1:7447"
+"""Where rmw_zenoh's router (``ros2 run rmw_zenoh_cpp rmw_zenohd``) listens by default."""
+
+
+def add_interop_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--foxglove",
+        type=port_number,
+        nargs="?",
+        const=8766,
+        default=None,
+        metavar="PORT",
+        help="serve the live session to Foxglove (its WebSocket, protocol foxglove.sdk.v1) on "
+        "127.0.0.1:PORT (default 8766, beside the view's 8765; 0: any free port); needs "
+        "pip install 'vest-engine[foxglove]'",
+    )
+    parser.add_argument(
+        "--ros2",
+        nargs="?",
+        const=ROUTER,
+        default=None,
+        metavar="ROUTER",
+        help=f"join a ROS 2 graph that runs rmw_zenoh through its Zenoh router (default {ROUTER}"
+        "; ZENOH_SESSION_CONFIG_URI and ROS_DOMAIN_ID as ROS 2 reads them): the sensors, "
+        "actions and each tree's BehaviorTreeLog as ROS 2 topics (docs/interop.md); needs "
+        "pip install 'vest-engine[ros2]'",
+    )
+    parser.add_argument(
+        "--ros2-commands",
+        action="store_true",
+        help="also take commands (say, led, move, read) on /vest/command, carried out by the "
+        "iot_command tree as an operator's are; anyone on the graph may then send them",
+    )
+
+
+def ros2_plan(args: argparse.Namespace) -> Ros2Plan | None:
+    """The graph the options name (UsageError for a bad ROS_DOMAIN_ID or --ros2-commands
+    alone); None without --ros2."""
+    if args.ros2 is None:
+        if args.ros2_commands:
+            raise UsageError("--ros2-commands takes commands from a ROS 2 graph: add --ros2")
+        return None
+    domain_text = os.environ.get("ROS_DOMAIN_ID", "0").strip() or "0"
+    if not (domain_text.isascii() and domain_text.isdigit() and int(domain_text) <= 232):
+        raise UsageError(f"ROS_DOMAIN_ID={domain_text!r}: a number 0..232, as in ROS 2")
+    config_file = os.environ.get("ZENOH_SESSION_CONFIG_URI") or None
+    return Ros2Plan(args.ros2, int(domain_text), args.ros2_commands, config_file)
+
+
+def tell_foxglove(live: FoxgloveLive) -> None:
+    tell(f"foxglove: {live.url} (in Foxglove: Open connection, Foxglove WebSocket)")
+
+
+def tell_ros2(bridge: Ros2Bridge) -> None:
+    taking = "; commands on /vest/command" if bridge.plan.commands else ""
+    tell(
+        f"ros2: node /vest on domain {bridge.plan.domain} through {bridge.where}{taking} "
+        "(ros2 topic list, with RMW_IMPLEMENTATION=rmw_zenoh_cpp)"
+    )

@@ -1,0 +1,62 @@
+"""The live session as topics: each session event as the topic, schema name and JSON
+message that ``vest replay --to mcap`` writes for it, shared by Foxglove's live server and
+the ROS 2 bridge so a layout made on one works on the others."""
+
+from __future__ import annotations
+
+import dataclasses
+from typing import Any
+
+from engine.recording.recorder import KEPT_AS_EVENTS
+from engine.services.telemetry import json_safe
+from engine.session.events import (
+    ActionEnded,
+    ActionStarted,
+    KeyChanged,
+    NodeStatus,
+    SessionEvent,
+    WorldEvent,
+)
+
+NodePaths = dict[tuple[str, int, int], tuple[str, str]]
+"""(tree, version, node index) -> (the node's path, its type), from each TreeStarted."""
+
+
+def live_message(event: SessionEvent, paths: NodePaths) -> tuple[str, str, dict[str, Any]] | None:
+    """(topic, schema, message) of a session event, as the MCAP export writes it; None for
+    what it does not carry."""
+    if isinstance(event, NodeStatus):
+        path, kind = paths.get((event.tree, event.version, event.node), ("", ""))
+        message = {
+            "tree": event.tree,
+            "version": event.version,
+            "tick": event.tick,
+            "node": event.node,
+            "path": path,
+            "type": kind,
+            "status": event.status,
+            "feedback": event.feedback,
+        }
+        return f"/vest/trees/{event.tree}/status", "vest.NodeStatus", message
+    if isinstance(event, KeyChanged):
+        message = {"key": event.key, "value": json_safe(event.value), "event": event.event}
+        return "/vest/blackboard", "vest.KeyChange", message
+    if isinstance(event, ActionStarted):
+        message = {"tree": event.tree, "action": event.action, "args": json_safe(event.args)}
+        return "/vest/actions", "vest.Action", message | {"outcome": None, "why": None}
+    if isinstance(event, ActionEnded):
+        message = {"tree": event.tree, "action": event.action, "args": json_safe(event.args)}
+        ended = {"outcome": event.outcome, "why": event.why or None}
+        return "/vest/actions/outcome", "vest.Action", message | ended
+    if isinstance(event, WorldEvent):
+        message = {"kind": event.scenario_event, "description": event.description}
+        return "/vest/world", "vest.WorldEvent", message
+    if event.kind in KEPT_AS_EVENTS:
+        data = {k: json_safe(v) for k, v in vars_of(event).items() if k not in ("t_s", "tree")}
+        message = {"kind": event.kind, "tree": str(getattr(event, "tree", "")), "data": data}
+        return "/vest/events", "vest.SessionEvent", message
+    return None
+
+
+def vars_of(event: SessionEvent) -> dict[str, Any]:
+    return {field.name: getattr(event, field.name) for field in dataclasses.fields(event)}

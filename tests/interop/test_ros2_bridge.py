@@ -1,0 +1,320 @@
+"""A lab's ROS 2 graph sees the robot: `vest run --ros2` joins it as rmw_zenoh nodes do.
+
+The lab here is a Zenoh peer in the test process, listening as rmw_zenoh's router would,
+that reads what a ROS 2 node reads (the liveliness tokens of the graph, CDR messages on
+rmw_zenoh's key expressions, decoded with rosbags' ROS 2 types) and sends a command as
+`ros2 topic pub /vest/command std_msgs/msg/String` would.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+import socket
+import subprocess
+import sys
+import threading
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+zenoh = pytest.importorskip("zenoh")  # the ros2 extra
+
+from engine.blackboard.board import Blackboard  # noqa: E402
+from engine.blackboard.catalogue import (  # noqa: E402
+    FORCE_LEFT_N,
+    IOT_INBOX,
+    TOUCH_ANY,
+    default_catalogue,
+)
+from engine.clock import VirtualClock  # noqa: E402
+from engine.composition.session_root import Ros2Plan  # noqa: E402
+from engine.interop.ros2_bridge import Ros2Bridge  # noqa: E402
+from engine.interop.ros2_wire import Wire, attachment  # noqa: E402
+from engine.privacy.consent import Consent  # noqa: E402
+from engine.session.events import (  # noqa: E402
+    ActionStarted,
+    KeyChanged,
+    NodeInfo,
+    NodeStatus,
+    TreeStarted,
+)
+
+ROOT = Path(__file__).resolve().parents[2]
+VEST = [sys.executable, "-c", "import sys; from engine.cli import main; sys.exit(main())"]
+STRING_HASH = "RIHS01_df668c740482bbd48fb39d76a70dfd4bd59db1288021743503259e948f6b1a18"
+"""std_msgs/msg/String's type hash as ROS 2 Jazzy computes it (`ros2 topic info -v`)."""
+WAIT_S = 20.0
+WIRE = Wire()
+
+
+class Lab:
+    """A Zenoh peer that reads the graph as a ROS 2 node would."""
+
+    def __init__(self) -> None:
+        probe = socket.socket()
+        probe.bind(("127.0.0.1", 0))
+        self.endpoint = f"tcp/127.0.0.1:{probe.getsockname()[1]}"
+        probe.close()
+        config = zenoh.Config()
+        config.insert_json5("mode", '"peer"')
+        config.insert_json5("scouting/multicast/enabled", "false")
+        config.insert_json5("listen/endpoints", json.dumps([self.endpoint]))
+        self.session = zenoh.open(config)
+        self.samples: list[tuple[str, bytes, bytes | None]] = []
+        self.tokens: list[str] = []
+        self.arrived = threading.Condition()
+        self._subscriber = self.session.declare_subscriber("0/vest/**", self._sample)
+        self._tokens = self.session.liveliness().declare_subscriber(
+            "@ros2_lv/**", self._token, history=True
+        )
+
+    def _sample(self, sample: Any) -> None:
+        extra = sample.attachment.to_bytes() if sample.attachment is not None else None
+        with self.arrived:
+            self.samples.append((str(sample.key_expr), sample.payload.to_bytes(), extra))
+            self.arrived.notify_all()
+
+    def _token(self, sample: Any) -> None:
+        with self.arrived:
+            if sample.kind == zenoh.SampleKind.PUT:
+                self.tokens.append(str(sample.key_expr))
+            self.arrived.notify_all()
+
+    def messages(self, topic: str, typename: str) -> list[Any]:
+        """What has come on ``topic`` (as ROS 2 names it), decoded as ``typename``."""
+        prefix = f"0/{topic.lstrip('/')}/"
+        with self.arrived:
+            found = [payload for key, payload, _ in self.samples if key.startswith(prefix)]
+        return [WIRE.decode(typename, payload) for payload in found]
+
+    def wait_for(self, what: str, found: Any) -> Any:
+        """Waits (at most WAIT_S) until ``found()`` gives something, and returns it."""
+        with self.arrived:
+            result = self.arrived.wait_for(found, timeout=WAIT_S)
+        assert result, f"the lab never saw {what}"
+        return result
+
+    def results(self) -> list[dict[str, Any]]:
+        return [json.loads(m.data) for m in self.messages("/vest/command/result", STRING)]
+
+    def send(self, text: str) -> None:
+        """A command, as `ros2 topic pub /vest/command std_msgs/msg/String` sends it."""
+        key = f"0/vest/command/std_msgs::msg::dds_::String_/{STRING_HASH}"
+        payload = WIRE.encode(STRING, {"data": text})
+        self.session.put(key, payload, attachment=attachment(1, 0, bytes(16)))
+
+    def close(self) -> None:
+        self.session.close()
+
+
+STRING = "std_msgs/msg/String"
+
+
+@pytest.fixture
+def lab() -> Iterator[Lab]:
+    graph = Lab()
+    yield graph
+    graph.close()
+
+
+def bridge_on(
+    lab: Lab, *covers: str, commands: bool = False
+) -> tuple[Ros2Bridge, Blackboard, VirtualClock]:
+    clock = VirtualClock()
+    catalogue = default_catalogue()
+    consent = Consent("kid-17", frozenset(covers))
+    bridge = Ros2Bridge(Ros2Plan(lab.endpoint, 0, commands), clock, 1.7e9, consent, catalogue)
+    board = Blackboard(catalogue, clock)
+    bridge.start(board)
+    return bridge, board, clock
+
+
+HUG = TreeStarted(
+    0.0,
+    "hug",
+    1,
+    Path("trees/hug.yaml"),
+    (Path("trees/hug.yaml"),),
+    20.0,
+    50,
+    (NodeInfo(0, "hug", "Sequence", "Sequence", 0), NodeInfo(1, "hug/0", "IsSqueezed", "", 1)),
+    "",
+)
+
+
+def test_a_ros2_node_sees_vest_its_topics_and_each_tree_s_behavior_tree_log(lab: Lab) -> None:
+    bridge, _, _ = bridge_on(lab, "sensors", "cloud_telemetry")
+    try:
+        bridge.on_event(HUG)
+        bridge.on_event(NodeStatus(0.05, "hug", 1, 1, 1, "RUNNING", ""))
+        bridge.on_event(NodeStatus(0.10, "hug", 1, 2, 1, "SUCCESS", ""))
+        bridge.on_event(KeyChanged(0.10, FORCE_LEFT_N, 12.5, "12.5", False, "force"))
+        bridge.on_event(KeyChanged(0.10, TOUCH_ANY, True, "true", False, "touch"))
+        log_type = "nav2_msgs/msg/BehaviorTreeLog"
+        logs = lab.wait_for("hug's log", lambda: lab.messages("/vest/trees/hug/log", log_type))
+        force = lab.wait_for(
+            "the force", lambda: lab.messages("/vest/sensors/force/left_n", "std_msgs/msg/Float64")
+        )
+        touched = lab.wait_for(
+            "a touch", lambda: lab.messages("/vest/sensors/touch/any", "std_msgs/msg/Bool")
+        )
+        tokens = lab.wait_for(
+            "the node", lambda: [t for t in lab.tokens if t.endswith("/NN/%/%/vest")]
+        )
+    finally:
+        bridge.stop()
+    changes = [(c.node_name, c.uid, c.previous_status, c.current_status) for c in logs[0].event_log]
+    assert changes == [("hug/0", 2, "IDLE", "RUNNING"), ("hug/0", 2, "RUNNING", "SUCCESS")]
+    assert logs[0].event_log[0].timestamp.sec == 1_700_000_000
+    assert force[0].data == 12.5 and touched[0].data is True
+    assert tokens, "ros2 node list would not show /vest"
+    publishers = [t for t in lab.tokens if "/MP/" in t]
+    assert any(
+        "/%vest%sensors%force%left_n/std_msgs::msg::dds_::Float64_/RIHS01_" in t for t in publishers
+    )
+    with lab.arrived:
+        sequences = [extra for key, _, extra in lab.samples if "/trees/hug/log/" in key]
+    assert sequences[0] is not None and len(sequences[0]) == 8 + 8 + 1 + 16  # rmw_zenoh's
+
+
+def test_without_telemetry_consent_no_reading_leaves_the_robot(lab: Lab) -> None:
+    bridge, _, _ = bridge_on(lab, "sensors")  # may be recorded, never sent
+    try:
+        bridge.on_event(KeyChanged(0.1, FORCE_LEFT_N, 12.5, "12.5", False, "force"))
+        bridge.on_event(KeyChanged(0.1, "/devices/leds/color", "pink", '"pink"', False, "leds"))
+        lab.wait_for("the LEDs' color", lambda: lab.messages("/vest/devices/leds/color", STRING))
+    finally:
+        bridge.stop()
+    with lab.arrived:
+        assert not [key for key, _, _ in lab.samples if "/sensors/" in key]
+
+
+def test_a_command_from_the_graph_goes_the_cloud_s_way_and_its_result_comes_back(
+    lab: Lab,
+) -> None:
+    bridge, board, _ = bridge_on(lab, "sensors", "cloud_telemetry", commands=True)
+    try:
+        lab.wait_for("the command subscription", lambda: [t for t in lab.tokens if "/MS/" in t])
+        lab.send(json.dumps({"id": "wave-1", "type": "say", "args": {"text": "hello"}}))
+        lab.wait_for("the command taken", lab.results)
+        board.commit()
+        staged = board.event_log(IOT_INBOX).latest
+        assert staged is not None
+        assert staged.value == {"id": "ros2:wave-1", "type": "say", "args": {"text": "hello"}}
+        report = {"id": "ros2:wave-1", "status": "succeeded", "result": None}
+        bridge.on_event(ActionStarted(1.0, 7, "iot_command", "report", report))
+        results = lab.wait_for("the result", lambda: len(lab.results()) > 1 and lab.results())
+    finally:
+        bridge.stop()
+    assert [(r["id"], r["status"]) for r in results] == [
+        ("wave-1", "RECEIVED"),
+        ("wave-1", "SUCCEEDED"),
+    ]
+
+
+@pytest.mark.parametrize(
+    ("sent", "why"),
+    [
+        ("say hello", "not a std_msgs/String of JSON"),
+        ('["say"]', "a command is a JSON object"),
+        ('{"type": "dance"}', "type: one of say, led, move, read"),
+        ('{"type": "say", "args": {"text": "hi", "volume": 5}}', "'volume'"),
+        ('{"type": "led", "args": {"color": "blurple"}}', "unknown color"),
+        ('{"type": "say", "id": "../../x", "args": {"text": "hi"}}', "id: up to 64"),
+    ],
+)
+def test_a_command_the_robot_would_refuse_is_refused_at_once(lab: Lab, sent: str, why: str) -> None:
+    bridge, board, _ = bridge_on(lab, commands=True)
+    try:
+        lab.wait_for("the command subscription", lambda: [t for t in lab.tokens if "/MS/" in t])
+        lab.send(sent)
+        results = lab.wait_for("the refusal", lab.results)
+    finally:
+        bridge.stop()
+    assert results[0]["status"] == "REFUSED" and why in results[0]["result"]["error"]
+    board.commit()
+    assert board.event_log(IOT_INBOX).latest is None
+
+
+def test_a_read_without_telemetry_consent_answers_failed_never_the_reading(lab: Lab) -> None:
+    bridge, _, _ = bridge_on(lab, "sensors", commands=True)
+    try:
+        lab.wait_for("the command subscription", lambda: [t for t in lab.tokens if "/MS/" in t])
+        lab.send(json.dumps({"id": "r1", "type": "read", "args": {"sensor": "force"}}))
+        lab.wait_for("the command taken", lab.results)
+        reading = {FORCE_LEFT_N: 12.5}
+        report = {"id": "ros2:r1", "status": "succeeded", "result": reading}
+        bridge.on_event(ActionStarted(1.0, 7, "iot_command", "report", report))
+        results = lab.wait_for("the result", lambda: len(lab.results()) > 1 and lab.results())
+    finally:
+        bridge.stop()
+    assert results[1]["status"] == "FAILED" and "12.5" not in json.dumps(results[1])
+
+
+def test_without_ros2_commands_the_robot_takes_none(lab: Lab) -> None:
+    bridge, board, _ = bridge_on(lab)
+    try:
+        bridge.on_event(KeyChanged(0.1, "/devices/leds/color", "pink", '"pink"', False, "leds"))
+        lab.wait_for("the node's first topic", lambda: [t for t in lab.tokens if "/MP/" in t])
+        lab.send(json.dumps({"type": "say", "args": {"text": "hello"}}))
+    finally:
+        bridge.stop()
+    assert not [t for t in lab.tokens if "/MS/" in t]  # nobody listens on /vest/command
+    board.commit()
+    assert board.event_log(IOT_INBOX).latest is None
+
+
+def test_vest_run_carries_out_a_say_sent_from_the_graph(lab: Lab) -> None:
+    on_the_graph = ["--ros2", lab.endpoint, "--ros2-commands"]
+    robot = subprocess.Popen(
+        [*VEST, "run", "--speech", "text", "--duration", "20", *on_the_graph],
+        cwd=ROOT,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        assert robot.stderr is not None
+        said = next(line for line in robot.stderr if line.startswith("ros2: "))
+        assert "node /vest on domain 0" in said and "commands on /vest/command" in said
+        lab.wait_for("the command subscription", lambda: [t for t in lab.tokens if "/MS/" in t])
+        lab.send(json.dumps({"id": "hello-1", "type": "say", "args": {"text": "hello there"}}))
+        results = lab.wait_for("the say's result", lambda: len(lab.results()) > 1 and lab.results())
+        log_type = "nav2_msgs/msg/BehaviorTreeLog"
+        iot_log = lab.messages("/vest/trees/iot_command/log", log_type)
+    finally:
+        robot.terminate()
+        robot.wait(timeout=60)
+    assert [(r["id"], r["status"]) for r in results[:2]] == [
+        ("hello-1", "RECEIVED"),
+        ("hello-1", "SUCCEEDED"),
+    ]
+    assert any(c.current_status == "SUCCESS" for m in iot_log for c in m.event_log)
+
+
+@pytest.mark.parametrize(
+    ("options", "environment", "said"),
+    [
+        (["--ros2", "nonsense"], {}, r"--ros2 nonsense: Zenoh cannot use it"),
+        (["--ros2-commands"], {}, r"--ros2-commands .* add --ros2"),
+        (["--ros2"], {"ROS_DOMAIN_ID": "abc"}, r"ROS_DOMAIN_ID='abc': a number 0..232"),
+        (["--ros2"], {"ZENOH_SESSION_CONFIG_URI": "/no/such.json5"}, r"Zenoh cannot use it"),
+    ],
+)
+def test_a_graph_vest_cannot_join_is_named_in_one_line(
+    options: list[str], environment: dict[str, str], said: str
+) -> None:
+    done = subprocess.run(
+        [*VEST, "run", "--fast", "--duration", "1", *options],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        env=os.environ | environment,
+        timeout=120,
+    )
+    assert done.returncode != 0
+    assert re.search(said, done.stderr) and "Traceback" not in done.stderr
