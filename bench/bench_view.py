@@ -1,10 +1,12 @@
 """What watching and recording cost the robot: tick lateness and tick time with the live
 view (a page connected and reading every change), with Foxglove's live server (a client
-subscribed to every topic, reading every message) and with a recording, against the same
-run with none of them, in one run.
+subscribed to every topic, reading every message), on a ROS 2 graph (``--ros2``: a Zenoh
+peer of this process reading every message, the person's consent covering sensors and
+telemetry so everything is sent) and with a recording, against the same run with none of
+them, in one run.
 
 Run: ``.venv/bin/python bench/bench_view.py`` (``--seconds S``, ``--rounds N``); about
-3 minutes with the defaults (4 ways x 2 rounds x 20 s).
+4 minutes with the defaults (5 ways x 2 rounds x 20 s).
 
 Each run is ``vest run --speech text`` on the demo scenario in real time (every tree of
 trees/, the simulated vest with its poller threads), ``--duration S``; the ways are
@@ -72,7 +74,32 @@ def read_foxglove(address: str, counted: list[int], stop: threading.Event) -> No
                 client.send(json.dumps({"op": "subscribe", "subscriptions": wanted}))
 
 
-def run(way: str, seconds: float, folder: Path) -> dict[str, float]:
+class RosGraph:
+    """A Zenoh peer that listens as rmw_zenoh's router would and counts what the robot
+    publishes (the ros2 extra)."""
+
+    def __init__(self) -> None:
+        import socket
+
+        import zenoh
+
+        probe = socket.socket()
+        probe.bind(("127.0.0.1", 0))
+        self.endpoint = f"tcp/127.0.0.1:{probe.getsockname()[1]}"
+        probe.close()
+        config = zenoh.Config()
+        config.insert_json5("mode", '"peer"')
+        config.insert_json5("scouting/multicast/enabled", "false")
+        config.insert_json5("listen/endpoints", json.dumps([self.endpoint]))
+        self.session = zenoh.open(config)
+        self.counted = [0]
+        self._subscriber = self.session.declare_subscriber("0/vest/**", self._count)
+
+    def _count(self, sample: object) -> None:
+        self.counted[0] += 1
+
+
+def run(way: str, seconds: float, folder: Path, graph: RosGraph | None = None) -> dict[str, float]:
     """One run of ``way``; a recording goes to a new file in ``folder`` (vest never
     replaces an earlier session)."""
     args = [*VEST, "run", "--speech", "text", "--duration", str(seconds)]
@@ -82,6 +109,9 @@ def run(way: str, seconds: float, folder: Path) -> dict[str, float]:
         args += ["--view", "--view-port", "0"]
     if way == "foxglove":
         args += ["--foxglove", "0"]
+    if way == "ros2" and graph is not None:
+        args += ["--ros2", graph.endpoint, "--person", "bench-1"]
+        graph.counted[0] = 0
     site = {"VEST_DATA": str(folder.parent / "site")}  # a site of its own: its key, its index
     process = subprocess.Popen(
         args,
@@ -106,6 +136,8 @@ def run(way: str, seconds: float, folder: Path) -> dict[str, float]:
                 break
     out, err = process.communicate(timeout=seconds + 120)
     stop.set()
+    if graph is not None and way == "ros2":
+        counted = graph.counted
     rows = ROW.findall(out)
     if not rows:
         raise SystemExit(f"no statistics from vest run ({way}):\n{out[-2000:]}{err[-2000:]}")
@@ -126,14 +158,19 @@ def main() -> None:
     args = parser.parse_args()
     if args.quick:
         args.seconds, args.rounds = 3.0, 1
-    ways = ("plain", "record", "view", "foxglove")
+    ways = ("plain", "record", "view", "foxglove", "ros2")
     results: dict[str, list[dict[str, float]]] = {way: [] for way in ways}
+    graph = RosGraph()
     with tempfile.TemporaryDirectory() as scratch:
         folder = Path(scratch) / "recordings"
         folder.mkdir()
+        site = {"VEST_DATA": str(folder.parent / "site")}
+        covers = ["--covers", "sensors,speech_text,cloud_telemetry"]
+        consent = [*VEST, "data", "consent", "bench-1", "--given-by", "bench", *covers]
+        subprocess.run(consent, cwd=ROOT, env={**os.environ, **site}, check=True)
         for round_number in range(args.rounds):
             for way in ways:
-                results[way].append(run(way, args.seconds, folder))
+                results[way].append(run(way, args.seconds, folder, graph))
                 print(f"round {round_number + 1} {way:7} {results[way][-1]}", flush=True)
     base = {key: statistics.median(r[key] for r in results["plain"]) for key in results["plain"][0]}
     print(f"\nworst tree over {args.rounds} rounds of {args.seconds:g} s (median of rounds)")

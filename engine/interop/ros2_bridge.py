@@ -31,6 +31,7 @@ A session reader: the scheduler's thread only hands each event over
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import logging
 import re
@@ -61,6 +62,7 @@ from engine.recording.kept_by_consent import VISION_PREFIX, KeptByConsent
 from engine.remote_commands import COMMAND_TYPES, command_problem
 from engine.services.telemetry import WITHHELD, carries_sensor_values, json_safe
 from engine.session.events import (
+    ActionEnded,
     ActionStarted,
     KeyChanged,
     NodeStatus,
@@ -169,6 +171,12 @@ class Ros2Bridge:
             kept = self._keeps.kept(event)
             if kept is None:
                 continue
+            if (
+                isinstance(kept, ActionStarted | ActionEnded)
+                and not self.telemetry_allowed
+                and carries_sensor_values(kept.args)
+            ):  # a read's result, reported: not without consent
+                kept = dataclasses.replace(kept, args={"result": WITHHELD})
             if isinstance(kept, TreeStarted):
                 for node in kept.nodes:
                     self._paths[(kept.tree, kept.version, node.index)] = (node.path, node.type)

@@ -67,7 +67,7 @@ class TelemetrySnapshot:
             return dict(self._values)
 
 
-WITHHELD = "not sent: the person's consent does not cover sensor readings sent to the cloud"
+WITHHELD = "not sent: the person's consent does not cover sensor readings sent off the robot"
 """A command's result that carries sensor values, when the person did not consent."""
 
 

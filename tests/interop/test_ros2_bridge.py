@@ -250,9 +250,11 @@ def test_a_read_without_telemetry_consent_answers_failed_never_the_reading(lab: 
         report = {"id": "ros2:r1", "status": "succeeded", "result": reading}
         bridge.on_event(ActionStarted(1.0, 7, "iot_command", "report", report))
         results = lab.wait_for("the result", lambda: len(lab.results()) > 1 and lab.results())
+        actions = lab.wait_for("the report", lambda: lab.messages("/vest/actions", STRING))
     finally:
         bridge.stop()
     assert results[1]["status"] == "FAILED" and "12.5" not in json.dumps(results[1])
+    assert "12.5" not in actions[0].data and "consent does not cover" in actions[0].data
 
 
 def test_without_ros2_commands_the_robot_takes_none(lab: Lab) -> None:
