@@ -9,15 +9,12 @@ from typing import TYPE_CHECKING
 
 from engine.cli.output import tell
 from engine.cli.view_options import port_number
-from engine.composition.session_root import Ros2Plan
 from engine.errors import UsageError
+from engine.interop.ros2_plan import ROUTER, Ros2Plan
 
 if TYPE_CHECKING:
     from engine.interop.foxglove_live import FoxgloveLive
     from engine.interop.ros2_bridge import Ros2Bridge
-
-ROUTER = "tcp/127.0.0.1:7447"
-"""Where rmw_zenoh's router (``ros2 run rmw_zenoh_cpp rmw_zenohd``) listens by default."""
 
 
 def add_interop_arguments(parser: argparse.ArgumentParser) -> None:

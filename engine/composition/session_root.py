@@ -25,6 +25,7 @@ from engine.buttons.wizard import Wizard
 from engine.clock import Clock
 from engine.errors import ConfigError
 from engine.hardware.config import RobotConfig
+from engine.interop.ros2_plan import Ros2Plan
 from engine.privacy.consent import Consent, without_record
 from engine.privacy.sealed_sqlite import Error as SealedError
 from engine.privacy.site import Site
@@ -65,17 +66,6 @@ class RecordPlan:
 
     path: Path
     site: Site
-
-
-@dataclass(frozen=True)
-class Ros2Plan:
-    """Where the ROS 2 graph is: its Zenoh router (rmw_zenoh's ``tcp/127.0.0.1:7447``), or
-    a Zenoh config file in its place; the ROS domain; whether commands are taken from it."""
-
-    router: str = "tcp/127.0.0.1:7447"
-    domain: int = 0
-    commands: bool = False
-    config_file: str | None = None
 
 
 @dataclass

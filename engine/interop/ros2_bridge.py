@@ -44,8 +44,8 @@ from engine.blackboard.board import Blackboard
 from engine.blackboard.catalogue import DEVICES_PREFIX, IOT_INBOX, SENSORS_PREFIX, KeyCatalogue
 from engine.blackboard.events import EventLog
 from engine.clock import Clock
-from engine.composition.session_root import Ros2Plan
 from engine.errors import ConfigError
+from engine.interop.ros2_plan import Ros2Plan
 from engine.interop.ros2_wire import (
     Endpoint,
     NodeName,
@@ -138,12 +138,12 @@ class Ros2Bridge:
         if self.plan.commands:
             command = self.wire.endpoint(COMMAND_TOPIC, STRING)
             entity = self._next_entity()
-            token = command.token(self.plan.domain, self._zid, self.node, entity, "MS")
-            self._tokens.append(self._declare_token(token))
+            self._publisher(RESULT_TOPIC, STRING)  # declared now: a sender can wait for it
             self._tokens.append(
                 self._session.declare_subscriber(command.key(self.plan.domain), self._command_in)
-            )
-            self._publisher(RESULT_TOPIC, STRING)  # declared now: a sender can wait for it
+            )  # then its token: a node that sees the token finds the subscriber there
+            token = command.token(self.plan.domain, self._zid, self.node, entity, "MS")
+            self._tokens.append(self._declare_token(token))
         self._handoff.start()
 
     @property

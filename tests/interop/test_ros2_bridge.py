@@ -31,8 +31,8 @@ from engine.blackboard.catalogue import (  # noqa: E402
     default_catalogue,
 )
 from engine.clock import VirtualClock  # noqa: E402
-from engine.composition.session_root import Ros2Plan  # noqa: E402
 from engine.interop.ros2_bridge import Ros2Bridge  # noqa: E402
+from engine.interop.ros2_plan import Ros2Plan  # noqa: E402
 from engine.interop.ros2_wire import Wire, attachment  # noqa: E402
 from engine.privacy.consent import Consent  # noqa: E402
 from engine.session.events import (  # noqa: E402
@@ -47,7 +47,7 @@ ROOT = Path(__file__).resolve().parents[2]
 VEST = [sys.executable, "-c", "import sys; from engine.cli import main; sys.exit(main())"]
 STRING_HASH = "RIHS01_df668c740482bbd48fb39d76a70dfd4bd59db1288021743503259e948f6b1a18"
 """std_msgs/msg/String's type hash as ROS 2 Jazzy computes it (`ros2 topic info -v`)."""
-WAIT_S = 20.0
+WAIT_S = 30.0
 WIRE = Wire()
 
 
@@ -273,7 +273,7 @@ def test_without_ros2_commands_the_robot_takes_none(lab: Lab) -> None:
 def test_vest_run_carries_out_a_say_sent_from_the_graph(lab: Lab) -> None:
     on_the_graph = ["--ros2", lab.endpoint, "--ros2-commands"]
     robot = subprocess.Popen(
-        [*VEST, "run", "--speech", "text", "--duration", "20", *on_the_graph],
+        [*VEST, "run", "--speech", "text", "--duration", "60", *on_the_graph],
         cwd=ROOT,
         stdout=subprocess.DEVNULL,
         stderr=subprocess.PIPE,
