@@ -148,6 +148,27 @@ def run(way: str, seconds: float, folder: Path, graph: RosGraph | None = None) -
     }
 
 
+def measure(
+    ways: tuple[str, ...],
+    results: dict[str, list[dict[str, float]]],
+    graph: RosGraph,
+    seconds: float,
+    rounds: int,
+) -> None:
+    """Every way, round by round (interleaved: a busy machine hurts them alike)."""
+    with tempfile.TemporaryDirectory() as scratch:
+        folder = Path(scratch) / "recordings"
+        folder.mkdir()
+        site = {"VEST_DATA": str(folder.parent / "site")}
+        covers = ["--covers", "sensors,speech_text,cloud_telemetry"]
+        consent = [*VEST, "data", "consent", "bench-1", "--given-by", "bench", *covers]
+        subprocess.run(consent, cwd=ROOT, env={**os.environ, **site}, check=True)
+        for round_number in range(rounds):
+            for way in ways:
+                results[way].append(run(way, seconds, folder, graph))
+                print(f"round {round_number + 1} {way:7} {results[way][-1]}", flush=True)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seconds", type=float, default=20.0, help="each run's length")
@@ -161,17 +182,10 @@ def main() -> None:
     ways = ("plain", "record", "view", "foxglove", "ros2")
     results: dict[str, list[dict[str, float]]] = {way: [] for way in ways}
     graph = RosGraph()
-    with tempfile.TemporaryDirectory() as scratch:
-        folder = Path(scratch) / "recordings"
-        folder.mkdir()
-        site = {"VEST_DATA": str(folder.parent / "site")}
-        covers = ["--covers", "sensors,speech_text,cloud_telemetry"]
-        consent = [*VEST, "data", "consent", "bench-1", "--given-by", "bench", *covers]
-        subprocess.run(consent, cwd=ROOT, env={**os.environ, **site}, check=True)
-        for round_number in range(args.rounds):
-            for way in ways:
-                results[way].append(run(way, args.seconds, folder, graph))
-                print(f"round {round_number + 1} {way:7} {results[way][-1]}", flush=True)
+    try:
+        measure(ways, results, graph, args.seconds, args.rounds)
+    finally:
+        graph.session.close()  # its threads would keep the process alive
     base = {key: statistics.median(r[key] for r in results["plain"]) for key in results["plain"][0]}
     print(f"\nworst tree over {args.rounds} rounds of {args.seconds:g} s (median of rounds)")
     print(f"{'':8} {'tick p99 ms':>12} {'late p99 ms':>12} {'changes read':>13}")

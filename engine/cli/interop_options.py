@@ -5,6 +5,9 @@ from __future__ import annotations
 
 import argparse
 import os
+import re
+import stat
+from pathlib import Path
 from typing import TYPE_CHECKING
 
 from engine.cli.output import tell
@@ -15,6 +18,13 @@ from engine.interop.ros2_plan import ROUTER, Ros2Plan
 if TYPE_CHECKING:
     from engine.interop.foxglove_live import FoxgloveLive
     from engine.interop.ros2_bridge import Ros2Bridge
+
+
+_ENDPOINT = re.compile(
+    r"(tcp|udp|tls|quic)/[A-Za-z0-9.\-]+:\d{1,5}|(tcp|udp|tls|quic)/\[[0-9A-Fa-f:.]+\]:\d{1,5}"
+)
+"""A router's endpoint: protocol/host:port (an IPv6 host in brackets)."""
+CONFIG_AT_MOST_BYTES = 1_000_000
 
 
 def add_interop_arguments(parser: argparse.ArgumentParser) -> None:
@@ -55,11 +65,31 @@ def ros2_plan(args: argparse.Namespace) -> Ros2Plan | None:
         if args.ros2_commands:
             raise UsageError("--ros2-commands takes commands from a ROS 2 graph: add --ros2")
         return None
+    if not _ENDPOINT.fullmatch(args.ros2) or not 0 < int(args.ros2.rpartition(":")[2]) < 65536:
+        raise UsageError(
+            f"--ros2 {args.ros2!r}: the router's Zenoh endpoint, like tcp/192.168.1.20:7447 "
+            "(tcp, udp, tls or quic; a port 1..65535)"
+        )
     domain_text = os.environ.get("ROS_DOMAIN_ID", "0").strip() or "0"
     if not (domain_text.isascii() and domain_text.isdigit() and int(domain_text) <= 232):
         raise UsageError(f"ROS_DOMAIN_ID={domain_text!r}: a number 0..232, as in ROS 2")
     config_file = os.environ.get("ZENOH_SESSION_CONFIG_URI") or None
+    if config_file is not None:
+        _check_config_file(Path(config_file))
     return Ros2Plan(args.ros2, int(domain_text), args.ros2_commands, config_file)
+
+
+def _check_config_file(path: Path) -> None:
+    """A Zenoh config file Zenoh may read: a file of at most CONFIG_AT_MOST_BYTES."""
+    where = f"ZENOH_SESSION_CONFIG_URI={path}"
+    try:
+        found = path.stat()
+    except OSError as error:
+        raise UsageError(f"{where}: cannot read it ({error.strerror})") from None
+    if not stat.S_ISREG(found.st_mode):
+        raise UsageError(f"{where}: not a file (a Zenoh config file, JSON5)")
+    if found.st_size > CONFIG_AT_MOST_BYTES:
+        raise UsageError(f"{where}: {found.st_size} bytes; a Zenoh config is a few kB")
 
 
 def tell_foxglove(live: FoxgloveLive) -> None:
@@ -72,3 +102,10 @@ def tell_ros2(bridge: Ros2Bridge) -> None:
         f"ros2: node /vest on domain {bridge.plan.domain} through {bridge.where}{taking} "
         "(ros2 topic list, with RMW_IMPLEMENTATION=rmw_zenoh_cpp)"
     )
+    sent = (
+        "sensor readings too (consent covers sensors and cloud_telemetry)"
+        if bridge.readings_leave
+        else "the robot's own account only, no reading and no heard word (no consent to "
+        "sensors and cloud_telemetry)"
+    )
+    tell(f"ros2: sends {sent}")

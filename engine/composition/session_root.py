@@ -20,6 +20,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, TypeVar
 
+from engine.blackboard.catalogue import IOT_INBOX
 from engine.buttons.button_file import ButtonBoard
 from engine.buttons.wizard import Wizard
 from engine.clock import Clock
@@ -210,6 +211,12 @@ def _around(assembled: AssembledRobot, plan: SessionPlan) -> RunningSession:
     if plan.ros2 is not None:
         from engine.interop.ros2_bridge import Ros2Bridge  # the ros2 extra
 
+        if plan.ros2.commands and not _takes_commands(plan.behaviors):
+            raise ConfigError(
+                "--ros2-commands: no tree carries commands out (the iot_command tree, "
+                "trees/iot_command.yaml, reads /iot/inbox): add it to --trees"
+            )
+
         started = float(plan.facts.get("started", "0") or 0)
         bridge = Ros2Bridge(
             plan.ros2, plan.clock, started - start_s, plan.consent, assembled.blackboard.catalogue
@@ -266,6 +273,15 @@ def _telling(
             told(part)
 
     return start_and_tell
+
+
+def _takes_commands(behaviors: Behaviors) -> bool:
+    """Whether a tree reads the commands staged on /iot/inbox."""
+    return any(
+        IOT_INBOX in node.args.values()
+        for definition in behaviors.trees
+        for node in definition.root.walk()
+    )
 
 
 def _nothing() -> None:

@@ -13,17 +13,15 @@ installed. It publishes:
   ``vest replay --to mcap`` (``/vest/actions``, ``/vest/actions/outcome``, ``/vest/world``,
   ``/vest/events``) as ``std_msgs/String`` holding the same JSON.
 
-What leaves the robot follows the person's consent as the cloud's telemetry does: without
-``cloud_telemetry``, the robot's own account only (statuses, actions, devices), never a
-sensor reading nor a heard word; with it, what a recording of them would keep.
+What leaves the robot follows the person's consent, as the cloud's telemetry does: without
+``cloud_telemetry`` (or without ``sensors``) only the robot's own account: its trees'
+statuses, which actions it took and how they ended (not their arguments: what it said or
+where it looked can tell a reading), its devices; never a reading, a heard word, the
+world's or the session's events. With both, what a recording of the person keeps.
 
 Commands, only when asked for (``--ros2-commands``: a ROS 2 graph has no accounts, so
-anyone on it may then command the robot): a ``std_msgs/String`` on ``/vest/command``
-holding ``{"type": "say"|"led"|"move"|"read", "args": {...}, "id": "..."}`` goes the cloud's
-way, checked as the cloud checks it, then staged on ``/iot/inbox`` for the iot_command tree
-(its checks, and the safety envelope, as for an operator's); how it ended comes back on
-``/vest/command/result``. Never raw actuator access: a robot without the iot_command tree
-carries nothing out.
+anyone on it may then command the robot), go the cloud's way
+(:mod:`engine.interop.ros2_commands`): never raw actuator access.
 
 A session reader: the scheduler's thread only hands each event over
 (:class:`~engine.session.handoff.Handoff`); a thread beside it publishes.
@@ -34,17 +32,17 @@ from __future__ import annotations
 import dataclasses
 import json
 import logging
-import re
 import threading
 from typing import Any
 
 import zenoh
 
 from engine.blackboard.board import Blackboard
-from engine.blackboard.catalogue import DEVICES_PREFIX, IOT_INBOX, SENSORS_PREFIX, KeyCatalogue
+from engine.blackboard.catalogue import DEVICES_PREFIX, SENSORS_PREFIX, KeyCatalogue
 from engine.blackboard.events import EventLog
 from engine.clock import Clock
 from engine.errors import ConfigError
+from engine.interop.ros2_commands import GraphCommands
 from engine.interop.ros2_plan import Ros2Plan
 from engine.interop.ros2_wire import (
     Endpoint,
@@ -57,10 +55,10 @@ from engine.interop.ros2_wire import (
     session_config,
 )
 from engine.interop.session_topics import NodePaths, live_message
+from engine.periodic import Periodic
 from engine.privacy.consent import Consent
 from engine.recording.kept_by_consent import VISION_PREFIX, KeptByConsent
-from engine.remote_commands import COMMAND_TYPES, command_problem
-from engine.services.telemetry import WITHHELD, carries_sensor_values, json_safe
+from engine.services.telemetry import json_safe
 from engine.session.events import (
     ActionEnded,
     ActionStarted,
@@ -68,6 +66,7 @@ from engine.session.events import (
     NodeStatus,
     SessionEvent,
     TreeStarted,
+    TurnTaken,
 )
 from engine.session.handoff import Handoff
 
@@ -76,14 +75,12 @@ CAPACITY = 50_000
 """Events the queue holds before it drops (seconds of the busiest session)."""
 PUBLISHED_KEYS = (SENSORS_PREFIX, VISION_PREFIX, "/speech/", DEVICES_PREFIX)
 COMMAND_TOPIC, RESULT_TOPIC = "/vest/command", "/vest/command/result"
-STRING, BOOL, FLOAT = "std_msgs/msg/String", "std_msgs/msg/Bool", "std_msgs/msg/Float64"
+STRING, BOOL = "std_msgs/msg/String", "std_msgs/msg/Bool"
+FLOAT, INTEGER = "std_msgs/msg/Float64", "std_msgs/msg/Int64"
 TREE_LOG = "nav2_msgs/msg/BehaviorTreeLog"
-AT_MOST_WAITING = 8
-"""Commands from the graph carried out or waiting at once; more are refused (a flood)."""
-WAITING_AT_MOST_S = 65.0
-"""A command whose result has not come in this long is forgotten (CarryOut gives up after
-60 s; a tree cut off never reports)."""
-_COMMAND_ID = re.compile(r"[A-Za-z0-9_.:-]{1,64}")
+CLOSING_AT_MOST_S = 2.0
+"""How long stopping waits for Zenoh to close (a router that took the connection and
+never answers would hold it for its 10 s handshake)."""
 BT_STATUS = {"INVALID": "IDLE", "RUNNING": "RUNNING", "SUCCESS": "SUCCESS", "FAILURE": "FAILURE"}
 
 
@@ -102,32 +99,29 @@ class Ros2Bridge:
         turns the clock's seconds into seconds since the epoch (ROS time)."""
         self.plan, self.clock, self.epoch_offset_s = plan, clock, epoch_offset_s
         self.catalogue = catalogue
-        self.telemetry_allowed = consent.allows("cloud_telemetry")
-        leaving = consent.covers if self.telemetry_allowed else consent.covers - {"sensors"}
-        if not self.telemetry_allowed:
-            leaving -= {"speech_text"}
-        self._keeps = KeptByConsent(Consent(consent.person, frozenset(leaving)))
+        self.readings_leave = consent.allows("cloud_telemetry") and consent.allows("sensors")
+        """Whether readings (and, with speech_text, heard words) may leave the robot."""
+        self._keeps = KeptByConsent(consent)
         self.node = NodeName("vest")
         self.wire = Wire()
-        self.blackboard: Blackboard | None = None
         self._session: zenoh.Session | None = None
         self._zid = ""
         self._tokens: list[Any] = []  # liveliness tokens, kept while the bridge runs
-        self._publishers: dict[str, tuple[Endpoint, Any, bytes]] = {}
-        self._sequence: dict[str, int] = {}
+        self._publishers: dict[tuple[str, str], tuple[Endpoint, Any, bytes]] = {}
+        self._sequence: dict[tuple[str, str], int] = {}
         self._paths: NodePaths = {}
         self._statuses: dict[tuple[str, int, int], str] = {}
-        self._waiting: dict[str, float] = {}  # command id -> when it was staged (clock s)
-        self._lock = threading.Lock()  # publishers and waiting commands, two threads
-        self._count = 0  # commands taken, for those sent without an id
+        self._lock = threading.Lock()  # the publishers: two threads publish
         self._entities = 0  # the node's publishers and subscriptions, numbered
         self._handoff = Handoff("ros2", self._send, capacity=CAPACITY)
+        self.commands = GraphCommands(clock, self._tell, readings_may_leave=self.readings_leave)
+        self._sweep = Periodic(clock, 1.0, self.commands.sweep, name="ros2-commands")
 
     # -- lifecycle -----------------------------------------------------------------------
     def start(self, blackboard: Blackboard) -> None:
         """Joins the graph (ConfigError for a router address or file Zenoh cannot use; a
         router not up yet is tried again by Zenoh meanwhile) and starts publishing."""
-        self.blackboard = blackboard
+        self.commands.blackboard = blackboard
         try:
             self._session = zenoh.open(session_config(self.plan.router, self.plan.config_file))
         except zenoh.ZError as error:
@@ -144,6 +138,7 @@ class Ros2Bridge:
             )  # then its token: a node that sees the token finds the subscriber there
             token = command.token(self.plan.domain, self._zid, self.node, entity, "MS")
             self._tokens.append(self._declare_token(token))
+            self._sweep.start()
         self._handoff.start()
 
     @property
@@ -155,9 +150,17 @@ class Ros2Bridge:
         self._handoff.put(event)
 
     def stop(self) -> None:
+        """Publishes what is queued, tells commands still waiting LOST, leaves the graph
+        (its tokens go: the graph sees the node leave), waiting for Zenoh at most
+        CLOSING_AT_MOST_S."""
         self._handoff.close()
+        if self._sweep.running:
+            self._sweep.stop()
         if self._session is not None:
-            self._session.close()  # type: ignore[no-untyped-call]  # its tokens go: the graph sees the node leave
+            self.commands.stopped()
+            closing = threading.Thread(target=self._session.close, name="ros2-close", daemon=True)
+            closing.start()
+            closing.join(CLOSING_AT_MOST_S)
             self._session = None
         if self._handoff.dropped:
             log.warning("ros2: %d events were dropped", self._handoff.dropped)
@@ -167,16 +170,10 @@ class Ros2Bridge:
         logs: dict[str, list[dict[str, Any]]] = {}
         for event in events:
             if isinstance(event, ActionStarted) and event.action == "report":
-                self._result(event)
-            kept = self._keeps.kept(event)
+                self.commands.reported(event)
+            kept = self._leaving(event)
             if kept is None:
                 continue
-            if (
-                isinstance(kept, ActionStarted | ActionEnded)
-                and not self.telemetry_allowed
-                and carries_sensor_values(kept.args)
-            ):  # a read's result, reported: not without consent
-                kept = dataclasses.replace(kept, args={"result": WITHHELD})
             if isinstance(kept, TreeStarted):
                 for node in kept.nodes:
                     self._paths[(kept.tree, kept.version, node.index)] = (node.path, node.type)
@@ -195,14 +192,22 @@ class Ros2Bridge:
             stamp = ros_time(now_s + self.epoch_offset_s)
             topic = ros_name(f"/vest/trees/{tree}/log")
             self._publish(topic, TREE_LOG, {"timestamp": stamp, "event_log": changes}, now_s)
-        with self._lock:
-            lost = [key for key, at_s in self._waiting.items() if now_s - at_s > WAITING_AT_MOST_S]
-            for command_id in lost:
-                del self._waiting[command_id]
-        for command_id in lost:
-            why = f"no result in {WAITING_AT_MOST_S:.0f} s: is the iot_command tree running?"
-            self._tell(command_id, "LOST", {"error": why})
         return True
+
+    def _leaving(self, event: SessionEvent) -> SessionEvent | None:
+        """What of ``event`` may leave the robot (None: nothing), by the person's consent."""
+        kept = self._keeps.kept(event)
+        if kept is None or self.readings_leave:
+            return kept
+        if isinstance(kept, ActionStarted):  # the act, not what it carried
+            return dataclasses.replace(kept, args={})
+        if isinstance(kept, ActionEnded):
+            return dataclasses.replace(kept, args={}, why="")
+        if isinstance(kept, TreeStarted | NodeStatus | TurnTaken):
+            return kept
+        if isinstance(kept, KeyChanged) and kept.key.startswith(DEVICES_PREFIX):
+            return kept
+        return None
 
     def _status_change(self, event: NodeStatus) -> dict[str, Any]:
         where = (event.tree, event.version, event.node)
@@ -231,21 +236,11 @@ class Ros2Bridge:
             self._publish(topic, FLOAT, {"data": float(value)}, event.t_s)
         elif declared is float and value is None:  # no reading: NaN, as ROS drivers say it
             self._publish(topic, FLOAT, {"data": float("nan")}, event.t_s)
-        elif declared not in (bool, float):
+        elif declared is int and isinstance(value, int) and not isinstance(value, bool):
+            self._publish(topic, INTEGER, {"data": max(-(2**63), min(value, 2**63 - 1))}, event.t_s)
+        elif declared not in (bool, float, int):
             text = value if isinstance(value, str) else json.dumps(json_safe(value))
             self._publish(topic, STRING, {"data": text}, event.t_s)
-
-    def _result(self, event: ActionStarted) -> None:
-        """A command from the graph ended: its report, on the result topic."""
-        command_id = str(event.args.get("id", ""))
-        with self._lock:
-            if self._waiting.pop(command_id, None) is None:
-                return  # the cloud's, or a scenario's
-        result = event.args.get("result")
-        status = str(event.args.get("status", "")).upper()
-        if not self.telemetry_allowed and carries_sensor_values(result):
-            status, result = "FAILED", {"error": WITHHELD}
-        self._tell(command_id, status, json_safe(result))
 
     def _publish(self, topic: str, typename: str, fields: dict[str, Any], at_s: float) -> None:
         try:
@@ -255,7 +250,8 @@ class Ros2Bridge:
             return
         with self._lock:
             endpoint, publisher, gid = self._publisher(topic, typename)
-            sequence = self._sequence[topic] = self._sequence.get(topic, 0) + 1
+            typed = (topic, typename)
+            sequence = self._sequence[typed] = self._sequence.get(typed, 0) + 1
         source_ns = max(0, round((at_s + self.epoch_offset_s) * 1e9))
         try:
             publisher.put(payload, attachment=attachment(sequence, source_ns, gid))
@@ -265,7 +261,7 @@ class Ros2Bridge:
     def _publisher(self, topic: str, typename: str) -> tuple[Endpoint, Any, bytes]:
         """The publisher of ``topic`` (declared, with its token, on first use; the lock
         held where another thread may publish too)."""
-        found = self._publishers.get(topic)
+        found = self._publishers.get((topic, typename))
         if found is not None:
             return found
         assert self._session is not None
@@ -275,59 +271,21 @@ class Ros2Bridge:
         publisher = self._session.declare_publisher(endpoint.key(domain))
         token = endpoint.token(domain, self._zid, self.node, entity, "MP")
         self._tokens.append(self._declare_token(token))
-        found = self._publishers[topic] = (endpoint, publisher, publisher_gid(self._zid, entity))
+        gid = publisher_gid(self._zid, entity)
+        found = self._publishers[(topic, typename)] = (endpoint, publisher, gid)
         return found
 
     # -- commands (Zenoh's thread) ---------------------------------------------------------
     def _command_in(self, sample: zenoh.Sample) -> None:
-        """A command from the graph: checked, then staged for the iot_command tree; a
-        command that cannot be carried out is answered at once (REFUSED, with why)."""
         try:
             text = self.wire.decode(STRING, bytes(sample.payload.to_bytes())).data
-            command = json.loads(text)
-        except (ValueError, AttributeError) as error:
-            self._refuse(None, f"not a std_msgs/String of JSON ({error})")
+        except ValueError as error:
+            self.commands.refuse(None, f"not a std_msgs/msg/String ({error})")
             return
-        if not isinstance(command, dict):
-            self._refuse(None, 'a command is a JSON object: {"type": "say", "args": {...}}')
-            return
-        given = command.get("id")
-        if given is not None and not (isinstance(given, str) and _COMMAND_ID.fullmatch(given)):
-            self._refuse(None, "id: up to 64 letters, digits and _ . : -")
-            return
-        kind, args = command.get("type"), command.get("args", {})
-        if kind not in COMMAND_TYPES:
-            self._refuse(given, f"type: one of {', '.join(COMMAND_TYPES)}")
-            return
-        if not isinstance(args, dict):
-            self._refuse(given, "args: a JSON object")
-            return
-        problem = command_problem(kind, args)
-        if problem is not None:
-            self._refuse(given, problem)
-            return
-        with self._lock:
-            self._count += 1
-            command_id = f"ros2:{given or self._count}"
-            if command_id in self._waiting or len(self._waiting) >= AT_MOST_WAITING:
-                busy = True
-            else:
-                busy = False
-                self._waiting[command_id] = self.clock.now()
-        if busy:
-            self._refuse(given, f"busy: {AT_MOST_WAITING} commands are waiting, or this id is")
-            return
-        assert self.blackboard is not None
-        self.blackboard.stage_event(IOT_INBOX, {"id": command_id, "type": kind, "args": args})
-        self._tell(command_id, "RECEIVED", None)
+        self.commands.received(str(text))
 
-    def _refuse(self, given: Any, why: str) -> None:
-        log.warning("ros2: a command was refused: %s", why)
-        self._tell(f"ros2:{given}" if given else None, "REFUSED", {"error": why})
-
-    def _tell(self, command_id: str | None, status: str, result: Any) -> None:
+    def _tell(self, given: str | None, status: str, result: Any) -> None:
         """How a command stands, on the result topic, under the id its sender gave."""
-        given = command_id.removeprefix("ros2:") if command_id else None
         message = {"id": given, "status": status, "result": result}
         self._publish(RESULT_TOPIC, STRING, {"data": json.dumps(message)}, self.clock.now())
 

@@ -21,6 +21,7 @@ Types are ROS 2 Jazzy's (``std_msgs``, ``builtin_interfaces``), and Nav2's
 from __future__ import annotations
 
 import hashlib
+import json
 import re
 from dataclasses import dataclass
 from typing import Any
@@ -44,8 +45,8 @@ nav2_msgs/msg/BehaviorTreeStatusChange[] event_log
 """
 LIVELINESS_PREFIX = "@ros2_lv"
 RELIABLE_DEPTH_10 = "::,10:,:,:,,"
-"""rmw_zenoh's QoS in a token: reliable, volatile, keep last 10 (the defaults, written
-empty), no deadline, lifespan or liveliness lease."""
+"""rmw_zenoh's QoS in a token: reliable, volatile, keep last (its defaults, written empty),
+depth 10 (written: rmw_zenoh's default depth is 42), no deadline, lifespan or lease."""
 _NAME_TOKEN = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 
 
@@ -172,6 +173,6 @@ def session_config(connect: str, config_file: str | None) -> zenoh.Config:
     config = zenoh.Config()
     config.insert_json5("mode", '"peer"')
     config.insert_json5("scouting/multicast/enabled", "false")  # the router tells of peers
-    config.insert_json5("connect/endpoints", f'["{connect}"]')
+    config.insert_json5("connect/endpoints", json.dumps([connect]))
     config.insert_json5("listen/endpoints", '["tcp/127.0.0.1:0"]')
     return config

@@ -219,12 +219,13 @@ def test_a_command_from_the_graph_goes_the_cloud_s_way_and_its_result_comes_back
 @pytest.mark.parametrize(
     ("sent", "why"),
     [
-        ("say hello", "not a std_msgs/String of JSON"),
+        ("say hello", "not JSON"),
+        ("[" * 1000 + "]" * 1000, "nests at most 8 levels"),
         ('["say"]', "a command is a JSON object"),
         ('{"type": "dance"}', "type: one of say, led, move, read"),
         ('{"type": "say", "args": {"text": "hi", "volume": 5}}', "'volume'"),
         ('{"type": "led", "args": {"color": "blurple"}}', "unknown color"),
-        ('{"type": "say", "id": "../../x", "args": {"text": "hi"}}', "id: up to 64"),
+        ('{"type": "say", "id": "../../x", "args": {"text": "hi"}}', "id: 1 to 64"),
     ],
 )
 def test_a_command_the_robot_would_refuse_is_refused_at_once(lab: Lab, sent: str, why: str) -> None:
@@ -254,7 +255,49 @@ def test_a_read_without_telemetry_consent_answers_failed_never_the_reading(lab: 
     finally:
         bridge.stop()
     assert results[1]["status"] == "FAILED" and "12.5" not in json.dumps(results[1])
-    assert "12.5" not in actions[0].data and "consent does not cover" in actions[0].data
+    assert "consent does not cover" in results[1]["result"]["error"]
+    assert json.loads(actions[0].data)["args"] == {}  # what the robot did, not what it read
+
+
+def test_telemetry_consent_without_sensors_sends_no_reading_either(lab: Lab) -> None:
+    bridge, _, _ = bridge_on(lab, "cloud_telemetry", commands=True)
+    try:
+        lab.wait_for("the command subscription", lambda: [t for t in lab.tokens if "/MS/" in t])
+        lab.send(json.dumps({"id": "r2", "type": "read", "args": {"sensor": "force"}}))
+        lab.wait_for("the command taken", lab.results)
+        report = {"id": "ros2:r2", "status": "succeeded", "result": {FORCE_LEFT_N: 12.5}}
+        bridge.on_event(ActionStarted(1.0, 7, "iot_command", "report", report))
+        results = lab.wait_for("the result", lambda: len(lab.results()) > 1 and lab.results())
+    finally:
+        bridge.stop()
+    assert results[1]["status"] == "FAILED" and "12.5" not in json.dumps(results)
+
+
+def test_a_command_still_waiting_when_the_robot_stops_is_told_lost(lab: Lab) -> None:
+    bridge, _, _ = bridge_on(lab, commands=True)
+    try:
+        lab.wait_for("the command subscription", lambda: [t for t in lab.tokens if "/MS/" in t])
+        lab.send(json.dumps({"type": "say", "args": {"text": "hello"}}))  # no id: one is given
+        lab.wait_for("the command taken", lab.results)
+    finally:
+        bridge.stop()
+    results = lab.wait_for("its end", lambda: len(lab.results()) > 1 and lab.results())
+    assert [r["status"] for r in results] == ["RECEIVED", "LOST"]
+    assert results[0]["id"] == results[1]["id"] == "n1"
+    assert "stopped" in results[1]["result"]["error"]
+
+
+def test_a_second_command_under_a_waiting_id_is_refused(lab: Lab) -> None:
+    bridge, _, _ = bridge_on(lab, commands=True)
+    try:
+        lab.wait_for("the command subscription", lambda: [t for t in lab.tokens if "/MS/" in t])
+        for _ in range(2):
+            lab.send(json.dumps({"id": "same", "type": "say", "args": {"text": "hi"}}))
+        results = lab.wait_for("both answers", lambda: len(lab.results()) > 1 and lab.results())
+    finally:
+        bridge.stop()
+    assert [r["status"] for r in results[:2]] == ["RECEIVED", "REFUSED"]
+    assert "still waiting" in results[1]["result"]["error"]
 
 
 def test_without_ros2_commands_the_robot_takes_none(lab: Lab) -> None:
@@ -301,10 +344,14 @@ def test_vest_run_carries_out_a_say_sent_from_the_graph(lab: Lab) -> None:
 @pytest.mark.parametrize(
     ("options", "environment", "said"),
     [
-        (["--ros2", "nonsense"], {}, r"--ros2 nonsense: Zenoh cannot use it"),
+        (["--ros2", "nonsense"], {}, r"--ros2 'nonsense': the router's Zenoh endpoint"),
+        (["--ros2", 'tcp/1.2.3.4:7447"]'], {}, r"the router's Zenoh endpoint"),
+        (["--ros2", "tcp/127.0.0.1:99999"], {}, r"a port 1..65535"),
+        (["--ros2"], {"ZENOH_SESSION_CONFIG_URI": "/dev/zero"}, r"/dev/zero: not a file"),
         (["--ros2-commands"], {}, r"--ros2-commands .* add --ros2"),
         (["--ros2"], {"ROS_DOMAIN_ID": "abc"}, r"ROS_DOMAIN_ID='abc': a number 0..232"),
-        (["--ros2"], {"ZENOH_SESSION_CONFIG_URI": "/no/such.json5"}, r"Zenoh cannot use it"),
+        (["--ros2"], {"ZENOH_SESSION_CONFIG_URI": "/no/such.json5"}, r"cannot read it"),
+        (["--ros2", "--ros2-commands", "--trees", "trees/hug.yaml"], {}, r"no tree carries"),
     ],
 )
 def test_a_graph_vest_cannot_join_is_named_in_one_line(
