@@ -21,8 +21,7 @@ from engine.cli.run_inputs import dialogs_folder
 from engine.dialogs.library import DialogLibrary, load_dialog
 from engine.dialogs.model import Dialog, DialogRule, FollowUp
 from engine.errors import ConfigError
-from engine.media.audio import Audio, with_noise
-from engine.speech.hearing import hear
+from engine.speech.hearing import hear, spoken
 from engine.speech.recognizer import WhisperRecognizer
 from engine.speech.vad import SileroVad
 from engine.speech.voice_models import load_voice
@@ -135,7 +134,9 @@ def main(args: argparse.Namespace) -> int:
                     tried += 1
                     if progress:
                         print(f"\r{tried} spoken", end="", file=sys.stderr, flush=True)
-                    audio = _spoken(voices[variant.voice], phrase.text, variant)
+                    audio = spoken(
+                        voices[variant.voice], phrase.text, variant.speed, variant.snr_db
+                    )
                     hearing = hear(audio, vad, recognizer, dialog, context)
                     match = hearing.verdict.match if hearing.verdict is not None else None
                     if match is not None and match.rule.id == rule.id:
@@ -160,12 +161,3 @@ def main(args: argparse.Namespace) -> int:
         print(f"confused: rule {said!r} heard as rule {taken!r} {count} time(s)")
     print(f"{tried} phrase recordings ({len(variants)} per phrase): {reported} problem(s)")
     return 1 if reported else 0
-
-
-def _spoken(voice: Voice, text: str, variant: Variant) -> Audio:
-    speech = voice.synthesize(text, speed=variant.speed)
-    pad = Audio.silence(0.3, speech.rate_hz)
-    audio = pad.then(speech).then(pad)
-    if variant.snr_db is not None:
-        audio = with_noise(audio, variant.snr_db, seed=len(text))
-    return audio.scaled(0.5)

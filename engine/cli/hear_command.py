@@ -5,8 +5,14 @@ the answer (or the fallback; [name] is a value the robot fills in from its senso
 recording with several utterances is heard as a conversation: one line each, and an
 answer that asks a question (then:) hears the next utterance as its reply. --json prints
 one object per utterance (per file, for a file of one question):
-{"file": ..., "heard": text or null, "rule": rule id or null, "score": ..., "answer": ...}.
+{"file": ..., "heard": text or null, "rule": rule id or null, "score": ..., "answer": ...,
+"latency_s": ...}: latency_s is the seconds from the end of speech (its last voiced frame)
+to the intent, as the robot would live on this machine (the silence it waits to be sure,
+then recognizing and matching, measured here).
 --mic listens on the microphone instead (the robot config's, or --device) until Ctrl-C.
+--text "do you like dogs" hears a typed phrase as the robot would hear it spoken: said by
+the robot's voice (joe, natural speed), then through the same hearing (its "file" is the
+text, quoted).
 """
 
 from __future__ import annotations
@@ -23,13 +29,26 @@ from engine.dialogs.library import DialogLibrary
 from engine.dialogs.model import Dialog
 from engine.errors import ConfigError, UsageError
 from engine.media.audio import read_wav
-from engine.speech.hearing import Hearing, conversation
+from engine.speech.hearing import Hearing, conversation, spoken
 from engine.speech.recognizer import WhisperRecognizer
+from engine.speech.voice_models import load_voice
+from engine.speech.voices import NeuralVoice
+
+MAX_TYPED_CHARS = 400
+"""The longest typed phrase (a sentence or two)."""
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("files", type=Path, nargs="*", metavar="FILE.wav", help="recordings")
     parser.add_argument("--mic", action="store_true", help="listen on the microphone")
+    parser.add_argument(
+        "--text",
+        action="append",
+        default=[],
+        metavar="PHRASE",
+        help="hear a typed phrase, spoken by the robot's voice (e.g. --text \"do you like "
+        'dogs"); may be given several times',
+    )
     parser.add_argument(
         "--device", default=None, help="ALSA capture device for --mic (default: the config's)"
     )
@@ -76,12 +95,23 @@ def describe(name: str, hearing: Hearing) -> str:
 
 
 def main(args: argparse.Namespace) -> int:
-    if args.mic and args.files:
-        raise UsageError("give WAV files or --mic, not both")
-    if not args.mic and not args.files:
-        raise UsageError("give WAV files to hear, or --mic to listen on the microphone")
+    if args.mic and (args.files or args.text):
+        raise UsageError("give WAV files or --text, or --mic, not both")
+    if not args.mic and not args.files and not args.text:
+        raise UsageError(
+            'give WAV files to hear, --text "a phrase", or --mic to listen on the microphone'
+        )
+    for phrase in args.text:
+        if not phrase.strip() or len(phrase) > MAX_TYPED_CHARS:
+            raise UsageError(
+                f"--text {phrase[:40]!r}: a phrase of 1 to {MAX_TYPED_CHARS} characters"
+            )
     library, dialog = load_dialog_named(args.dialogs, args.dialog)
-    audio = [(path, read_wav(path)) for path in args.files]  # every file read before any work
+    audio = [(str(path), read_wav(path)) for path in args.files]  # read before any work
+    if args.text:
+        voice = load_voice("joe")
+        steady = voice.steady() if isinstance(voice, NeuralVoice) else voice
+        audio += [(repr(phrase), spoken(steady, phrase)) for phrase in args.text]
     from engine.speech.vad import SileroVad
 
     recognizer = WhisperRecognizer()
@@ -91,10 +121,10 @@ def main(args: argparse.Namespace) -> int:
         from engine.cli.hear_live import listen_live
 
         return listen_live(args, recognizer, dialog, RealClock())
-    for path, recording in audio:
+    for name, recording in audio:
         for hearing in conversation(recording, vad, recognizer, dialog):
             if args.json:
-                print(json.dumps(hearing.as_json(str(path)), ensure_ascii=False))
+                print(json.dumps(hearing.as_json(name), ensure_ascii=False))
             else:
-                print(describe(shown(str(path)), hearing))
+                print(describe(shown(name), hearing))
     return 0

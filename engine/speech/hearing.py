@@ -7,12 +7,14 @@ without the threads.
 from __future__ import annotations
 
 import string
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
+from engine.clock import stopwatch
 from engine.dialogs.model import Dialog, FollowUp, Verdict
-from engine.media.audio import SPEECH_RATE_HZ, Audio
+from engine.media.audio import SPEECH_RATE_HZ, Audio, with_noise
 from engine.speech.recognizer import Recognizer
-from engine.speech.vad import SpeechDetector, SpeechProbability
+from engine.speech.vad import SpeechDetector, SpeechProbability, Utterance
+from engine.speech.voices import Voice
 from engine.values.templates import CompiledTemplate
 
 TRAILING_SILENCE_S = 0.5
@@ -37,6 +39,10 @@ class Hearing:
     verdict: Verdict | None
     answer: str | None
     """The answer (fields shown as ``[name]``), or the fallback; None for neither."""
+    latency_s: float | None = None
+    """Seconds from the end of speech (its last voiced frame) to the intent, as the robot
+    would live on this machine: the silence it waits to be sure the speaker is done, then
+    the recognizer and the matcher (measured here). None when nothing was heard."""
 
     def as_json(self, name: str) -> dict[str, object]:
         match = self.verdict.match if self.verdict is not None else None
@@ -46,17 +52,18 @@ class Hearing:
             "rule": match.rule.id if match is not None else None,
             "score": round(match.score, 3) if match is not None else None,
             "answer": self.answer,
+            "latency_s": round(self.latency_s, 3) if self.latency_s is not None else None,
         }
 
 
-def utterances(audio: Audio, vad: SpeechProbability) -> list[Audio]:
+def utterances(audio: Audio, vad: SpeechProbability) -> list[Utterance]:
     """The utterances Silero finds in ``audio``."""
     vad.reset()
     detector = SpeechDetector(vad)
     samples = audio.resampled(SPEECH_RATE_HZ).then(Audio.silence(TRAILING_SILENCE_S)).samples
-    found = [u.audio for u in detector.feed(samples)]
+    found = detector.feed(samples)
     last = detector.flush()
-    return found + ([last.audio] if last is not None else [])
+    return found + ([last] if last is not None else [])
 
 
 def hear(
@@ -67,7 +74,7 @@ def hear(
     follow_up: FollowUp | None = None,
 ) -> Hearing:
     """What the robot hears in ``audio`` and how ``dialog`` answers it."""
-    texts = [recognizer.transcribe(part).text for part in utterances(audio, vad)]
+    texts = [recognizer.transcribe(part.audio).text for part in utterances(audio, vad)]
     heard = " ".join(t for t in texts if t) or None
     if heard is None or dialog is None:
         return Hearing(heard, None, None)
@@ -92,11 +99,24 @@ def conversation(
     hearings: list[Hearing] = []
     follow_up: FollowUp | None = None
     for part in utterances(audio, vad):
-        text = recognizer.transcribe(part).text
+        started = stopwatch()
+        text = recognizer.transcribe(part.audio).text
         if not text:
             continue
         hearing = _judged(text, dialog, follow_up)
+        hearing = replace(hearing, latency_s=part.quiet_s + stopwatch() - started)
         hearings.append(hearing)
         match = hearing.verdict.match if hearing.verdict is not None else None
         follow_up = match.rule.follow_up if match is not None else None
     return hearings or [Hearing(None, None, None)]
+
+
+def spoken(voice: Voice, text: str, speed: float = 1.0, snr_db: float | None = None) -> Audio:
+    """``text`` said by ``voice`` at ``speed`` as a microphone would take it in: with
+    0.3 s of silence around it, noise at ``snr_db`` dB SNR (None: none), at half level."""
+    speech = voice.synthesize(text, speed=speed)
+    pad = Audio.silence(0.3, speech.rate_hz)
+    audio = pad.then(speech).then(pad)
+    if snr_db is not None:
+        audio = with_noise(audio, snr_db, seed=len(text))
+    return audio.scaled(0.5)

@@ -53,6 +53,9 @@ class Utterance:
 
     audio: Audio
     end_sample: int
+    quiet_s: float = 0.0
+    """The silence heard after the last voiced frame before the end was called (the
+    hangover the robot waits before it hears the utterance), seconds."""
 
 
 @dataclass
@@ -126,9 +129,10 @@ class SpeechDetector:
         return None
 
     def _end(self) -> Utterance | None:
-        speech, voiced = self._speech, self._voiced_frames
+        speech, voiced, quiet = self._speech, self._voiced_frames, self._quiet_frames
         self._speech, self._voiced_frames, self._quiet_frames = [], 0, 0
         self._history.clear()
         if voiced * FRAME_S < self.min_speech_s:
             return None  # a click or a cough
-        return Utterance(Audio(np.concatenate(speech), SPEECH_RATE_HZ), self.position)
+        audio = Audio(np.concatenate(speech), SPEECH_RATE_HZ)
+        return Utterance(audio, self.position, quiet * FRAME_S)

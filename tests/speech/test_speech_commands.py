@@ -39,6 +39,8 @@ def test_hear_says_what_it_heard_the_rule_and_the_answer_per_file(
     capsys.readouterr()
     assert main(["hear", "--json", str(question), str(silence)]) == 0
     first, second = (json.loads(line) for line in capsys.readouterr().out.splitlines())
+    latency_s = first.pop("latency_s")  # this machine's: the 0.3 s wait, then recognizing
+    assert isinstance(latency_s, float) and latency_s >= 0.3
     assert first == {
         "file": str(question),
         "heard": "What is the temperature?",
@@ -52,7 +54,25 @@ def test_hear_says_what_it_heard_the_rule_and_the_answer_per_file(
         "rule": None,
         "score": None,
         "answer": None,
+        "latency_s": None,
     }
+
+
+def test_hear_takes_a_typed_phrase_as_the_robot_would_hear_it_spoken(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    assert main(["hear", "--json", "--text", "What is the temperature?"]) == 0
+    heard = json.loads(capsys.readouterr().out)
+    assert heard["file"] == "'What is the temperature?'"
+    assert (heard["rule"], heard["answer"]) == (
+        "temperature",
+        "The temperature is [temperature_f] degrees",
+    )
+
+
+def test_hear_refuses_an_empty_typed_phrase(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["hear", "--text", "  "]) == 2
+    assert "a phrase of 1 to 400 characters" in capsys.readouterr().err
 
 
 def test_hear_refuses_a_file_that_is_not_a_wav(
@@ -111,8 +131,8 @@ def test_hear_follows_a_conversation_in_one_recording(
 @pytest.mark.parametrize(
     ("args", "message"),
     [
-        (["hear"], "give WAV files to hear, or --mic"),
-        (["hear", "--mic", "x.wav"], "give WAV files or --mic, not both"),
+        (["hear"], "give WAV files to hear, --text \"a phrase\", or --mic"),
+        (["hear", "--mic", "x.wav"], "give WAV files or --text, or --mic, not both"),
         (["say", "  ...  "], "nothing to say"),
     ],
 )
