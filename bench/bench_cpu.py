@@ -26,6 +26,12 @@ free of start-up by construction (Linux only).
 There is no target in DESIGN.md for this figure: it is printed for the reader. What a
 steady-state percentage means: the share of one core the robot needs, all threads
 together, with the demo's events (touch, hug, wave, obstacle, speech) going on.
+
+Then an idle robot (issue 24: trees that wake when something happens): ``vest run`` on a
+scenario where nothing happens, with the shipped trees (their ``wake_on:``) and with the
+same trees with ``wake_on:`` taken out (every tree ticks at its rate), one after the
+other, each read inside the run from /proc as above. Target: with ``wake_on`` at most half
+of the CPU without.
 """
 
 from __future__ import annotations
@@ -35,6 +41,7 @@ import os
 import platform
 import re
 import resource
+import shutil
 import statistics
 import subprocess
 import sys
@@ -107,6 +114,51 @@ def measure(command: list[str], *, sample: bool = False) -> Run:
         readings,
         output,
     )
+
+
+def steady_share(run: Run, skip_s: float) -> float | None:
+    """The share of one core ``run`` used after ``skip_s`` seconds (/proc readings)."""
+    window = [(t, cpu) for t, cpu in run.readings if t >= skip_s]
+    if len(window) < 2 or window[-1][0] <= window[0][0]:
+        return None
+    (t0, cpu0), (t1, cpu1) = window[0], window[-1]
+    return (cpu1 - cpu0) / (t1 - t0)
+
+
+def idle_robot(seconds: float, skip_s: float, rounds: int) -> None:
+    """CPU of an idle robot with the shipped trees' wake_on and without it."""
+    with tempfile.TemporaryDirectory() as folder:
+        idle = Path(folder) / "idle.yaml"
+        idle.write_text(f"description: nothing happens\nduration_s: {seconds:g}\nevents: []\n")
+        ticking = Path(folder) / "trees"
+        shutil.copytree(ROOT / "trees", ticking)
+        for tree in ticking.rglob("*.yaml"):
+            lines = tree.read_text().splitlines(keepends=True)
+            tree.write_text("".join(ln for ln in lines if not ln.startswith("wake_on:")))
+        ways = {
+            "wake_on (as shipped)": [*VEST, "run", "--scenario", str(idle)],
+            "every tree at its rate": [
+                *VEST,
+                "run",
+                "--scenario",
+                str(idle),
+                "--trees",
+                str(ticking),
+            ],
+        }
+        shares: dict[str, list[float]] = {name: [] for name in ways}
+        for _ in range(rounds):  # interleaved: a busy machine hurts both alike
+            for name, command in ways.items():
+                share = steady_share(measure(command, sample=True), skip_s)
+                if share is not None:
+                    shares[name].append(share)
+    print(f"idle robot (a {seconds:g} s scenario where nothing happens; median of {rounds}):")
+    medians = {name: statistics.median(values) for name, values in shares.items() if values}
+    for name, share in medians.items():
+        print(f"  {name:<26}{100 * share:5.1f} % of one core")
+    if len(medians) == 2:
+        woken, ticking_share = medians.values()
+        print(f"  with wake_on / without: {woken / ticking_share:.2f} (target <= 0.50)")
 
 
 def median_run(runs: list[Run]) -> Run:
@@ -193,6 +245,7 @@ def main(argv: list[str] | None = None) -> int:
         f"  start-up: {imports.cpu_s:.2f} s CPU for Python and the imports, "
         f"{short.cpu_s - imports.cpu_s:+.2f} s more for vest run's own start-up and shutdown"
     )
+    idle_robot(args.seconds, args.skip, 1 if args.quick else 2)
     return 0
 
 

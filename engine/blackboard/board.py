@@ -45,30 +45,54 @@ class Blackboard:
         A watcher that raises is logged the first time and counted (:meth:`watcher_failures`);
         the commit goes on for the other writes and watchers."""
         self._watcher_failures: dict[int, int] = {}  # by id(): a watcher may be unhashable
+        self.wake_keys: frozenset[str] = frozenset()
+        """Keys some tree wakes on (``wake_on:``): a change to one calls :attr:`on_wake`."""
+        self.on_wake: Callable[[], None] | None = None
+        """Called (from the writing thread) when a wake key is staged with a new value,
+        gets an event, or is written by a tree: the scheduler steps at once."""
+        self._last_staged: dict[str, Any] = {}
+        self._changed: set[str] = set()
+        self._committing = False
 
     # -- producers (any thread) ---------------------------------------------------------
     def stage(self, key: str, value: Any) -> None:
         """Queue ``key = value`` for the next commit."""
         with self._lock:
             self._pending.append((key, value, False))
+            wakes = key in self.wake_keys and not _same(self._last_staged.get(key, _NONE), value)
+            if wakes:
+                self._last_staged[key] = value
+        if wakes and self.on_wake is not None:
+            self.on_wake()
 
     def stage_event(self, key: str, value: Any) -> None:
         """Queue one event on ``key`` for the next commit."""
         with self._lock:
             self._pending.append((key, value, True))
+        if key in self.wake_keys and self.on_wake is not None:
+            self.on_wake()
+
+    def take_changed(self) -> set[str]:
+        """The wake keys that changed since the last call (the scheduler's thread)."""
+        changed, self._changed = self._changed, set()
+        return changed
 
     # -- the scheduler's thread ---------------------------------------------------------
     def commit(self) -> int:
         """Apply every staged write, in order; returns how many there were."""
         with self._lock:
             pending, self._pending = self._pending, []
-        for key, value, is_event in pending:
-            if is_event:
-                self._append_event(key, value)
-            else:
-                self._write(key, value)
-            for watcher in self.watchers:
-                self._tell(watcher, key, value)
+        self._committing = True  # the scheduler reads what changed right after: no wake-up
+        try:
+            for key, value, is_event in pending:
+                if is_event:
+                    self._append_event(key, value)
+                else:
+                    self._write(key, value)
+                for watcher in self.watchers:
+                    self._tell(watcher, key, value)
+        finally:
+            self._committing = False
         return len(pending)
 
     def _tell(self, watcher: Watcher, key: str, value: Any) -> None:
@@ -124,10 +148,15 @@ class Blackboard:
         """Forget every key and pending write (a fresh robot)."""
         with self._lock:
             self._pending.clear()
+            self._last_staged.clear()
         self._updated_s.clear()
         self._values.clear()
 
     def _write(self, key: str, value: Any) -> None:
+        if key in self.wake_keys and not _same(self._values.get(key, _NONE), value):
+            self._changed.add(key)
+            if self.on_wake is not None and not self._committing:  # a tree wrote it
+                self.on_wake()
         self._values[key] = value
         self._updated_s[key] = self.clock.now()
 
@@ -135,3 +164,21 @@ class Blackboard:
         now = self.clock.now()
         self._values[key] = self.event_log(key).appended(value, now)
         self._updated_s[key] = now
+        if key in self.wake_keys:
+            self._changed.add(key)
+            if self.on_wake is not None and not self._committing:
+                self.on_wake()
+
+
+_NONE = object()
+"""A key with no value yet."""
+
+
+def _same(old: Any, new: Any) -> bool:
+    """Whether a key's new value is its old one (a value that cannot say counts as new)."""
+    if old is new:
+        return True
+    try:
+        return bool(old == new)
+    except Exception:  # an array's comparison, say
+        return False

@@ -188,6 +188,7 @@ def btcpp_xml(definition: TreeDefinition, registry: NodeRegistry) -> str:
         "priority": definition.priority,
         "wait_for_turn_s": definition.wait_for_turn_s,
         "when_interrupted": definition.when_interrupted,
+        "wake_on": list(definition.wake_on),
         "description": definition.description.strip(),
     }
     writer.trees[definition.name] = writer.element(definition.root, 2, top=True)

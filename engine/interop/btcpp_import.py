@@ -26,7 +26,14 @@ from engine.values.param_problems import did_you_mean
 from engine.values.params import Boolean, Integer, ListOf, Number
 from engine.values.templates import Template
 
-SETTINGS = ("rate_hz", "priority", "wait_for_turn_s", "when_interrupted", "description")
+SETTINGS = (
+    "rate_hz",
+    "priority",
+    "wait_for_turn_s",
+    "when_interrupted",
+    "wake_on",
+    "description",
+)
 DEFAULT_RATE_HZ = 10.0
 MAX_NODES = 5000
 MAX_DEPTH = 200
@@ -302,6 +309,9 @@ def tree_yaml(text: str, name: str, registry: NodeRegistry) -> tuple[str, list[s
     for key, default in (("priority", 0), ("wait_for_turn_s", 0.0), ("when_interrupted", "let_go")):
         if settings.get(key, default) != default:
             head.append(f"{key}: {_scalar(settings[key])}")
+    wake_on = settings.get("wake_on")
+    if isinstance(wake_on, list) and wake_on and all(isinstance(k, str) for k in wake_on):
+        head.append(f"wake_on: [{', '.join(_scalar(key) for key in wake_on)}]")
     if settings.get("description"):
         head.append(f"description: {_scalar(str(settings['description']))}")
     notes = []

@@ -59,6 +59,8 @@ class TreeDefinition:
     when_interrupted: str = "let_go"
     """A round a higher tree cut short: ``let_go`` (the events that started it are spent)
     or ``try_again`` (it starts again with them)."""
+    wake_on: tuple[str, ...] = ()
+    """Keys whose change ticks the tree at once; with them it rests between rounds."""
 
     def build(self, ctx: TreeContext) -> py_trees.trees.BehaviourTree:
         """A fresh py_trees tree whose nodes use ``ctx``."""

@@ -146,6 +146,7 @@ class TreeLoader:
             priority=settings.priority,
             wait_for_turn_s=settings.wait_for_turn_s,
             when_interrupted=settings.when_interrupted,
+            wake_on=settings.wake_on,
         )
 
     # -- file level -----------------------------------------------------------------------

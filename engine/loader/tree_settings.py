@@ -7,6 +7,7 @@
     wait_for_turn_s: 2     # how long an action waits for a busy resource (0: let it go)
     when_interrupted: try_again   # a round a higher tree cut short starts again (default:
                                   # let_go, the events that started it are spent)
+    wake_on: [/sensors/touch/pat] # rest between rounds; tick at once when one changes
 
 Each may be a ``${parameter}``, so a profile can set it.
 """
@@ -20,7 +21,7 @@ from engine.files.problems import Problems
 from engine.files.yaml_source import YMap, plain
 from engine.loader.substitution import ParamValue, substitute, unresolved
 from engine.values.param_problems import CheckContext, ParamProblem
-from engine.values.params import RATE_HZ, Choice, Integer, Number, Param
+from engine.values.params import RATE_HZ, Choice, Integer, Key, ListOf, Number, Param
 
 DEFAULT_RATE_HZ = 10.0
 PRIORITY = Integer(0, 99)
@@ -55,6 +56,14 @@ SETTINGS = (
         "or try_again (it starts again with the same events, its actions waiting up to "
         "wait_for_turn_s for their turn), e.g. when_interrupted: try_again",
     ),
+    Param(
+        "wake_on",
+        ListOf(Key(kinds=("state", "event")), max_items=32),
+        [],
+        "blackboard keys whose change wakes the tree: it ticks at once (at most rate_hz "
+        "times a second) and rests between rounds instead of ticking at its rate, e.g. "
+        "wake_on: [/sensors/touch/pat, /sensors/force/squeeze]",
+    ),
 )
 
 
@@ -64,6 +73,7 @@ class TreeSettings:
     priority: int = 0
     wait_for_turn_s: float = 0.0
     when_interrupted: str = "let_go"
+    wake_on: tuple[str, ...] = ()
 
 
 def read_settings(
@@ -83,4 +93,5 @@ def read_settings(
             values[param.name] = param.type.convert(plain(raw), ctx)
         except ParamProblem as problem:
             problems.add(raw.mark, f"{param.name!r} {problem.message}", param.doc)
+    values["wake_on"] = tuple(dict.fromkeys(values["wake_on"]))  # each key once
     return TreeSettings(**values)

@@ -88,6 +88,13 @@ def tree_schema(registry: NodeRegistry) -> dict[str, Any]:
             "rate_hz": _value({"type": "number", "exclusiveMinimum": 0, "maximum": 1000}),
             "priority": _value({"type": "integer", "minimum": 0, "maximum": 99}),
             "wait_for_turn_s": _value({"type": "number", "minimum": 0, "maximum": 60}),
+            "when_interrupted": _value({"enum": ["let_go", "try_again"]}),
+            "wake_on": {
+                "type": "array",
+                "items": {"type": "string", "pattern": "^/"},
+                "maxItems": 32,
+                "description": "blackboard keys whose change wakes the tree",
+            },
             "params": {"type": "object", "description": "parameters used as ${name}"},
             "root": _NODE,
         },

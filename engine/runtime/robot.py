@@ -9,7 +9,7 @@ from engine.blackboard.board import Blackboard
 from engine.blackboard.catalogue import KeyCatalogue
 from engine.clock import Clock
 from engine.dialogs.library import DialogLibrary
-from engine.files.problems import LoadError, Mark, Problems
+from engine.files.problems import LoadError, Mark, Problem, Problems
 from engine.files.yaml_source import YMap, load_yaml
 from engine.loader.substitution import Profile, load_profile, read_params, undeclared_params
 from engine.loader.tree_definition import TreeDefinition
@@ -25,6 +25,7 @@ from engine.services.turns import Turns
 from engine.session.blackboard_news import BlackboardNews
 from engine.session.events import TurnTaken
 from engine.session.stream import SessionStream
+from engine.values.params import Key
 
 
 def tree_files(paths: list[Path]) -> list[Path]:
@@ -117,11 +118,37 @@ def load_behaviors(
                 "rename one",
             )
         names[definition.name] = definition.path
+    problems.extend(unwritten_wake_keys(definitions))
     if not definitions and not problems:
         place = Mark(str(trees[0]) if trees else ".", 1, 1)
         problems.add(place, "no tree files (*.yaml) found", "name a tree file or a folder of them")
     problems.raise_if_any()
     return Behaviors(definitions, dialogs, loader)
+
+
+def unwritten_wake_keys(definitions: list[TreeDefinition]) -> list[Problem]:
+    """A tree that waits on a variable (``wake_on: [/vars/...]``) no tree writes would
+    never wake: one problem each (the catalogue's keys each have their writer)."""
+    written = {
+        value
+        for definition in definitions
+        for node in definition.root.walk()
+        for param in node.type.params
+        if isinstance(param.type, Key) and param.type.access == "write"
+        for value in [node.args.get(param.name)]
+        if isinstance(value, str)
+    }
+    return [
+        Problem(
+            definition.root.mark,
+            f"tree {definition.name!r} wakes on {key!r}, which no tree writes: it would rest "
+            "for ever",
+            "write it with save_as: or SetValue in another tree, or wake on a sensor key",
+        )
+        for definition in definitions
+        for key in definition.wake_on
+        if key.startswith("/vars/") and key not in written
+    ]
 
 
 class Robot:

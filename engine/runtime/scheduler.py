@@ -5,6 +5,12 @@ not add up. Before the trees due at a deadline tick, the hooks run (the scenario
 reload) and the blackboard's staged writes are committed: every tree ticked at one
 deadline sees the same snapshot. A tick that overran whole periods skips them (counted).
 
+A tree that says what wakes it (``wake_on:``, keys) rests between rounds: once a round
+ends (its root not RUNNING) it is not ticked at its deadlines, until one of those keys
+changes (a producer stages a new value or an event, or another tree writes it); then the
+scheduler steps at once and the tree ticks, no sooner than a period after its last tick
+(``rate_hz`` stays its fastest), and at its rate while the round runs.
+
 Within one step the trees due tick in order of priority, highest first (the therapist's
 buttons, then the behaviors): what several trees claim at one moment (the speaker, the
 face LEDs, a joint) is settled by priority before a lower tree starts anything, never by
@@ -49,6 +55,12 @@ class RunningTree:
     """A paused tree keeps its deadlines but is not ticked (the therapist paused it)."""
     retrying: bool = False
     """The round under way is one cut short and tried again (it is tried again once)."""
+    resting: bool = False
+    """A tree with ``wake_on`` between rounds: its deadlines pass until a key wakes it."""
+    woken: bool = False
+    """One of its keys changed since its round began: it ticks (a new round) as soon as
+    its rate allows."""
+    last_tick_s: float = -math.inf
     _round_start: list[tuple[Any, int]] = field(default_factory=list)
     _readers: list[Any] = field(default_factory=list)
     _readers_of: Any = None
@@ -115,6 +127,7 @@ class RunningTree:
                 client.unregister(clear=False)
         self.origin_s = self.next_deadline_s
         self.period_index = 0
+        self.resting = self.woken = False  # the new version's first round starts now
         self.definition = definition
         self.tree = new_tree
         actions = self.context.actions
@@ -160,6 +173,9 @@ class Scheduler:
         self.trees: list[RunningTree] = []
         self._measure = measure
         self._stop = clock.event()
+        self._attention = clock.event()
+        self._wake_keys_of: tuple[TreeDefinition, ...] = ()
+        """Set by a stop, and by a change to a key a resting tree wakes on."""
         self.hook_errors = 0
 
     def add_hook(self, hook: Hook, *, first: bool = False) -> None:
@@ -186,7 +202,17 @@ class Scheduler:
         tree.origin_s = self.clock.now() if started or not self.trees else self.trees[0].origin_s
         tree.period_index = 0
         self.trees.append(tree)
+        self.blackboard.on_wake = self._attention.set
+        self._listen_for_wake_keys()
         return tree
+
+    def _listen_for_wake_keys(self) -> None:
+        """Tell the blackboard which keys wake a tree (again after a reload changed them)."""
+        definitions = tuple(tree.definition for tree in self.trees)
+        if definitions != self._wake_keys_of:
+            self._wake_keys_of = definitions
+            keys = (key for definition in definitions for key in definition.wake_on)
+            self.blackboard.wake_keys = frozenset(keys)
 
     def tree(self, name: str) -> RunningTree:
         for tree in self.trees:
@@ -198,6 +224,7 @@ class Scheduler:
         """Ask the loop to end after the current tick (safe from a signal handler); only
         the scheduler's own wait is cut short, never a driver's or a poller's sleep."""
         self._stop.set()
+        self._attention.set()
 
     @property
     def stopping(self) -> bool:
@@ -233,8 +260,10 @@ class Scheduler:
                 if until_s is not None and deadline > until_s:
                     self.clock.sleep_until(until_s, self._stop)
                     break
-                if self.clock.sleep_until(deadline, self._stop):
-                    break
+                if self.clock.sleep_until(deadline, self._attention):
+                    if self._stop.is_set():
+                        break
+                    self._attention.clear()  # a key woke a resting tree: step now
                 self.step()
         finally:
             for tree in self.trees if halt_at_end else ():  # nothing goes on after the run
@@ -254,24 +283,38 @@ class Scheduler:
             except Exception as error:  # a broken hook (scenario, reload, poller) is reported
                 self.hook_errors += 1
                 _log.exception("scheduler hook %r failed: %s", hook, error)
+        self._listen_for_wake_keys()  # a hook may have reloaded a tree
         self.blackboard.commit()
+        changed = self.blackboard.take_changed()
+        for tree in self.trees:
+            if changed.intersection(tree.definition.wake_on):  # resting or in a round
+                tree.woken = True
         due = sorted(
-            (tree for tree in self.trees if tree.next_deadline_s <= now + 1e-9),
+            (
+                tree
+                for tree in self.trees
+                if tree.next_deadline_s <= now + 1e-9 or _may_wake(tree, now)
+            ),
             key=lambda tree: -tree.priority,  # stable: one priority keeps the added order
         )
+        ticked = []
         for tree in due:
-            if tree.paused:  # its deadlines go by untouched
+            if tree.paused or (tree.resting and not tree.woken):  # its deadlines go by
                 tree.period_index = math.floor((now - tree.origin_s) / tree.period_s)
                 while tree.next_deadline_s <= now + 1e-9:
                     tree.period_index += 1
-            else:
-                self._tick(tree)
-        return [tree for tree in due if not tree.paused]
+                continue
+            if tree.next_deadline_s > now + 1e-9:  # woken between deadlines: a new grid
+                tree.origin_s, tree.period_index = now, 0
+            self._tick(tree)
+            ticked.append(tree)
+        return ticked
 
     def _tick(self, tree: RunningTree) -> None:
         now = self.clock.now()  # hooks and earlier trees of this step count as lateness
         lateness = now - tree.next_deadline_s
-        if tree.status != py_trees.common.Status.RUNNING:
+        fresh = tree.status != py_trees.common.Status.RUNNING  # a round starts: sees it all
+        if fresh:
             tree.round_starts()
         started = self._measure()
         try:
@@ -294,7 +337,16 @@ class Scheduler:
                 self.hook_errors += 1
                 _log.exception("after-tick observer %r failed: %s", observer, error)
         tree.period_index += 1
+        tree.last_tick_s = now
+        tree.woken = tree.woken and not fresh  # what came during a round wakes the next one
+        waits = status != py_trees.common.Status.RUNNING and not tree.retrying
+        tree.resting = bool(tree.definition.wake_on) and waits and not tree.woken
         if tree.next_deadline_s <= now:
             behind = math.floor((now - tree.origin_s) / tree.period_s) + 1
             tree.stats.skipped += behind - tree.period_index
             tree.period_index = behind
+
+
+def _may_wake(tree: RunningTree, now: float) -> bool:
+    """A woken tree whose rate lets it tick now (a period since its last tick)."""
+    return tree.woken and not tree.paused and now - tree.last_tick_s >= tree.period_s - 1e-9
