@@ -131,7 +131,7 @@ def test_hear_follows_a_conversation_in_one_recording(
 @pytest.mark.parametrize(
     ("args", "message"),
     [
-        (["hear"], "give WAV files to hear, --text \"a phrase\", or --mic"),
+        (["hear"], 'give WAV files to hear, --text "a phrase", or --mic'),
         (["hear", "--mic", "x.wav"], "give WAV files or --text, or --mic, not both"),
         (["say", "  ...  "], "nothing to say"),
     ],
