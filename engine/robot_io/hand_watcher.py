@@ -14,12 +14,22 @@ due by then, in order, so a run is the same every time.
 
 The camera is a device like the chips: ``/devices/<camera>/ok`` is False while it gives
 no frames, and it is re-opened every ``reopen_s`` until it answers again.
+
+Attention, not a timer (the paper's "attention activation"): while no hand is seen and
+nothing is shown, a frame that looks like the last one the network read (each cell of a
+16 x 9 grid of its grey levels within ``STILL_LEVELS``) is not read again: the reading
+stays "no hand". Something coming into view changes the cells and is read at once; the
+network still reads a frame at least once a second (``LOOK_AT_LEAST_EVERY_S``), so a
+change too small for the grid is never missed for long.
 """
 
 from __future__ import annotations
 
 import logging
 import threading
+
+import cv2
+import numpy as np
 
 from engine.blackboard.board import Blackboard
 from engine.blackboard.catalogue import HAND_CONFIDENCE, HAND_FINGERS, HAND_HELD, HAND_SHOWN
@@ -30,6 +40,11 @@ from engine.media.images import Frame
 from engine.vision.classifier import FingerCounter, HandReading
 
 log = logging.getLogger(__name__)
+STILL_LEVELS = 6.0
+"""How far (grey levels, 0..255) a cell of the grid may move and the view still count as
+the same: above a webcam's noise averaged over a cell, far below a hand coming in."""
+GRID = (16, 9)
+LOOK_AT_LEAST_EVERY_S = 1.0
 REOPEN_S = 2.0
 STOP_WAIT_S = 5.0
 """How long stopping waits for a frame being read (a webcam gives one within a second)."""
@@ -86,6 +101,11 @@ class HandWatcher:
         self.steady = SteadyCount(steady_frames)
         self.frames = 0
         self.dropped = 0
+        self.looked = 0
+        """Frames the network read (the others looked like the last one, with no hand)."""
+        self._seen: np.ndarray | None = None  # the grid of the last frame the network read
+        self._seen_s = float("-inf")
+        self._last: HandReading | None = None
         self._open = False
         self._next_s: float | None = None
         self._retry_s = 0.0
@@ -94,8 +114,23 @@ class HandWatcher:
 
     # -- one frame ------------------------------------------------------------------------
     def process(self, frame: Frame) -> HandReading:
-        """Count the fingers in ``frame`` and stage what was seen."""
-        reading = self.model.read(frame)
+        """Count the fingers in ``frame`` (or, when nothing is going on and it looks like
+        the last frame read, keep that reading) and stage what was seen."""
+        grid = _grid(frame)
+        now_s = self.clock.now()
+        last = self._last
+        if (
+            last is None
+            or last.fingers is not None
+            or self.steady.shown is not None
+            or self._seen is None
+            or now_s - self._seen_s >= LOOK_AT_LEAST_EVERY_S
+            or float(np.abs(grid - self._seen).max()) > STILL_LEVELS
+        ):
+            last = self._last = self.model.read(frame)
+            self._seen, self._seen_s = grid, now_s
+            self.looked += 1
+        reading = last
         self.frames += 1
         self.blackboard.stage(HAND_FINGERS, reading.fingers)
         self.blackboard.stage(HAND_CONFIDENCE, round(reading.confidence, 4))
@@ -200,3 +235,9 @@ class HandWatcher:
             return
         self.camera.close()
         self._open = False
+
+
+def _grid(frame: Frame) -> np.ndarray:
+    """The frame's grey levels averaged over a GRID of cells (float32)."""
+    grey = cv2.cvtColor(frame, cv2.COLOR_BGR2GRAY) if frame.ndim == 3 else frame
+    return np.asarray(cv2.resize(grey, GRID, interpolation=cv2.INTER_AREA), dtype=np.float32)

@@ -162,3 +162,18 @@ def test_frames_smaller_than_the_window_put_the_camera_offline_with_the_reason()
     assert board.get(CAMERA_OK) is False
     assert "smaller than the 2x2 window" in (watcher.health.last_error or "")
     assert watcher.frames == 0
+
+
+def test_an_empty_view_that_does_not_change_is_read_once_a_second() -> None:
+    watcher, _, board, clock = watching([None])
+    run(watcher, board, clock, 3.0)
+    assert watcher.frames == 30  # every frame taken and staged...
+    assert watcher.looked == 3  # ...but the network read one a second: nothing going on
+    assert board.get(FINGERS) is None
+
+
+def test_a_hand_coming_into_view_is_read_at_once_and_every_frame_while_it_is_there() -> None:
+    watcher, _, board, clock = watching([None] * 5 + [3] * 5 + [None] * 5)
+    run(watcher, board, clock, 1.5)
+    assert shown(board) == [3]  # as without attention: the third frame of the hand
+    assert watcher.looked == 1 + 5 + 3  # the empty view once; the hand; until it is gone
