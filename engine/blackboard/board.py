@@ -149,6 +149,7 @@ class Blackboard:
         with self._lock:
             self._pending.clear()
             self._last_staged.clear()
+        self._changed.clear()
         self._updated_s.clear()
         self._values.clear()
 
@@ -178,6 +179,8 @@ def _same(old: Any, new: Any) -> bool:
     """Whether a key's new value is its old one (a value that cannot say counts as new)."""
     if old is new:
         return True
+    if isinstance(old, float) and isinstance(new, float) and old != old and new != new:
+        return True  # NaN, read again: no reading still
     try:
         return bool(old == new)
     except Exception:  # an array's comparison, say

@@ -44,6 +44,10 @@ class EventReader:
         """Forget the events already on the key: only later ones count."""
         self.handled_seq = self.node.ctx.blackboard.event_log(self.key).last_seq
 
+    def unread(self) -> bool:
+        """Whether events came on the key that this node has not looked at yet."""
+        return self.node.ctx.blackboard.event_log(self.key).last_seq > self.handled_seq
+
     def take(self) -> tuple[bool, Any]:
         """(True, value) of the oldest new event that counts, or (False, None)."""
         log = self.node.read(self.key)

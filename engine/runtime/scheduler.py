@@ -97,10 +97,19 @@ class RunningTree:
         that tries again: the others pay nothing)."""
         if not self.tries_again:
             return
-        if self._readers_of is not self.tree.root:  # the nodes that read events, once a version
+        self._round_start = [(node, node.events.handled_seq) for node in self._event_readers()]
+
+    def _event_readers(self) -> list[Any]:
+        """The nodes that read events (found once a version)."""
+        if self._readers_of is not self.tree.root:
             self._readers = [n for n in self.tree.root.iterate() if hasattr(n, "events")]
             self._readers_of = self.tree.root
-        self._round_start = [(node, node.events.handled_seq) for node in self._readers]
+        return self._readers
+
+    def has_unread_events(self) -> bool:
+        """Whether an event came that a node of the tree has not handled yet (a second
+        pat in one round, a command that came while another was carried out)."""
+        return any(node.events.unread() for node in self._event_readers())
 
     def try_again(self) -> None:
         """Hand the events of the round that was cut short back to its nodes: at its next
@@ -340,6 +349,8 @@ class Scheduler:
         tree.last_tick_s = now
         tree.woken = tree.woken and not fresh  # what came during a round wakes the next one
         waits = status != py_trees.common.Status.RUNNING and not tree.retrying
+        if tree.definition.wake_on and waits and not tree.woken:
+            tree.woken = tree.has_unread_events()  # one event a round: the next one, next
         tree.resting = bool(tree.definition.wake_on) and waits and not tree.woken
         if tree.next_deadline_s <= now:
             behind = math.floor((now - tree.origin_s) / tree.period_s) + 1

@@ -120,3 +120,22 @@ def test_a_tree_cannot_wait_on_a_variable_no_tree_writes(tmp_path: Path) -> None
         load_behaviors([tmp_path])
     (tmp_path / "writer.yaml").write_text("root:\n  SetValue: {key: /vars/ready, value: true}\n")
     assert len(load_behaviors([tmp_path]).trees) == 2
+
+
+def test_two_commands_in_one_moment_are_both_carried_out(tmp_path: Path) -> None:
+    commands = """\
+    rate_hz: 10
+    wake_on: [/iot/inbox]
+    root:
+      Sequence:
+        - OnEvent: {key: /iot/inbox}
+        - Say: {text: done}
+    """
+    robot, board, _ = robot_with(tmp_path, iot=commands)
+    robot.scheduler.step()
+    board.stage_event("/iot/inbox", {"id": "a"})
+    board.stage_event("/iot/inbox", {"id": "b"})  # in the same commit: one a round
+    robot.scheduler.run(until_s=2.0)
+    said = [call[0] for call in robot.services.speech.calls]  # type: ignore[attr-defined]
+    assert said == ["done", "done"]
+    assert robot.trees[0].resting  # then it rests: nothing is left unread
