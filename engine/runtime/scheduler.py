@@ -5,8 +5,9 @@ not add up. Before the trees due at a deadline tick, the hooks run (the scenario
 reload) and the blackboard's staged writes are committed: every tree ticked at one
 deadline sees the same snapshot. A tick that overran whole periods skips them (counted).
 
-A tree that says what wakes it (``wake_on:``, keys) rests between rounds: once a round
-ends (its root not RUNNING) it is not ticked at its deadlines, until one of those keys
+A tree that says what wakes it (``wake_on:``, keys) rests between rounds: once a tick
+finds nothing to do (its root FAILURE: the condition that starts it not met; after a
+round that acted, the next tick) it is not ticked at its deadlines, until one of those keys
 changes (a producer stages a new value or an event, or another tree writes it); then the
 scheduler steps at once and the tree ticks, no sooner than a period after its last tick
 (``rate_hz`` stays its fastest), and at its rate while the round runs.
@@ -348,7 +349,9 @@ class Scheduler:
         tree.period_index += 1
         tree.last_tick_s = now
         tree.woken = tree.woken and not fresh  # what came during a round wakes the next one
-        waits = status != py_trees.common.Status.RUNNING and not tree.retrying
+        # it waits once a tick finds nothing to do (FAILURE: its condition not met); after a
+        # round that acted (SUCCESS) it ticks once more, so its nodes say they wait again
+        waits = status == py_trees.common.Status.FAILURE and not tree.retrying
         if tree.definition.wake_on and waits and not tree.woken:
             tree.woken = tree.has_unread_events()  # one event a round: the next one, next
         tree.resting = bool(tree.definition.wake_on) and waits and not tree.woken
