@@ -87,11 +87,9 @@ class RosGraph:
         probe.bind(("127.0.0.1", 0))
         self.endpoint = f"tcp/127.0.0.1:{probe.getsockname()[1]}"
         probe.close()
-        config = zenoh.Config()
-        config.insert_json5("mode", '"peer"')
-        config.insert_json5("scouting/multicast/enabled", "false")
-        config.insert_json5("listen/endpoints", json.dumps([self.endpoint]))
-        self.session = zenoh.open(config)
+        from engine.interop.ros2_wire import session_config
+
+        self.session = zenoh.open(session_config(None, None, listen=self.endpoint))
         self.counted = [0]
         self._subscriber = self.session.declare_subscriber("0/vest/**", self._count)
 

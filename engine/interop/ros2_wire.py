@@ -163,16 +163,20 @@ def ros_time(seconds: float) -> dict[str, int]:
     return {"sec": nanoseconds // 1_000_000_000, "nanosec": nanoseconds % 1_000_000_000}
 
 
-def session_config(connect: str, config_file: str | None) -> zenoh.Config:
+def session_config(
+    connect: str | None, config_file: str | None, *, listen: str = "tcp/127.0.0.1:0"
+) -> zenoh.Config:
     """A peer session that connects to the Zenoh router at ``connect`` (as rmw_zenoh's
-    nodes do: ``tcp/127.0.0.1:7447`` by default) and listens on loopback for its peers;
-    ``config_file`` (rmw_zenoh's ``ZENOH_SESSION_CONFIG_URI``) replaces all of this.
-    Raises zenoh.ZError for an endpoint or file it cannot use."""
+    nodes do: ``tcp/127.0.0.1:7447`` by default; None: to nobody) and listens on ``listen``
+    for its peers (loopback, any port); ``config_file`` (rmw_zenoh's
+    ``ZENOH_SESSION_CONFIG_URI``) replaces all of this. A graph's stand-in (the tests', the
+    bench's) connects to nobody and listens where the robot connects. Raises zenoh.ZError
+    for an endpoint or file it cannot use."""
     if config_file:
         return zenoh.Config.from_file(config_file)
     config = zenoh.Config()
     config.insert_json5("mode", '"peer"')
     config.insert_json5("scouting/multicast/enabled", "false")  # the router tells of peers
-    config.insert_json5("connect/endpoints", json.dumps([connect]))
-    config.insert_json5("listen/endpoints", '["tcp/127.0.0.1:0"]')
+    config.insert_json5("connect/endpoints", json.dumps([connect] if connect else []))
+    config.insert_json5("listen/endpoints", json.dumps([listen]))
     return config

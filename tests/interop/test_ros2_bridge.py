@@ -33,7 +33,7 @@ from engine.blackboard.catalogue import (  # noqa: E402
 from engine.clock import VirtualClock  # noqa: E402
 from engine.interop.ros2_bridge import Ros2Bridge  # noqa: E402
 from engine.interop.ros2_plan import Ros2Plan  # noqa: E402
-from engine.interop.ros2_wire import Wire, attachment  # noqa: E402
+from engine.interop.ros2_wire import Wire, attachment, session_config  # noqa: E402
 from engine.privacy.consent import Consent  # noqa: E402
 from engine.session.events import (  # noqa: E402
     ActionStarted,
@@ -59,11 +59,7 @@ class Lab:
         probe.bind(("127.0.0.1", 0))
         self.endpoint = f"tcp/127.0.0.1:{probe.getsockname()[1]}"
         probe.close()
-        config = zenoh.Config()
-        config.insert_json5("mode", '"peer"')
-        config.insert_json5("scouting/multicast/enabled", "false")
-        config.insert_json5("listen/endpoints", json.dumps([self.endpoint]))
-        self.session = zenoh.open(config)
+        self.session = zenoh.open(session_config(None, None, listen=self.endpoint))
         self.samples: list[tuple[str, bytes, bytes | None]] = []
         self.tokens: list[str] = []
         self.arrived = threading.Condition()
@@ -97,6 +93,14 @@ class Lab:
             result = self.arrived.wait_for(found, timeout=WAIT_S)
         assert result, f"the lab never saw {what}"
         return result
+
+    def listening_for_commands(self) -> None:
+        """Waits until the robot's command subscription is on the graph."""
+        self.wait_for("the command subscription", lambda: [t for t in self.tokens if "/MS/" in t])
+
+    def two_results(self, what: str) -> list[dict[str, Any]]:
+        """Waits for a command's second result (after RECEIVED), and returns them all."""
+        return self.wait_for(what, lambda: len(self.results()) > 1 and self.results())
 
     def results(self) -> list[dict[str, Any]]:
         return [json.loads(m.data) for m in self.messages("/vest/command/result", STRING)]
@@ -198,7 +202,7 @@ def test_a_command_from_the_graph_goes_the_cloud_s_way_and_its_result_comes_back
 ) -> None:
     bridge, board, _ = bridge_on(lab, "sensors", "cloud_telemetry", commands=True)
     try:
-        lab.wait_for("the command subscription", lambda: [t for t in lab.tokens if "/MS/" in t])
+        lab.listening_for_commands()
         lab.send(json.dumps({"id": "wave-1", "type": "say", "args": {"text": "hello"}}))
         lab.wait_for("the command taken", lab.results)
         board.commit()
@@ -207,7 +211,7 @@ def test_a_command_from_the_graph_goes_the_cloud_s_way_and_its_result_comes_back
         assert staged.value == {"id": "ros2:wave-1", "type": "say", "args": {"text": "hello"}}
         report = {"id": "ros2:wave-1", "status": "succeeded", "result": None}
         bridge.on_event(ActionStarted(1.0, 7, "iot_command", "report", report))
-        results = lab.wait_for("the result", lambda: len(lab.results()) > 1 and lab.results())
+        results = lab.two_results("the result")
     finally:
         bridge.stop()
     assert [(r["id"], r["status"]) for r in results] == [
@@ -231,7 +235,7 @@ def test_a_command_from_the_graph_goes_the_cloud_s_way_and_its_result_comes_back
 def test_a_command_the_robot_would_refuse_is_refused_at_once(lab: Lab, sent: str, why: str) -> None:
     bridge, board, _ = bridge_on(lab, commands=True)
     try:
-        lab.wait_for("the command subscription", lambda: [t for t in lab.tokens if "/MS/" in t])
+        lab.listening_for_commands()
         lab.send(sent)
         results = lab.wait_for("the refusal", lab.results)
     finally:
@@ -244,13 +248,13 @@ def test_a_command_the_robot_would_refuse_is_refused_at_once(lab: Lab, sent: str
 def test_a_read_without_telemetry_consent_answers_failed_never_the_reading(lab: Lab) -> None:
     bridge, _, _ = bridge_on(lab, "sensors", commands=True)
     try:
-        lab.wait_for("the command subscription", lambda: [t for t in lab.tokens if "/MS/" in t])
+        lab.listening_for_commands()
         lab.send(json.dumps({"id": "r1", "type": "read", "args": {"sensor": "force"}}))
         lab.wait_for("the command taken", lab.results)
         reading = {FORCE_LEFT_N: 12.5}
         report = {"id": "ros2:r1", "status": "succeeded", "result": reading}
         bridge.on_event(ActionStarted(1.0, 7, "iot_command", "report", report))
-        results = lab.wait_for("the result", lambda: len(lab.results()) > 1 and lab.results())
+        results = lab.two_results("the result")
         actions = lab.wait_for("the report", lambda: lab.messages("/vest/actions", STRING))
     finally:
         bridge.stop()
@@ -262,12 +266,12 @@ def test_a_read_without_telemetry_consent_answers_failed_never_the_reading(lab: 
 def test_telemetry_consent_without_sensors_sends_no_reading_either(lab: Lab) -> None:
     bridge, _, _ = bridge_on(lab, "cloud_telemetry", commands=True)
     try:
-        lab.wait_for("the command subscription", lambda: [t for t in lab.tokens if "/MS/" in t])
+        lab.listening_for_commands()
         lab.send(json.dumps({"id": "r2", "type": "read", "args": {"sensor": "force"}}))
         lab.wait_for("the command taken", lab.results)
         report = {"id": "ros2:r2", "status": "succeeded", "result": {FORCE_LEFT_N: 12.5}}
         bridge.on_event(ActionStarted(1.0, 7, "iot_command", "report", report))
-        results = lab.wait_for("the result", lambda: len(lab.results()) > 1 and lab.results())
+        results = lab.two_results("the result")
     finally:
         bridge.stop()
     assert results[1]["status"] == "FAILED" and "12.5" not in json.dumps(results)
@@ -276,12 +280,12 @@ def test_telemetry_consent_without_sensors_sends_no_reading_either(lab: Lab) -> 
 def test_a_command_still_waiting_when_the_robot_stops_is_told_lost(lab: Lab) -> None:
     bridge, _, _ = bridge_on(lab, commands=True)
     try:
-        lab.wait_for("the command subscription", lambda: [t for t in lab.tokens if "/MS/" in t])
+        lab.listening_for_commands()
         lab.send(json.dumps({"type": "say", "args": {"text": "hello"}}))  # no id: one is given
         lab.wait_for("the command taken", lab.results)
     finally:
         bridge.stop()
-    results = lab.wait_for("its end", lambda: len(lab.results()) > 1 and lab.results())
+    results = lab.two_results("its end")
     assert [r["status"] for r in results] == ["RECEIVED", "LOST"]
     assert results[0]["id"] == results[1]["id"] == "n1"
     assert "stopped" in results[1]["result"]["error"]
@@ -290,10 +294,10 @@ def test_a_command_still_waiting_when_the_robot_stops_is_told_lost(lab: Lab) -> 
 def test_a_second_command_under_a_waiting_id_is_refused(lab: Lab) -> None:
     bridge, _, _ = bridge_on(lab, commands=True)
     try:
-        lab.wait_for("the command subscription", lambda: [t for t in lab.tokens if "/MS/" in t])
+        lab.listening_for_commands()
         for _ in range(2):
             lab.send(json.dumps({"id": "same", "type": "say", "args": {"text": "hi"}}))
-        results = lab.wait_for("both answers", lambda: len(lab.results()) > 1 and lab.results())
+        results = lab.two_results("both answers")
     finally:
         bridge.stop()
     assert [r["status"] for r in results[:2]] == ["RECEIVED", "REFUSED"]
@@ -326,9 +330,9 @@ def test_vest_run_carries_out_a_say_sent_from_the_graph(lab: Lab) -> None:
         assert robot.stderr is not None
         said = next(line for line in robot.stderr if line.startswith("ros2: "))
         assert "node /vest on domain 0" in said and "commands on /vest/command" in said
-        lab.wait_for("the command subscription", lambda: [t for t in lab.tokens if "/MS/" in t])
+        lab.listening_for_commands()
         lab.send(json.dumps({"id": "hello-1", "type": "say", "args": {"text": "hello there"}}))
-        results = lab.wait_for("the say's result", lambda: len(lab.results()) > 1 and lab.results())
+        results = lab.two_results("the say's result")
         log_type = "nav2_msgs/msg/BehaviorTreeLog"
         iot_log = lab.messages("/vest/trees/iot_command/log", log_type)
     finally:
