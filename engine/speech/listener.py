@@ -3,9 +3,14 @@
 The microphone hands audio to :meth:`Listener.hear` from its own thread (or, on the
 simulated vest, from a tick hook). Voice activity is found at once (Silero is cheap);
 each finished utterance is recognized in the listener's worker, never in a tick, and
-``on_heard`` gets the text. While the robot speaks, the microphone is ignored
-(:class:`~engine.speech.speaker.SelfHearing`): it never answers its own voice. Someone
-who speaks over the robot is therefore not heard; what can be known of it is told to
+``on_heard`` gets the text. The worker starts on an utterance before the robot's wait
+for silence is over: on the detector's draft (the speech so far, after a short pause);
+when the utterance ends with nothing said after the draft, the draft's text is the
+utterance's and is told at once (a draft that fell short is forgotten).
+
+While the robot speaks, the microphone is ignored
+(:class:`~engine.speech.speaker.SelfHearing`): it never answers its own voice. Someone who
+speaks over the robot is therefore not heard; what can be known of it is told to
 ``on_not_listened(from_s, until_s, why)``: here, speech already under way when the robot
 stops (its start was lost). Telling speech *within* the robot's voice apart from its echo
 needs echo cancellation, which a microphone here does not have; the simulated room knows
@@ -66,11 +71,14 @@ class Listener:
         self.settling = settling or Settling()
         self._working = 0
         self._lock = threading.Lock()
-        self._queue: queue.Queue[tuple[Utterance, float] | None] = queue.Queue()
+        self._queue: queue.Queue[tuple[Utterance, float | None] | None] = queue.Queue()
+        """Utterances to recognize with when they ended (None: a draft, not told)."""
+        self._draft_text: str | None = None
         self._thread: threading.Thread | None = None
         self.ignored_s = 0.0
         """Seconds of microphone audio ignored because the robot was speaking."""
         self.on_not_listened = on_not_listened
+        detector.on_pause = self._draft
         self._deaf_since_s: float | None = None
         self._listening_since_s: float | None = None
 
@@ -117,7 +125,11 @@ class Listener:
         """No utterance waits for recognition."""
         return self._working == 0
 
-    def _submit(self, utterance: Utterance, ended_s: float) -> None:
+    def _draft(self, utterance: Utterance) -> None:
+        """The speech so far, recognized while the robot waits to be sure it ended."""
+        self._submit(utterance, None)
+
+    def _submit(self, utterance: Utterance, ended_s: float | None) -> None:
         with self._lock:
             self._working += 1
         self._queue.put((utterance, ended_s))
@@ -141,16 +153,24 @@ class Listener:
             if item is None:
                 return
             utterance, ended_s = item
+            drafted = self._draft_text if utterance.drafted else None
+            self._draft_text = None
+            text = drafted if drafted is not None else self._recognized(utterance)
             try:
-                text = self.recognizer.transcribe(utterance.audio).text
-            except Exception as error:  # a model that failed on this audio
-                log.warning("recognition failed: %s", error)
-                text = ""
-            try:
-                self.on_heard(Heard(text, ended_s, self.clock.now()))
+                if ended_s is None:
+                    self._draft_text = text
+                else:
+                    self.on_heard(Heard(text, ended_s, self.clock.now()))
             except Exception:  # whoever listens must not stop the robot hearing
                 log.exception("handling what was heard failed")
             finally:
                 with self._lock:
                     self._working -= 1
                 self.settling.changed()
+
+    def _recognized(self, utterance: Utterance) -> str:
+        try:
+            return self.recognizer.transcribe(utterance.audio).text
+        except Exception as error:  # a model that failed on this audio
+            log.warning("recognition failed: %s", error)
+            return ""

@@ -1,13 +1,16 @@
-"""The speech settings a profile may give: the voice and how fast it speaks."""
+"""The speech settings a profile may give: the voice, how fast it speaks, and the
+recognizer that hears."""
 
 from __future__ import annotations
 
 from typing import Any
 
-VOICE_NAMES = ("joe", "espeak")
-SPEECH_PROFILE_PARAMS = ("voice", "speech_rate")
+VOICE_NAMES = ("hibari", "joe", "espeak")
+RECOGNIZER_NAMES = ("moonshine", "whisper")
+SPEECH_PROFILE_PARAMS = ("voice", "speech_rate", "recognizer")
 """Profile parameters the speech itself reads (no tree needs to declare them):
-``voice`` (joe or espeak) and ``speech_rate`` (1 natural, 0.5..2)."""
+``voice`` (hibari, joe or espeak), ``speech_rate`` (1 natural, 0.5..2) and ``recognizer``
+(moonshine or whisper)."""
 
 
 def check_speech_params(params: dict[str, Any]) -> list[tuple[str, str, str]]:
@@ -17,6 +20,15 @@ def check_speech_params(params: dict[str, Any]) -> list[tuple[str, str, str]]:
     voice = params.get("voice")
     if voice is not None and voice not in VOICE_NAMES:
         problems.append(("voice", f"no voice {voice!r}", "voices: " + ", ".join(VOICE_NAMES)))
+    recognizer = params.get("recognizer")
+    if recognizer is not None and recognizer not in RECOGNIZER_NAMES:
+        problems.append(
+            (
+                "recognizer",
+                f"no recognizer {recognizer!r}",
+                "recognizers: " + ", ".join(RECOGNIZER_NAMES),
+            )
+        )
     rate = params.get("speech_rate")
     if rate is not None and (
         isinstance(rate, bool) or not isinstance(rate, int | float) or not 0.5 <= rate <= 2.0

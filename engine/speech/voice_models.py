@@ -10,7 +10,14 @@ import importlib.util
 from pathlib import Path
 
 from engine.speech.settings import VOICE_NAMES
-from engine.speech.voices import EspeakVoice, NeuralVoice, Voice, VoiceError, VoiceModel
+from engine.speech.voices import (
+    EspeakVoice,
+    HibariVoice,
+    NeuralVoice,
+    Voice,
+    VoiceError,
+    VoiceModel,
+)
 
 
 def joe_voice_model() -> VoiceModel | None:
@@ -26,6 +33,8 @@ def load_voice(name: str) -> Voice:
     """The voice called ``name``; VoiceError saying why it cannot speak."""
     if name == "espeak":
         return EspeakVoice()
+    if name == "hibari":
+        return HibariVoice()
     if name == "joe":
         files = joe_voice_model()
         if files is None:

@@ -178,3 +178,52 @@ class NeuralVoice:
         if peak > 1e-8:
             samples = samples / peak * 0.9
         return Audio(samples.astype(np.float32), self.rate_hz)
+
+
+class HibariVoice:
+    """hibari's "heart" voice (PyPI hibari-tts, Apache-2.0: distilled from Kokoro-82M,
+    Apache-2.0): its own spelling-to-sound rules and lexicons, no espeak-ng, an 8 MB ONNX
+    model run by ONNX Runtime; 24 kHz. Only the voice inside the package is used: its
+    other voices would be downloaded, and the robot downloads nothing."""
+
+    def __init__(self, *, threads: int = 1, seed: int | None = None) -> None:
+        """``seed``: None, a little different each time, as a person; a number, the same
+        audio for the same text (:meth:`steady`)."""
+        try:
+            from hibari import Hibari
+            from hibari.voices import voice_path
+
+            model = voice_path("heart", download_missing=False)
+            self.tts = Hibari(voice="heart", model=model, threads=threads)
+        except ImportError:
+            raise VoiceError("the hibari voice is not installed (pip package hibari-tts)") from None
+        except Exception as error:  # its model missing, or onnxruntime refusing it
+            raise VoiceError(f"the hibari voice cannot load ({error})") from None
+        self.name = "hibari"
+        self.rate_hz = int(self.tts.sample_rate)
+        self.seed = seed
+
+    def steady(self) -> HibariVoice:
+        """This voice with its noise fixed: the same text always gives the same audio."""
+        twin = copy.copy(self)
+        twin.seed = 0
+        return twin
+
+    def synthesize(self, sentence: str, *, speed: float = 1.0) -> Audio:
+        try:
+            output = self.tts(sentence, speed=max(0.5, min(2.0, speed)), seed=self.seed)
+        except Exception as error:  # its G2P or model failing on this text
+            raise VoiceError(f"the hibari voice failed on {sentence[:40]!r} ({error})") from None
+        samples = np.asarray(output, dtype=np.float32).reshape(-1)
+        peak = float(np.max(np.abs(samples))) if len(samples) else 0.0
+        if peak > 1e-8:
+            samples = samples / peak * 0.9
+        return Audio(samples, self.rate_hz)
+
+
+def steady_voice(voice: Voice) -> Voice:
+    """``voice`` saying the same text the same way every time, where it can vary (the
+    neural voices); espeak-ng always does."""
+    if isinstance(voice, NeuralVoice | HibariVoice):
+        return voice.steady()
+    return voice

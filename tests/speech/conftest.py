@@ -11,10 +11,11 @@ from engine.blackboard.catalogue import default_catalogue
 from engine.dialogs.library import load_dialog
 from engine.dialogs.model import Dialog
 from engine.media.audio import Audio, with_noise
-from engine.speech.recognizer import WhisperRecognizer
+from engine.speech.recognizer import Recognizer, WhisperRecognizer
+from engine.speech.recognizers import DEFAULT_RECOGNIZER, load_recognizer
 from engine.speech.vad import SileroVad
 from engine.speech.voice_models import load_voice
-from engine.speech.voices import NeuralVoice, Voice
+from engine.speech.voices import NeuralVoice, Voice, steady_voice
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -25,7 +26,16 @@ def default_dialog() -> Dialog:
 
 
 @pytest.fixture(scope="session")
-def recognizer(default_dialog: Dialog) -> WhisperRecognizer:
+def recognizer(default_dialog: Dialog) -> Recognizer:
+    """The robot's default recognizer, listening for the default dialog."""
+    recognizer = load_recognizer(DEFAULT_RECOGNIZER)
+    recognizer.listen_for(default_dialog.phrases)
+    return recognizer
+
+
+@pytest.fixture(scope="session")
+def whisper(default_dialog: Dialog) -> WhisperRecognizer:
+    """Whisper tiny.en, the recognizer a profile may choose instead."""
     recognizer = WhisperRecognizer()
     recognizer.listen_for(default_dialog.phrases)
     return recognizer
@@ -40,7 +50,11 @@ def vad() -> SileroVad:
 def voices() -> dict[str, Voice]:
     joe = load_voice("joe")
     assert isinstance(joe, NeuralVoice)
-    return {"joe": joe.steady(), "espeak": load_voice("espeak")}
+    return {
+        "hibari": steady_voice(load_voice("hibari")),
+        "joe": joe.steady(),
+        "espeak": load_voice("espeak"),
+    }
 
 
 @pytest.fixture(scope="session")

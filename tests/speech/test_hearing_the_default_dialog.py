@@ -10,7 +10,7 @@ import pytest
 from engine.dialogs.model import Dialog
 from engine.media.audio import Audio
 from engine.speech.hearing import hear
-from engine.speech.recognizer import WhisperRecognizer
+from engine.speech.recognizer import Recognizer
 from engine.speech.vad import SileroVad
 
 QUESTIONS = {
@@ -38,7 +38,7 @@ def test_every_rule_is_understood_in_each_voice_speed_and_in_noise(
     snr_db: float | None,
     spoken: Callable[..., Audio],
     vad: SileroVad,
-    recognizer: WhisperRecognizer,
+    recognizer: Recognizer,
     default_dialog: Dialog,
 ) -> None:
     hearing = hear(spoken(QUESTIONS[rule], voice, speed, snr_db), vad, recognizer, default_dialog)
@@ -60,7 +60,7 @@ def test_questions_outside_the_dialog_get_the_fallback(
     sentence: str,
     spoken: Callable[..., Audio],
     vad: SileroVad,
-    recognizer: WhisperRecognizer,
+    recognizer: Recognizer,
     default_dialog: Dialog,
 ) -> None:
     hearing = hear(spoken(sentence), vad, recognizer, default_dialog)
@@ -72,7 +72,7 @@ def test_questions_outside_the_dialog_get_the_fallback(
 def test_the_answer_to_the_robot_s_question_is_heard_as_the_follow_up(
     spoken: Callable[..., Audio],
     vad: SileroVad,
-    recognizer: WhisperRecognizer,
+    recognizer: Recognizer,
     default_dialog: Dialog,
 ) -> None:
     pets = next(rule for rule in default_dialog.rules if rule.id == "pets")
@@ -85,7 +85,7 @@ def test_the_answer_to_the_robot_s_question_is_heard_as_the_follow_up(
 
 
 def test_noise_alone_is_not_heard_as_anything(
-    vad: SileroVad, recognizer: WhisperRecognizer, default_dialog: Dialog
+    vad: SileroVad, recognizer: Recognizer, default_dialog: Dialog
 ) -> None:
     from engine.media.audio import noise
 

