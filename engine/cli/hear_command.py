@@ -11,7 +11,7 @@ to the intent, as the robot would live on this machine (the silence it waits to 
 then recognizing and matching, measured here).
 --mic listens on the microphone instead (the robot config's, or --device) until Ctrl-C.
 --text "do you like dogs" hears a typed phrase as the robot would hear it spoken: said by
-the robot's voice (joe, natural speed), then through the same hearing (its "file" is the
+the robot's voice (hibari, natural speed), then through the same hearing (its "file" is the
 text, quoted).
 """
 
@@ -33,7 +33,7 @@ from engine.media.audio import read_wav
 from engine.speech.hearing import Hearing, conversation, spoken
 from engine.speech.recognizers import default_recognizer
 from engine.speech.settings import RECOGNIZER_NAMES
-from engine.speech.voice_models import load_voice
+from engine.speech.voice_models import DEFAULT_VOICE, load_voice
 from engine.speech.voices import steady_voice
 
 MAX_TYPED_CHARS = 400
@@ -117,7 +117,7 @@ def main(args: argparse.Namespace) -> int:
     library, dialog = load_dialog_named(args.dialogs, args.dialog)
     audio = [(str(path), read_wav(path)) for path in args.files]  # read before any work
     if args.text:
-        voice = load_voice("joe")
+        voice = load_voice(DEFAULT_VOICE)
         steady = steady_voice(voice)
         audio += [(repr(phrase), spoken(steady, phrase)) for phrase in args.text]
     from engine.speech.vad import SileroVad

@@ -1,6 +1,6 @@
 """Speak with the robot's voice: on the speaker, or into a WAV file with -o.
 
-The voice and speed are a profile's (--profile child), or --voice (joe, the neural voice,
+The voice and speed are a profile's (--profile child), or --voice (hibari, the default; joe;
 or espeak) and --rate (1 is the voice's natural speed). Sentences are synthesized one
 by one; the first plays while the next is made.
 """
@@ -19,7 +19,7 @@ from engine.media.audio import Audio, write_wav
 from engine.robot_io.robot_speech import speech_settings
 from engine.speech.settings import VOICE_NAMES
 from engine.speech.speaker import Speaker
-from engine.speech.voice_models import load_voice
+from engine.speech.voice_models import DEFAULT_VOICE, load_voice
 from engine.speech.voices import EspeakVoice, sentences
 
 MAX_TEXT_CHARS = 5000
@@ -51,7 +51,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="a profile (name in trees/profiles/ or path): its voice and speech_rate",
     )
     parser.add_argument(
-        "--voice", choices=VOICE_NAMES, default=None, help="default: the profile's, or joe"
+        "--voice",
+        choices=VOICE_NAMES,
+        default=None,
+        help=f"default: the profile's, or {DEFAULT_VOICE}",
     )
     parser.add_argument(
         "--rate", type=_rate, default=None, help="speed, 0.5..2 (default: the profile's, or 1)"
@@ -78,7 +81,7 @@ def main(args: argparse.Namespace) -> int:
     if args.profile is not None:
         path = resolve_profile(args.profile, [Path("trees")])
         settings = speech_settings(load_profile(path)) if path is not None else {}
-    args.voice = args.voice or settings.get("voice_name", "joe")
+    args.voice = args.voice or settings.get("voice_name", DEFAULT_VOICE)
     args.rate = args.rate or settings.get("speed", 1.0)
     if args.output is not None and args.output.suffix.lower() != ".wav":
         raise UsageError(f"-o {args.output}: vest writes WAV files; name it .wav")

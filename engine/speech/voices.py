@@ -180,6 +180,11 @@ class NeuralVoice:
         return Audio(samples.astype(np.float32), self.rate_hz)
 
 
+HIBARI_LEAD_S = 0.05
+HIBARI_TAIL_S = 0.2
+"""Silence kept before and after a sentence of the hibari voice, seconds."""
+
+
 class HibariVoice:
     """hibari's "heart" voice (PyPI hibari-tts, Apache-2.0: distilled from Kokoro-82M,
     Apache-2.0): its own spelling-to-sound rules and lexicons, no espeak-ng, an 8 MB ONNX
@@ -218,7 +223,9 @@ class HibariVoice:
         peak = float(np.max(np.abs(samples))) if len(samples) else 0.0
         if peak > 1e-8:
             samples = samples / peak * 0.9
-        return Audio(samples, self.rate_hz)
+        # it leaves about 0.3 s of silence before a sentence and 0.45 s after: cut to what
+        # joe leaves, so the answer starts sooner and sentences follow as they would
+        return Audio(samples, self.rate_hz).trimmed(lead_s=HIBARI_LEAD_S, tail_s=HIBARI_TAIL_S)
 
 
 def steady_voice(voice: Voice) -> Voice:
