@@ -193,13 +193,17 @@ class Dialog:
 
     def all_rules(self) -> list[DialogRule]:
         """Every rule, follow-ups included."""
-        found: list[DialogRule] = []
-        pending = list(self.rules)
+        return [rule for rule, _ in self.rules_in_context()]
+
+    def rules_in_context(self) -> list[tuple[DialogRule, FollowUp | None]]:
+        """Every rule with the follow-up it is heard in (None: the dialog's own rules)."""
+        found: list[tuple[DialogRule, FollowUp | None]] = []
+        pending: list[tuple[DialogRule, FollowUp | None]] = [(r, None) for r in self.rules]
         while pending:
-            rule = pending.pop(0)
-            found.append(rule)
+            rule, context = pending.pop(0)
+            found.append((rule, context))
             if rule.follow_up is not None:
-                pending.extend(rule.follow_up.rules)
+                pending.extend((r, rule.follow_up) for r in rule.follow_up.rules)
         return found
 
     @property

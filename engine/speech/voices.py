@@ -207,6 +207,7 @@ class HibariVoice:
         self.name = "hibari"
         self.rate_hz = int(self.tts.sample_rate)
         self.seed = seed
+        self.synthesize("Hello.")  # its spelling rules load on first use: 0.3 s, not now
 
     def steady(self) -> HibariVoice:
         """This voice with its noise fixed: the same text always gives the same audio."""
