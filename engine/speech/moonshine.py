@@ -80,7 +80,7 @@ def said_once(said: tuple[Word, ...]) -> tuple[Word, ...]:
     by repeating it ("Hello. Hello.", "How are you? How are you? How are"). The words are
     compared as the matcher reads them (case and marks aside)."""
     spoken = [words(word.text) for word in said]
-    for length in range(1, len(said)):
+    for length in range(1, len(said) // 2 + 1):  # said whole at least twice
         if all(spoken[k] == spoken[k % length] for k in range(length, len(said))):
             return said[:length]
     return said

@@ -1,0 +1,146 @@
+"""Issue 24: the robot starts recognizing during its wait for silence, hears fast with
+Moonshine and asks Whisper when Moonshine heard none of the dialogs' phrases.
+
+These stories use fakes for the models (a voice-activity stand-in that reads loudness, a
+recognizer that says what it was given), so they are exact; the real models are tried in
+test_hearing_the_default_dialog.py and test_real_voices.py."""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+
+import numpy as np
+import pytest
+
+from engine.clock import VirtualClock
+from engine.dialogs.words import words
+from engine.media.audio import SPEECH_RATE_HZ, Audio
+from engine.speech.listener import Heard, Listener
+from engine.speech.moonshine import said_once, without_loop
+from engine.speech.recognizer import Transcript, Word
+from engine.speech.recognizers import SecondOpinion, holds_a_phrase
+from engine.speech.vad import FRAME_S, SpeechDetector
+
+
+class LoudnessVad:
+    """Speech wherever a frame is loud: the stand-in for Silero in these stories."""
+
+    def __call__(self, frame: np.ndarray) -> float:
+        return 1.0 if float(np.max(np.abs(frame))) > 0.1 else 0.0
+
+    def reset(self) -> None:
+        pass
+
+
+class CountingRecognizer:
+    """Hears the length of what it is given (so a draft and its utterance differ), and
+    counts its work."""
+
+    def __init__(self, says: str = "") -> None:
+        self.says = says
+        self.heard: list[float] = []
+
+    def listen_for(self, phrases: Iterable[str]) -> None:
+        pass
+
+    def transcribe(self, audio: Audio) -> Transcript:
+        self.heard.append(audio.seconds)
+        return Transcript(self.says or f"{audio.seconds:.3f} seconds")
+
+
+def speech(seconds: float) -> Audio:
+    return Audio(np.full(round(seconds * SPEECH_RATE_HZ), 0.5, dtype=np.float32), SPEECH_RATE_HZ)
+
+
+def listened(audio: Audio, recognizer: CountingRecognizer) -> list[Heard]:
+    told: list[Heard] = []
+    listener = Listener(SpeechDetector(LoudnessVad()), recognizer, VirtualClock(), told.append)
+    listener.hear(audio, audio.seconds)
+    listener.close()
+    return told
+
+
+def test_a_sentence_followed_by_silence_is_recognized_once_from_its_draft() -> None:
+    recognizer = CountingRecognizer()
+    told = listened(Audio.silence(0.5).then(speech(1.0)).then(Audio.silence(1.0)), recognizer)
+    # one recognition, of the draft: the speech and 3 quiet frames of the 0.3 s wait
+    assert len(recognizer.heard) == 1
+    assert [heard.text for heard in told] == [f"{recognizer.heard[0]:.3f} seconds"]
+    assert recognizer.heard[0] < 1.0 + 0.3 + 6 * FRAME_S  # shorter than the utterance
+
+
+def test_speech_that_goes_on_after_a_pause_is_recognized_whole() -> None:
+    recognizer = CountingRecognizer()
+    pause = Audio.silence(0.2)  # longer than the draft's 96 ms, shorter than the 0.3 s wait
+    audio = speech(0.6).then(pause).then(speech(0.6)).then(Audio.silence(1.0))
+    told = listened(audio, recognizer)
+    assert len(told) == 1  # one utterance: the pause did not end it
+    # the first draft fell short; the second held all of it, and its words were told
+    assert len(recognizer.heard) == 2
+    assert recognizer.heard[1] > 1.4
+    assert told[0].text == f"{recognizer.heard[1]:.3f} seconds"
+
+
+def test_a_click_is_no_draft_and_no_utterance() -> None:
+    recognizer = CountingRecognizer()
+    assert listened(speech(0.1).then(Audio.silence(1.0)), recognizer) == []
+    assert recognizer.heard == []
+
+
+PHRASES = [words(p) for p in ("do you like dog", "how are you", "what is your name")]
+
+
+@pytest.mark.parametrize(
+    ("heard", "holds"),
+    [
+        ("Do you like dogs?", True),
+        ("do you like dogs and cats", False),  # "cat": a meaning word no phrase has
+        ("How are you?", True),
+        ("How are you doing today", False),
+        ("What's your name?", True),
+        ("What is your favorite mid-colour?", False),
+        ("Do you like it?", False),  # a phrase's meaning word ("dog") is missing
+        ("", False),
+    ],
+)
+def test_moonshine_s_words_are_kept_only_when_they_hold_a_phrase(heard: str, holds: bool) -> None:
+    assert holds_a_phrase(heard, PHRASES) is holds
+
+
+def test_whisper_hears_again_only_what_moonshine_did_not_hold() -> None:
+    fast, careful = CountingRecognizer("Do you like it?"), CountingRecognizer("Do you like dogs?")
+    both = SecondOpinion(fast, careful)
+    both.listen_for(["do you like dog"])
+    assert both.transcribe(speech(1.0)).text == "Do you like dogs?"
+    fast.says = "Do you like dogs?"
+    assert both.transcribe(speech(1.0)).text == "Do you like dogs?"
+    assert (len(fast.heard), len(careful.heard), both.second_opinions) == (2, 1, 1)
+
+
+def said(*texts: str) -> tuple[Word, ...]:
+    return tuple(Word(text, 0.9) for text in texts)
+
+
+@pytest.mark.parametrize(
+    ("heard", "kept"),
+    [
+        (said("Hello.", "Hello."), said("Hello.")),
+        (
+            said("How", "are", "you?", "How", "are", "you?", "How", "are"),
+            said("How", "are", "you?"),
+        ),
+        (said("Hi", "hi"), said("Hi")),
+        (said("I", "have", "a", "dog"), said("I", "have", "a", "dog")),
+        (said("yes", "I", "do", "yes"), said("yes", "I", "do", "yes")),
+    ],
+)
+def test_a_short_utterance_moonshine_says_again_is_kept_once(
+    heard: tuple[Word, ...], kept: tuple[Word, ...]
+) -> None:
+    assert said_once(heard) == kept
+
+
+def test_a_decoding_that_loops_is_cut_where_the_loop_starts() -> None:
+    assert without_loop([5, 6, 7, 8, 7, 8, 7, 8, 7]) == [5, 6, 7, 8]
+    assert without_loop([5, 6, 7, 8]) == [5, 6, 7, 8]
+    assert without_loop([9, 9, 9, 9]) == [9]
