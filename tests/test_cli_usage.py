@@ -67,6 +67,7 @@ IMPORTED_AS = {
     "faster-whisper": "faster_whisper",
     "pydantic-settings": "pydantic_settings",
     "sqlcipher3-binary": "sqlcipher3",
+    "hibari-tts": "hibari",
 }
 
 
@@ -81,6 +82,6 @@ def test_what_the_command_line_says_to_install_follows_pyproject() -> None:
     project = tomllib.loads((Path(__file__).parents[1] / "pyproject.toml").read_text())
     for extra in ("robot", "cloud"):
         for requirement in project["project"]["optional-dependencies"][extra]:
-            name = re.split(r"[<>=!~ ]", requirement, maxsplit=1)[0]
+            name = re.split(r"[<>=!~ ;]", requirement, maxsplit=1)[0]
             imported = IMPORTED_AS.get(name, name.lower().replace("-", "_"))
             assert imported in EXTRAS[extra], f"{extra}: {requirement} ({imported})"

@@ -329,6 +329,7 @@ def _run_for_site(
         if assembled.vision is not None and assembled.vision.problem:
             tell(f"warning: camera: {shown(assembled.vision.problem)}")
         if assembled.speech is not None:
+            tell(f"speech: {assembled.speech.describe()}")
             for part, why in assembled.speech.problems.items():
                 tell(f"warning: speech {part}: {shown(why)}")
         session.subscribe(timeline, TOLD_KINDS)  # every reader reads the one session stream

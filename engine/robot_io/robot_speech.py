@@ -106,6 +106,15 @@ class RobotSpeech:
     """On a virtual clock: what was heard, and when it is staged."""
     _due_lock: threading.Lock = field(default_factory=threading.Lock)
 
+    def describe(self) -> str:
+        """Which voice speaks and which recognizer hears, in words (told at start-up)."""
+        hears = (
+            f"hears with {getattr(self.listener.recognizer, 'name', 'its recognizer')}"
+            if self.listener is not None
+            else "does not hear"
+        )
+        return f"the {self.voice.name} voice; {hears}"
+
     def __call__(self, now_s: float) -> None:
         """A tick hook: the simulated microphone hears the room up to now; on a virtual
         clock, first let the speaker place what it was asked to say (the microphone must

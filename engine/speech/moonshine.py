@@ -12,10 +12,10 @@ decoder's key/value cache.
 
 Moonshine takes no prompt: it writes what it hears, and the dialog matcher decides what
 it means (``listen_for`` changes nothing). A decoding that loops (the same words again
-and again, which sequence models do on noise) is cut where the loop starts, a short
-utterance said again after itself is kept once, and a transcript the model itself doubts
-(mean token probability under :data:`DOUBTED_BELOW`) is heard as nothing: the robot says
-it did not understand rather than answer a guess.
+and again, which sequence models do on sounds that are no words) is heard as nothing, a
+short utterance said once more after itself is kept once, and a transcript the model
+itself doubts (mean token probability under :data:`DOUBTED_BELOW`) is heard as nothing:
+the robot says it did not understand rather than answer a guess.
 """
 
 from __future__ import annotations
@@ -30,7 +30,7 @@ import numpy as np
 from engine.dialogs.words import words
 from engine.media.audio import SPEECH_RATE_HZ, Audio
 from engine.speech.onnx_folding import folded_model
-from engine.speech.recognizer import RecognizerError, Transcript, Word
+from engine.speech.recognizer import RecognizerError, Transcript, Word, said_in_a_loop
 
 MODEL_PACKAGE = "moonshine_cpp"
 START_TOKEN, END_TOKEN = 1, 2
@@ -106,8 +106,8 @@ def without_loop(tokens: list[int]) -> list[int]:
 class MoonshineRecognizer:
     """Moonshine Base English on ONNX Runtime, one utterance at a time."""
 
-    def __init__(self, model_dir: Path | None = None, *, threads: int = 2) -> None:
-        """``threads``: ONNX Runtime's threads for each model (the robot has few cores;
+    def __init__(self, model_dir: Path | None = None, *, threads: int = 1) -> None:
+        """``threads``: ONNX Runtime's threads for each model (one was faster than two here;
         recognition runs in the listener's worker, never in a tick)."""
         folder = model_dir or moonshine_model_dir()
         if folder is None:
@@ -146,11 +146,13 @@ class MoonshineRecognizer:
         if len(samples) < SPEECH_RATE_HZ // 10:  # shorter than the encoder's window
             return Transcript("")
         tokens, probabilities = self._decode(samples)
-        kept = without_loop(tokens)
-        probabilities = probabilities[: len(kept)]
-        heard = said_once(self._words(kept, probabilities))
+        said = self._words(tokens, probabilities)
         mean = sum(probabilities) / len(probabilities) if probabilities else 0.0
-        log_prob = sum(math.log(max(p, 1e-12)) for p in probabilities) / max(1, len(kept))
+        log_prob = sum(math.log(max(p, 1e-12)) for p in probabilities) / max(1, len(tokens))
+        looped = len(without_loop(tokens)) < len(tokens)
+        if looped or said_in_a_loop(" ".join(w.text for w in said)):
+            return Transcript("", said, 1.0 - mean, log_prob)  # sounds that are no words
+        heard = said_once(said)
         text = " ".join(w.text for w in heard)
         if not text or mean < DOUBTED_BELOW:
             return Transcript("", heard, 1.0 - mean, log_prob)

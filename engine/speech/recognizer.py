@@ -49,6 +49,28 @@ NO_SPEECH_AFTER = 0.4
 dropped (the invented closing lines measured here: 0.52)."""
 
 
+LOOP_TIMES = 3
+"""A group of two or more words said this many times in a row is a loop (one word: 5)."""
+
+
+def said_in_a_loop(text: str) -> bool:
+    """Whether ``text`` says one group of words over and over: what a recognizer writes for
+    sounds that are no words (speech played backwards, voices over each other), Whisper
+    prompted with the dialogs' phrases above all ("It is cold? It is cold? ..." fifty
+    times, for 21 s of reversed speech). People repeat a word ("no no no"), not a
+    sentence three times in one breath; such a transcript is heard as nothing."""
+    said = words_of(text)
+    for size in range(1, len(said) // LOOP_TIMES + 1):
+        times = LOOP_TIMES if size > 1 else 5
+        for start in range(0, len(said) - size * times + 1):
+            group = said[start : start + size]
+            if all(
+                said[start + k * size : start + (k + 1) * size] == group for k in range(1, times)
+            ):
+                return True
+    return False
+
+
 class RecognizerError(DeviceError):
     """No recognizer model installed, or it cannot load; in words."""
 
@@ -169,6 +191,12 @@ class WhisperRecognizer:
         self.prompt = prompt_for(phrases)
 
     def transcribe(self, audio: Audio) -> Transcript:
+        heard = self._heard(audio)
+        if said_in_a_loop(heard.text):
+            return Transcript("", heard.words, heard.no_speech, heard.log_prob)
+        return heard
+
+    def _heard(self, audio: Audio) -> Transcript:
         samples = audio.resampled(SPEECH_RATE_HZ).samples
         heard = self._decode(samples)
         if not any(_meaningful(w) for w in heard.words):

@@ -17,7 +17,7 @@ from engine.dialogs.words import words
 from engine.media.audio import SPEECH_RATE_HZ, Audio
 from engine.speech.listener import Heard, Listener
 from engine.speech.moonshine import said_once, without_loop
-from engine.speech.recognizer import Transcript, Word
+from engine.speech.recognizer import Transcript, Word, said_in_a_loop
 from engine.speech.recognizers import SecondOpinion, holds_a_phrase
 from engine.speech.vad import FRAME_S, SpeechDetector
 
@@ -144,3 +144,18 @@ def test_a_decoding_that_loops_is_cut_where_the_loop_starts() -> None:
     assert without_loop([5, 6, 7, 8, 7, 8, 7, 8, 7]) == [5, 6, 7, 8]
     assert without_loop([5, 6, 7, 8]) == [5, 6, 7, 8]
     assert without_loop([9, 9, 9, 9]) == [9]
+
+
+@pytest.mark.parametrize(
+    ("heard", "looped"),
+    [
+        ("It is cold? " * 50, True),  # Whisper on 21 s of speech played backwards
+        ("I am a dog? I am a dog? I am a dog?", True),
+        ("no no no", False),  # a child says that
+        ("no no no no no", True),
+        ("Hello. Hello.", False),  # said twice: Moonshine's repeat, kept once
+        ("do you like dogs do you like cats", False),
+    ],
+)
+def test_a_sentence_said_over_and_over_is_no_person(heard: str, looped: bool) -> None:
+    assert said_in_a_loop(heard) is looped

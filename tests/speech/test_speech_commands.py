@@ -25,7 +25,7 @@ def test_say_writes_the_robot_s_voice_to_a_wav(
     out = tmp_path / "hello.wav"
     assert main(["say", "Hello. I am the robot.", "-o", str(out)]) == 0
     audio = read_wav(out)
-    assert audio.rate_hz == 22050 and 1.0 < audio.seconds < 4.0
+    assert audio.rate_hz == 24000 and 1.0 < audio.seconds < 4.0  # the hibari voice
 
 
 def test_hear_says_what_it_heard_the_rule_and_the_answer_per_file(
