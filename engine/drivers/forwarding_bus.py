@@ -14,6 +14,27 @@ from smbus2 import i2c_msg
 
 from engine.drivers.bus_protocols import I2CBus
 
+WRITE_EACH = "write_byte_data_each"
+"""Several register writes as one access of the wrapper (:func:`write_each`)."""
+
+
+def call_on(bus: Any, method: str, *args: Any) -> Any:
+    """``bus.method(*args)``; :data:`WRITE_EACH` on a bus without it (smbus2's own, a
+    simulated one) is its writes one after another."""
+    if method == WRITE_EACH and not hasattr(bus, WRITE_EACH):
+        address, writes = args
+        for register, value in writes:
+            bus.write_byte_data(address, register, value)
+        return None
+    return getattr(bus, method)(*args)
+
+
+def write_each(bus: Any, i2c_addr: int, writes: Sequence[tuple[int, int]]) -> None:
+    """Write each ``(register, value)`` to the chip at ``i2c_addr``, in order: on a wrapper
+    (the bus manager's transaction, a lock, a multiplexer's channel) as one access, so a
+    chip's run of setup writes costs one hand-off, not one each; elsewhere one by one."""
+    call_on(bus, WRITE_EACH, i2c_addr, tuple(writes))
+
 
 class ForwardingI2C(I2CBus):
     """Every ``smbus2.SMBus`` call becomes ``self._forward(method_name, *args)``.
@@ -24,6 +45,10 @@ class ForwardingI2C(I2CBus):
 
     def _forward(self, method: str, *args: Any) -> Any:
         raise NotImplementedError(f"{type(self).__name__} must implement _forward()")
+
+    def write_byte_data_each(self, i2c_addr: int, writes: Sequence[tuple[int, int]]) -> None:
+        """Each ``(register, value)`` written in order, as one access of this wrapper."""
+        self._forward(WRITE_EACH, i2c_addr, tuple(writes))
 
     def write_quick(self, i2c_addr: int, force: bool | None = None) -> None:
         self._forward("write_quick", i2c_addr)

@@ -27,7 +27,7 @@ from typing import Any
 
 from engine.drivers.bus_protocols import I2CBus
 from engine.drivers.device_errors import device_error
-from engine.drivers.forwarding_bus import ForwardingI2C
+from engine.drivers.forwarding_bus import ForwardingI2C, call_on
 from engine.drivers.tca9548a_registers import ADDRESSES, CHANNELS, CONTROL_NONE
 
 CHIP = "TCA9548A"
@@ -58,7 +58,7 @@ class LockedBus(ForwardingI2C):
 
     def _forward(self, method: str, *args: Any) -> Any:
         with self.lock:
-            return getattr(self.bus, method)(*args)
+            return call_on(self.bus, method, *args)
 
 
 class TCA9548A:
@@ -184,7 +184,7 @@ class TCA9548AChannel(ForwardingI2C):
         with self.mux.lock:
             try:
                 self.mux.ensure_selected(self.channel)
-                return getattr(self.mux.bus, method)(*args)
+                return call_on(self.mux.bus, method, *args)
             except OSError:
                 self.mux.forget_selection()  # a glitch may have reset or confused the mux
                 raise

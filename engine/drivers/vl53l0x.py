@@ -40,6 +40,7 @@ from engine.clock import Clock
 from engine.drivers import vl53l0x_registers as reg
 from engine.drivers.bus_protocols import I2CBus
 from engine.drivers.device_errors import ImplausibleReadingError, device_error, i2c_place
+from engine.drivers.forwarding_bus import write_each
 from engine.drivers.vl53l0x_spads import (
     SPAD_MAP_BYTES,
     ReferenceSpads,
@@ -70,10 +71,11 @@ MAX_RANGE_MM = 2000  # the chip's reach (long-range mode); a valid range beyond 
 
 BOOT_TIME_S = 0.002  # after XSHUT rises, with a margin over tBOOT (reg.TBOOT_MAX_S)
 POLL_INTERVAL_S = 0.002
-FIRST_LOOK = 0.9
+FIRST_LOOK = 1.0
 """A measurement is first asked about after this share of the timing budget: it takes the
-budget, so asking every 2 ms from the start was 15 bus reads of nothing per reading (the
-bus the touch and force chips share; issue 24, an idle robot)."""
+budget (ST: the budget is the time of one measurement), so asking every 2 ms from the start
+was 15 bus reads of nothing per reading, on the bus the touch and force chips share (issue
+24, an idle robot); a chip that finishes sooner is read at most that much later."""
 
 
 # -- pure conversions -------------------------------------------------------------------------
@@ -162,8 +164,8 @@ class VL53L0X:
         self._bus.write_byte_data(self._address, register, value & 0xFF)
 
     def _write_all(self, writes: Iterable[tuple[int, int]]) -> None:
-        for register, value in writes:
-            self._write(register, value)
+        """The writes in order, as one access of a wrapping bus (one bus-manager job)."""
+        write_each(self._bus, self._address, [(r, v & 0xFF) for r, v in writes])
 
     def _write_u16(self, register: int, value: int) -> None:
         # 16-bit registers are big-endian: most significant byte at the lower address.
@@ -355,10 +357,16 @@ class VL53L0X:
         """
         with self._lock:
             with self._off_main_page():
-                self._write_all((*reg.ENTER_PRIVATE_PAGE, (reg.STOP_VARIABLE, self._stop_variable)))
-                self._write_all(reg.LEAVE_PRIVATE_PAGE)
-            self._write(reg.SYSTEM_INTERRUPT_CLEAR, 0x01)  # a stale result must not pass for ours
-            self._write(reg.SYSRANGE_START, reg.SYSRANGE_START_SINGLESHOT)
+                self._write_all(
+                    (
+                        *reg.ENTER_PRIVATE_PAGE,
+                        (reg.STOP_VARIABLE, self._stop_variable),
+                        *reg.LEAVE_PRIVATE_PAGE,
+                        # a stale result must not pass for ours
+                        (reg.SYSTEM_INTERRUPT_CLEAR, 0x01),
+                        (reg.SYSRANGE_START, reg.SYSRANGE_START_SINGLESHOT),
+                    )
+                )
             started = self._clock.now()
             deadline = started + self.timeout_s
             self._wait_for(self._start_bit_clear, deadline, "start of ranging")

@@ -15,7 +15,7 @@ from collections.abc import Callable, Sequence
 from typing import Any, TypeVar
 
 from engine.drivers.bus_manager import DeviceHandle, Priority
-from engine.drivers.forwarding_bus import ForwardingI2C
+from engine.drivers.forwarding_bus import ForwardingI2C, call_on
 
 T = TypeVar("T")
 
@@ -51,7 +51,7 @@ class ManagedI2C(_OnHandle, ForwardingI2C):
     """An ``smbus2.SMBus``-compatible bus: each call is one transaction of its handle."""
 
     def _forward(self, method: str, *args: Any) -> Any:
-        return self._call(lambda bus: getattr(bus, method)(*args))
+        return self._call(lambda bus: call_on(bus, method, *args))
 
     def close(self) -> None:
         """Nothing to release: the bus belongs to its manager's owner."""

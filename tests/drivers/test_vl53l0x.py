@@ -236,3 +236,23 @@ def test_a_garbled_timing_register_is_a_device_error_never_a_budget(
     GarbledAt(clock, bus, register)
     with pytest.raises(DeviceError, match=rf"VL53L0X at 0x29: .*{named} reads 0xff"):
         VL53L0X(bus, clock=clock)
+
+
+def test_a_reading_through_the_bus_manager_is_five_transactions_with_every_write_in_order(
+    clock: VirtualClock, bus: SimI2CBus, chip: SimVL53L0X
+) -> None:
+    """Issue 24 (an idle robot): the writes before a measurement go as one transaction of
+    the bus manager, and the chip is first asked about the measurement near the end of its
+    timing budget; the chip sees the same register writes, in the same order."""
+    from engine.drivers.bus_manager import BusManager
+    from engine.hardware.managed_buses import ManagedI2C
+
+    manager: BusManager[SimI2CBus] = BusManager(bus, name="1", clock=clock, threaded=False)
+    handle = manager.claim("tof", 0x29)
+    sensor = VL53L0X(ManagedI2C(handle), clock=clock)
+    chip.distance_mm = 420
+    before = handle.stats().transactions
+    assert sensor.read_range_mm() == 420
+    # the writes (page, stop variable, page back, clear, start), the start bit, the
+    # interrupt, the result, the clear
+    assert handle.stats().transactions - before == 5
