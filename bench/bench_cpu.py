@@ -20,8 +20,10 @@ in the same run, each run ``--repeat`` times, half before and half after the lon
 steady state = (CPU of the long run - CPU of the short run) / (wall of the long run - wall
 of the short run). As a cross-check, the bench also reads the long run's
 ``/proc/PID/stat`` (utime + stime, clock ticks) every 0.25 s and reports the CPU used
-between ``--skip`` seconds after the start and the last reading, measured inside the run,
-free of start-up by construction (Linux only).
+while the scenario ran: from ``--skip`` seconds after vest run printed its timeline's
+heading (start-up done: trees checked, speech models loaded, the voice warmed up) to the
+last reading before the blank line that ends the timeline (shutdown follows), free of
+start-up and shutdown by construction (Linux only).
 
 There is no target in DESIGN.md for this figure: it is printed for the reader. What a
 steady-state percentage means: the share of one core the robot needs, all threads
@@ -30,13 +32,20 @@ together, with the demo's events (touch, hug, wave, obstacle, speech) going on.
 Then an idle robot (issue 24: trees that wake when something happens): ``vest run`` on a
 scenario where nothing happens, with the shipped trees (their ``wake_on:``) and with the
 same trees with ``wake_on:`` taken out (every tree ticks at its rate), one after the
-other, each read inside the run from /proc as above. Target: with ``wake_on`` at most half
-of the CPU without.
+other, each read inside the run from /proc as above. With ``--against FOLDER`` (a checkout
+of an earlier commit, e.g. ``git worktree add /tmp/before 20d1990``, main before issue 24)
+the same idle scenario also runs on that checkout's code (with this checkout's
+interpreter and packages), interleaved with the others. Target (issue 24): an idle robot
+spends at most half of what it did before issue 24. What it spends is mostly not the
+trees' ticking (compare the first two lines) but the sensors' polling, the camera and the
+microphone: the issue's range-sensor, camera-attention and noise-floor changes, which
+``wake_on`` alone does not switch off, are what ``--against`` measures.
 """
 
 from __future__ import annotations
 
 import argparse
+import math
 import os
 import platform
 import re
@@ -72,6 +81,8 @@ class Run:
     readings: list[tuple[float, float]] = field(default_factory=list)
     """(seconds since start, CPU seconds so far) from /proc/PID/stat."""
     output: str = ""
+    running: tuple[float, ...] = ()
+    """When vest run's scenario began and ended (seconds since the start), as its output said."""
 
     @property
     def cpu_s(self) -> float:
@@ -88,18 +99,21 @@ def proc_cpu_s(pid: int) -> float | None:
     return (int(fields[11]) + int(fields[12])) / TICKS_PER_S  # fields 14 and 15 of stat
 
 
-def measure(command: list[str], *, sample: bool = False) -> Run:
-    """Run ``command`` from the project folder; its CPU time from RUSAGE_CHILDREN."""
+def measure(command: list[str], *, sample: bool = False, cwd: Path = ROOT) -> Run:
+    """Run ``command`` from ``cwd`` (the project folder); its CPU time from RUSAGE_CHILDREN."""
     with tempfile.TemporaryFile(mode="w+") as out:
         before = resource.getrusage(resource.RUSAGE_CHILDREN)
         started = stopwatch()
-        process = subprocess.Popen(command, cwd=ROOT, stdout=out, stderr=subprocess.STDOUT)
+        process = subprocess.Popen(command, cwd=cwd, stdout=out, stderr=subprocess.STDOUT)
         readings: list[tuple[float, float]] = []
+        running: list[float] = []  # when the run began and ended, seconds since the start
         while process.poll() is None:
             if sample:
                 cpu_s = proc_cpu_s(process.pid)
                 if cpu_s is not None:
-                    readings.append((stopwatch() - started, cpu_s))
+                    now = stopwatch() - started
+                    readings.append((now, cpu_s))
+                    running = _running_marks(out.fileno(), running, now)
             time.sleep(SAMPLE_EVERY_S if sample else 0.005)
         wall_s = stopwatch() - started
         after = resource.getrusage(resource.RUSAGE_CHILDREN)
@@ -113,20 +127,47 @@ def measure(command: list[str], *, sample: bool = False) -> Run:
         after.ru_stime - before.ru_stime,
         readings,
         output,
+        tuple(running),
     )
 
 
-def steady_share(run: Run, skip_s: float) -> float | None:
-    """The share of one core ``run`` used after ``skip_s`` seconds (/proc readings)."""
-    window = [(t, cpu) for t, cpu in run.readings if t >= skip_s]
+def _running_marks(output: int, marks: list[float], now: float) -> list[float]:
+    """``marks`` with ``now`` added when vest run's output has just begun or ended its run.
+
+    vest run prints its timeline's heading as the scenario starts (start-up done: models
+    loaded, voice warmed up) and a blank line as it ends (shutdown follows).
+    """
+    if len(marks) == 2:
+        return marks
+    text = os.pread(output, 1 << 20, 0)  # leaves the file's offset, which the child shares
+    lines = text.decode(errors="replace").splitlines()
+    began = any(line.lstrip().startswith("t (s)") for line in lines)
+    ended = began and "" in lines[[ln.lstrip().startswith("t (s)") for ln in lines].index(True) :]
+    if len(marks) == 0 and began:
+        marks = [now]
+    if len(marks) == 1 and ended:
+        marks = [*marks, now]
+    return marks
+
+
+def steady_window(run: Run, skip_s: float) -> tuple[float, float, float] | None:
+    """(share of one core, from, to): what ``run`` used while its scenario ran (/proc readings).
+
+    From ``skip_s`` seconds after the scenario began (after the process started when its
+    output never said) to the last reading before the scenario ended; None if too short.
+    """
+    began = run.running[0] if run.running else 0.0
+    ended = run.running[1] if len(run.running) == 2 else math.inf
+    window = [(t, cpu) for t, cpu in run.readings if began + skip_s <= t <= ended]
     if len(window) < 2 or window[-1][0] <= window[0][0]:
         return None
     (t0, cpu0), (t1, cpu1) = window[0], window[-1]
-    return (cpu1 - cpu0) / (t1 - t0)
+    return (cpu1 - cpu0) / (t1 - t0), t0, t1
 
 
-def idle_robot(seconds: float, skip_s: float, rounds: int) -> None:
-    """CPU of an idle robot with the shipped trees' wake_on and without it."""
+def idle_robot(seconds: float, skip_s: float, rounds: int, against: Path | None) -> None:
+    """CPU of an idle robot with the shipped trees' wake_on and without it (and on the
+    checkout ``against``)."""
     with tempfile.TemporaryDirectory() as folder:
         idle = Path(folder) / "idle.yaml"
         idle.write_text(f"description: nothing happens\nduration_s: {seconds:g}\nevents: []\n")
@@ -146,19 +187,32 @@ def idle_robot(seconds: float, skip_s: float, rounds: int) -> None:
                 str(ticking),
             ],
         }
+        folders = dict.fromkeys(ways, ROOT)
+        if against is not None:
+            name = f"{against.name} (--against)"
+            ways[name] = [*VEST, "run", "--scenario", str(idle)]
+            folders[name] = against
         shares: dict[str, list[float]] = {name: [] for name in ways}
-        for _ in range(rounds):  # interleaved: a busy machine hurts both alike
+        for _ in range(rounds):  # interleaved: a busy machine hurts all alike
             for name, command in ways.items():
-                share = steady_share(measure(command, sample=True), skip_s)
-                if share is not None:
-                    shares[name].append(share)
+                run = measure(command, sample=True, cwd=folders[name])
+                steady = steady_window(run, skip_s)
+                if steady is not None:
+                    shares[name].append(steady[0])
     print(f"idle robot (a {seconds:g} s scenario where nothing happens; median of {rounds}):")
     medians = {name: statistics.median(values) for name, values in shares.items() if values}
     for name, share in medians.items():
         print(f"  {name:<26}{100 * share:5.1f} % of one core")
-    if len(medians) == 2:
-        woken, ticking_share = medians.values()
-        print(f"  with wake_on / without: {woken / ticking_share:.2f} (target <= 0.50)")
+    shipped, ticking_share = (
+        medians.get("wake_on (as shipped)"),
+        medians.get("every tree at its rate"),
+    )
+    if shipped is not None and ticking_share:
+        print(f"  with wake_on / without: {shipped / ticking_share:.2f}")
+    if against is not None and shipped is not None:
+        earlier = medians.get(f"{against.name} (--against)")
+        if earlier:
+            print(f"  now / {against.name}: {shipped / earlier:.2f} (target <= 0.50)")
 
 
 def median_run(runs: list[Run]) -> Run:
@@ -180,15 +234,21 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument(
         "--skip",
         type=float,
-        default=2.0,
-        help="seconds of the long run left out of the /proc reading (start-up; default 2)",
+        default=1.0,
+        help="seconds after the scenario began left out of the /proc reading (default 1)",
     )
     parser.add_argument(
         "--quick", action="store_true", help="a short run that only shows it still works"
     )
+    parser.add_argument(
+        "--against",
+        type=Path,
+        metavar="FOLDER",
+        help="a checkout of an earlier commit: its idle robot is measured too",
+    )
     args = parser.parse_args(argv)
     if args.quick:
-        args.seconds, args.repeat, args.skip = 3.0, 2, 1.0
+        args.seconds, args.repeat, args.skip = 3.0, 2, 0.5
     if args.seconds <= 1.0 or args.repeat < 2 or not 0 <= args.skip < args.seconds:
         parser.error("--seconds above 1, --repeat at least 2, --skip within 0..--seconds")
 
@@ -234,18 +294,20 @@ def main(argv: list[str] | None = None) -> int:
         f"  steady state: {100 * steady:5.1f} % of one core (long run minus the short run: "
         f"{long_run.cpu_s - short.cpu_s:.2f} s CPU in {long_run.wall_s - short.wall_s:.2f} s)"
     )
-    window = [(t, cpu) for t, cpu in long_run.readings if t >= args.skip]
-    if len(window) >= 2 and window[-1][0] > window[0][0]:
-        (t0, cpu0), (t1, cpu1) = window[0], window[-1]
+    inside = steady_window(long_run, args.skip)
+    if inside is not None:
+        share, t0, t1 = inside
         print(
-            f"  steady state: {100 * (cpu1 - cpu0) / (t1 - t0):5.1f} % of one core, read "
-            f"inside the run (/proc/PID/stat, {t0:.1f} s .. {t1:.1f} s after the start)"
+            f"  steady state: {100 * share:5.1f} % of one core, read inside the run "
+            f"(/proc/PID/stat, {t0:.1f} s .. {t1:.1f} s after the start, the scenario running)"
         )
     print(
         f"  start-up: {imports.cpu_s:.2f} s CPU for Python and the imports, "
         f"{short.cpu_s - imports.cpu_s:+.2f} s more for vest run's own start-up and shutdown"
     )
-    idle_robot(args.seconds, args.skip, 1 if args.quick else 2)
+    if args.against is not None and not (args.against / "engine" / "cli").is_dir():
+        parser.error(f"--against {args.against}: not a checkout of vest (no engine/cli)")
+    idle_robot(args.seconds, args.skip, 1 if args.quick else 3, args.against)
     return 0
 
 

@@ -44,6 +44,7 @@ STILL_LEVELS = 6.0
 """How far (grey levels, 0..255) a cell of the grid may move and the view still count as
 the same: above a webcam's noise averaged over a cell, far below a hand coming in."""
 GRID = (16, 9)
+GRID_STRIDE = 4
 LOOK_AT_LEAST_EVERY_S = 1.0
 REOPEN_S = 2.0
 STOP_WAIT_S = 5.0
@@ -238,6 +239,10 @@ class HandWatcher:
 
 
 def _grid(frame: Frame) -> np.ndarray:
-    """The frame's grey levels averaged over a GRID of cells (float32)."""
-    grey = cv2.cvtColor(frame, cv2.COLOR_BGR2GRAY) if frame.ndim == 3 else frame
-    return np.asarray(cv2.resize(grey, GRID, interpolation=cv2.INTER_AREA), dtype=np.float32)
+    """The frame's grey levels averaged over a GRID of cells (float32), from every
+    :data:`GRID_STRIDE`-th pixel of every :data:`GRID_STRIDE`-th row: a cell still averages
+    over a hundred pixels, a quarter of a millisecond a frame where the whole frame took
+    0.8 ms."""
+    small = cv2.resize(frame[::GRID_STRIDE, ::GRID_STRIDE], GRID, interpolation=cv2.INTER_AREA)
+    grey = cv2.cvtColor(small, cv2.COLOR_BGR2GRAY) if small.ndim == 3 else small
+    return np.asarray(grey, dtype=np.float32)

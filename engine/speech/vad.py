@@ -18,9 +18,10 @@ when the wait ends, instead of a recognition later.
 
 from __future__ import annotations
 
+import math
 from collections import deque
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Protocol
 
 import numpy as np
@@ -55,6 +56,37 @@ class SileroVad:
         self._detector.reset()
 
 
+REOPEN_FRESH_S = 1.0
+"""The VAD's network starts afresh when the room rises above its floor after this long
+below it (seconds): its memory of a sound that long ago says nothing of this one."""
+
+
+@dataclass
+class NoiseFloor:
+    """The room's steady noise, so that the VAD's network is asked only about frames that
+    rise above it: in a quiet or steadily humming room an idle robot spends next to nothing
+    listening. Minimum statistics: the floor falls at once to a quieter frame and rises
+    ``rises_db_per_s`` when the room grows louder for good. A frame within ``margin_db`` of
+    the floor is the room's own noise; speech, even at 0 dB SNR, is about 3 dB above it."""
+
+    margin_db: float = 3.0
+    rises_db_per_s: float = 2.0
+    starts_dbfs: float = -40.0
+    """The floor before the first frame (dB of full scale): speech from the very first
+    frame, louder than this, is not taken for the room."""
+    level_dbfs: float = field(init=False)
+
+    def __post_init__(self) -> None:
+        self.level_dbfs = self.starts_dbfs
+
+    def quiet(self, frame: Samples) -> bool:
+        """Whether ``frame`` is the room's noise (the floor learns from it)."""
+        power = float(np.mean(np.square(frame, dtype=np.float64)))
+        dbfs = 10.0 * math.log10(power + 1e-12)
+        self.level_dbfs = min(dbfs, self.level_dbfs + self.rises_db_per_s * FRAME_S)
+        return dbfs < self.level_dbfs + self.margin_db
+
+
 @dataclass(frozen=True)
 class Utterance:
     """What someone said: the audio, and where it ended in the stream (samples since the
@@ -85,6 +117,9 @@ class SpeechDetector:
     """Quiet after speech (3 frames) before the utterance so far is told to ``on_pause``."""
     on_pause: Callable[[Utterance], None] | None = None
     """Told each draft (None: no drafts)."""
+    noise_floor: NoiseFloor | None = field(default_factory=NoiseFloor)
+    """Between utterances, frames no louder than the room's noise are not asked about
+    (None: every frame is)."""
 
     def __post_init__(self) -> None:
         self._pending = np.zeros(0, dtype=np.float32)
@@ -93,6 +128,7 @@ class SpeechDetector:
         self._voiced_frames = 0
         self._quiet_frames = 0
         self._drafted = False
+        self._below_floor = 0  # frames in a row the noise floor kept from the VAD
         self.position = 0
         """Samples taken so far."""
 
@@ -126,7 +162,7 @@ class SpeechDetector:
         return self._end() if self._speech else None
 
     def _frame(self, frame: Samples) -> Utterance | None:
-        probability = self.vad(frame)
+        probability = self._probability(frame)
         if not self._speech:
             if probability >= self.start_threshold:
                 self._speech = [*self._history, frame]
@@ -148,6 +184,17 @@ class SpeechDetector:
         if len(self._speech) * FRAME_S >= self.max_utterance_s:
             return self._end()
         return None
+
+    def _probability(self, frame: Samples) -> float:
+        """The VAD's probability; 0 for the room's noise between utterances."""
+        floor = self.noise_floor
+        if floor is not None and floor.quiet(frame) and not self._speech:
+            self._below_floor += 1
+            return 0.0
+        if self._below_floor * FRAME_S >= REOPEN_FRESH_S:
+            self.vad.reset()
+        self._below_floor = 0
+        return self.vad(frame)
 
     def _draft(self) -> None:
         if self.on_pause is None or self._voiced_frames * FRAME_S < self.min_speech_s:
