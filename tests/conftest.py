@@ -113,3 +113,23 @@ def _content_length(head: bytes) -> int | None:
 def http_answer() -> Callable[..., str]:
     """:func:`read_answer`, for tests that speak HTTP on a raw socket."""
     return read_answer
+
+
+def serious_accessibility_problems(page: Page) -> list[str]:
+    """What axe-core (the engine of the browsers' own accessibility tools) finds serious or
+    critical on ``page`` as it is now: one line per rule, with the elements it names."""
+    from axe_playwright_python.sync_playwright import Axe
+
+    found = Axe().run(page).response["violations"]
+    return [
+        f"{rule['id']} ({rule['impact']}): {rule['help']}: "
+        + ", ".join(str(node["target"]) for node in rule["nodes"][:5])
+        for rule in found
+        if rule["impact"] in ("serious", "critical")
+    ]
+
+
+@pytest.fixture
+def accessibility() -> Callable[[Page], list[str]]:
+    """:func:`serious_accessibility_problems`, for the page tests."""
+    return serious_accessibility_problems

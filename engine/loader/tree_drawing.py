@@ -181,6 +181,22 @@ def dot_source(definition: TreeDefinition) -> str:
     return "\n".join(lines) + "\n"
 
 
+def without_title_and_legend(dot: str) -> str:
+    """``dot`` (from :func:`dot_source`, or a recording's copy of it) without its title and
+    legend: a page that shows the tree's name above the drawing and one legend for all
+    its drawings draws each tree without them."""
+    kept: list[str] = []
+    in_legend = False
+    for line in dot.splitlines():
+        if line.startswith("  subgraph cluster_legend"):
+            in_legend = True
+        elif in_legend:
+            in_legend = line != "  }"
+        elif not line.startswith(("  title [", "  title -> ")):
+            kept.append(line)
+    return "\n".join(kept) + "\n"
+
+
 def _widths(root: NodeDefinition) -> dict[int, int]:
     """How many nodes each depth holds."""
     widths: dict[int, int] = {}

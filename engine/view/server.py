@@ -43,6 +43,7 @@ from starlette.routing import BaseRoute, Route
 
 from engine.buttons.wizard import Wizard
 from engine.errors import ConfigError
+from engine.loader.tree_drawing import without_title_and_legend
 from engine.view.hub import Change, ViewHub
 from engine.web.body_limit import BodyLimit
 from engine.web.broadcast import Reader
@@ -194,6 +195,8 @@ class ViewServer:
             if key in self._svg:
                 return self._svg[key]
         source = self.source.dot(tree, version)
+        if source is not None:
+            source = without_title_and_legend(source)  # the card names it; one legend
         dot = shutil.which("dot")
         if source is None or dot is None:
             return None

@@ -114,15 +114,20 @@ def test_a_command_for_a_robot_that_is_off_waits_and_can_be_canceled(
     expect(row.locator("button.cancel")).to_have_count(0)
 
 
-def test_the_page_fits_a_tablet_held_upright(browser: Browser, lab: dict[str, Any]) -> None:
+def test_the_page_fits_a_tablet_held_upright_and_axe_finds_nothing_serious(
+    browser: Browser, lab: dict[str, Any], accessibility: Callable[[Page], list[str]]
+) -> None:
     context = browser.new_context(viewport={"width": 768, "height": 1024}, has_touch=True)
     page = context.new_page()
     try:
+        page.goto(lab["url"])
+        assert accessibility(page) == []  # the login form
         log_in(page, lab["url"], lab["token"])
         expect(page.locator("#robot")).to_be_visible()
         assert page.evaluate("document.documentElement.scrollWidth") <= 768
         box = page.locator("#send button[type=submit]").bounding_box()
         assert box is not None and box["height"] >= 44  # a finger can hit it
+        assert accessibility(page) == []  # a robot watched, its commands and sensors
     finally:
         context.close()
 

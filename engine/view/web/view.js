@@ -17,6 +17,8 @@ const history = new Map(); // "tree/version/node" -> [{at, status, feedback}], l
 let info = { mode: "live" };
 let chosen = null; // {tree, version, node}
 const MAX_HISTORY = 20;
+const WORDS = { RUNNING: "running", SUCCESS: "succeeded", FAILURE: "did not succeed", INVALID: "stopped" };
+const ANSWERS = { SUCCESS: "answered yes", FAILURE: "answered no", INVALID: "stopped" }; // a question
 
 function nodeKey(tree, version, node) {
   return `${tree}/${version}/${node}`;
@@ -37,6 +39,53 @@ function load(snapshot) {
   state.keys = new Map(snapshot.keys.map((change) => [change.key, change]));
   state.happened = snapshot.happened ?? [];
   state.stats = snapshot.stats;
+}
+
+// -- what a status means to a reader ------------------------------------------------------
+// A question (a condition, drawn as an ellipse) that answers no has not failed: the robot
+// is waiting for something. A node that failed only because its questions said no is
+// waiting too; it failed when something it did failed. Each status has a word and a mark
+// as well as a colour (the legend in index.html shows them once for every drawing).
+const SHOWN = {
+  running: { mark: "\u25B6", word: "running" },
+  done: { mark: "\u2713", word: "done" },
+  yes: { mark: "\u2713", word: "yes" },
+  failed: { mark: "\u2717", word: "failed" },
+  no: { mark: "\u2013", word: "no" },
+  waiting: { mark: "\u2026", word: "waiting" },
+  idle: { mark: "", word: "not run yet" },
+};
+
+const questions = new Map(); // "tree/version" -> the numbers of its conditions (ellipses)
+
+function parents(tree) {
+  const stack = [];
+  return tree.nodes.map((node) => {
+    stack.length = node.depth;
+    const parent = node.depth > 0 ? stack[node.depth - 1] : null;
+    stack[node.depth] = node.index;
+    return parent;
+  });
+}
+
+function shownStatuses(tree) {
+  const parent = parents(tree);
+  const shown = new Array(tree.nodes.length).fill("idle");
+  const failedBelow = new Array(tree.nodes.length).fill(false);
+  for (let index = tree.nodes.length - 1; index >= 0; index -= 1) { // children first
+    const change = tree.byNode.get(index);
+    const status = change ? change.status : "INVALID";
+    const question = Boolean(questions.get(`${tree.tree}/${tree.version}`)?.has(index));
+    if (status === "RUNNING") shown[index] = "running";
+    else if (status === "SUCCESS") shown[index] = question ? "yes" : "done";
+    else if (status === "FAILURE") {
+      const leaf = !tree.nodes.some((_, child) => parent[child] === index);
+      if (question) shown[index] = "no";
+      else shown[index] = leaf || failedBelow[index] ? "failed" : "waiting";
+    }
+    if (shown[index] === "failed" && parent[index] !== null) failedBelow[parent[index]] = true;
+  }
+  return shown;
 }
 
 // -- drawing ------------------------------------------------------------------------------
@@ -69,10 +118,18 @@ async function drawTrees() {
     card.className = "tree";
     card.dataset.id = id;
     card.dataset.tree = tree.tree;
-    card.innerHTML = `<h2></h2><div class="drawing">drawing...</div>`;
-    card.querySelector("h2").textContent = `${tree.tree} (${tree.rate_hz} Hz)`;
-    container.append(card);
+    card.innerHTML = `<h2><span class="name"></span> <span class="status"></span>
+      <button type="button" class="fit" aria-pressed="false">fit to width</button></h2>
+      <div class="drawing" tabindex="0" role="group">drawing...</div>`;
+    card.querySelector("h2 .name").textContent = `${tree.tree} (${tree.rate_hz} times a second)`;
     const drawing = card.querySelector(".drawing");
+    drawing.setAttribute("aria-label", `the ${tree.tree} tree`);
+    const fit = card.querySelector(".fit");
+    fit.addEventListener("click", () => {
+      const fitted = card.classList.toggle("fitted");
+      fit.setAttribute("aria-pressed", String(fitted));
+    });
+    container.append(card);
     const response = await fetch(api(`/api/svg/${encodeURIComponent(tree.tree)}/${tree.version}`));
     if (response.ok) {
       drawing.replaceChildren(cleanSvg(await response.text()));
@@ -84,11 +141,26 @@ async function drawTrees() {
         svg.style.width = `${Math.round(width * 0.9)}px`;
         svg.style.height = `${Math.round(height * 0.9)}px`;
       }
+      const asks = new Set();
+      questions.set(id, asks);
       for (const group of drawing.querySelectorAll("g.node")) {
         const title = group.querySelector("title")?.textContent ?? "";
         if (!/^n\d+$/.test(title)) continue;
-        group.dataset.node = title.slice(1);
-        group.addEventListener("click", () => choose(tree.tree, tree.version, Number(group.dataset.node)));
+        const index = Number(title.slice(1));
+        group.dataset.node = String(index);
+        if (group.querySelector("ellipse")) asks.add(index); // a condition's shape
+        chooseBy(group, tree, index);
+        const shape = group.querySelector("polygon, ellipse");
+        const box = shape ? shape.getBBox() : null;
+        if (box) { // the status's mark, at the shape's top right corner
+          const mark = document.createElementNS("http://www.w3.org/2000/svg", "text");
+          mark.setAttribute("class", "mark");
+          mark.setAttribute("x", String(box.x + box.width - 3));
+          mark.setAttribute("y", String(box.y + 12));
+          mark.setAttribute("text-anchor", "end");
+          mark.setAttribute("aria-hidden", "true");
+          group.append(mark);
+        }
       }
     } else {
       // no Graphviz on this machine: the nodes as an indented list
@@ -97,8 +169,9 @@ async function drawTrees() {
         const item = document.createElement("li");
         item.dataset.node = String(node.index);
         item.style.marginLeft = `${node.depth * 1.2}em`;
-        item.textContent = node.label;
-        item.addEventListener("click", () => choose(tree.tree, tree.version, node.index));
+        item.innerHTML = `<span class="mark" aria-hidden="true"></span> <span class="label"></span>`;
+        item.querySelector(".label").textContent = node.label;
+        chooseBy(item, tree, node.index);
         list.append(item);
       }
       drawing.replaceChildren(list);
@@ -110,16 +183,55 @@ async function drawTrees() {
 function colorTree(tree) {
   const card = document.querySelector(`.tree[data-id="${CSS.escape(`${tree.tree}/${tree.version}`)}"]`);
   if (!card) return;
+  const shown = shownStatuses(tree);
   for (const element of card.querySelectorAll("[data-node]")) {
-    const change = tree.byNode.get(Number(element.dataset.node));
-    const status = change ? change.status : "INVALID";
-    element.classList.remove("st-RUNNING", "st-SUCCESS", "st-FAILURE", "st-INVALID");
-    element.classList.add(`st-${status}`);
-    element.dataset.status = status;
+    const index = Number(element.dataset.node);
+    const change = tree.byNode.get(index);
+    const { mark, word } = SHOWN[shown[index]];
+    for (const name of Object.keys(SHOWN)) element.classList.remove(`st-${name}`);
+    element.classList.add(`st-${shown[index]}`);
+    element.dataset.status = change ? change.status : "INVALID";
+    element.dataset.shown = shown[index];
+    const markElement = element.querySelector(".mark");
+    if (markElement) markElement.textContent = mark;
+    element.setAttribute("aria-label", `${tree.nodes[index]?.label ?? ""}: ${word}`);
     const isChosen = chosen && chosen.tree === tree.tree && chosen.version === tree.version
-      && chosen.node === Number(element.dataset.node);
+      && chosen.node === index;
     element.classList.toggle("chosen", Boolean(isChosen));
   }
+  const status = card.querySelector("h2 .status");
+  status.textContent = SHOWN[shown[0] ?? "idle"].word;
+  status.className = `status st-${shown[0] ?? "idle"}`;
+}
+
+// a node is chosen by a click, or from the keyboard (Tab to it, then Enter or Space)
+function chooseBy(element, tree, index) {
+  element.setAttribute("tabindex", "0");
+  element.setAttribute("role", "button");
+  element.addEventListener("click", () => choose(tree.tree, tree.version, index));
+  element.addEventListener("keydown", (event) => {
+    if (event.key !== "Enter" && event.key !== " ") return;
+    event.preventDefault();
+    choose(tree.tree, tree.version, index);
+  });
+}
+
+// a blackboard value as a person reads it: words unquoted, nothing for null, lists joined
+function readable(json) {
+  let value;
+  try { value = JSON.parse(json); } catch { return String(json); }
+  if (value === null) return "nothing";
+  if (value === true) return "yes";
+  if (value === false) return "no";
+  if (Array.isArray(value)) {
+    if (value.length === 0) return "none";
+    if (value.every((each) => typeof each === "boolean")) {
+      const on = value.flatMap((each, at) => (each ? [String(at)] : []));
+      return on.length ? `on: ${on.join(", ")} (of ${value.length})` : `all ${value.length} off`;
+    }
+    return value.map((each) => (typeof each === "object" ? JSON.stringify(each) : String(each))).join(", ");
+  }
+  return typeof value === "object" ? JSON.stringify(value) : String(value);
 }
 
 function fill(selector, rows) {
@@ -142,7 +254,7 @@ function drawTables() {
   $("#clock").textContent = `${state.now.toFixed(2)} s`;
   const keys = [...state.keys.values()].sort((a, b) => a.key.localeCompare(b.key));
   fill("#keys", keys.map((change) => [[
-    [change.key], [change.value, "value"], [change.at.toFixed(2)], [change.writer || ""],
+    [change.key], [readable(change.value), "value"], [change.at.toFixed(2)], [change.writer || ""],
   ], state.now - change.at < 1, change.key]));
   const online = new Map();
   for (const change of keys) {
@@ -203,7 +315,7 @@ async function showChosen() {
   const facts = [
     ["tree", `${tree.tree} (version ${tree.version})`], ["node", `n${node.index}`],
     ["path", node.path], ["type", node.type], ["parameters", node.label],
-    ["status", change ? change.status : "not ticked"],
+    ["now", SHOWN[shownStatuses(tree)[chosen.node]].word],
     ["since", change ? `${change.at.toFixed(2)} s` : "-"],
     ["feedback", change && change.feedback ? change.feedback : "-"],
   ];
@@ -219,9 +331,11 @@ async function showChosen() {
     const all = await getJson("/api/node", { tree: tree.tree, version: tree.version, node: node.index });
     changes = all.filter((each) => each.at <= state.now).slice(-MAX_HISTORY);
   }
+  const asked = Boolean(questions.get(`${tree.tree}/${tree.version}`)?.has(node.index));
   $("#node-changes").replaceChildren(...changes.slice().reverse().map((each) => {
     const item = document.createElement("li");
-    item.textContent = `${each.at.toFixed(2)} s ${each.status}${each.feedback ? `: ${each.feedback}` : ""}`;
+    const said = asked ? ANSWERS[each.status] : WORDS[each.status];
+    item.textContent = `${each.at.toFixed(2)} s ${said ?? each.status}${each.feedback ? `: ${each.feedback}` : ""}`;
     return item;
   }));
 }
@@ -337,9 +451,11 @@ async function replay() {
       clearInterval(playing);
       playing = null;
       $("#play").innerHTML = "&#9654;";
+      $("#play").setAttribute("aria-label", "play");
       return;
     }
     $("#play").innerHTML = "&#10074;&#10074;";
+    $("#play").setAttribute("aria-label", "pause");
     playing = setInterval(() => {
       if (state.now >= info.duration) { $("#play").click(); return; }
       showMoment(state.now + 0.1);
