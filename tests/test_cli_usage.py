@@ -58,6 +58,7 @@ def test_the_cloud_on_a_robot_without_its_packages_says_what_to_install(
 
 IMPORTED_AS = {
     "pyyaml": "yaml",
+    "ruamel.yaml": "ruamel",
     "pyserial": "serial",
     "opencv-python-headless": "cv2",
     "psycopg[binary]": "psycopg",

@@ -12,6 +12,9 @@ right so twenty nodes stay readable.
 
 from __future__ import annotations
 
+import logging
+import shutil
+import subprocess
 import textwrap
 from collections.abc import Iterator
 from typing import Any
@@ -26,6 +29,10 @@ _COLORS = {
     "condition": "#B4DCFF",
     "action": "#B9F0B9",
 }
+log = logging.getLogger(__name__)
+DOT_TIMEOUT_S = 20.0
+"""The longest a drawing may take Graphviz (seconds): a huge tree is drawn, a stuck one
+is given up."""
 _SYMBOLS = {"Sequence": "->", "Selector": "?", "Parallel": "=>"}
 
 
@@ -51,7 +58,7 @@ def label(node: NodeDefinition) -> str:
     return " ".join(parts)
 
 
-_PLAIN = {
+PLAIN_WORDS = {  # what a composite or decorator does, in the words a drawing uses
     "Sequence": "in order",
     "Selector": "first that works",
     "Parallel": "at the same time",
@@ -72,8 +79,8 @@ LEGEND = (
 def plain_label(node: NodeDefinition) -> str:
     """What a node does, in a few words a line (for drawings people read)."""
     args, kind = node.args, node.type.name
-    if kind in _PLAIN:
-        head = _PLAIN[kind]
+    if kind in PLAIN_WORDS:
+        head = PLAIN_WORDS[kind]
         if kind == "OneShot" and args.get("after") == "completion":
             head = "only once, even failed"
     elif kind == "Cooldown":
@@ -195,6 +202,24 @@ def without_title_and_legend(dot: str) -> str:
         elif not line.startswith(("  title [", "  title -> ")):
             kept.append(line)
     return "\n".join(kept) + "\n"
+
+
+def svg_of(dot: str) -> bytes | None:
+    """``dot`` drawn by Graphviz as SVG; None when Graphviz is missing or fails (logged)."""
+    program = shutil.which("dot")
+    if program is None:
+        return None
+    try:
+        done = subprocess.run(
+            [program, "-Tsvg"], input=dot.encode(), capture_output=True, timeout=DOT_TIMEOUT_S
+        )
+    except (OSError, subprocess.TimeoutExpired) as error:
+        log.error("drawing a tree failed: %s", error)
+        return None
+    if done.returncode != 0:
+        log.error("Graphviz could not draw a tree: %s", done.stderr.decode(errors="replace"))
+        return None
+    return done.stdout
 
 
 def _widths(root: NodeDefinition) -> dict[int, int]:

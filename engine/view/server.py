@@ -27,8 +27,6 @@ import json
 import logging
 import math
 import re
-import shutil
-import subprocess
 import threading
 from collections.abc import AsyncIterator
 from pathlib import Path
@@ -43,7 +41,7 @@ from starlette.routing import BaseRoute, Route
 
 from engine.buttons.wizard import Wizard
 from engine.errors import ConfigError
-from engine.loader.tree_drawing import without_title_and_legend
+from engine.loader.tree_drawing import svg_of, without_title_and_legend
 from engine.view.hub import Change, ViewHub
 from engine.web.body_limit import BodyLimit
 from engine.web.broadcast import Reader
@@ -66,7 +64,6 @@ MAX_STREAMS = 32
 MAX_PRESS_BYTES = 1024
 PRESS_READ_TIMEOUT_S = 2.0
 """A press's body comes at once from the page; shorter than a server's grace on stopping."""
-DOT_TIMEOUT_S = 20.0
 
 
 class ViewSource(Protocol):
@@ -195,23 +192,14 @@ class ViewServer:
             if key in self._svg:
                 return self._svg[key]
         source = self.source.dot(tree, version)
-        if source is not None:
-            source = without_title_and_legend(source)  # the card names it; one legend
-        dot = shutil.which("dot")
-        if source is None or dot is None:
+        if source is None:
             return None
-        try:
-            done = subprocess.run(
-                [dot, "-Tsvg"], input=source.encode(), capture_output=True, timeout=DOT_TIMEOUT_S
-            )
-        except (OSError, subprocess.TimeoutExpired) as error:
-            log.error("drawing %s failed: %s", tree, error)
-            return None
-        if done.returncode != 0:
+        drawn = svg_of(without_title_and_legend(source))  # the card names it; one legend
+        if drawn is None:
             return None
         with self._svg_lock:
-            self._svg[key] = done.stdout
-        return done.stdout
+            self._svg[key] = drawn
+        return drawn
 
     # -- the endpoints (plain functions run in uvicorn's threads; streams on its loop) ---
     def _file(self, request: Request) -> Response:

@@ -1,0 +1,58 @@
+"""The checks `vest edit` shows as a therapist types: those of `vest validate`, run on the
+text being edited in its file's place among the folder's others (its subtrees, its
+dialogs, the robot's pads and joints), without writing it anywhere."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from engine.cli.run_inputs import robot_catalogue
+from engine.cli.validate_command import Validator, kind_of
+from engine.files.parsed_files import ParsedFiles
+from engine.files.problems import LoadError, Problem, Problems
+from engine.files.yaml_source import YValue, parse_yaml, resolved
+from engine.hardware.config import RobotConfig
+from engine.loader.tree_checks import variable_problems
+from engine.loader.tree_definition import TreeDefinition
+from engine.nodes.registry import NodeRegistry
+
+
+class _Overlaid(ParsedFiles):
+    """The folder's files, but one of them read from the text being edited."""
+
+    def __init__(self, path: Path, text: str) -> None:
+        super().__init__()
+        self.path, self.text = resolved(path), text
+
+    def load(self, path: Path, shown: str | None = None) -> YValue | None:
+        if resolved(path) == self.path:
+            return parse_yaml(self.text, shown or str(path))
+        return super().load(path, shown)
+
+
+class ValidateChecks:
+    """:class:`~engine.editor.workspace.Checks` as ``vest validate`` makes them, for trees
+    in ``folder`` on the robot of ``config`` (None: pads, joints and devices unchecked)."""
+
+    def __init__(self, folder: Path, registry: NodeRegistry, config: RobotConfig | None) -> None:
+        self.folder, self.registry, self.config = folder, registry, config
+        self.files = ParsedFiles()
+
+    def kind_of(self, path: Path) -> str:
+        try:
+            kind = kind_of(self.files.load(path)) or "other"
+        except LoadError:
+            return "unreadable"
+        return "subtree" if kind == "tree" and path.parent.name == "parts" else kind
+
+    def check(self, path: Path, text: str) -> tuple[list[Problem], TreeDefinition | None]:
+        problems = Problems()
+        validator = Validator(self.registry, self.config, None, problems)
+        validator.files = _Overlaid(path, text)
+        dialogs = self.folder / "dialogs"
+        validator.default_dialogs = dialogs if dialogs.is_dir() else None
+        validator.check(path)
+        if validator.trees and path.parent.name != "parts":  # as vest validate, for one tree
+            catalogue = robot_catalogue(self.config, self.registry)
+            problems.extend(variable_problems(validator.trees, catalogue))
+        return problems.items, validator.trees[0] if validator.trees else None

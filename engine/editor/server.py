@@ -1,0 +1,214 @@
+"""The tree editor's web server (``vest edit``): one page (engine/editor/web/) on the one web
+stack (:mod:`engine.web`), in a thread of its own.
+
+- ``GET /`` the page, ``/editor.js``, ``/editor.css``; ``/shared/`` what every page shares;
+- ``GET /api/palette`` the nodes, their parameters as form fields, the robot's words;
+- ``GET /api/files`` the folder's trees, subtrees, profiles and dialogs;
+- ``GET /api/file?name=F`` a file's text, its version and, for a tree, its outline;
+- ``POST /api/check`` ``{"file", "outline"}`` the text the outline makes, the validator's
+  problems (each with the node it belongs to) and, when there are none, the drawing;
+- ``POST /api/save`` ``{"file", "outline", "version", "over_problems"}`` writes it (409
+  when the file changed on disk since ``version``, or when the change has problems the
+  file has not and ``over_problems`` is false; ``version`` null for a new file).
+
+Bodies are JSON from the page's own origin; on loopback (the default) no token is asked, on
+any other address every request carries the token ``vest edit`` prints.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+from urllib.parse import urlparse
+
+from starlette.applications import Starlette
+from starlette.middleware import Middleware
+from starlette.requests import Request
+from starlette.responses import FileResponse, JSONResponse, Response
+from starlette.routing import BaseRoute, Route
+
+from engine.editor.tree_yaml import OutlineError, TreeText
+from engine.editor.workspace import MAX_FILE_BYTES, EditRefused, Workspace
+from engine.errors import ConfigError
+from engine.loader.tree_drawing import dot_source, svg_of, without_title_and_legend
+from engine.web.body_limit import BodyLimit
+from engine.web.guard import LoopbackOrToken, SecurityHeaders, check_listening
+from engine.web.serving import SHARED, ServerThread, address_of, listening_socket, shared_files
+
+WEB = Path(__file__).parent / "web"
+STATIC = {"/": "editor.html", "/editor.js": "editor.js", "/editor.css": "editor.css"}
+READ_TIMEOUT_S = 5.0
+
+
+class EditorServer:
+    """Serves ``workspace`` with ``palette`` on ``host``:``port`` (0: any free port); a
+    ConfigError when it cannot listen there or would listen beyond loopback without a
+    token."""
+
+    def __init__(
+        self,
+        workspace: Workspace,
+        palette: dict[str, Any],
+        *,
+        host: str = "127.0.0.1",
+        port: int = 8766,
+        token: str | None = None,
+    ) -> None:
+        check_listening(host, token, "the editor")
+        self.workspace, self.palette, self.host, self.token = workspace, palette, host, token
+        try:
+            sock = listening_socket(host, port, named=f"the editor on {host}:{port}")
+        except ConfigError as error:
+            raise ConfigError(f"{error}; choose another with --port (0: any free one)") from None
+        self._server = ServerThread(self.app(), sock, "editor")
+        self.port = self._server.port
+
+    @property
+    def url(self) -> str:
+        query = f"?token={self.token}" if self.token else ""
+        return address_of(self.host, self.port, "/") + query
+
+    def start(self) -> None:
+        self._server.start()
+
+    def stop(self) -> None:
+        self._server.stop()
+
+    def app(self) -> Starlette:
+        routes: list[BaseRoute] = [Route(path, self._file) for path in STATIC]
+        routes += [
+            shared_files(),
+            Route("/api/palette", lambda _: JSONResponse(self.palette)),
+            Route("/api/files", lambda _: JSONResponse(self.workspace.files())),
+            Route("/api/file", self._read),
+            Route("/api/check", self._check, methods=["POST"]),
+            Route("/api/save", self._save, methods=["POST"]),
+        ]
+        return Starlette(
+            routes=routes,
+            middleware=[
+                Middleware(SecurityHeaders),
+                Middleware(
+                    LoopbackOrToken,
+                    host=self.host,
+                    token=self.token,
+                    open_paths=STATIC,
+                    open_folders=[SHARED],
+                ),
+                Middleware(BodyLimit, max_bytes=2 * MAX_FILE_BYTES, read_timeout_s=READ_TIMEOUT_S),
+            ],
+        )
+
+    # -- endpoints (plain functions run in uvicorn's threads) ---------------------------
+    def _file(self, request: Request) -> Response:
+        return FileResponse(WEB / STATIC[request.url.path])
+
+    def _read(self, request: Request) -> Response:
+        name = request.query_params.get("name", "")
+        try:
+            text, version = self.workspace.read(name)
+        except EditRefused as refused:
+            return _refused(refused)
+        answer: dict[str, Any] = {"file": name, "text": text, "version": version, "outline": None}
+        try:
+            answer["outline"] = TreeText(text, self.workspace.registry).outline()
+        except OutlineError as error:
+            answer["why_not"] = str(error)  # a profile, a dialog: shown as text
+        return JSONResponse(answer)
+
+    async def _check(self, request: Request) -> Response:
+        try:
+            name, text, _ = await self._asked(request)
+            problems, tree = self.workspace.checked(name, text)
+        except EditRefused as refused:
+            return _refused(refused)
+        return JSONResponse(
+            {
+                "text": text,
+                "problems": _with_nodes(problems, text, self.workspace),
+                "svg": _drawing(tree),
+            }
+        )
+
+    async def _save(self, request: Request) -> Response:
+        try:
+            name, text, body = await self._asked(request)
+        except EditRefused as refused:
+            return _refused(refused)
+        try:
+            version = body.get("version")
+            if version is not None and not isinstance(version, str):
+                raise EditRefused(400, "version is the text the file's reading gave, or null")
+            saved = self.workspace.save(
+                name, text, version, over_problems=body.get("over_problems") is True
+            )
+        except EditRefused as refused:
+            return _refused(refused, text)
+        return JSONResponse({"version": saved.version, "problems": saved.problems})
+
+    async def _asked(self, request: Request) -> tuple[str, str, dict[str, Any]]:
+        """The file named and the text the body's outline makes of it; EditRefused (400,
+        403) for a body that is not the page's."""
+        origin = request.headers.get("origin")
+        if origin is not None and urlparse(origin).netloc != request.headers.get("host"):
+            raise EditRefused(403, "changes come from the editor's page only")
+        if request.headers.get("content-type", "").split(";")[0].strip() != "application/json":
+            raise EditRefused(400, 'send JSON: {"file": ..., "outline": ...}')
+        try:
+            body = json.loads(await request.body())
+        except (ValueError, RecursionError):
+            raise EditRefused(400, "the body is not JSON") from None
+        if not isinstance(body, dict) or not isinstance(body.get("file"), str):
+            raise EditRefused(400, 'send JSON: {"file": ..., "outline": ...}')
+        name: str = body["file"]
+        self.workspace.path_of(name)  # refused before anything is read
+        outline = body.get("outline")
+        if not isinstance(outline, dict):
+            raise EditRefused(400, "outline: the tree as the page holds it")
+        try:
+            base = self.workspace.read(name)[0] if body.get("version") is not None else None
+        except EditRefused as refused:
+            if refused.status != 404:
+                raise
+            base = None
+        try:
+            tree = TreeText(base or _skeleton(outline), self.workspace.registry)
+            return name, tree.written(outline), body
+        except (OutlineError, RecursionError) as error:
+            raise EditRefused(400, f"{name}: {error}") from None
+
+
+def _skeleton(outline: dict[str, Any]) -> str:
+    """The text a new tree starts from (its settings and root come from the outline)."""
+    settings = outline.get("settings") if isinstance(outline.get("settings"), dict) else {}
+    name = str((settings or {}).get("name") or "new_tree")
+    return f"name: {json.dumps(name)}\nrate_hz: 10\nroot:\n  Sequence: []\n"
+
+
+def _with_nodes(
+    problems: list[dict[str, Any]], text: str, workspace: Workspace
+) -> list[dict[str, Any]]:
+    """Each problem in the edited file with the node (its id in ``text``) it belongs to."""
+    try:
+        lines = TreeText(text, workspace.registry).node_lines()
+    except OutlineError:
+        lines = []
+    for problem in problems:
+        before = [ident for line, ident in lines if line <= problem["line"]]
+        problem["node"] = before[-1] if problem["here"] and before else None
+    return problems
+
+
+def _drawing(tree: Any) -> str | None:
+    if tree is None:
+        return None
+    drawn = svg_of(without_title_and_legend(dot_source(tree)))
+    return drawn.decode("utf-8") if drawn is not None else None
+
+
+def _refused(refused: EditRefused, text: str | None = None) -> Response:
+    body: dict[str, Any] = {"message": str(refused), "problems": refused.problems}
+    if text is not None:
+        body["text"] = text
+    return JSONResponse(body, status_code=refused.status)

@@ -1,0 +1,468 @@
+// The tree editor: a tree held as an outline (settings and nodes), changed from forms and
+// a palette, checked by the server as you type (the checks of `vest validate`), saved as
+// YAML that keeps the file's comments and layout. Undo and redo keep whole outlines.
+
+const token = new URLSearchParams(location.search).get("token");
+const api = (path, params = {}) => {
+  const query = new URLSearchParams(params);
+  if (token) query.set("token", token);
+  const text = query.toString();
+  return text ? `${path}?${text}` : path;
+};
+const $ = (selector) => document.querySelector(selector);
+const make = (tag, props = {}, ...children) => {
+  const element = document.createElement(tag);
+  Object.assign(element, props);
+  element.append(...children);
+  return element;
+};
+
+let palette = { nodes: [], pads: [], joints: [], colors: [], keys: [], kinds: {} };
+const types = new Map(); // node type name -> its declaration
+let file = null; // {name, version (null: new), outline}
+let chosen = null; // the chosen node object
+let undone = [];
+let done = [];
+let saved = ""; // the outline as last read or saved (JSON)
+let checking = null;
+
+const SETTINGS = [
+  { name: "name", label: "Name", kind: "text", doc: "the tree's name (unique in its folder)" },
+  { name: "description", label: "What it does", kind: "text", doc: "for people" },
+  { name: "rate_hz", label: "Looks how often (times a second)", kind: "number", min: 0.1, max: 100, doc: "20 suits touch" },
+  { name: "priority", label: "Priority", kind: "integer", min: 0, max: 1000, doc: "the higher wins the speaker, the LEDs, a joint" },
+  { name: "wake_on", label: "Wakes on (keys)", kind: "list", item: { kind: "key" }, doc: "rests until one of these changes; e.g. /sensors/touch/pat" },
+];
+
+async function getJson(path, params) {
+  const response = await fetch(api(path, params));
+  const body = await response.json().catch(() => ({ message: `${response.status}` }));
+  if (!response.ok) throw new Error(body.message ?? `${path}: ${response.status}`);
+  return body;
+}
+
+async function postJson(path, body) {
+  const response = await fetch(api(path), {
+    method: "POST", headers: { "content-type": "application/json" }, body: JSON.stringify(body),
+  });
+  return { status: response.status, body: await response.json().catch(() => ({})) };
+}
+
+// the server is gone (vest edit ended): nothing is lost on the page; saving says so
+function unreachable() {
+  $("#state").textContent = "cannot reach vest edit: is it still running? (changes not saved)";
+}
+
+function say(text, tone = "") {
+  $("#message").textContent = text;
+  $("#message").className = tone;
+}
+
+// -- the outline --------------------------------------------------------------------------
+const snapshot = () => JSON.stringify(file.outline);
+const childrenOf = (type) => (type === "Subtree" ? "none" : types.get(type)?.children ?? "none");
+
+function walk(node, visit, parent = null, path = "root") {
+  visit(node, parent, path);
+  const one = childrenOf(node.type) === "one";
+  node.children.forEach((child, index) => walk(child, visit, node, `${path}/${one ? "child" : index}`));
+}
+
+function parentOf(target) {
+  let found = null;
+  walk(file.outline.root, (node, parent) => { if (node === target) found = parent; });
+  return found;
+}
+
+function change(edit, redrawForm = true) { // every change: undoable, checked, drawn
+  done.push(snapshot());
+  undone = [];
+  edit();
+  changed(redrawForm);
+}
+
+// a field's own edit leaves its form as it is (the person may be typing in the next field)
+function changed(redrawForm = true) {
+  $("#undo").disabled = done.length === 0;
+  $("#redo").disabled = undone.length === 0;
+  const dirty = snapshot() !== saved;
+  $("#state").textContent = dirty ? "changed, not saved" : "saved";
+  document.body.dataset.dirty = String(dirty);
+  drawOutline();
+  if (redrawForm) drawNodeForm();
+  checkSoon();
+}
+
+function restore(text) {
+  const path = chosen ? pathOf(chosen) : null;
+  file.outline = JSON.parse(text);
+  chosen = path ? nodeAt(path) : null;
+  changed();
+}
+
+function pathOf(target) {
+  let found = null;
+  walk(file.outline.root, (node, _, path) => { if (node === target) found = path; });
+  return found;
+}
+
+function nodeAt(path) {
+  let found = null;
+  walk(file.outline.root, (node, _, at) => { if (at === path) found = node; });
+  return found;
+}
+
+function summary(node) { // "in order (Sequence)", "Say, text: Hello"
+  const words = types.get(node.type)?.words;
+  const what = words ? `${words} (${node.type})` : node.type;
+  const args = Object.entries(node.args).map(([key, value]) => `${key}: ${shown(value)}`);
+  return [node.name ? `${node.name}: ${what}` : what, ...args].join(", ");
+}
+
+const shown = (value) => (Array.isArray(value) ? value.join(", ") : typeof value === "object" && value !== null ? JSON.stringify(value) : String(value));
+
+let problemsByNode = new Map();
+
+function drawOutline() {
+  const list = $("#outline");
+  const item = (node, path, depth) => {
+    const row = make("li", { role: "treeitem" });
+    row.setAttribute("aria-level", String(depth));
+    row.setAttribute("aria-selected", String(node === chosen));
+    const kind = types.get(node.type)?.kind ?? "action";
+    const button = make("button", { type: "button", className: `node kind-${kind}` });
+    button.dataset.path = path;
+    button.append(make("span", { className: "what", textContent: summary(node) }));
+    const problems = problemsByNode.get(path) ?? [];
+    if (problems.length) {
+      button.append(make("span", { className: "badge", textContent: `${problems.length} problem${problems.length > 1 ? "s" : ""}` }));
+    }
+    button.addEventListener("click", () => { chosen = node; drawOutline(); drawNodeForm(); });
+    row.append(button);
+    if (node.children.length) {
+      const group = make("ul", { role: "group" });
+      const one = childrenOf(node.type) === "one";
+      node.children.forEach((child, index) => group.append(item(child, `${path}/${one ? "child" : index}`, depth + 1)));
+      row.append(group);
+    }
+    return row;
+  };
+  const focused = document.activeElement?.closest?.("#outline") ? document.activeElement.dataset.path : null;
+  list.replaceChildren(item(file.outline.root, "root", 1));
+  if (focused) list.querySelector(`[data-path="${CSS.escape(focused)}"]`)?.focus(); // the list was drawn anew
+  const parent = chosen ? parentOf(chosen) : null;
+  $("#add-inside").disabled = !chosen || childrenOf(chosen.type) === "none"
+    || (childrenOf(chosen.type) === "one" && chosen.children.length > 0);
+  $("#add-after").disabled = !parent || childrenOf(parent.type) !== "many";
+  $("#delete").disabled = !chosen || !parent;
+  const index = parent ? parent.children.indexOf(chosen) : -1;
+  $("#move-up").disabled = !parent || index <= 0;
+  $("#move-down").disabled = !parent || index >= parent.children.length - 1;
+  $("#move-out").disabled = !parent || !parentOf(parent) || childrenOf(parentOf(parent).type) !== "many";
+}
+
+// -- forms ---------------------------------------------------------------------------------
+// A value as typed becomes what YAML would hold: a number where a number is meant (but a
+// ${param} stays text), a list from commas; an empty field is no value at all.
+function typed(text, field) {
+  const trimmed = text.trim();
+  if (trimmed === "") return undefined;
+  if (field.kind === "list") return trimmed.split(",").map((part) => typed(part, field.item ?? { kind: "any" })).filter((v) => v !== undefined);
+  if (["number", "integer", "any"].includes(field.kind) && /^-?\d+(\.\d+)?$/.test(trimmed)) return Number(trimmed);
+  if (field.kind === "any" && (trimmed === "true" || trimmed === "false")) return trimmed === "true";
+  return trimmed;
+}
+
+function fieldFor(field, value, set, idPrefix) {
+  const id = `${idPrefix}-${field.name}`;
+  const wrap = make("div", { className: "field" });
+  const range = field.min !== undefined || field.max !== undefined
+    ? ` ${field.min ?? ""}..${field.max ?? ""}` : "";
+  const unit = field.unit ? ` ${field.unit}` : "";
+  const label = make("label", { htmlFor: id, textContent: `${field.label ?? field.name}${field.required ? " (needed)" : ""}` });
+  const help = make("p", { className: "help", id: `${id}-help`, textContent: `${field.doc ?? ""}${range || unit ? ` (${(range + unit).trim()})` : ""}` });
+  let input;
+  const words = field.words ? palette[field.words] ?? [] : [];
+  if (field.kind === "list" && words.length) { // the robot's pads: tick the ones meant
+    input = make("fieldset", { id, className: "choices" });
+    input.append(make("legend", { textContent: label.textContent }));
+    const chosenWords = new Set(Array.isArray(value) ? value : []);
+    for (const word of words) {
+      const box = make("input", { type: "checkbox", id: `${id}-${word}`, checked: chosenWords.has(word) });
+      box.addEventListener("change", () => {
+        const now = words.filter((w) => (w === word ? box.checked : chosenWords.has(w)));
+        if (box.checked) chosenWords.add(word); else chosenWords.delete(word);
+        set(now.length ? now : undefined);
+      });
+      input.append(make("label", { htmlFor: box.id, className: "choice" }, box, ` ${word}`));
+    }
+    input.setAttribute("aria-describedby", help.id);
+    wrap.append(input, help);
+    return wrap;
+  }
+  if (field.kind === "choice" || field.kind === "boolean") {
+    input = make("select", { id });
+    const options = field.kind === "boolean" ? ["true", "false"] : field.options;
+    input.append(make("option", { value: "", textContent: field.default !== undefined ? `(default: ${field.default})` : "(none)" }));
+    for (const option of options) input.append(make("option", { value: option, textContent: option, selected: String(value) === option }));
+    input.addEventListener("change", () => set(input.value === "" ? undefined : field.kind === "boolean" ? input.value === "true" : input.value));
+  } else {
+    input = make("input", { id, type: "text", value: value === undefined ? "" : shown(value) });
+    if (field.kind === "number" || field.kind === "integer") input.inputMode = "decimal";
+    const suggestions = words.length ? words : field.kind === "key" || field.item?.kind === "key" ? palette.keys : [];
+    if (suggestions.length) {
+      const listId = `${id}-words`;
+      input.setAttribute("list", listId);
+      wrap.append(make("datalist", { id: listId }, ...suggestions.map((word) => make("option", { value: word }))));
+    }
+    if (field.default !== undefined) input.placeholder = `default: ${shown(field.default)}`;
+    input.addEventListener("change", () => set(typed(input.value, field)));
+  }
+  input.setAttribute("aria-describedby", help.id);
+  wrap.prepend(label);
+  wrap.append(input, help);
+  return wrap;
+}
+
+function drawSettings() {
+  const box = $("#settings");
+  box.replaceChildren(make("legend", { textContent: "The tree" }));
+  const settings = file.outline.settings;
+  for (const field of SETTINGS) {
+    box.append(fieldFor(field, settings[field.name], (value) => change(() => {
+      if (value === undefined) delete settings[field.name]; else settings[field.name] = value;
+    }, false), "setting"));
+  }
+}
+
+function drawNodeForm() {
+  const form = $("#node-form");
+  $("#no-node").hidden = Boolean(chosen);
+  form.hidden = !chosen;
+  if (!chosen) return;
+  const node = chosen;
+  const declared = types.get(node.type);
+  const fields = [{ name: "name", kind: "text", doc: "a name people read in drawings (optional)" }, ...(declared?.params ?? [])];
+  form.replaceChildren(
+    make("h3", { textContent: declared?.words ? `${declared.words} (${node.type})` : node.type }),
+    make("p", { className: "help", textContent: declared?.summary ?? "a node this robot does not know" }),
+    declared?.doc && declared.doc !== declared.summary
+      ? make("details", {}, make("summary", { textContent: "more about it" }), make("p", { className: "help", textContent: declared.doc.replaceAll("``", "") }))
+      : "",
+    make("div", { id: "node-problems", role: "status" }),
+    ...fields.map((field) => fieldFor(field, field.name === "name" ? node.name ?? undefined : node.args[field.name], (value) => change(() => {
+      if (field.name === "name") node.name = value ?? null;
+      else if (value === undefined) delete node.args[field.name];
+      else node.args[field.name] = value;
+    }, false), "node")),
+  );
+  drawNodeProblems();
+}
+
+function drawNodeProblems() {
+  const box = $("#node-problems");
+  if (!box || !chosen) return;
+  const problems = problemsByNode.get(pathOf(chosen)) ?? [];
+  box.replaceChildren(...problems.map((problem) => make("p", { className: "problem", textContent: problemText(problem) })));
+}
+
+const problemText = (problem) => `line ${problem.line}: ${problem.message}${problem.hint ? ` (${problem.hint})` : ""}`;
+
+// -- checking and drawing -------------------------------------------------------------------
+function checkSoon() {
+  clearTimeout(checking);
+  checking = setTimeout(() => check().catch(unreachable), 250);
+}
+
+async function check() {
+  const asked = snapshot();
+  const { status, body } = await postJson("/api/check", { file: file.name, outline: file.outline, version: file.version });
+  if (asked !== snapshot()) return; // changed again meanwhile: that check comes
+  if (status !== 200) { say(body.message ?? `the check failed (${status})`, "bad"); return; }
+  problemsByNode = new Map();
+  for (const problem of body.problems) {
+    const list = problemsByNode.get(problem.node) ?? [];
+    list.push(problem);
+    problemsByNode.set(problem.node, list);
+  }
+  $("#problems").replaceChildren(...(body.problems.length ? body.problems.map((problem) => {
+    const item = make("li", { className: "problem" });
+    const where = problem.node ? nodeAt(problem.node) : null;
+    if (where) {
+      const go = make("button", { type: "button", textContent: problemText(problem) });
+      go.addEventListener("click", () => { chosen = where; drawOutline(); drawNodeForm(); $("#node-panel").focus(); });
+      item.append(go);
+    } else item.textContent = `${problem.here ? "" : `${problem.file}: `}${problemText(problem)}`;
+    return item;
+  }) : [make("li", { className: "fine", textContent: "none: vest validate accepts this tree" })]));
+  document.body.dataset.problems = String(body.problems.length);
+  if (body.svg) {
+    const parsed = new DOMParser().parseFromString(body.svg, "image/svg+xml").documentElement;
+    for (const element of parsed.querySelectorAll("script, foreignObject, a")) element.remove();
+    $("#drawing").replaceChildren(document.importNode(parsed, true));
+  } else if (body.problems.length) {
+    $("#drawing").textContent = "(drawn once the problems are fixed)";
+  }
+  drawOutline();
+  drawNodeProblems();
+}
+
+// -- the toolbar ------------------------------------------------------------------------------
+let adding = null; // "inside" or "after"
+
+function openPalette(where) {
+  adding = where;
+  $("#palette-filter").value = "";
+  drawPalette("");
+  $("#palette").showModal();
+  $("#palette-filter").focus();
+}
+
+function drawPalette(filter) {
+  const groups = $("#palette-groups");
+  const wanted = filter.trim().toLowerCase();
+  groups.replaceChildren(...Object.entries(palette.kinds).map(([kind, words]) => {
+    const nodes = palette.nodes.filter((node) => node.kind === kind
+      && (!wanted || `${node.name} ${node.summary}`.toLowerCase().includes(wanted)));
+    if (!nodes.length) return "";
+    return make("section", {}, make("h3", { textContent: words }), ...nodes.map((node) => {
+      const button = make("button", { type: "button", className: "palette-node" },
+        make("strong", { textContent: node.words ? `${node.words} (${node.name})` : node.name }), ` ${node.summary}`);
+      button.setAttribute("aria-label", `${node.name}: ${node.words ? `${node.words}; ` : ""}${node.summary}`);
+      button.addEventListener("click", () => { $("#palette").close(); add(node); });
+      return button;
+    }));
+  }));
+}
+
+function add(declared) {
+  const node = { type: declared.name, name: null, args: {}, children: [] };
+  for (const param of declared.params) if (param.required && param.default !== undefined) node.args[param.name] = param.default;
+  change(() => {
+    if (adding === "inside") chosen.children.push(node);
+    else { const parent = parentOf(chosen); parent.children.splice(parent.children.indexOf(chosen) + 1, 0, node); }
+    chosen = node;
+  });
+  $("#node-panel").focus();
+}
+
+function move(step) {
+  const parent = parentOf(chosen);
+  const index = parent.children.indexOf(chosen);
+  change(() => { parent.children.splice(index, 1); parent.children.splice(index + step, 0, chosen); });
+}
+
+function moveOut() {
+  const parent = parentOf(chosen);
+  const grand = parentOf(parent);
+  change(() => {
+    parent.children.splice(parent.children.indexOf(chosen), 1);
+    grand.children.splice(grand.children.indexOf(parent) + 1, 0, chosen);
+  });
+}
+
+function remove() {
+  const parent = parentOf(chosen);
+  change(() => { parent.children.splice(parent.children.indexOf(chosen), 1); chosen = parent; });
+}
+
+async function save(overProblems = false) {
+  const { status, body } = await postJson("/api/save", {
+    file: file.name, outline: file.outline, version: file.version, over_problems: overProblems,
+  });
+  if (status === 200) {
+    say(`saved ${file.name}${body.problems.length ? ` with ${body.problems.length} problems` : ""}`, "good");
+    await open(file.name, true);
+    return;
+  }
+  if (status === 409 && body.problems?.length) {
+    $("#confirm-text").textContent = body.message;
+    $("#confirm").returnValue = "";
+    $("#confirm").showModal();
+    $("#confirm").addEventListener("close", () => { if ($("#confirm").returnValue === "yes") save(true).catch(unreachable); }, { once: true });
+    return;
+  }
+  say(body.message ?? `not saved (${status})`, "bad");
+}
+
+// -- files --------------------------------------------------------------------------------------
+async function listFiles() {
+  const files = await getJson("/api/files");
+  const groups = new Map();
+  for (const each of files) groups.set(each.kind, [...(groups.get(each.kind) ?? []), each]);
+  $("#files").replaceChildren(...[...groups.entries()].map(([kind, list]) => make("section", {},
+    make("h3", { textContent: `${kind}${kind.endsWith("s") ? "" : "s"}` }),
+    make("ul", {}, ...list.map((each) => {
+      const button = make("button", { type: "button", textContent: each.file });
+      button.addEventListener("click", () => leave() && open(each.file).catch((error) => say(error.message, "bad")));
+      return make("li", {}, button);
+    })))));
+}
+
+const leave = () => document.body.dataset.dirty !== "true" || confirm("Leave this tree? Its changes are not saved.");
+
+async function open(name, keepMessage = false) {
+  const read = await getJson("/api/file", { name });
+  if (!keepMessage) say("");
+  if (!read.outline) {
+    $("#editing").hidden = true; $("#nothing").hidden = true; $("#as-text").hidden = false;
+    $("#text-name").textContent = name;
+    $("#text-why").textContent = `Not a tree (${read.why_not}): shown as it is; edit it by hand.`;
+    $("#text").textContent = read.text;
+    file = null;
+    return;
+  }
+  start({ name, version: read.version, outline: read.outline });
+}
+
+function start(opened) {
+  file = opened;
+  saved = snapshot();
+  done = []; undone = [];
+  chosen = file.outline.root;
+  $("#nothing").hidden = true; $("#as-text").hidden = true; $("#editing").hidden = false;
+  $("#file-name").textContent = file.name + (file.version ? "" : " (new)");
+  drawSettings();
+  changed();
+}
+
+function newTree(event) {
+  event.preventDefault();
+  if (!leave()) return;
+  const name = $("#new-name").value.trim();
+  start({
+    name: `trees/${name}.yaml`, version: null,
+    outline: { settings: { name, rate_hz: 20, description: "" }, root: { type: "Sequence", name: null, args: {}, children: [] } },
+  });
+  $("#file-name").focus?.();
+}
+
+async function main() {
+  palette = await getJson("/api/palette");
+  for (const node of palette.nodes) types.set(node.name, node);
+  $("#where").textContent = "";
+  await listFiles();
+  $("#state").textContent = "ready";
+  $("#new-tree").addEventListener("submit", newTree);
+  $("#undo").addEventListener("click", () => { undone.push(snapshot()); restore(done.pop()); });
+  $("#redo").addEventListener("click", () => { done.push(snapshot()); restore(undone.pop()); });
+  $("#add-inside").addEventListener("click", () => openPalette("inside"));
+  $("#add-after").addEventListener("click", () => openPalette("after"));
+  $("#move-up").addEventListener("click", () => move(-1));
+  $("#move-down").addEventListener("click", () => move(1));
+  $("#move-out").addEventListener("click", moveOut);
+  $("#delete").addEventListener("click", remove);
+  $("#save").addEventListener("click", () => save().catch(unreachable));
+  $("#palette-filter").addEventListener("input", (event) => drawPalette(event.target.value));
+  document.addEventListener("keydown", (event) => {
+    if (!file || !(event.ctrlKey || event.metaKey)) return;
+    const key = event.key.toLowerCase();
+    if (key === "z" && !$("#undo").disabled) { event.preventDefault(); $("#undo").click(); }
+    if (key === "y" && !$("#redo").disabled) { event.preventDefault(); $("#redo").click(); }
+    if (key === "s") { event.preventDefault(); save().catch(unreachable); }
+  });
+  addEventListener("beforeunload", (event) => { if (document.body.dataset.dirty === "true") event.preventDefault(); });
+  document.body.dataset.ready = "true";
+}
+
+main().catch((error) => { $("#state").textContent = `cannot load the editor: ${error.message}`; });

@@ -1,0 +1,199 @@
+"""The folder ``vest edit`` works in: what it lists, reads, checks and saves.
+
+Only files inside the folder are read or written (a name that leads out of it, through
+``..`` or a link, is refused), only ``.yaml`` files, and a save is checked first:
+
+- the file must be as it was when the page read it (its version, a hash of its bytes):
+  a file changed on disk meanwhile is never overwritten silently;
+- the new text is checked as ``vest validate`` checks it, in its place among the
+  folder's other files (its subtrees, its dialogs, the robot's pads and joints); a text
+  with problems is never saved over a file without them unless the person said so;
+- the text is written whole or not at all (a temporary file beside it, then renamed), so a
+  robot running ``vest run`` on the folder reloads either the old tree or the new one.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import hashlib
+import os
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Protocol
+
+from engine.files.problems import Problem
+from engine.files.yaml_source import resolved
+from engine.loader.tree_definition import TreeDefinition
+from engine.nodes.registry import NodeRegistry
+
+LISTED = ("trees", "dialogs")
+"""The folders listed when the folder holds them (a project); else the folder itself."""
+MAX_FILE_BYTES = 1_000_000
+
+
+class EditRefused(Exception):  # noqa: N818 - a refusal told to the page, not a failure
+    """Why a read or save is refused: ``status`` is the HTTP status the page gets."""
+
+    def __init__(self, status: int, message: str, problems: list[dict[str, Any]] | None = None):
+        super().__init__(message)
+        self.status = status
+        self.problems = problems or []
+
+
+@dataclass(frozen=True)
+class Saved:
+    version: str
+    problems: list[dict[str, Any]]
+
+
+def version_of(data: bytes) -> str:
+    """A file's version as the page holds it: the hash of its bytes."""
+    return hashlib.sha256(data).hexdigest()[:16]
+
+
+class Checks(Protocol):
+    """The checks of ``vest validate`` (engine.cli.edit_checks gives them): what a file is,
+    and what is wrong with a text in a file's place."""
+
+    def kind_of(self, path: Path) -> str:
+        """tree, subtree, profile, dialog, buttons, scenario, robot config, other, or
+        unreadable."""
+        ...
+
+    def check(self, path: Path, text: str) -> tuple[list[Problem], TreeDefinition | None]:
+        """The problems of ``path`` if it held ``text``, and the tree it makes (None: not
+        a tree without problems)."""
+        ...
+
+
+class Workspace:
+    """The folder being edited: ``registry`` knows the nodes, ``checks`` what is wrong."""
+
+    def __init__(self, folder: Path, registry: NodeRegistry, checks: Checks) -> None:
+        self.folder = folder.resolve()
+        self.registry = registry
+        self.checks = checks
+
+    # -- where ----------------------------------------------------------------------------
+    def path_of(self, name: str) -> Path:
+        """The file ``name`` (relative to the folder); EditRefused when it is not a YAML
+        file inside the folder."""
+        if not name or "\x00" in name or Path(name).is_absolute():
+            raise EditRefused(400, f"{name!r}: give a file's name inside the folder")
+        path = (self.folder / name).resolve()
+        if not path.is_relative_to(self.folder):
+            raise EditRefused(403, f"{name}: outside the folder the editor works in")
+        if path.suffix not in (".yaml", ".yml"):
+            raise EditRefused(400, f"{name}: the editor edits .yaml files only")
+        return path
+
+    def files(self) -> list[dict[str, str]]:
+        """Every YAML file listed, with what it is: tree, subtree, profile, dialog, ..."""
+        roots = [self.folder / name for name in LISTED if (self.folder / name).is_dir()]
+        found: list[dict[str, str]] = []
+        for root in roots or [self.folder]:
+            for path in sorted(root.rglob("*.y*ml")):
+                shown = path.relative_to(self.folder)
+                if any(part.startswith(".") for part in shown.parts):
+                    continue
+                if not path.resolve().is_relative_to(self.folder):
+                    continue  # a link out of the folder is not listed
+                found.append({"file": shown.as_posix(), "kind": self.checks.kind_of(path)})
+        return found
+
+    # -- read, check, save ----------------------------------------------------------------
+    def read(self, name: str) -> tuple[str, str]:
+        """The file's text and version; EditRefused when there is none or it is too big."""
+        path = self.path_of(name)
+        try:
+            data = path.read_bytes()
+        except FileNotFoundError:
+            raise EditRefused(404, f"{name}: no such file") from None
+        except OSError as error:
+            raise EditRefused(400, f"{name}: cannot be read ({error.strerror})") from None
+        if len(data) > MAX_FILE_BYTES:
+            raise EditRefused(413, f"{name}: over {MAX_FILE_BYTES // 1000} kB")
+        try:
+            return data.decode("utf-8"), version_of(data)
+        except UnicodeDecodeError:
+            raise EditRefused(400, f"{name}: not UTF-8 text") from None
+
+    def check(self, name: str, text: str) -> list[dict[str, Any]]:
+        """What ``vest validate`` would say of ``name`` if it held ``text``: each problem
+        with its line, column, message and hint (empty: none)."""
+        return self.checked(name, text)[0]
+
+    def checked(self, name: str, text: str) -> tuple[list[dict[str, Any]], TreeDefinition | None]:
+        """:meth:`check`'s problems, and the tree ``text`` makes (None: not a good tree)."""
+        path = self.path_of(name)
+        problems, tree = self.checks.check(path, text)
+        found = [_described(p, path, self.folder) for p in dict.fromkeys(problems)]
+        return found, tree if not found else None
+
+    def save(
+        self, name: str, text: str, version: str | None, *, over_problems: bool = False
+    ) -> Saved:
+        """Write ``text`` to ``name`` if the file is still at ``version`` (None: a new
+        file, which must not exist yet); EditRefused (409) when it changed meanwhile, or
+        when ``text`` has problems the file on disk has not and ``over_problems`` is
+        False."""
+        path = self.path_of(name)
+        on_disk: str | None
+        try:
+            on_disk, current = self.read(name)
+        except EditRefused as refused:
+            if refused.status != 404:
+                raise
+            on_disk, current = None, None
+        if current != version:
+            said = "exists already" if version is None else "changed on disk since it was opened"
+            raise EditRefused(409, f"{name}: {said}; open it again to see the change")
+        problems = self.check(name, text)
+        if problems and not over_problems:
+            was_valid = on_disk is None or not self.check(name, on_disk)
+            if was_valid:
+                raise EditRefused(
+                    409,
+                    f"{name}: the change has {len(problems)} problem"
+                    f"{'s' if len(problems) != 1 else ''}; saving would replace a file "
+                    "without any (save anyway to keep it unfinished)",
+                    problems,
+                )
+        data = text.encode("utf-8")
+        path.parent.mkdir(parents=True, exist_ok=True)
+        _write_whole(path, data)
+        return Saved(version_of(data), problems)
+
+
+def _write_whole(path: Path, data: bytes) -> None:
+    """``data`` into ``path`` at once: a temporary file beside it, then renamed over it."""
+    handle, temporary = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(handle, "wb") as file:
+            file.write(data)
+            file.flush()
+            os.fsync(file.fileno())
+        if path.exists():
+            os.chmod(temporary, path.stat().st_mode & 0o777)
+        os.replace(temporary, path)
+    except BaseException:
+        Path(temporary).unlink(missing_ok=True)
+        raise
+
+
+def _described(problem: Problem, path: Path, folder: Path) -> dict[str, Any]:
+    mark = problem.mark
+    here = resolved(Path(mark.file)) == resolved(path) or mark.file == str(path)
+    shown = mark.file
+    with contextlib.suppress(ValueError):
+        shown = resolved(Path(mark.file)).relative_to(folder).as_posix()
+    return {
+        "file": shown,
+        "here": here,
+        "line": mark.line,
+        "column": mark.column,
+        "message": problem.message,
+        "hint": problem.hint,
+        "text": str(problem),
+    }

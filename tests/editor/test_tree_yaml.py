@@ -1,0 +1,121 @@
+"""A tree file to the editor's outline and back: what was not changed stays as written."""
+
+from __future__ import annotations
+
+import copy
+from pathlib import Path
+
+import pytest
+
+from engine.editor.tree_yaml import OutlineError, TreeText
+from engine.nodes.registry import default_registry
+
+ROOT = Path(__file__).resolve().parents[2]
+REGISTRY = default_registry()
+TICKLES = """\
+# trees/tickles.yaml: a therapist's own file, with comments
+name: tickles
+rate_hz: 20
+wake_on: [/sensors/touch/pat]  # rest until a pat comes
+priority: 42                   # above touch_thanks (40)
+root:
+  Sequence:
+    - OnTouch: {pads: [left_shoulder, right_shoulder]}
+    - Cooldown:
+        seconds: 5
+        counting_from: start   # 5 s after the last answer began
+        child:
+          Sequence:
+            - Parallel:
+                - Say: {text: "That tickles!"}  # said with the arm going up
+                - MoveServo: {joint: left_arm, angle_deg: 45, speed_dps: 60}
+            - MoveServo: {joint: left_arm, angle_deg: 0, speed_dps: 60}
+"""
+
+
+def shipped_trees() -> list[Path]:
+    return sorted(p for p in (ROOT / "trees").rglob("*.yaml") if "root:" in p.read_text())
+
+
+@pytest.mark.parametrize("path", shipped_trees(), ids=lambda p: p.name)
+def test_opening_and_saving_unchanged_leaves_every_shipped_tree_byte_for_byte(path: Path) -> None:
+    text = path.read_text()
+    tree = TreeText(text, REGISTRY)
+    assert tree.written(tree.outline()) == text
+    touched = copy.deepcopy(tree.outline())
+    touched["settings"]["unknown"] = 1  # not a setting the editor changes: a rewrite all the same
+    assert tree.written(touched) == text
+
+
+def test_a_changed_number_keeps_every_comment_and_the_other_lines() -> None:
+    tree = TreeText(TICKLES, REGISTRY)
+    outline = tree.outline()
+    cooldown = outline["root"]["children"][1]
+    assert cooldown["type"] == "Cooldown" and cooldown["args"] == {
+        "seconds": 5,
+        "counting_from": "start",
+    }
+    cooldown["args"]["seconds"] = 8
+    written = tree.written(outline)
+    assert written == TICKLES.replace("seconds: 5\n", "seconds: 8\n")
+
+
+def test_a_node_added_moved_and_removed_changes_only_its_own_lines() -> None:
+    tree = TreeText(TICKLES, REGISTRY)
+    outline = tree.outline()
+    inner = outline["root"]["children"][1]["children"][0]["children"]
+    parallel = inner[0]["children"]
+    parallel.append({"type": "SetLed", "name": None, "args": {"color": "pink", "seconds": 2}})
+    parallel[0], parallel[1] = parallel[1], parallel[0]  # the arm first, then the words
+    written = tree.written(outline)
+    assert '- Say: {text: "That tickles!"}  # said with the arm going up' in written
+    assert written.index("MoveServo: {joint: left_arm, angle_deg: 45") < written.index("Say:")
+    assert "- SetLed: {color: pink, seconds: 2}\n" in written
+    assert written.startswith("# trees/tickles.yaml: a therapist's own file, with comments\n")
+
+    outline["root"]["children"][1]["children"][0]["children"].pop()  # the arm stays up
+    assert "angle_deg: 0" not in tree.written(outline)
+
+
+def test_a_named_node_and_a_new_list_read_as_a_person_writes_them() -> None:
+    tree = TreeText(TICKLES, REGISTRY)
+    outline = tree.outline()
+    outline["root"]["name"] = "a pat on a shoulder"
+    outline["root"]["children"][0]["args"]["pads"] = ["left_shoulder"]
+    written = tree.written(outline)
+    assert '  Sequence:\n    name: "a pat on a shoulder"\n    children:\n' in written
+    assert "- OnTouch: {pads: [left_shoulder]}\n" in written
+    again = TreeText(written, REGISTRY).outline()
+    assert again["root"]["name"] == "a pat on a shoulder"
+    assert again["root"]["children"][0]["args"] == {"pads": ["left_shoulder"]}
+
+
+def test_settings_change_in_place_and_one_taken_out_is_gone() -> None:
+    tree = TreeText(TICKLES, REGISTRY)
+    outline = tree.outline()
+    outline["settings"]["priority"] = 45
+    del outline["settings"]["wake_on"]
+    written = tree.written(outline)
+    assert "priority: 45                   # above touch_thanks (40)\n" in written
+    assert "wake_on" not in written
+
+
+@pytest.mark.parametrize(
+    "text, why",
+    [
+        ("root: [", "not YAML"),
+        ("name: x\nrate_hz: 3\n", "not a tree file"),
+        ("- 1\n", "not a tree"),
+    ],
+)
+def test_what_is_not_a_tree_file_is_said_in_words(text: str, why: str) -> None:
+    with pytest.raises(OutlineError, match=why):
+        TreeText(text, REGISTRY)
+
+
+def test_an_outline_without_types_is_refused_with_its_place() -> None:
+    tree = TreeText(TICKLES, REGISTRY)
+    outline = tree.outline()
+    outline["root"]["children"][0] = {"args": {}}
+    with pytest.raises(OutlineError, match="root/0: a node needs a type"):
+        tree.written(outline)
