@@ -323,7 +323,7 @@ function drawPalette(filter) {
   const wanted = filter.trim().toLowerCase();
   groups.replaceChildren(...Object.entries(palette.kinds).map(([kind, words]) => {
     const nodes = palette.nodes.filter((node) => node.kind === kind
-      && (!wanted || `${node.name} ${node.summary}`.toLowerCase().includes(wanted)));
+      && (!wanted || `${node.name} ${node.words ?? ""} ${node.summary}`.toLowerCase().includes(wanted)));
     if (!nodes.length) return "";
     return make("section", {}, make("h3", { textContent: words }), ...nodes.map((node) => {
       const button = make("button", { type: "button", className: "palette-node" },
