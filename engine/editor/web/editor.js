@@ -297,14 +297,26 @@ async function check() {
   }) : [make("li", { className: "fine", textContent: "none: vest validate accepts this tree" })]));
   document.body.dataset.problems = String(body.problems.length);
   if (body.svg) {
-    const parsed = new DOMParser().parseFromString(body.svg, "image/svg+xml").documentElement;
-    for (const element of parsed.querySelectorAll("script, foreignObject, a")) element.remove();
-    $("#drawing").replaceChildren(document.importNode(parsed, true));
+    $("#drawing").replaceChildren(cleanSvg(body.svg));
   } else if (body.problems.length) {
     $("#drawing").textContent = "(drawn once the problems are fixed)";
   }
   drawOutline();
   drawNodeProblems();
+}
+
+// A drawing is data, never code: scripts, links and event attributes are dropped.
+function cleanSvg(text) {
+  const svg = new DOMParser().parseFromString(text, "image/svg+xml").documentElement;
+  for (const element of svg.querySelectorAll("script, foreignObject")) element.remove();
+  for (const link of svg.querySelectorAll("a")) link.replaceWith(...link.childNodes);
+  for (const element of [svg, ...svg.querySelectorAll("*")]) {
+    for (const attribute of [...element.attributes]) {
+      const name = attribute.name.toLowerCase();
+      if (name.startsWith("on") || name.endsWith("href")) element.removeAttribute(attribute.name);
+    }
+  }
+  return document.importNode(svg, true);
 }
 
 // -- the toolbar ------------------------------------------------------------------------------
