@@ -2,6 +2,8 @@
 // a palette, checked by the server as you type (the checks of `vest validate`), saved as
 // YAML that keeps the file's comments and layout. Undo and redo keep whole outlines.
 
+import { cleanSvg } from "/shared/drawing.js";
+
 const token = new URLSearchParams(location.search).get("token");
 const api = (path, params = {}) => {
   const query = new URLSearchParams(params);
@@ -303,20 +305,6 @@ async function check() {
   }
   drawOutline();
   drawNodeProblems();
-}
-
-// A drawing is data, never code: scripts, links and event attributes are dropped.
-function cleanSvg(text) {
-  const svg = new DOMParser().parseFromString(text, "image/svg+xml").documentElement;
-  for (const element of svg.querySelectorAll("script, foreignObject")) element.remove();
-  for (const link of svg.querySelectorAll("a")) link.replaceWith(...link.childNodes);
-  for (const element of [svg, ...svg.querySelectorAll("*")]) {
-    for (const attribute of [...element.attributes]) {
-      const name = attribute.name.toLowerCase();
-      if (name.startsWith("on") || name.endsWith("href")) element.removeAttribute(attribute.name);
-    }
-  }
-  return document.importNode(svg, true);
 }
 
 // -- the toolbar ------------------------------------------------------------------------------

@@ -2,6 +2,7 @@
 // recording). One data model for both: the server's snapshot, then changes applied to it.
 
 import { follow } from "/shared/stream.js";
+import { cleanSvg } from "/shared/drawing.js";
 
 const token = new URLSearchParams(location.search).get("token");
 const api = (path, params = {}) => {
@@ -89,21 +90,6 @@ function shownStatuses(tree) {
 }
 
 // -- drawing ------------------------------------------------------------------------------
-// A drawing is data, never code: links, scripts and event attributes are dropped.
-function cleanSvg(text) {
-  const parsed = new DOMParser().parseFromString(text, "image/svg+xml");
-  const svg = parsed.documentElement;
-  for (const element of svg.querySelectorAll("script, foreignObject")) element.remove();
-  for (const link of svg.querySelectorAll("a")) link.replaceWith(...link.childNodes);
-  for (const element of [svg, ...svg.querySelectorAll("*")]) {
-    for (const attribute of [...element.attributes]) {
-      const name = attribute.name.toLowerCase();
-      if (name.startsWith("on") || name.endsWith("href")) element.removeAttribute(attribute.name);
-    }
-  }
-  return document.importNode(svg, true);
-}
-
 async function drawTrees() {
   const container = $("#trees");
   const wanted = [...state.trees.values()];
