@@ -135,7 +135,7 @@ class TreeText:
             raise OutlineError(f"{where}: args is a mapping and children a list")
         if node.get("name"):
             args = {"name": str(node["name"]), **args}
-        raw = originals.get(str(node.get("id")))
+        raw = originals.pop(str(node.get("id")), None)  # once: a second use is a new node
         same = raw is not None and next(iter(raw)) == type_name
         mapping = raw if same and raw is not None else CommentedMap()
         body = mapping.get(type_name) if same else None

@@ -119,3 +119,13 @@ def test_an_outline_without_types_is_refused_with_its_place() -> None:
     outline["root"]["children"][0] = {"args": {}}
     with pytest.raises(OutlineError, match="root/0: a node needs a type"):
         tree.written(outline)
+
+
+def test_a_node_given_twice_is_written_twice_not_as_a_yaml_alias() -> None:
+    tree = TreeText(TICKLES, REGISTRY)
+    outline = tree.outline()
+    touch = outline["root"]["children"][0]
+    outline["root"]["children"].append(copy.deepcopy(touch))  # the same id twice
+    written = tree.written(outline)
+    assert "&" not in written and "*" not in written
+    assert written.count("- OnTouch: {pads: [left_shoulder, right_shoulder]}") == 2
