@@ -1,10 +1,17 @@
-"""The checks `vest edit` shows as a therapist types: those of `vest validate`, run on the
-text being edited in its file's place among the folder's others (its subtrees, its
-dialogs, the robot's pads and joints), without writing it anywhere."""
+"""What `vest edit` runs for the page: the checks a therapist sees as they type (those of
+`vest validate`, on the text being edited in its file's place among the folder's others:
+its subtrees, its dialogs, the robot's pads and joints; nothing written) and a try of the
+tree on the simulated vest with one event (a pat, a squeeze, words said, a wave)."""
 
 from __future__ import annotations
 
+import shutil
+import subprocess
+import sys
+import tempfile
 from pathlib import Path
+
+import yaml
 
 from engine.cli.run_inputs import robot_catalogue
 from engine.cli.validate_command import Validator, kind_of
@@ -56,3 +63,88 @@ class ValidateChecks:
             catalogue = robot_catalogue(self.config, self.registry)
             problems.extend(variable_problems(validator.trees, catalogue))
         return problems.items, validator.trees[0] if validator.trees else None
+
+
+TRY_AT_S = 1.0
+TRY_FOR_S = 8.0
+"""A try: the event at 1 s, the tree watched until 8 s (a cooldown's rest, a slow arm)."""
+TRY_TIMEOUT_S = 60.0
+MAX_SAID = 200
+VEST = "import sys; from engine.cli import main; sys.exit(main())"
+
+
+class TryError(ValueError):
+    """A try the page asked for that cannot be made, in words."""
+
+
+def tried_event(asked: object, pads: list[str]) -> dict[str, object]:
+    """The scenario event the page asked for: ``{"kind": "pat", "pad": ...}``,
+    ``{"kind": "squeeze"}``, ``{"kind": "say", "text": ...}`` or ``{"kind": "wave"}``."""
+    if not isinstance(asked, dict):
+        raise TryError("event: a pat, a squeeze, a phrase said or a wave")
+    kind = asked.get("kind")
+    if kind == "pat":
+        pad = asked.get("pad")
+        if pad not in pads:
+            raise TryError(f"no pad {pad!r} on this robot (pads: {', '.join(pads)})")
+        return {"at": TRY_AT_S, "touch": {"pad": pad, "seconds": 0.3}}
+    if kind == "squeeze":
+        return {"at": TRY_AT_S, "squeeze": {"left_n": 6.0, "right_n": 6.0, "seconds": 2.0}}
+    if kind == "say":
+        said = asked.get("text")
+        if not isinstance(said, str) or not said.strip() or len(said) > MAX_SAID:
+            raise TryError(f"say: the words a person says, 1 to {MAX_SAID} characters")
+        return {"at": TRY_AT_S, "hear": {"text": said.strip()}}
+    if kind == "wave":
+        return {"at": TRY_AT_S, "gesture": "wave"}
+    raise TryError("event: a pat, a squeeze, a phrase said or a wave")
+
+
+class TryOnSimulatedVest:
+    """Runs a tree being edited on the simulated vest, on a virtual clock, with one event:
+    ``vest run --fast --speech text`` in a process of its own (a tree that hangs or fails
+    cannot take the editor with it), on a copy of the folder's trees (its subtrees), the
+    folder's dialogs and ``hardware``. Its timeline, in sentences, is the answer."""
+
+    def __init__(self, folder: Path, hardware: Path | None, pads: list[str]) -> None:
+        self.folder, self.hardware, self.pads = folder, hardware, pads
+
+    def __call__(self, name: str, text: str, asked: object) -> list[str]:
+        """The timeline of ``text`` (the file ``name``) tried with the event ``asked``;
+        TryError (a ValueError) for an event that cannot be or a run that failed."""
+        event = tried_event(asked, self.pads)
+        with tempfile.TemporaryDirectory(prefix="vest-try-") as scratch:
+            copy = Path(scratch) / "folder"
+            trees = self.folder / "trees"
+            if trees.is_dir():
+                shutil.copytree(trees, copy / "trees", symlinks=False)
+            tried = copy / name
+            tried.parent.mkdir(parents=True, exist_ok=True)
+            tried.write_text(text, encoding="utf-8")
+            scenario = Path(scratch) / "try.yaml"
+            scenario.write_text(
+                yaml.safe_dump({"duration_s": TRY_FOR_S, "events": [event]}), encoding="utf-8"
+            )
+            command = [sys.executable, "-c", VEST, "run", "--fast", "--speech", "text"]
+            command += ["--trees", str(tried), "--scenario", str(scenario)]
+            if (self.folder / "dialogs").is_dir():
+                command += ["--dialogs", str(self.folder / "dialogs")]
+            if self.hardware is not None:
+                command += ["--hardware", str(self.hardware)]
+            try:
+                done = subprocess.run(
+                    command, capture_output=True, text=True, timeout=TRY_TIMEOUT_S, check=False
+                )
+            except subprocess.TimeoutExpired:
+                raise TryError(f"the try ran over {TRY_TIMEOUT_S:g} s and was stopped") from None
+        if done.returncode != 0:
+            said = done.stderr.strip().splitlines()
+            raise TryError(said[-1] if said else f"vest run ended with {done.returncode}")
+        timeline = done.stdout.split("\n\n", 1)[0].splitlines()[1:]  # after its heading
+        return [_sentence(line) for line in timeline if line.strip()]
+
+
+def _sentence(line: str) -> str:
+    """``"    1.00  tickles   says ..."`` as ``"1.00 s tickles: says ..."``."""
+    at, who, what = [*line.split(None, 2), "", ""][:3]
+    return f"{at} s {who}: {what}"

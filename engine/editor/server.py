@@ -9,7 +9,10 @@ stack (:mod:`engine.web`), in a thread of its own.
   problems (each with the node it belongs to) and, when there are none, the drawing;
 - ``POST /api/save`` ``{"file", "outline", "version", "over_problems"}`` writes it (409
   when the file changed on disk since ``version``, or when the change has problems the
-  file has not and ``over_problems`` is false; ``version`` null for a new file).
+  file has not and ``over_problems`` is false; ``version`` null for a new file);
+- ``POST /api/try`` ``{"file", "outline", "version", "event"}`` runs the tree as it is on
+  the page on the simulated vest with one event and answers its timeline (400 with why
+  when the event or the run cannot be).
 
 Bodies are JSON from the page's own origin; on loopback (the default) no token is asked, on
 any other address every request carries the token ``vest edit`` prints.
@@ -18,11 +21,13 @@ any other address every request carries the token ``vest edit`` prints.
 from __future__ import annotations
 
 import json
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 from urllib.parse import urlparse
 
 from starlette.applications import Starlette
+from starlette.concurrency import run_in_threadpool
 from starlette.middleware import Middleware
 from starlette.requests import Request
 from starlette.responses import FileResponse, JSONResponse, Response
@@ -41,6 +46,11 @@ STATIC = {"/": "editor.html", "/editor.js": "editor.js", "/editor.css": "editor.
 READ_TIMEOUT_S = 5.0
 
 
+TryOut = Callable[[str, str, object], list[str]]
+"""Runs a tree's text (its file's name) with an event the page asked for: the timeline's
+lines; a ValueError saying why not."""
+
+
 class EditorServer:
     """Serves ``workspace`` with ``palette`` on ``host``:``port`` (0: any free port); a
     ConfigError when it cannot listen there or would listen beyond loopback without a
@@ -54,8 +64,10 @@ class EditorServer:
         host: str = "127.0.0.1",
         port: int = 8766,
         token: str | None = None,
+        try_out: TryOut | None = None,
     ) -> None:
         check_listening(host, token, "the editor")
+        self.try_out = try_out
         self.workspace, self.palette, self.host, self.token = workspace, palette, host, token
         try:
             sock = listening_socket(host, port, named=f"the editor on {host}:{port}")
@@ -85,6 +97,8 @@ class EditorServer:
             Route("/api/check", self._check, methods=["POST"]),
             Route("/api/save", self._save, methods=["POST"]),
         ]
+        if self.try_out is not None:
+            routes.append(Route("/api/try", self._try, methods=["POST"]))
         return Starlette(
             routes=routes,
             middleware=[
@@ -146,6 +160,18 @@ class EditorServer:
         except EditRefused as refused:
             return _refused(refused, text)
         return JSONResponse({"version": saved.version, "problems": saved.problems})
+
+    async def _try(self, request: Request) -> Response:
+        assert self.try_out is not None
+        try:
+            name, text, body = await self._asked(request)
+        except EditRefused as refused:
+            return _refused(refused)
+        try:
+            timeline = await run_in_threadpool(self.try_out, name, text, body.get("event"))
+        except ValueError as why:
+            return JSONResponse({"message": str(why), "problems": []}, status_code=400)
+        return JSONResponse({"timeline": timeline})
 
     async def _asked(self, request: Request) -> tuple[str, str, dict[str, Any]]:
         """The file named and the text the body's outline makes of it; EditRefused (400,

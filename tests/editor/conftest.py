@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from engine.cli.edit_checks import ValidateChecks
+from engine.cli.edit_checks import TryOnSimulatedVest, ValidateChecks
 from engine.cli.run_inputs import DEFAULT_HARDWARE, load_config, robot_catalogue
 from engine.editor.palette import palette
 from engine.editor.server import EditorServer
@@ -44,7 +44,8 @@ def editor(workspace: Workspace) -> Iterator[str]:
     """The editor on ``project``, on loopback: its address."""
     registry = workspace.registry
     offered = palette(registry, CONFIG, robot_catalogue(CONFIG, registry))
-    server = EditorServer(workspace, offered, port=0)
+    try_out = TryOnSimulatedVest(workspace.folder, ROOT / DEFAULT_HARDWARE, offered["pads"])
+    server = EditorServer(workspace, offered, port=0, try_out=try_out)
     server.start()
     try:
         yield server.url

@@ -1,6 +1,6 @@
 """The therapist guide's "That tickles!" behaviour, built in the editor as its section says,
-click by click, without a line of YAML: the file saved is the tree the guide writes by
-hand, and `vest validate` accepts it."""
+click by click, without a line of YAML, and tried on the simulated vest with a pat: the
+file saved is the tree the guide writes by hand, and `vest validate` accepts it."""
 
 from __future__ import annotations
 
@@ -78,6 +78,10 @@ def test_a_therapist_builds_that_tickles_in_the_editor_as_the_guide_says(
     fill(page, "speed_dps", "60")
 
     expect(page.locator("#problems")).to_contain_text("vest validate accepts this tree")
+    page.get_by_label("Pad").select_option("left_shoulder")  # tried before it is saved
+    page.get_by_role("button", name="Try it").click()
+    expect(page.locator("#tried")).to_contain_text("left_shoulder touched", timeout=60_000)
+    expect(page.locator("#tried")).to_contain_text('1.00 s tickles: says "That tickles!"')
     page.get_by_role("button", name="Save").click()
     expect(page.locator("#message")).to_have_text("saved trees/tickles.yaml")
 

@@ -385,6 +385,27 @@ async function save(overProblems = false) {
   say(body.message ?? `not saved (${status})`, "bad");
 }
 
+// -- a try on the simulated vest -------------------------------------------------------------
+function tryKindChanged() {
+  const kind = $("#try-kind").value;
+  $("#try-pad-field").hidden = kind !== "pat";
+  $("#try-text-field").hidden = kind !== "say";
+}
+
+async function tryIt(event) {
+  event.preventDefault();
+  const kind = $("#try-kind").value;
+  const asked = { kind, pad: $("#try-pad").value, text: $("#try-text").value };
+  $("#tried").replaceChildren(make("li", { textContent: "trying on the simulated vest..." }));
+  const { status, body } = await postJson("/api/try", { file: file.name, outline: file.outline, version: file.version, event: asked });
+  if (status !== 200) {
+    $("#tried").replaceChildren(make("li", { className: "problem", textContent: body.message ?? `the try failed (${status})` }));
+    return;
+  }
+  const lines = body.timeline.length ? body.timeline : ["nothing happened in 8 seconds"];
+  $("#tried").replaceChildren(...lines.map((line) => make("li", { textContent: line })));
+}
+
 // -- files --------------------------------------------------------------------------------------
 async function listFiles() {
   const files = await getJson("/api/files");
@@ -454,6 +475,9 @@ async function main() {
   $("#delete").addEventListener("click", remove);
   $("#save").addEventListener("click", () => save().catch(unreachable));
   $("#palette-filter").addEventListener("input", (event) => drawPalette(event.target.value));
+  $("#try-pad").replaceChildren(...palette.pads.map((pad) => make("option", { value: pad, textContent: pad })));
+  $("#try-kind").addEventListener("change", tryKindChanged);
+  $("#try").addEventListener("submit", (event) => tryIt(event).catch(unreachable));
   document.addEventListener("keydown", (event) => {
     if (!file || !(event.ctrlKey || event.metaKey)) return;
     const key = event.key.toLowerCase();
