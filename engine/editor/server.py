@@ -33,7 +33,8 @@ from starlette.requests import Request
 from starlette.responses import FileResponse, JSONResponse, Response
 from starlette.routing import BaseRoute, Route
 
-from engine.editor.tree_yaml import OutlineError, TreeText
+from engine.editor.round_trip import OutlineError
+from engine.editor.tree_yaml import TreeText
 from engine.editor.workspace import MAX_FILE_BYTES, EditRefused, Workspace
 from engine.errors import ConfigError
 from engine.loader.tree_drawing import dot_source, svg_of, without_title_and_legend

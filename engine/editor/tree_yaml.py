@@ -13,16 +13,12 @@ outline that changes nothing gives back the file's own text, byte for byte.
 
 from __future__ import annotations
 
-import io
-import re
 from collections.abc import Iterator
 from typing import Any
 
-from ruamel.yaml import YAML
 from ruamel.yaml.comments import CommentedMap, CommentedSeq
-from ruamel.yaml.error import YAMLError
-from ruamel.yaml.scalarstring import DoubleQuotedScalarString
 
+from engine.editor.round_trip import OutlineError, dumped, plain, read, refilled, update
 from engine.nodes.registry import NodeRegistry
 
 SETTINGS = ("name", "description", "rate_hz", "priority", "wake_on")
@@ -30,32 +26,6 @@ SETTINGS = ("name", "description", "rate_hz", "priority", "wake_on")
 SUBTREE = "Subtree"
 STRUCTURE = ("child", "children")
 """A node's keys that hold its children, not its parameters."""
-STYLES = ((2, 4, 2), (2, 2, 2), (2, 2, 0), (4, 4, 2))
-"""Indentation styles (mapping, sequence, dash offset) a file is tried against; the first
-that reads and writes its text unchanged is the file's (vest's own files use the first)."""
-
-
-PLAIN_WORD = re.compile(r"[A-Za-z_/#][A-Za-z0-9_./#-]*")
-"""Text written without quotes: a word, a blackboard key, a colour (#FF5A8C)."""
-
-
-class OutlineError(ValueError):
-    """An outline or a file the editor cannot take, in words."""
-
-
-def _yaml(style: tuple[int, int, int] = STYLES[0]) -> YAML:
-    yaml = YAML()  # round-trip: comments, order, flow style and quotes are kept
-    yaml.preserve_quotes = True
-    yaml.width = 4096  # a line the person wrote is never wrapped anew
-    mapping, sequence, offset = style
-    yaml.indent(mapping=mapping, sequence=sequence, offset=offset)
-    return yaml
-
-
-def _dumped(document: Any, style: tuple[int, int, int]) -> str:
-    out = io.StringIO()
-    _yaml(style).dump(document, out)
-    return out.getvalue()
 
 
 class TreeText:
@@ -64,21 +34,14 @@ class TreeText:
     def __init__(self, text: str, registry: NodeRegistry) -> None:
         self.text = text
         self.registry = registry
-        try:
-            self.document = _yaml().load(text)
-        except YAMLError as error:
-            raise OutlineError(f"not YAML the editor can read: {error}") from None
+        self.document, self.style = read(text)
         if not isinstance(self.document, CommentedMap) or "root" not in self.document:
             raise OutlineError("not a tree file (a tree has 'root:')")
-        self.style = next(
-            (style for style in STYLES if _dumped(_yaml(style).load(text), style) == text),
-            STYLES[0],
-        )
 
     # -- the file to the outline ---------------------------------------------------------
     def outline(self) -> dict[str, Any]:
         """The settings and the root, as the page edits them."""
-        settings = {key: _plain(self.document[key]) for key in SETTINGS if key in self.document}
+        settings = {key: plain(self.document[key]) for key in SETTINGS if key in self.document}
         return {"settings": settings, "root": self._node(self.document["root"], "root")}
 
     def _node(self, raw: Any, ident: str) -> dict[str, Any]:
@@ -99,7 +62,7 @@ class TreeText:
                 elif key == "children" and isinstance(value, CommentedSeq):
                     children = [self._node(item, f"{ident}/{i}") for i, item in enumerate(value)]
                 else:
-                    args[str(key)] = _plain(value)
+                    args[str(key)] = plain(value)
         return {"id": ident, "type": str(type_name), "name": name, "args": args,
                 "children": children}  # fmt: skip
 
@@ -115,15 +78,15 @@ class TreeText:
         """The file's text with ``outline``'s changes made; its own text when none."""
         if outline == self.outline():
             return self.text
-        document = _yaml(self.style).load(self.text)  # a fresh copy: this one stays as read
+        document = read(self.text)[0]  # a fresh copy: this one stays as read
         originals = dict(_originals(document["root"], "root"))
         settings = outline.get("settings", {})
         if not isinstance(settings, dict):
             raise OutlineError("settings must be a mapping")
         others = tuple(str(key) for key in document if key not in SETTINGS)
-        _update(document, {k: v for k, v in settings.items() if k in SETTINGS}, others)
+        update(document, {k: v for k, v in settings.items() if k in SETTINGS}, others)
         document["root"] = self._built(outline.get("root"), originals, "root")
-        return _dumped(document, self.style)
+        return dumped(document, self.style)
 
     def _built(self, node: Any, originals: dict[str, CommentedMap], where: str) -> CommentedMap:
         if not isinstance(node, dict) or not isinstance(node.get("type"), str):
@@ -142,15 +105,15 @@ class TreeText:
         built = [self._built(child, originals, f"{where}/{i}") for i, child in enumerate(children)]
         many = self._children_of(type_name)
         if many == "many" and len(args) == 0 and not isinstance(body, CommentedMap):
-            mapping[type_name] = _refilled(body, built)
+            mapping[type_name] = refilled(body, built)
         elif many == "many":
             body = body if isinstance(body, CommentedMap) else CommentedMap()
-            _update(body, args, STRUCTURE)
-            body["children"] = _refilled(body.get("children"), built)
+            update(body, args, STRUCTURE)
+            body["children"] = refilled(body.get("children"), built)
             mapping[type_name] = body
         else:
             body = body if isinstance(body, CommentedMap) else _new_body(many, args)
-            _update(body, args, STRUCTURE)
+            update(body, args, STRUCTURE)
             if many == "one":
                 if built:
                     body["child"] = built[0]
@@ -187,53 +150,3 @@ def _new_body(children: str, args: dict[str, Any]) -> CommentedMap:
     if children == "none" and all(not isinstance(v, dict) for v in args.values()):
         body.fa.set_flow_style()
     return body
-
-
-def _refilled(sequence: Any, items: list[CommentedMap]) -> CommentedSeq:
-    """``sequence`` (its comments kept) holding ``items`` now."""
-    kept = sequence if isinstance(sequence, CommentedSeq) else CommentedSeq()
-    if list(kept) != items:
-        kept[:] = items
-    return kept
-
-
-def _update(mapping: CommentedMap, values: dict[str, Any], kept: tuple[str, ...]) -> None:
-    """``mapping`` holding ``values``: changed values set, others removed (but the keys in
-    ``kept``, which the caller handles), unchanged ones left as written (their quotes and
-    comments)."""
-    for key in list(mapping.keys()):
-        if key not in values and key not in kept:
-            del mapping[key]
-    for key, value in values.items():
-        if key in mapping and _plain(mapping[key]) == value:
-            continue
-        mapping[key] = _yaml_value(value)
-
-
-def _yaml_value(value: Any) -> Any:
-    """A new value as YAML holds it; text other than one plain word (a pad, a key, a
-    colour) in double quotes, as the therapist guide writes spoken text."""
-    if isinstance(value, str) and not PLAIN_WORD.fullmatch(value):
-        return DoubleQuotedScalarString(value)
-    if isinstance(value, list):
-        items = CommentedSeq(_yaml_value(item) for item in value)
-        items.fa.set_flow_style()
-        return items
-    if isinstance(value, dict):
-        return CommentedMap((str(k), _yaml_value(v)) for k, v in value.items())
-    return value
-
-
-def _plain(value: Any) -> Any:
-    """A round-trip value as plain JSON (its quotes and styles dropped)."""
-    if isinstance(value, dict):
-        return {str(key): _plain(item) for key, item in value.items()}
-    if isinstance(value, list):
-        return [_plain(item) for item in value]
-    if isinstance(value, bool) or value is None:
-        return value
-    if isinstance(value, int):
-        return int(value)
-    if isinstance(value, float):
-        return float(value)
-    return str(value)

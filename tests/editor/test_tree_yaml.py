@@ -7,7 +7,8 @@ from pathlib import Path
 
 import pytest
 
-from engine.editor.tree_yaml import OutlineError, TreeText
+from engine.editor.round_trip import OutlineError
+from engine.editor.tree_yaml import TreeText
 from engine.nodes.registry import default_registry
 
 ROOT = Path(__file__).resolve().parents[2]
