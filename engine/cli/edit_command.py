@@ -15,7 +15,7 @@ import argparse
 import secrets
 from pathlib import Path
 
-from engine.cli.edit_checks import TryOnSimulatedVest, ValidateChecks
+from engine.cli.edit_checks import HearCheck, TryOnSimulatedVest, ValidateChecks
 from engine.cli.output import tell
 from engine.cli.run_inputs import DEFAULT_HARDWARE, found, load_config, robot_catalogue
 from engine.cli.view_options import port_number
@@ -80,7 +80,13 @@ def main(args: argparse.Namespace) -> int:
     offered = palette(registry, config, robot_catalogue(config, registry))
     try_out = TryOnSimulatedVest(folder.resolve(), hardware if config else None, offered["pads"])
     server = EditorServer(
-        workspace, offered, host=args.host, port=args.port, token=token, try_out=try_out
+        workspace,
+        offered,
+        host=args.host,
+        port=args.port,
+        token=token,
+        try_out=try_out,
+        hear_check=HearCheck(),
     )
     server.start()
     tell(f"editor: {server.url}  (the folder {workspace.folder}; Ctrl-C ends it)")

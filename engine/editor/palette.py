@@ -10,6 +10,7 @@ from engine.blackboard.catalogue import KeyCatalogue
 from engine.colors import NAMED_COLORS
 from engine.hardware.config import RobotConfig
 from engine.loader.tree_drawing import PLAIN_WORDS
+from engine.loader.tree_settings import SETTINGS as TREE_SETTINGS
 from engine.nodes.registry import NodeRegistry
 from engine.values.params import (
     REQUIRED,
@@ -43,8 +44,8 @@ def palette(
         {
             "name": node.name,
             "kind": node.kind,
-            "summary": node.doc.strip().splitlines()[0] if node.doc.strip() else "",
-            "doc": node.doc.strip(),
+            "summary": _plain_doc(node.doc).split("\n", 1)[0],
+            "doc": _plain_doc(node.doc),
             "children": node.children,
             "source": node.source,
             "words": PLAIN_WORDS.get(node.name),
@@ -69,6 +70,7 @@ def palette(
     devices = config.devices.values() if config is not None else []
     return {
         "kinds": KINDS_IN_WORDS,
+        "settings": [field_of(setting) for setting in TREE_SETTINGS],
         "nodes": nodes,
         "pads": [name for device in devices for name in device.pad_names],
         "joints": [joint.name for device in devices for joint in device.joints],
@@ -81,7 +83,7 @@ def field_of(param: Param[Any]) -> dict[str, Any]:
     """One parameter as a form field."""
     field: dict[str, Any] = {
         "name": param.name,
-        "doc": param.doc,
+        "doc": _plain_doc(param.doc),
         "required": param.default is REQUIRED,
         **_type_of(param.type),
     }
@@ -115,3 +117,8 @@ def _type_of(kind: ParamType[Any]) -> dict[str, Any]:
     if isinstance(kind, Text | Template):
         return {"kind": "text", "describe": kind.describe()}
     return {"kind": "any", "describe": kind.describe()}  # a number, a word or a list
+
+
+def _plain_doc(doc: str) -> str:
+    """A docstring as a person reads it: without reStructuredText's ``double quotes``."""
+    return doc.strip().replace("``", "")

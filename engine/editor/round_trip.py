@@ -8,11 +8,15 @@ import io
 import re
 from typing import Any
 
+import yaml
 from ruamel.yaml import YAML
 from ruamel.yaml.comments import CommentedMap, CommentedSeq
 from ruamel.yaml.error import YAMLError
-from ruamel.yaml.scalarstring import DoubleQuotedScalarString
+from ruamel.yaml.scalarstring import DoubleQuotedScalarString, SingleQuotedScalarString
 
+from engine.files.yaml_source import MAX_DEPTH
+
+_FAST = hasattr(yaml, "CSafeLoader")
 Style = tuple[int, int, int]
 STYLES: tuple[Style, ...] = ((2, 4, 2), (2, 2, 2), (2, 2, 0), (4, 4, 2))
 """Indentation styles (mapping, sequence, dash offset) a file is tried against; the first
@@ -26,17 +30,23 @@ class OutlineError(ValueError):
 
 
 def _yaml(style: Style = STYLES[0]) -> YAML:
-    yaml = YAML()  # round-trip: comments, order, flow style and quotes are kept
-    yaml.preserve_quotes = True
-    yaml.width = 4096  # a line the person wrote is never wrapped anew
+    loader = YAML()  # round-trip: comments, order, flow style and quotes are kept
+    loader.preserve_quotes = True
+    loader.width = 4096  # a line the person wrote is never wrapped anew
     mapping, sequence, offset = style
-    yaml.indent(mapping=mapping, sequence=sequence, offset=offset)
-    return yaml
+    loader.indent(mapping=mapping, sequence=sequence, offset=offset)
+    return loader
 
 
 def read(text: str) -> tuple[Any, Style]:
     """``text`` as a round-trip document, and the indentation style it is written in;
-    OutlineError when it is not YAML."""
+    OutlineError when it is not YAML, or YAML the editor leaves to hand editing: anchors
+    and aliases (``&x`` / ``*x``: one node in two places; an edit of one would change the
+    other, and a few lines of them can stand for billions of nodes) or nesting deeper
+    than vest's own files may be. Windows line ends are read as plain ones (written back
+    with :func:`newline_of`'s)."""
+    text = text.replace("\r\n", "\n")
+    _plain_enough(text)
     try:
         document = _yaml().load(text)
     except YAMLError as error:
@@ -48,10 +58,36 @@ def read(text: str) -> tuple[Any, Style]:
     return document, style
 
 
-def dumped(document: Any, style: Style) -> str:
+def _plain_enough(text: str) -> None:
+    depth = 0
+    try:
+        for event in yaml.parse(text, Loader=yaml.CSafeLoader if _FAST else yaml.SafeLoader):
+            if isinstance(event, yaml.AliasEvent) or getattr(event, "anchor", None):
+                raise OutlineError(
+                    "the file uses YAML anchors (&name, *name): edit it by hand, or write "
+                    "each node out where it is used"
+                )
+            if isinstance(event, yaml.CollectionStartEvent):
+                depth += 1
+                if depth > MAX_DEPTH:
+                    raise OutlineError(f"nested more than {MAX_DEPTH} deep: edit it by hand")
+            elif isinstance(event, yaml.CollectionEndEvent):
+                depth -= 1
+    except yaml.YAMLError as error:
+        raise OutlineError(f"not YAML the editor can read: {error}") from None
+
+
+def dumped(document: Any, style: Style, newline: str = "\n") -> str:
+    """``document`` as text in ``style``, its lines ending in ``newline`` (the file's)."""
     out = io.StringIO()
     _yaml(style).dump(document, out)
-    return out.getvalue()
+    return out.getvalue().replace("\n", newline)
+
+
+def newline_of(text: str) -> str:
+    """How the file's lines end: Windows' ``\r\n`` when its first line does."""
+    first = text.find("\n")
+    return "\r\n" if first > 0 and text[first - 1] == "\r" else "\n"
 
 
 def refilled(sequence: Any, items: list[Any]) -> CommentedSeq:
@@ -79,6 +115,8 @@ def yaml_value(value: Any) -> Any:
     """A new value as YAML holds it; text other than one plain word (a pad, a key, a
     colour) in double quotes, as the therapist guide writes spoken text."""
     if isinstance(value, str) and not PLAIN_WORD.fullmatch(value):
+        if '"' in value and "'" not in value:  # 'A "quoted" word', never \"
+            return SingleQuotedScalarString(value)
         return DoubleQuotedScalarString(value)
     if isinstance(value, list):
         items = CommentedSeq(yaml_value(item) for item in value)

@@ -33,7 +33,8 @@ from starlette.requests import Request
 from starlette.responses import FileResponse, JSONResponse, Response
 from starlette.routing import BaseRoute, Route
 
-from engine.editor.round_trip import OutlineError
+from engine.editor.dialog_yaml import DialogText
+from engine.editor.round_trip import PLAIN_WORD, OutlineError
 from engine.editor.tree_yaml import TreeText
 from engine.editor.workspace import MAX_FILE_BYTES, EditRefused, Workspace
 from engine.errors import ConfigError
@@ -50,6 +51,9 @@ READ_TIMEOUT_S = 5.0
 TryOut = Callable[[str, str, object], list[str]]
 """Runs a tree's text (its file's name) with an event the page asked for: the timeline's
 lines; a ValueError saying why not."""
+HearCheck = Callable[[str, str], list[str]]
+"""Says a dialog's phrases as the robot would hear them (its text, its file's name): the
+check's lines; a ValueError saying why not."""
 
 
 class EditorServer:
@@ -66,9 +70,10 @@ class EditorServer:
         port: int = 8766,
         token: str | None = None,
         try_out: TryOut | None = None,
+        hear_check: HearCheck | None = None,
     ) -> None:
         check_listening(host, token, "the editor")
-        self.try_out = try_out
+        self.try_out, self.hear_check = try_out, hear_check
         self.workspace, self.palette, self.host, self.token = workspace, palette, host, token
         try:
             sock = listening_socket(host, port, named=f"the editor on {host}:{port}")
@@ -100,6 +105,8 @@ class EditorServer:
         ]
         if self.try_out is not None:
             routes.append(Route("/api/try", self._try, methods=["POST"]))
+        if self.hear_check is not None:
+            routes.append(Route("/api/hear", self._hear, methods=["POST"]))
         return Starlette(
             routes=routes,
             middleware=[
@@ -126,61 +133,85 @@ class EditorServer:
         except EditRefused as refused:
             return _refused(refused)
         answer: dict[str, Any] = {"file": name, "text": text, "version": version, "outline": None}
+        answer["kind"] = "tree"
         try:
             answer["outline"] = TreeText(text, self.workspace.registry).outline()
         except OutlineError as error:
-            answer["why_not"] = str(error)  # a profile, a dialog: shown as text
+            answer["kind"], answer["why_not"] = "dialog", str(error)
+        if answer["outline"] is None:
+            try:
+                answer["outline"] = DialogText(text).outline()
+            except OutlineError:
+                answer["kind"] = "other"  # a profile, buttons: shown as text
         return JSONResponse(answer)
 
     async def _check(self, request: Request) -> Response:
-        try:
-            name, text, _ = await self._asked(request)
-            problems, tree = self.workspace.checked(name, text)
-        except EditRefused as refused:
-            return _refused(refused)
-        return JSONResponse(
-            {
-                "text": text,
-                "problems": _with_nodes(problems, text, self.workspace),
-                "svg": _drawing(tree),
-            }
-        )
+        return await self._answer(request, self._checked)
 
     async def _save(self, request: Request) -> Response:
-        try:
-            name, text, body = await self._asked(request)
-        except EditRefused as refused:
-            return _refused(refused)
-        try:
-            version = body.get("version")
-            if version is not None and not isinstance(version, str):
-                raise EditRefused(400, "version is the text the file's reading gave, or null")
-            saved = self.workspace.save(
-                name, text, version, over_problems=body.get("over_problems") is True
-            )
-        except EditRefused as refused:
-            return _refused(refused, text)
-        return JSONResponse({"version": saved.version, "problems": saved.problems})
+        return await self._answer(request, self._saved)
 
     async def _try(self, request: Request) -> Response:
-        assert self.try_out is not None
+        return await self._answer(request, self._tried)
+
+    async def _hear(self, request: Request) -> Response:
+        return await self._answer(request, self._heard)
+
+    async def _answer(
+        self, request: Request, work: Callable[[dict[str, Any]], dict[str, Any]]
+    ) -> Response:
+        """The page's JSON body, worked on in a thread of the pool (a long check or try
+        never holds up the server's other requests); a refusal in words."""
         try:
-            name, text, body = await self._asked(request)
+            body = await self._body(request)
+            return JSONResponse(await run_in_threadpool(work, body))
         except EditRefused as refused:
             return _refused(refused)
-        try:
-            timeline = await run_in_threadpool(self.try_out, name, text, body.get("event"))
-        except ValueError as why:
-            return JSONResponse({"message": str(why), "problems": []}, status_code=400)
-        return JSONResponse({"timeline": timeline})
 
-    async def _asked(self, request: Request) -> tuple[str, str, dict[str, Any]]:
-        """The file named and the text the body's outline makes of it; EditRefused (400,
-        403) for a body that is not the page's."""
+    # -- the work (in the pool's threads) -------------------------------------------------
+    def _checked(self, body: dict[str, Any]) -> dict[str, Any]:
+        name, text = self._text_of(body)
+        problems, tree = self.workspace.checked(name, text)
+        return {
+            "text": text,
+            "problems": _with_nodes(problems, text, self.workspace),
+            "svg": _drawing(tree),
+        }
+
+    def _saved(self, body: dict[str, Any]) -> dict[str, Any]:
+        name, text = self._text_of(body)
+        version = body.get("version")
+        if version is not None and not isinstance(version, str):
+            raise EditRefused(400, "version is the text the file's reading gave, or null")
+        saved = self.workspace.save(
+            name, text, version, over_problems=body.get("over_problems") is True
+        )
+        return {"version": saved.version, "problems": saved.problems}
+
+    def _tried(self, body: dict[str, Any]) -> dict[str, Any]:
+        assert self.try_out is not None
+        name, text = self._text_of(body)
+        try:
+            return {"timeline": self.try_out(name, text, body.get("event"))}
+        except ValueError as why:
+            raise EditRefused(400, str(why)) from None
+
+    def _heard(self, body: dict[str, Any]) -> dict[str, Any]:
+        assert self.hear_check is not None
+        name, text = self._text_of(body)
+        try:
+            return {"lines": self.hear_check(name, text)}
+        except ValueError as why:
+            raise EditRefused(400, str(why)) from None
+
+    async def _body(self, request: Request) -> dict[str, Any]:
+        """The page's JSON body naming a file and holding an outline; EditRefused (400,
+        403) for one that is not the page's."""
         origin = request.headers.get("origin")
         if origin is not None and urlparse(origin).netloc != request.headers.get("host"):
             raise EditRefused(403, "changes come from the editor's page only")
-        if request.headers.get("content-type", "").split(";")[0].strip() != "application/json":
+        kind = request.headers.get("content-type", "").split(";")[0].strip().lower()
+        if kind != "application/json":
             raise EditRefused(400, 'send JSON: {"file": ..., "outline": ...}')
         try:
             body = json.loads(await request.body())
@@ -188,11 +219,15 @@ class EditorServer:
             raise EditRefused(400, "the body is not JSON") from None
         if not isinstance(body, dict) or not isinstance(body.get("file"), str):
             raise EditRefused(400, 'send JSON: {"file": ..., "outline": ...}')
+        if not isinstance(body.get("outline"), dict):
+            raise EditRefused(400, "outline: the tree or dialog as the page holds it")
+        return body
+
+    def _text_of(self, body: dict[str, Any]) -> tuple[str, str]:
+        """The file named and the text the body's outline makes of the file as it is."""
         name: str = body["file"]
+        outline: dict[str, Any] = body["outline"]
         self.workspace.path_of(name)  # refused before anything is read
-        outline = body.get("outline")
-        if not isinstance(outline, dict):
-            raise EditRefused(400, "outline: the tree as the page holds it")
         try:
             base = self.workspace.read(name)[0] if body.get("version") is not None else None
         except EditRefused as refused:
@@ -200,17 +235,22 @@ class EditorServer:
                 raise
             base = None
         try:
+            if "rules" in outline:  # a dialog's questions and answers
+                dialog = DialogText(base or f"dialog: {json.dumps(Path(name).stem)}\nrules: []\n")
+                return name, dialog.written(outline)
             tree = TreeText(base or _skeleton(outline), self.workspace.registry)
-            return name, tree.written(outline), body
+            return name, tree.written(outline)
         except (OutlineError, RecursionError) as error:
-            raise EditRefused(400, f"{name}: {error}") from None
+            why = "nested too deep" if isinstance(error, RecursionError) else str(error)
+            raise EditRefused(400, f"{name}: {why}") from None
 
 
 def _skeleton(outline: dict[str, Any]) -> str:
     """The text a new tree starts from (its settings and root come from the outline)."""
     settings = outline.get("settings") if isinstance(outline.get("settings"), dict) else {}
     name = str((settings or {}).get("name") or "new_tree")
-    return f"name: {json.dumps(name)}\nrate_hz: 10\nroot:\n  Sequence: []\n"
+    shown = name if PLAIN_WORD.fullmatch(name) else json.dumps(name)
+    return f"name: {shown}\nrate_hz: 10\nroot:\n  Sequence: []\n"
 
 
 def _with_nodes(
@@ -221,7 +261,7 @@ def _with_nodes(
         lines = TreeText(text, workspace.registry).node_lines()
     except OutlineError:
         lines = []
-    for problem in problems:
+    for problem in problems:  # a problem above the root (a setting) is no node's
         before = [ident for line, ident in lines if line <= problem["line"]]
         problem["node"] = before[-1] if problem["here"] and before else None
     return problems
@@ -234,8 +274,6 @@ def _drawing(tree: Any) -> str | None:
     return drawn.decode("utf-8") if drawn is not None else None
 
 
-def _refused(refused: EditRefused, text: str | None = None) -> Response:
-    body: dict[str, Any] = {"message": str(refused), "problems": refused.problems}
-    if text is not None:
-        body["text"] = text
+def _refused(refused: EditRefused) -> Response:
+    body = {"message": str(refused), "problems": refused.problems}
     return JSONResponse(body, status_code=refused.status)

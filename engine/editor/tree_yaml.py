@@ -18,10 +18,12 @@ from typing import Any
 
 from ruamel.yaml.comments import CommentedMap, CommentedSeq
 
-from engine.editor.round_trip import OutlineError, dumped, plain, read, refilled, update
+from engine.editor.round_trip import OutlineError, dumped, newline_of, plain, read, refilled, update
+from engine.files.yaml_source import MAX_DEPTH
+from engine.loader.tree_settings import SETTINGS as TREE_SETTINGS
 from engine.nodes.registry import NodeRegistry
 
-SETTINGS = ("name", "description", "rate_hz", "priority", "wake_on")
+SETTINGS = ("name", "description", *(setting.name for setting in TREE_SETTINGS))
 """The tree's own settings the editor shows in its form (the rest stay as written)."""
 SUBTREE = "Subtree"
 STRUCTURE = ("child", "children")
@@ -35,6 +37,7 @@ class TreeText:
         self.text = text
         self.registry = registry
         self.document, self.style = read(text)
+        self.newline = newline_of(text)
         if not isinstance(self.document, CommentedMap) or "root" not in self.document:
             raise OutlineError("not a tree file (a tree has 'root:')")
 
@@ -85,8 +88,9 @@ class TreeText:
             raise OutlineError("settings must be a mapping")
         others = tuple(str(key) for key in document if key not in SETTINGS)
         update(document, {k: v for k, v in settings.items() if k in SETTINGS}, others)
+        _settings_first(document)
         document["root"] = self._built(outline.get("root"), originals, "root")
-        return dumped(document, self.style)
+        return dumped(document, self.style, self.newline)
 
     def _built(self, node: Any, originals: dict[str, CommentedMap], where: str) -> CommentedMap:
         if not isinstance(node, dict) or not isinstance(node.get("type"), str):
@@ -102,8 +106,13 @@ class TreeText:
         same = raw is not None and next(iter(raw)) == type_name
         mapping = raw if same and raw is not None else CommentedMap()
         body = mapping.get(type_name) if same else None
-        built = [self._built(child, originals, f"{where}/{i}") for i, child in enumerate(children)]
         many = self._children_of(type_name)
+        if (many == "none" and children) or (many == "one" and len(children) > 1):
+            takes = "no node under it" if many == "none" else "one node under it"
+            raise OutlineError(f"{where}: {type_name} takes {takes}, got {len(children)}")
+        if where.count("/") >= MAX_DEPTH:
+            raise OutlineError(f"{where}: nested more than {MAX_DEPTH} deep")
+        built = [self._built(child, originals, f"{where}/{i}") for i, child in enumerate(children)]
         if many == "many" and len(args) == 0 and not isinstance(body, CommentedMap):
             mapping[type_name] = refilled(body, built)
         elif many == "many":
@@ -150,3 +159,17 @@ def _new_body(children: str, args: dict[str, Any]) -> CommentedMap:
     if children == "none" and all(not isinstance(v, dict) for v in args.values()):
         body.fa.set_flow_style()
     return body
+
+
+def _settings_first(document: CommentedMap) -> None:
+    """A setting the page added goes where a person writes it: in the settings' order,
+    above ``params`` and ``root`` (ruamel.yaml adds a new key at the end)."""
+    keys = list(document.keys())
+    body = [key for key in ("params", "root") if key in keys]
+    if not body:
+        return
+    first_body = keys.index(body[0])
+    late = [key for key in keys[first_body:] if key in SETTINGS]
+    for key in sorted(late, key=SETTINGS.index):
+        value = document.pop(key)
+        document.insert(list(document.keys()).index(body[0]), key, value)

@@ -22,8 +22,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Protocol
 
-from engine.files.problems import Problem
-from engine.files.yaml_source import resolved
+from engine.files.problems import LoadError, Problem
+from engine.files.yaml_source import read_bytes, resolved
 from engine.loader.tree_definition import TreeDefinition
 from engine.nodes.registry import NodeRegistry
 
@@ -74,6 +74,10 @@ class Workspace:
         self.folder = folder.resolve()
         self.registry = registry
         self.checks = checks
+        mask = os.umask(0)  # read once, at the start, before any thread writes
+        os.umask(mask)
+        self.new_mode = 0o666 & ~mask
+        """A new file's permissions: what the person's umask gives (0644 as a rule)."""
 
     # -- where ----------------------------------------------------------------------------
     def path_of(self, name: str) -> Path:
@@ -106,14 +110,12 @@ class Workspace:
     def read(self, name: str) -> tuple[str, str]:
         """The file's text and version; EditRefused when there is none or it is too big."""
         path = self.path_of(name)
-        try:
-            data = path.read_bytes()
-        except FileNotFoundError:
-            raise EditRefused(404, f"{name}: no such file") from None
-        except OSError as error:
-            raise EditRefused(400, f"{name}: cannot be read ({error.strerror})") from None
-        if len(data) > MAX_FILE_BYTES:
-            raise EditRefused(413, f"{name}: over {MAX_FILE_BYTES // 1000} kB")
+        if not path.exists() and not path.is_symlink():
+            raise EditRefused(404, f"{name}: no such file")
+        try:  # the one reader of a person's files: regular files only (never a FIFO), sized
+            data = read_bytes(path, name, max_bytes=MAX_FILE_BYTES)
+        except LoadError as error:
+            raise EditRefused(400, str(error.problems[0])) from None
         try:
             return data.decode("utf-8"), version_of(data)
         except UnicodeDecodeError:
@@ -162,11 +164,11 @@ class Workspace:
                 )
         data = text.encode("utf-8")
         path.parent.mkdir(parents=True, exist_ok=True)
-        _write_whole(path, data)
+        _write_whole(path, data, self.new_mode)
         return Saved(version_of(data), problems)
 
 
-def _write_whole(path: Path, data: bytes) -> None:
+def _write_whole(path: Path, data: bytes, new_mode: int) -> None:
     """``data`` into ``path`` at once: a temporary file beside it, then renamed over it."""
     handle, temporary = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
     try:
@@ -174,8 +176,7 @@ def _write_whole(path: Path, data: bytes) -> None:
             file.write(data)
             file.flush()
             os.fsync(file.fileno())
-        if path.exists():
-            os.chmod(temporary, path.stat().st_mode & 0o777)
+        os.chmod(temporary, path.stat().st_mode & 0o777 if path.exists() else new_mode)
         os.replace(temporary, path)
     except BaseException:
         Path(temporary).unlink(missing_ok=True)

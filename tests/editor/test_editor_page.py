@@ -6,7 +6,6 @@ nothing serious."""
 
 from __future__ import annotations
 
-import re
 from collections.abc import Callable
 from pathlib import Path
 
@@ -31,7 +30,7 @@ def node(page: Page, path: str):
 
 def add(page: Page, where: str, node_type: str) -> None:
     page.get_by_role("button", name=f"Add a node {where}").click()
-    page.get_by_role("button", name=re.compile(f"^{node_type}:")).click()
+    page.locator(f'#palette .palette-node[data-node="{node_type}"]').click()
 
 
 def validate(path: Path, capsys) -> str:

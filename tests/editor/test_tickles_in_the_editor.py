@@ -4,7 +4,6 @@ file saved is the tree the guide writes by hand, and `vest validate` accepts it.
 
 from __future__ import annotations
 
-import re
 from pathlib import Path
 
 from playwright.sync_api import Page, expect
@@ -32,7 +31,7 @@ def without_ids(node: dict) -> dict:
 def add(page: Page, where: str, find: str, node_type: str) -> None:
     page.get_by_role("button", name=f"Add a node {where}").click()
     page.get_by_label("Find").fill(find)
-    page.get_by_role("button", name=re.compile(f"^{node_type}:")).click()
+    page.locator(f'#palette .palette-node[data-node="{node_type}"]').click()
     expect(page.locator("#node-form h3")).to_contain_text(node_type)
 
 
@@ -62,20 +61,20 @@ def test_a_therapist_builds_that_tickles_in_the_editor_as_the_guide_says(
     page.get_by_label("right_shoulder").first.check()
     add(page, "after", "rest", "Cooldown")
     fill(page, "seconds (needed)", "5")
-    page.get_by_label("counting_from").select_option("start")
+    page.get_by_label("counting from").select_option("start")
     add(page, "inside", "order", "Sequence")
     add(page, "inside", "same time", "Parallel")
     add(page, "inside", "say", "Say")
     fill(page, "text (needed)", "That tickles!")
     add(page, "after", "servo", "MoveServo")
     fill(page, "joint (needed)", "left_arm")
-    fill(page, "angle_deg (needed)", "45")
-    fill(page, "speed_dps", "60")
+    fill(page, "angle deg (needed)", "45")
+    fill(page, "speed dps", "60")
     choose(page, "root/1/child/0")  # the Parallel
     add(page, "after", "servo", "MoveServo")
     fill(page, "joint (needed)", "left_arm")
-    fill(page, "angle_deg (needed)", "0")
-    fill(page, "speed_dps", "60")
+    fill(page, "angle deg (needed)", "0")
+    fill(page, "speed dps", "60")
 
     expect(page.locator("#problems")).to_contain_text("vest validate accepts this tree")
     page.get_by_label("Pad").select_option("left_shoulder")  # tried before it is saved

@@ -130,3 +130,56 @@ def test_a_node_given_twice_is_written_twice_not_as_a_yaml_alias() -> None:
     written = tree.written(outline)
     assert "&" not in written and "*" not in written
     assert written.count("- OnTouch: {pads: [left_shoulder, right_shoulder]}") == 2
+
+
+def test_a_file_with_yaml_anchors_is_left_to_hand_editing() -> None:
+    shared = TICKLES.replace(
+        '- Say: {text: "That tickles!"}', '- &said Say: {text: "That tickles!"}'
+    ).replace(
+        "- MoveServo: {joint: left_arm, angle_deg: 0",
+        "- *said\n            - MoveServo: {joint: left_arm, angle_deg: 0",
+    )
+    with pytest.raises(OutlineError, match="anchors"):
+        TreeText(shared, REGISTRY)
+
+
+def test_a_thousand_aliases_deep_are_refused_before_they_are_expanded() -> None:
+    laughs = "a: &a [x, x, x, x, x, x, x, x, x, x]\n" + "".join(
+        f"{chr(98 + i)}: &{chr(98 + i)} [{', '.join(['*' + chr(97 + i)] * 10)}]\n" for i in range(8)
+    )
+    with pytest.raises(OutlineError, match="anchors"):
+        TreeText(laughs + "root: {Sequence: [*i]}\n", REGISTRY)
+
+
+def test_windows_line_ends_stay_windows_line_ends_after_an_edit() -> None:
+    windows = TICKLES.replace("\n", "\r\n")
+    tree = TreeText(windows, REGISTRY)
+    outline = tree.outline()
+    outline["settings"]["priority"] = 43
+    written = tree.written(outline)
+    assert written == windows.replace("priority: 42 ", "priority: 43 ")
+
+
+def test_children_under_a_leaf_or_two_under_a_decorator_are_refused() -> None:
+    tree = TreeText(TICKLES, REGISTRY)
+    outline = tree.outline()
+    say = {"type": "Say", "name": None, "args": {"text": "hi"}, "children": []}
+    outline["root"]["children"][0]["children"] = [say]  # under OnTouch
+    with pytest.raises(OutlineError, match="OnTouch takes no node under it, got 1"):
+        tree.written(outline)
+    outline = tree.outline()
+    outline["root"]["children"][1]["children"].append(say)  # a second child of Cooldown
+    with pytest.raises(OutlineError, match="Cooldown takes one node under it, got 2"):
+        tree.written(outline)
+
+
+def test_an_outline_nested_past_vest_s_limit_is_refused_in_words() -> None:
+    tree = TreeText(TICKLES, REGISTRY)
+    outline = tree.outline()
+    deepest = outline["root"]
+    for _ in range(150):
+        inner = {"type": "Sequence", "name": None, "args": {}, "children": []}
+        deepest["children"] = [inner]
+        deepest = inner
+    with pytest.raises(OutlineError, match="nested more than 100 deep"):
+        tree.written(outline)

@@ -100,3 +100,22 @@ def test_a_check_says_what_vest_validate_says_about_the_robot_s_pads(
     assert "left_shoulder" in problem["hint"]
     assert problem["line"] == 5
     assert not (workspace.folder / "trees" / "tickles.yaml").exists()  # a check writes nothing
+
+
+def test_a_fifo_named_like_a_tree_is_refused_not_waited_on(workspace: Workspace) -> None:
+    os.mkfifo(workspace.folder / "trees" / "pipe.yaml")
+    with pytest.raises(EditRefused, match=r"is not a regular file \(a FIFO\)"):
+        workspace.read("trees/pipe.yaml")
+
+
+def test_a_subtree_s_change_is_checked_in_the_trees_that_use_it(workspace: Workspace) -> None:
+    text, version = workspace.read("trees/parts/greet.yaml")
+    without_phrase = text.replace('  phrase: "Hello"\n', "")
+    problems = workspace.check("trees/parts/greet.yaml", without_phrase)
+    assert any(
+        p["file"] == "trees/wave_greeting.yaml" and "unknown parameter 'phrase'" in p["message"]
+        for p in problems
+    )
+    with pytest.raises(EditRefused) as refused:  # asked first: wave_greeting is fine today
+        workspace.save("trees/parts/greet.yaml", without_phrase, version)
+    assert refused.value.status == 409

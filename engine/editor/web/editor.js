@@ -28,12 +28,16 @@ let done = [];
 let saved = ""; // the outline as last read or saved (JSON)
 let checking = null;
 
-const SETTINGS = [
+// the tree's settings: name and description, then those the loader declares (palette)
+const SETTING_LABELS = {
+  rate_hz: "Looks how often (times a second)", priority: "Priority",
+  wait_for_turn_s: "Waits for its turn (seconds)", when_interrupted: "When cut short",
+  wake_on: "Wakes on (keys)",
+};
+const settingFields = () => [
   { name: "name", label: "Name", kind: "text", doc: "the tree's name (unique in its folder)" },
   { name: "description", label: "What it does", kind: "text", doc: "for people" },
-  { name: "rate_hz", label: "Looks how often (times a second)", kind: "number", min: 0.1, max: 100, doc: "20 suits touch" },
-  { name: "priority", label: "Priority", kind: "integer", min: 0, max: 1000, doc: "the higher wins the speaker, the LEDs, a joint" },
-  { name: "wake_on", label: "Wakes on (keys)", kind: "list", item: { kind: "key" }, doc: "rests until one of these changes; e.g. /sensors/touch/pat" },
+  ...palette.settings.map((field) => ({ ...field, label: SETTING_LABELS[field.name] ?? field.name, required: false })),
 ];
 
 async function getJson(path, params) {
@@ -56,8 +60,9 @@ function unreachable() {
 }
 
 function say(text, tone = "") {
-  $("#message").textContent = text;
-  $("#message").className = tone;
+  const box = file?.kind === "dialog" ? $("#d-message") : $("#message");
+  box.textContent = text;
+  box.className = tone;
 }
 
 // -- the outline --------------------------------------------------------------------------
@@ -76,29 +81,42 @@ function parentOf(target) {
   return found;
 }
 
-function change(edit, redrawForm = true) { // every change: undoable, checked, drawn
-  done.push(snapshot());
+let typingIn = null; // the field being typed in: its keystrokes are one undo step
+
+function change(edit, redrawForm = true, field = null) { // every change: undoable, checked, drawn
+  if (field === null || field !== typingIn) done.push(snapshot());
+  typingIn = field;
   undone = [];
   edit();
+  say("");
   changed(redrawForm);
 }
 
 // a field's own edit leaves its form as it is (the person may be typing in the next field)
 function changed(redrawForm = true) {
-  $("#undo").disabled = done.length === 0;
-  $("#redo").disabled = undone.length === 0;
-  const dirty = snapshot() !== saved;
+  for (const id of ["#undo", "#d-undo"]) $(id).disabled = done.length === 0;
+  for (const id of ["#redo", "#d-redo"]) $(id).disabled = undone.length === 0;
+  const dirty = snapshot() !== saved || !file.version; // a new file is not saved yet
   $("#state").textContent = dirty ? "changed, not saved" : "saved";
   document.body.dataset.dirty = String(dirty);
-  drawOutline();
-  if (redrawForm) drawNodeForm();
+  if (file.kind === "dialog") {
+    if (redrawForm) drawRules();
+  } else {
+    drawOutline();
+    if (redrawForm) drawNodeForm();
+  }
   checkSoon();
 }
 
+const undo = () => { if (done.length) { undone.push(snapshot()); restore(done.pop()); } };
+const redo = () => { if (undone.length) { done.push(snapshot()); restore(undone.pop()); } };
+
 function restore(text) {
-  const path = chosen ? pathOf(chosen) : null;
+  const path = chosen && file.kind !== "dialog" ? pathOf(chosen) : null;
   file.outline = JSON.parse(text);
   chosen = path ? nodeAt(path) : null;
+  typingIn = null;
+  if (file.kind !== "dialog") drawSettings(); // the forms show the values undone
   changed();
 }
 
@@ -181,7 +199,7 @@ function fieldFor(field, value, set, idPrefix) {
   const range = field.min !== undefined || field.max !== undefined
     ? ` ${field.min ?? ""}..${field.max ?? ""}` : "";
   const unit = field.unit ? ` ${field.unit}` : "";
-  const label = make("label", { htmlFor: id, textContent: `${field.label ?? field.name}${field.required ? " (needed)" : ""}` });
+  const label = make("label", { htmlFor: id, textContent: `${field.label ?? field.name.replaceAll("_", " ")}${field.required ? " (needed)" : ""}` });
   const help = make("p", { className: "help", id: `${id}-help`, textContent: `${field.doc ?? ""}${range || unit ? ` (${(range + unit).trim()})` : ""}` });
   let input;
   const words = field.words ? palette[field.words] ?? [] : [];
@@ -218,7 +236,8 @@ function fieldFor(field, value, set, idPrefix) {
       wrap.append(make("datalist", { id: listId }, ...suggestions.map((word) => make("option", { value: word }))));
     }
     if (field.default !== undefined) input.placeholder = `default: ${shown(field.default)}`;
-    input.addEventListener("change", () => set(typed(input.value, field)));
+    input.addEventListener("input", () => set(typed(input.value, field), id)); // as you type
+    input.addEventListener("blur", () => { if (typingIn === id) typingIn = null; });
   }
   input.setAttribute("aria-describedby", help.id);
   wrap.prepend(label);
@@ -230,10 +249,10 @@ function drawSettings() {
   const box = $("#settings");
   box.replaceChildren(make("legend", { textContent: "The tree" }));
   const settings = file.outline.settings;
-  for (const field of SETTINGS) {
-    box.append(fieldFor(field, settings[field.name], (value) => change(() => {
+  for (const field of settingFields()) {
+    box.append(fieldFor(field, settings[field.name], (value, typing = null) => change(() => {
       if (value === undefined) delete settings[field.name]; else settings[field.name] = value;
-    }, false), "setting"));
+    }, false, typing), "setting"));
   }
 }
 
@@ -252,11 +271,10 @@ function drawNodeForm() {
       ? make("details", {}, make("summary", { textContent: "more about it" }), make("p", { className: "help", textContent: declared.doc.replaceAll("``", "") }))
       : "",
     make("div", { id: "node-problems", role: "status" }),
-    ...fields.map((field) => fieldFor(field, field.name === "name" ? node.name ?? undefined : node.args[field.name], (value) => change(() => {
+    ...fields.map((field) => fieldFor(field, field.name === "name" ? node.name ?? undefined : node.args[field.name], (value, typing = null) => change(() => {
       if (field.name === "name") node.name = value ?? null;
-      else if (value === undefined) delete node.args[field.name];
-      else node.args[field.name] = value;
-    }, false), "node")),
+      else node.args = inDeclaredOrder({ ...node.args, [field.name]: value }, declared);
+    }, false, typing), "node")),
   );
   drawNodeProblems();
 }
@@ -266,6 +284,14 @@ function drawNodeProblems() {
   if (!box || !chosen) return;
   const problems = problemsByNode.get(pathOf(chosen)) ?? [];
   box.replaceChildren(...problems.map((problem) => make("p", { className: "problem", textContent: problemText(problem) })));
+}
+
+// a node's parameters in the order its declaration gives them (as `vest nodes` lists them)
+function inDeclaredOrder(args, declared) {
+  const order = (declared?.params ?? []).map((param) => param.name);
+  const rank = (name) => (order.includes(name) ? order.indexOf(name) : order.length);
+  return Object.fromEntries(Object.entries(args).filter(([, value]) => value !== undefined)
+    .sort(([a], [b]) => rank(a) - rank(b)));
 }
 
 const problemText = (problem) => `line ${problem.line}: ${problem.message}${problem.hint ? ` (${problem.hint})` : ""}`;
@@ -281,6 +307,13 @@ async function check() {
   const { status, body } = await postJson("/api/check", { file: file.name, outline: file.outline, version: file.version });
   if (asked !== snapshot()) return; // changed again meanwhile: that check comes
   if (status !== 200) { say(body.message ?? `the check failed (${status})`, "bad"); return; }
+  if (file.kind === "dialog") {
+    $("#d-problems").replaceChildren(...(body.problems.length
+      ? body.problems.map((problem) => make("li", { className: "problem", textContent: problemText(problem) }))
+      : [make("li", { className: "fine", textContent: "none: vest validate accepts this dialog" })]));
+    document.body.dataset.problems = String(body.problems.length);
+    return;
+  }
   problemsByNode = new Map();
   for (const problem of body.problems) {
     const list = problemsByNode.get(problem.node) ?? [];
@@ -328,7 +361,7 @@ function drawPalette(filter) {
     return make("section", {}, make("h3", { textContent: words }), ...nodes.map((node) => {
       const button = make("button", { type: "button", className: "palette-node" },
         make("strong", { textContent: node.words ? `${node.words} (${node.name})` : node.name }), ` ${node.summary}`);
-      button.setAttribute("aria-label", `${node.name}: ${node.words ? `${node.words}; ` : ""}${node.summary}`);
+      button.dataset.node = node.name;
       button.addEventListener("click", () => { $("#palette").close(); add(node); });
       return button;
     }));
@@ -371,8 +404,10 @@ async function save(overProblems = false) {
     file: file.name, outline: file.outline, version: file.version, over_problems: overProblems,
   });
   if (status === 200) {
-    say(`saved ${file.name}${body.problems.length ? ` with ${body.problems.length} problems` : ""}`, "good");
+    const message = `saved ${file.name}${body.problems.length ? ` with ${body.problems.length} problems` : ""}`;
     await open(file.name, true);
+    say(message, "good");
+    await listFiles();
     return;
   }
   if (status === 409 && body.problems?.length) {
@@ -425,8 +460,12 @@ const leave = () => document.body.dataset.dirty !== "true" || confirm("Leave thi
 async function open(name, keepMessage = false) {
   const read = await getJson("/api/file", { name });
   if (!keepMessage) say("");
+  if (read.kind === "dialog") {
+    start({ name, kind: "dialog", version: read.version, outline: read.outline });
+    return;
+  }
   if (!read.outline) {
-    $("#editing").hidden = true; $("#nothing").hidden = true; $("#as-text").hidden = false;
+    $("#editing").hidden = true; $("#dialog-editing").hidden = true; $("#nothing").hidden = true; $("#as-text").hidden = false;
     $("#text-name").textContent = name;
     $("#text-why").textContent = `Not a tree (${read.why_not}): shown as it is; edit it by hand.`;
     $("#text").textContent = read.text;
@@ -440,11 +479,52 @@ function start(opened) {
   file = opened;
   saved = snapshot();
   done = []; undone = [];
-  chosen = file.outline.root;
-  $("#nothing").hidden = true; $("#as-text").hidden = true; $("#editing").hidden = false;
-  $("#file-name").textContent = file.name + (file.version ? "" : " (new)");
-  drawSettings();
+  const dialog = file.kind === "dialog";
+  chosen = dialog ? null : file.outline.root;
+  $("#nothing").hidden = true; $("#as-text").hidden = true;
+  $("#editing").hidden = dialog; $("#dialog-editing").hidden = !dialog;
+  $(dialog ? "#dialog-name" : "#file-name").textContent = file.name + (file.version ? "" : " (new)");
+  $("#heard").replaceChildren();
+  if (!dialog) drawSettings();
   changed();
+}
+
+// -- a dialog: questions and their answers -------------------------------------------------------
+function drawRules() {
+  $("#rules").replaceChildren(...file.outline.rules.map((rule, index) => {
+    const box = make("fieldset", { className: "rule" });
+    box.append(make("legend", { textContent: `Question ${index + 1}${rule.rule ? `: ${rule.rule}` : ""}` }));
+    const id = `rule-${index}`;
+    const text = (label, key, value, multi) => {
+      const input = make(multi ? "textarea" : "input", { id: `${id}-${key}`, value, rows: 3 });
+      input.addEventListener("change", () => change(() => {
+        rule[key] = multi ? input.value.split("\n").map((line) => line.trim()).filter(Boolean) : input.value.trim();
+      }, false));
+      return make("div", { className: "field" }, make("label", { htmlFor: input.id, textContent: label }), input);
+    };
+    box.append(
+      text("Its name (a word)", "rule", rule.rule ?? "", false),
+      text("A person says (one way of asking per line)", "hear", (rule.hear ?? []).join("\n"), true),
+      text("The robot answers", "say", rule.say ?? "", false),
+    );
+    if (rule.more) box.append(make("p", { className: "help", textContent: "It also asks back or reads a sensor: that part is kept as written (edit it by hand)." }));
+    const remove = make("button", { type: "button", textContent: `Delete question ${index + 1}` });
+    remove.addEventListener("click", () => change(() => file.outline.rules.splice(index, 1)));
+    box.append(remove);
+    return box;
+  }));
+}
+
+function addRule() {
+  change(() => file.outline.rules.push({ rule: "", hear: [], say: "" }));
+  $(`#rule-${file.outline.rules.length - 1}-rule`).focus();
+}
+
+async function hear() {
+  $("#heard").replaceChildren(make("li", { textContent: "saying each phrase and hearing it (about 20 s)..." }));
+  const { status, body } = await postJson("/api/hear", { file: file.name, outline: file.outline, version: file.version });
+  const lines = status === 200 ? body.lines : [body.message ?? `the check failed (${status})`];
+  $("#heard").replaceChildren(...lines.map((line) => make("li", { textContent: line, className: /problem|ambiguous|heard as/.test(line) && !/ 0 problem/.test(line) ? "problem" : "" })));
 }
 
 function newTree(event) {
@@ -465,8 +545,11 @@ async function main() {
   await listFiles();
   $("#state").textContent = "ready";
   $("#new-tree").addEventListener("submit", newTree);
-  $("#undo").addEventListener("click", () => { undone.push(snapshot()); restore(done.pop()); });
-  $("#redo").addEventListener("click", () => { done.push(snapshot()); restore(undone.pop()); });
+  for (const id of ["#undo", "#d-undo"]) $(id).addEventListener("click", undo);
+  for (const id of ["#redo", "#d-redo"]) $(id).addEventListener("click", redo);
+  $("#add-rule").addEventListener("click", addRule);
+  $("#d-save").addEventListener("click", () => save().catch(unreachable));
+  $("#hear").addEventListener("click", () => hear().catch(unreachable));
   $("#add-inside").addEventListener("click", () => openPalette("inside"));
   $("#add-after").addEventListener("click", () => openPalette("after"));
   $("#move-up").addEventListener("click", () => move(-1));
@@ -475,14 +558,19 @@ async function main() {
   $("#delete").addEventListener("click", remove);
   $("#save").addEventListener("click", () => save().catch(unreachable));
   $("#palette-filter").addEventListener("input", (event) => drawPalette(event.target.value));
+  $("#palette-filter").addEventListener("keydown", (event) => {
+    if (event.key !== "Enter") return;
+    event.preventDefault(); // not the dialog's form: the first node found is added
+    $("#palette-groups .palette-node")?.click();
+  });
   $("#try-pad").replaceChildren(...palette.pads.map((pad) => make("option", { value: pad, textContent: pad })));
   $("#try-kind").addEventListener("change", tryKindChanged);
   $("#try").addEventListener("submit", (event) => tryIt(event).catch(unreachable));
   document.addEventListener("keydown", (event) => {
     if (!file || !(event.ctrlKey || event.metaKey)) return;
     const key = event.key.toLowerCase();
-    if (key === "z" && !$("#undo").disabled) { event.preventDefault(); $("#undo").click(); }
-    if (key === "y" && !$("#redo").disabled) { event.preventDefault(); $("#redo").click(); }
+    if (key === "z") { event.preventDefault(); undo(); }
+    if (key === "y") { event.preventDefault(); redo(); }
     if (key === "s") { event.preventDefault(); save().catch(unreachable); }
   });
   addEventListener("beforeunload", (event) => { if (document.body.dataset.dirty === "true") event.preventDefault(); });
