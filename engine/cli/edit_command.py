@@ -15,7 +15,8 @@ import argparse
 import secrets
 from pathlib import Path
 
-from engine.cli.edit_checks import HearCheck, TryOnSimulatedVest, ValidateChecks
+from engine.cli.edit_checks import ValidateChecks
+from engine.cli.edit_tries import HearCheck, TryOnSimulatedVest
 from engine.cli.output import tell
 from engine.cli.run_inputs import DEFAULT_HARDWARE, found, load_config, robot_catalogue
 from engine.cli.view_options import port_number
@@ -87,6 +88,7 @@ def main(args: argparse.Namespace) -> int:
         token=token,
         try_out=try_out,
         hear_check=HearCheck(),
+        watch=try_out.watch,
     )
     server.start()
     tell(f"editor: {server.url}  (the folder {workspace.folder}; Ctrl-C ends it)")
@@ -97,4 +99,5 @@ def main(args: argparse.Namespace) -> int:
             pass
     finally:
         server.stop()
+        try_out.stop_watching()
     return 0

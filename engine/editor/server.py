@@ -12,7 +12,10 @@ stack (:mod:`engine.web`), in a thread of its own.
   file has not and ``over_problems`` is false; ``version`` null for a new file);
 - ``POST /api/try`` ``{"file", "outline", "version", "event"}`` runs the tree as it is on
   the page on the simulated vest with one event and answers its timeline (400 with why
-  when the event or the run cannot be).
+  when the event or the run cannot be); ``POST /api/watch`` the same in real time under
+  the live view, answering the view's address;
+- ``POST /api/hear`` ``{"file", "outline", "version"}`` a dialog's phrases said and heard
+  as the robot hears them (vest dialogs check --quick).
 
 Bodies are JSON from the page's own origin; on loopback (the default) no token is asked, on
 any other address every request carries the token ``vest edit`` prints.
@@ -51,6 +54,9 @@ READ_TIMEOUT_S = 5.0
 TryOut = Callable[[str, str, object], list[str]]
 """Runs a tree's text (its file's name) with an event the page asked for: the timeline's
 lines; a ValueError saying why not."""
+Watch = Callable[[str, str, object, str], str]
+"""Runs a tree's text in real time with an event under the live view on a host: the
+view's address; a ValueError saying why not."""
 HearCheck = Callable[[str, str], list[str]]
 """Says a dialog's phrases as the robot would hear them (its text, its file's name): the
 check's lines; a ValueError saying why not."""
@@ -71,9 +77,10 @@ class EditorServer:
         token: str | None = None,
         try_out: TryOut | None = None,
         hear_check: HearCheck | None = None,
+        watch: Watch | None = None,
     ) -> None:
         check_listening(host, token, "the editor")
-        self.try_out, self.hear_check = try_out, hear_check
+        self.try_out, self.hear_check, self.watch = try_out, hear_check, watch
         self.workspace, self.palette, self.host, self.token = workspace, palette, host, token
         try:
             sock = listening_socket(host, port, named=f"the editor on {host}:{port}")
@@ -107,6 +114,8 @@ class EditorServer:
             routes.append(Route("/api/try", self._try, methods=["POST"]))
         if self.hear_check is not None:
             routes.append(Route("/api/hear", self._hear, methods=["POST"]))
+        if self.watch is not None:
+            routes.append(Route("/api/watch", self._watch, methods=["POST"]))
         return Starlette(
             routes=routes,
             middleware=[
@@ -157,6 +166,9 @@ class EditorServer:
     async def _hear(self, request: Request) -> Response:
         return await self._answer(request, self._heard)
 
+    async def _watch(self, request: Request) -> Response:
+        return await self._answer(request, self._watched)
+
     async def _answer(
         self, request: Request, work: Callable[[dict[str, Any]], dict[str, Any]]
     ) -> Response:
@@ -193,6 +205,14 @@ class EditorServer:
         name, text = self._text_of(body)
         try:
             return {"timeline": self.try_out(name, text, body.get("event"))}
+        except ValueError as why:
+            raise EditRefused(400, str(why)) from None
+
+    def _watched(self, body: dict[str, Any]) -> dict[str, Any]:
+        assert self.watch is not None
+        name, text = self._text_of(body)
+        try:
+            return {"url": self.watch(name, text, body.get("event"), self.host)}
         except ValueError as why:
             raise EditRefused(400, str(why)) from None
 

@@ -9,7 +9,8 @@ from pathlib import Path
 
 import pytest
 
-from engine.cli.edit_checks import HearCheck, TryOnSimulatedVest, ValidateChecks
+from engine.cli.edit_checks import ValidateChecks
+from engine.cli.edit_tries import HearCheck, TryOnSimulatedVest
 from engine.cli.run_inputs import DEFAULT_HARDWARE, load_config, robot_catalogue
 from engine.editor.palette import palette
 from engine.editor.server import EditorServer
@@ -45,9 +46,12 @@ def editor(workspace: Workspace) -> Iterator[str]:
     registry = workspace.registry
     offered = palette(registry, CONFIG, robot_catalogue(CONFIG, registry))
     try_out = TryOnSimulatedVest(workspace.folder, ROOT / DEFAULT_HARDWARE, offered["pads"])
-    server = EditorServer(workspace, offered, port=0, try_out=try_out, hear_check=HearCheck())
+    server = EditorServer(
+        workspace, offered, port=0, try_out=try_out, hear_check=HearCheck(), watch=try_out.watch
+    )
     server.start()
     try:
         yield server.url
     finally:
         server.stop()
+        try_out.stop_watching()

@@ -6,8 +6,9 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
+from playwright.sync_api import Page, expect
 
-from engine.cli.edit_checks import TryError, TryOnSimulatedVest, tried_event
+from engine.cli.edit_tries import TryError, TryOnSimulatedVest, tried_event
 from tests.editor.conftest import CONFIG, ROOT
 
 PADS = [name for device in CONFIG.devices.values() for name in device.pad_names]
@@ -42,3 +43,17 @@ def test_words_said_reach_a_dialog_tree(project: Path) -> None:
 def test_an_event_that_cannot_be_is_refused_in_words(asked: object, why: str) -> None:
     with pytest.raises(TryError, match=why):
         tried_event(asked, PADS)
+
+
+def test_a_tree_watched_live_is_the_live_view_of_it_running(page: Page, editor: str) -> None:
+    page.goto(editor)
+    expect(page.locator("body")).to_have_attribute("data-ready", "true")
+    page.get_by_role("button", name="trees/hug.yaml").click()
+    page.get_by_label("What happens").select_option("squeeze")
+    page.get_by_role("button", name="Watch it live").click()
+    link = page.get_by_role("link", name="Open the live view")
+    expect(link).to_be_visible(timeout=60_000)
+    page.goto(link.get_attribute("href") or "")
+    expect(page.locator("body")).to_have_attribute("data-ready", "true", timeout=30_000)
+    assert page.locator('.tree[data-tree="hug"]').count() == 1
+    expect(page.locator("#actions")).to_contain_text("I love hugs!", timeout=30_000)

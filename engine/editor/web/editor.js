@@ -441,6 +441,17 @@ async function tryIt(event) {
   $("#tried").replaceChildren(...lines.map((line) => make("li", { textContent: line })));
 }
 
+// the same in real time under the live view: a link to open it (the event comes at 5 s)
+async function watchIt() {
+  const asked = { kind: $("#try-kind").value, pad: $("#try-pad").value, text: $("#try-text").value };
+  $("#watching").textContent = "starting the simulated vest...";
+  const { status, body } = await postJson("/api/watch", { file: file.name, outline: file.outline, version: file.version, event: asked });
+  if (status !== 200) { $("#watching").textContent = body.message ?? `cannot watch (${status})`; return; }
+  const link = make("a", { href: body.url, target: "_blank", rel: "noopener", textContent: "Open the live view" });
+  $("#watching").replaceChildren(link, " : the tree runs for 30 s on the simulated vest; what you chose happens 5 s after you pressed Watch.");
+  link.focus();
+}
+
 // -- files --------------------------------------------------------------------------------------
 async function listFiles() {
   const files = await getJson("/api/files");
@@ -566,6 +577,7 @@ async function main() {
   $("#try-pad").replaceChildren(...palette.pads.map((pad) => make("option", { value: pad, textContent: pad })));
   $("#try-kind").addEventListener("change", tryKindChanged);
   $("#try").addEventListener("submit", (event) => tryIt(event).catch(unreachable));
+  $("#watch").addEventListener("click", () => watchIt().catch(unreachable));
   document.addEventListener("keydown", (event) => {
     if (!file || !(event.ctrlKey || event.metaKey)) return;
     const key = event.key.toLowerCase();

@@ -1,0 +1,207 @@
+"""What `vest edit` runs beside the page, each in a process of its own (a tree that hangs
+or fails cannot take the editor with it): a tree as it is on the page tried on the
+simulated vest with one event (a pat, a squeeze, words said, a wave), on a virtual clock
+for its timeline or in real time under the live view to watch it; and a dialog's phrases
+said and heard as the robot hears them."""
+
+from __future__ import annotations
+
+import shutil
+import subprocess
+import sys
+import tempfile
+import threading
+from pathlib import Path
+from typing import IO
+
+import yaml
+
+from engine.files.yaml_source import resolved
+
+TRY_AT_S = 1.0
+TRY_FOR_S = 8.0
+"""A try: the event at 1 s, the tree watched until 8 s (a cooldown's rest, a slow arm)."""
+TRY_TIMEOUT_S = 60.0
+WATCH_AT_S = 5.0
+WATCH_FOR_S = 30.0
+"""Watched live: the event 5 s after the press (time to open the view), 30 s in all."""
+MAX_SAID = 200
+VEST = "import sys; from engine.cli import main; sys.exit(main())"
+STOP_WAIT_S = 10.0
+
+
+class TryError(ValueError):
+    """A try the page asked for that cannot be made, in words."""
+
+
+def tried_event(asked: object, pads: list[str], at_s: float = TRY_AT_S) -> dict[str, object]:
+    """The scenario event the page asked for: ``{"kind": "pat", "pad": ...}``,
+    ``{"kind": "squeeze"}``, ``{"kind": "say", "text": ...}`` or ``{"kind": "wave"}``."""
+    if not isinstance(asked, dict):
+        raise TryError("event: a pat, a squeeze, a phrase said or a wave")
+    kind = asked.get("kind")
+    if kind == "pat":
+        pad = asked.get("pad")
+        if pad not in pads:
+            raise TryError(f"no pad {pad!r} on this robot (pads: {', '.join(pads)})")
+        return {"at": at_s, "touch": {"pad": pad, "seconds": 0.3}}
+    if kind == "squeeze":
+        return {"at": at_s, "squeeze": {"left_n": 6.0, "right_n": 6.0, "seconds": 2.0}}
+    if kind == "say":
+        said = asked.get("text")
+        if not isinstance(said, str) or not said.strip() or len(said) > MAX_SAID:
+            raise TryError(f"say: the words a person says, 1 to {MAX_SAID} characters")
+        return {"at": at_s, "hear": {"text": said.strip()}}
+    if kind == "wave":
+        return {"at": at_s, "gesture": "wave"}
+    raise TryError("event: a pat, a squeeze, a phrase said or a wave")
+
+
+class TryOnSimulatedVest:
+    """Runs a tree being edited on the simulated vest, on a virtual clock, with one event:
+    ``vest run --fast --speech text`` in a process of its own (a tree that hangs or fails
+    cannot take the editor with it), on a copy of the folder's trees (its subtrees), the
+    folder's dialogs and ``hardware``. Its timeline, in sentences, is the answer."""
+
+    def __init__(self, folder: Path, hardware: Path | None, pads: list[str]) -> None:
+        self.folder, self.hardware, self.pads = folder, hardware, pads
+        self._one_at_a_time = threading.Lock()  # each try is a whole vest run
+        self._watching: tuple[subprocess.Popen[str], Path] | None = None
+
+    def __call__(self, name: str, text: str, asked: object) -> list[str]:
+        """The timeline of ``text`` (the file ``name``) tried with the event ``asked``;
+        TryError (a ValueError) for an event that cannot be or a run that failed."""
+        event = tried_event(asked, self.pads)
+        if not self._one_at_a_time.acquire(blocking=False):
+            raise TryError("another try is running: wait for its answer")
+        try:
+            return self._tried(name, text, event)
+        finally:
+            self._one_at_a_time.release()
+
+    def _tried(self, name: str, text: str, event: dict[str, object]) -> list[str]:
+        with tempfile.TemporaryDirectory(prefix="vest-try-") as scratch:
+            command = self._command(Path(scratch), name, text, event, TRY_FOR_S)
+            try:
+                done = subprocess.run(
+                    [*command, "--fast"],
+                    capture_output=True,
+                    text=True,
+                    timeout=TRY_TIMEOUT_S,
+                    check=False,
+                )
+            except subprocess.TimeoutExpired:
+                raise TryError(f"the try ran over {TRY_TIMEOUT_S:g} s and was stopped") from None
+        if done.returncode != 0:
+            said = done.stderr.strip().splitlines()
+            raise TryError(said[-1] if said else f"vest run ended with {done.returncode}")
+        timeline = done.stdout.split("\n\n", 1)[0].splitlines()[1:]  # after its heading
+        return [_sentence(line) for line in timeline if line.strip()]
+
+    def watch(self, name: str, text: str, asked: object, host: str) -> str:
+        """Run ``text`` in real time with the event ``asked`` at :data:`WATCH_AT_S` under
+        the live view (on ``host``, as the editor): the view's address. The run before
+        is stopped; TryError when it cannot start."""
+        event = tried_event(asked, self.pads, WATCH_AT_S)
+        with self._one_at_a_time:
+            self.stop_watching()
+            scratch = Path(tempfile.mkdtemp(prefix="vest-watch-"))
+            command = self._command(scratch, name, text, event, WATCH_FOR_S)
+            command += ["--view", "--view-port", "0", "--view-host", host]
+            process = subprocess.Popen(
+                command, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True
+            )
+            self._watching = (process, scratch)
+            assert process.stderr is not None
+            said: list[str] = []
+            for line in process.stderr:  # it prints the view's address once it serves
+                if line.startswith("view: "):
+                    _drain(process.stderr)
+                    return line.removeprefix("view: ").strip()
+                said.append(line.strip())
+            self.stop_watching()
+            raise TryError(said[-1] if said else "vest run ended before its view started")
+
+    def stop_watching(self) -> None:
+        """End the watched run, if one is going on, and remove its copy of the folder."""
+        if self._watching is None:
+            return
+        process, scratch = self._watching
+        self._watching = None
+        process.terminate()
+        try:
+            process.wait(timeout=STOP_WAIT_S)
+        except subprocess.TimeoutExpired:
+            process.kill()
+            process.wait()
+        shutil.rmtree(scratch, ignore_errors=True)
+
+    def _command(
+        self, scratch: Path, name: str, text: str, event: dict[str, object], seconds: float
+    ) -> list[str]:
+        """``vest run`` of ``text`` (the file ``name``) in a copy of the folder's trees in
+        ``scratch`` (its subtrees; a link leading out of the folder is not followed), on a
+        scenario of ``seconds`` with ``event``, the folder's dialogs and the robot config."""
+        copy = scratch / "folder"
+        trees = self.folder / "trees"
+        if trees.is_dir():
+            inside = resolved(self.folder)
+            shutil.copytree(
+                trees,
+                copy / "trees",
+                ignore=lambda at, names: [
+                    name for name in names if not resolved(Path(at) / name).is_relative_to(inside)
+                ],
+            )
+        tried = copy / name
+        tried.parent.mkdir(parents=True, exist_ok=True)
+        tried.write_text(text, encoding="utf-8")
+        scenario = scratch / "try.yaml"
+        scenario.write_text(
+            yaml.safe_dump({"duration_s": seconds, "events": [event]}), encoding="utf-8"
+        )
+        command = [sys.executable, "-c", VEST, "run", "--speech", "text"]
+        command += ["--trees", str(tried), "--scenario", str(scenario)]
+        if (self.folder / "dialogs").is_dir():
+            command += ["--dialogs", str(self.folder / "dialogs")]
+        if self.hardware is not None:
+            command += ["--hardware", str(self.hardware)]
+        return command
+
+
+def _drain(stream: IO[str]) -> None:
+    """Read what else ``stream`` says, in a thread, so the run never blocks on a full pipe."""
+    threading.Thread(target=lambda: [None for _ in stream], name="watch-drain", daemon=True).start()
+
+
+def _sentence(line: str) -> str:
+    """``"    1.00  tickles   says ..."`` as ``"1.00 s tickles: says ..."``."""
+    at, who, what = [*line.split(None, 2), "", ""][:3]
+    return f"{at} s {who}: {what}"
+
+
+HEAR_TIMEOUT_S = 300.0
+
+
+class HearCheck:
+    """`vest dialogs check --quick` on a dialog as it is on the page: each phrase said once
+    by the robot's neural voice and heard as the robot hears (a process of its own, about
+    20 s for the shipped dialogs). Its lines are the answer, the file named as the page
+    names it."""
+
+    def __call__(self, name: str, text: str) -> list[str]:
+        with tempfile.TemporaryDirectory(prefix="vest-hear-") as scratch:
+            checked = Path(scratch) / Path(name).name
+            checked.write_text(text, encoding="utf-8")
+            command = [sys.executable, "-c", VEST, "dialogs", "check", "--quick", str(checked)]
+            try:
+                done = subprocess.run(
+                    command, capture_output=True, text=True, timeout=HEAR_TIMEOUT_S, check=False
+                )
+            except subprocess.TimeoutExpired:
+                raise TryError(f"the check ran over {HEAR_TIMEOUT_S:g} s and was stopped") from None
+            said = (done.stdout + done.stderr).replace(str(checked), name)
+        if done.returncode not in (0, 1):  # 1: it found problems, which are the answer
+            lines = said.strip().splitlines()
+            raise TryError(lines[-1] if lines else f"the check ended with {done.returncode}")
+        return [line for line in said.splitlines() if line.strip()]
