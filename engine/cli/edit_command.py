@@ -19,8 +19,8 @@ from engine.cli.edit_checks import ValidateChecks
 from engine.cli.edit_tries import HearCheck, TryOnSimulatedVest
 from engine.cli.output import tell
 from engine.cli.run_inputs import DEFAULT_HARDWARE, found, load_config, robot_catalogue
+from engine.cli.stop_signals import serve_until_stopped
 from engine.cli.view_options import port_number
-from engine.clock import RealClock
 from engine.editor.palette import palette
 from engine.editor.server import EditorServer
 from engine.editor.workspace import Workspace
@@ -92,11 +92,8 @@ def main(args: argparse.Namespace) -> int:
     )
     server.start()
     tell(f"editor: {server.url}  (the folder {workspace.folder}; Ctrl-C ends it)")
-    clock = RealClock()
-    forever = clock.event()
     try:
-        while not clock.wait(forever, 3600.0):
-            pass
+        serve_until_stopped()
     finally:
         server.stop()
         try_out.stop_watching()

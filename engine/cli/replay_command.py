@@ -16,8 +16,8 @@ from pathlib import Path
 from engine.buttons.button_file import BUTTONS_TREE
 from engine.cli.output import new_file, tell
 from engine.cli.site_access import open_recording
+from engine.cli.stop_signals import serve_until_stopped
 from engine.cli.view_options import add_view_arguments, start_view
-from engine.clock import RealClock
 from engine.errors import ConfigError, UsageError
 from engine.privacy.site import Site
 from engine.recording.replay import Recording, moment
@@ -54,11 +54,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def _serve(recording: Recording, args: argparse.Namespace) -> int:
     """The replay page until Ctrl-C."""
     view = start_view(ReplaySource(recording), args)
-    clock = RealClock()
-    forever = clock.event()
     try:
-        while not clock.wait(forever, 3600.0):
-            pass
+        serve_until_stopped()
     finally:
         view.stop()
     return 0

@@ -67,3 +67,14 @@ class StopSignals:
             raise KeyboardInterrupt
         for callback in self._callbacks:
             callback()
+
+
+def serve_until_stopped() -> None:
+    """Wait, doing nothing, until Ctrl-C or SIGTERM ends the command (a page's server runs
+    in its threads meanwhile: `vest replay --view`, `vest edit`)."""
+    from engine.clock import RealClock
+
+    clock = RealClock()
+    forever = clock.event()
+    while not clock.wait(forever, 3600.0):
+        pass

@@ -3,14 +3,8 @@
 // YAML that keeps the file's comments and layout. Undo and redo keep whole outlines.
 
 import { cleanSvg } from "/shared/drawing.js";
+import { api } from "/shared/address.js";
 
-const token = new URLSearchParams(location.search).get("token");
-const api = (path, params = {}) => {
-  const query = new URLSearchParams(params);
-  if (token) query.set("token", token);
-  const text = query.toString();
-  return text ? `${path}?${text}` : path;
-};
 const $ = (selector) => document.querySelector(selector);
 const make = (tag, props = {}, ...children) => {
   const element = document.createElement(tag);

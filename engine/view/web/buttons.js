@@ -2,9 +2,8 @@
 // tick; which buttons show follows what the robot is doing (server-sent events).
 
 import { follow } from "/shared/stream.js";
+import { api } from "/shared/address.js";
 
-const token = new URLSearchParams(location.search).get("token");
-const api = (path) => (token ? `${path}?token=${encodeURIComponent(token)}` : path);
 const $ = (selector) => document.querySelector(selector);
 const byKey = new Map(); // keyboard key -> button id
 const elements = new Map(); // button id -> <button>

@@ -3,14 +3,8 @@
 
 import { follow } from "/shared/stream.js";
 import { cleanSvg } from "/shared/drawing.js";
+import { api } from "/shared/address.js";
 
-const token = new URLSearchParams(location.search).get("token");
-const api = (path, params = {}) => {
-  const query = new URLSearchParams(params);
-  if (token) query.set("token", token);
-  const text = query.toString();
-  return text ? `${path}?${text}` : path;
-};
 const $ = (selector) => document.querySelector(selector);
 
 const state = { trees: new Map(), keys: new Map(), happened: [], stats: null, now: 0 };
