@@ -10,13 +10,14 @@ at 1.0x clean and 0.9x at 10 dB SNR, and by the hibari voice at 1.0x at 20 dB SN
 1.15x at 10 dB SNR; and sentences no rule means (near misses such as "how old are you"
 and "do you like cake"), in three of those ways. Each clip goes the robot's way: Silero
 VAD on the stream (with its drafts), the recognizer, the dialog matcher; once with each
-recognizer (issue 24): "moonshine" (the default: Moonshine Base, Whisper's second opinion
-when it holds no phrase) and "whisper" (Whisper tiny.en alone, prompted with the phrases).
+recognizer (issue 24): "moonshine" (the default: Moonshine Base, hearing the utterance
+again against the phrases when what it wrote holds none: closed listening) and "whisper"
+(Whisper tiny.en alone, prompted with the phrases).
 
 Real voices (tests/speech/real_voices.py, where Debian's packages are installed): 43
 recordings of people; word error rate (jiwer) of Moonshine and of Whisper, each unprompted
-as a general transcriber (the default would ask Whisper for every one of these sentences,
-which no dialog holds), after the matcher's normalization.
+as a general transcriber (no phrases listened for, so no closed listening), after the
+matcher's normalization.
 
 Baseline in the same run: the character-similarity matcher the engine had before
 (difflib ratio >= 0.8, a contained phrase wins), on the very same transcripts, so the
@@ -57,7 +58,6 @@ from engine.media.audio import SPEECH_RATE_HZ, Audio, noise, with_noise  # noqa:
 from engine.speech.hearing import parts  # noqa: E402
 from engine.speech.moonshine import MoonshineRecognizer  # noqa: E402
 from engine.speech.recognizer import Recognizer, WhisperRecognizer  # noqa: E402
-from engine.speech.recognizers import SecondOpinion  # noqa: E402
 from engine.speech.vad import SileroVad, SpeechDetector  # noqa: E402
 from engine.speech.voice_models import load_voice  # noqa: E402
 from engine.speech.voices import Voice, sentences, steady_voice  # noqa: E402
@@ -179,7 +179,7 @@ def hear_clips(
     ours, base = Tally(), Tally()
     timing: dict[str, list[float]] = {
         "latency": [],
-        "fast": [],  # latencies of the utterances no second opinion was asked for
+        "fast": [],  # latencies of the utterances heard without closed listening
         "wait": [],
         "cpu": [],
         "work": [],
@@ -190,7 +190,7 @@ def hear_clips(
     for clip in clips:
         texts = []
         for part in parts(clip.audio, vad):
-            asked = getattr(recognizer, "second_opinions", 0)
+            asked = getattr(recognizer, "closed_listenings", 0)
             begun, cpu = time.perf_counter(), time.process_time()
             texts.append(recognizer.transcribe(part.heard).text)
             took = time.perf_counter() - begun
@@ -203,7 +203,7 @@ def hear_clips(
             # wait for silence and the recognition are over
             ready = max(wait, wait - part.utterance.quiet_s + part.starts_after_s + took)
             timing["latency"].append(max(0.0, ready))
-            if getattr(recognizer, "second_opinions", 0) == asked:
+            if getattr(recognizer, "closed_listenings", 0) == asked:
                 timing["fast"].append(max(0.0, ready))
         heard = " ".join(t for t in texts if t)
         verdict = dialog.judge(heard, clip.context) if heard else None
@@ -231,9 +231,9 @@ def hear_clips(
         print(f"  {way:22s} right {right:3d}/{total} ({100 * right / total:5.1f}%)")
     for line in examples:
         print(line)
-    second = getattr(recognizer, "second_opinions", None)
-    if second is not None:
-        print(f"  Whisper's second opinion asked for {second} of {len(timing['work'])} utterances")
+    closed = getattr(recognizer, "closed_listenings", None)
+    if closed is not None:
+        print(f"  heard again against the phrases: {closed} of {len(timing['work'])} utterances")
     return timing
 
 
@@ -284,7 +284,7 @@ def main() -> int:
     whisper = WhisperRecognizer(beam_size=args.beam)
     moonshine = MoonshineRecognizer()
     recognizers: dict[str, Recognizer] = {
-        "moonshine (default)": SecondOpinion(moonshine, whisper),
+        "moonshine (default)": moonshine,
         "whisper": whisper,
     }
     vad = SileroVad()
@@ -325,7 +325,7 @@ def main() -> int:
         fast = timing["fast"]
         if fast and len(fast) < len(latency):
             print(
-                f"{'  of which Moonshine alone':22s} p50 {statistics.median(fast) * 1000:4.0f} ms  "
+                f"{'  of which free alone':22s} p50 {statistics.median(fast) * 1000:4.0f} ms  "
                 f"p90 {pct(fast, 90) * 1000:4.0f} ms  ({len(fast)} of {len(latency)})"
             )
     first, second = (pct(t["latency"], 90) for t in timings.values())

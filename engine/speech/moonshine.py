@@ -11,7 +11,10 @@ once, at load: :mod:`engine.speech.onnx_folding`), greedy, one token at a time w
 decoder's key/value cache.
 
 Moonshine takes no prompt: it writes what it hears, and the dialog matcher decides what
-it means (``listen_for`` changes nothing). A decoding that loops (the same words again
+it means. When what it wrote holds none of the phrases the robot listens for
+(``listen_for``), it hears the utterance again allowed to write only those phrases, and
+the phrase it finds is kept when the audio bears it out (closed listening:
+:mod:`engine.speech.phrase_search`). A decoding that loops (the same words again
 and again, which sequence models do on sounds that are no words) is heard as nothing, a
 short utterance said once more after itself is kept once, and a transcript the model
 itself doubts (mean token probability under :data:`DOUBTED_BELOW`) is heard as nothing:
@@ -30,6 +33,7 @@ import numpy as np
 from engine.dialogs.words import words
 from engine.media.audio import SPEECH_RATE_HZ, Audio
 from engine.speech.onnx_folding import folded_model
+from engine.speech.phrase_search import PhraseGrammar, bears_out, closest_phrase, log_softmax
 from engine.speech.recognizer import RecognizerError, Transcript, Word, said_in_a_loop
 
 MODEL_PACKAGE = "moonshine_cpp"
@@ -103,6 +107,50 @@ def without_loop(tokens: list[int]) -> list[int]:
     return tokens
 
 
+class _Decoder:
+    """Moonshine's decoder on one utterance's encoder output, for one text or several at
+    once (rows), with its key/value cache: a :class:`~engine.speech.phrase_search.Decoding`."""
+
+    def __init__(self, recognizer: MoonshineRecognizer, hidden: np.ndarray) -> None:
+        self._recognizer = recognizer
+        self._hidden = hidden
+        self._cache = {name: recognizer._empty for name in recognizer._cache_names}
+        self._started = False
+        self._first: tuple[np.ndarray, dict[str, np.ndarray]] | None = None
+
+    def first(self) -> np.ndarray:
+        if self._first is None:  # the first step is the same for every text: run once
+            rows = self._run(np.array([[START_TOKEN]], dtype=np.int64))
+            self._first = (rows, dict(self._cache))
+        rows, self._cache = self._first[0], dict(self._first[1])
+        self._started = True
+        return rows
+
+    def then(self, parents: np.ndarray, tokens: np.ndarray) -> np.ndarray:
+        self._cache = {name: value[parents] for name, value in self._cache.items()}
+        return self._run(tokens[:, None])
+
+    def _run(self, ids: np.ndarray) -> np.ndarray:
+        """Log-probabilities of the next token after each row of ``ids``."""
+        rows = len(ids)
+        hidden = self._hidden if rows == 1 else np.repeat(self._hidden, rows, axis=0)
+        outputs = self._recognizer.decoder.run(
+            None,
+            {
+                "input_ids": ids,
+                "encoder_hidden_states": hidden,
+                "use_cache_branch": np.array([self._started]),
+                **self._cache,
+            },
+        )
+        for name, value in zip(self._recognizer._outputs[1:], outputs[1:], strict=True):
+            past = "past_key_values." + name.removeprefix("present.")
+            if not self._started or ".decoder." in past:  # the encoder's part is computed once
+                self._cache[past] = value
+        self._started = True
+        return log_softmax(outputs[0][:, -1].astype(np.float64))
+
+
 class MoonshineRecognizer:
     """Moonshine Base English on ONNX Runtime, one utterance at a time."""
 
@@ -136,57 +184,66 @@ class MoonshineRecognizer:
         heads, size = inputs[self._cache_names[0]].shape[1], inputs[self._cache_names[0]].shape[3]
         self._empty = np.zeros((1, int(heads), 0, int(size)), dtype=np.float32)
         self._outputs = [o.name for o in self.decoder.get_outputs()]
+        self._texts = [
+            "" if token <= END_TOKEN else piece.decode("utf-8", "replace").replace(WORD_START, " ")
+            for token, piece in enumerate(self.pieces)
+        ]
+        self.grammar = PhraseGrammar(())
+        self.closed_listenings = 0
+        """Utterances heard again against the phrases (for the benchmarks)."""
         self.name = f"moonshine base (cpu, {threads} threads)"
 
     def listen_for(self, phrases: Iterable[str]) -> None:
-        """Moonshine takes no prompt; the matcher alone decides what a transcript means."""
+        """The phrases closed listening may hear (:mod:`engine.speech.phrase_search`)."""
+        self.grammar = PhraseGrammar(phrases)
 
     def transcribe(self, audio: Audio) -> Transcript:
         samples = audio.resampled(SPEECH_RATE_HZ).samples.astype(np.float32)
         if len(samples) < SPEECH_RATE_HZ // 10:  # shorter than the encoder's window
             return Transcript("")
-        tokens, probabilities = self._decode(samples)
-        said = self._words(tokens, probabilities)
-        mean = sum(probabilities) / len(probabilities) if probabilities else 0.0
-        log_prob = sum(math.log(max(p, 1e-12)) for p in probabilities) / max(1, len(tokens))
-        looped = len(without_loop(tokens)) < len(tokens)
-        if looped or said_in_a_loop(" ".join(w.text for w in said)):
-            return Transcript("", said, 1.0 - mean, log_prob)  # sounds that are no words
-        heard = said_once(said)
-        text = " ".join(w.text for w in heard)
-        if not text or mean < DOUBTED_BELOW:
-            return Transcript("", heard, 1.0 - mean, log_prob)
-        return Transcript(text, heard, 1.0 - mean, log_prob)
-
-    def _decode(self, samples: np.ndarray) -> tuple[list[int], list[float]]:
-        """Greedy decoding: the tokens (without start and end) and each one's probability."""
         hidden = self.encoder.run(None, {"input_values": samples[None, :]})[0]
-        limit = int(len(samples) / SPEECH_RATE_HZ * TOKENS_PER_S) + 4
-        cache = {name: self._empty for name in self._cache_names}
-        token, tokens, probabilities = START_TOKEN, [], []
-        for step in range(limit):
-            outputs = self.decoder.run(
-                None,
-                {
-                    "input_ids": np.array([[token]], dtype=np.int64),
-                    "encoder_hidden_states": hidden,
-                    "use_cache_branch": np.array([step > 0]),
-                    **cache,
-                },
+        max_tokens = int(len(samples) / SPEECH_RATE_HZ * TOKENS_PER_S) + 4
+        decoder = _Decoder(self, hidden)
+        tokens, log_probs, free_log_prob = self._decode(decoder, max_tokens)
+        probabilities = [math.exp(p) for p in log_probs]
+        said = self._words(tokens, probabilities)
+        heard = said_once(said)
+        mean = sum(probabilities) / len(probabilities) if probabilities else 0.0
+        per_token = free_log_prob / max(1, len(tokens))
+        looped = len(without_loop(tokens)) < len(tokens) or said_in_a_loop(
+            " ".join(w.text for w in said)
+        )
+        text = "" if looped else " ".join(w.text for w in heard)
+        if not text or mean < DOUBTED_BELOW:
+            text = ""
+        if self.grammar and not (text and self.grammar.holds_a_phrase(text)):
+            self.closed_listenings += 1
+            found = closest_phrase(
+                decoder,
+                self.grammar,
+                self._texts,
+                end_token=END_TOKEN,
+                max_tokens=max_tokens,
             )
-            logits = outputs[0][0, -1].astype(np.float64)
-            token = int(np.argmax(logits))
-            top = logits[token]
-            probabilities.append(1.0 / float(np.sum(np.exp(logits - top))))
+            words_heard = [(w.text, w.probability) for w in heard]
+            if found is not None and bears_out(found, free_log_prob, words_heard, self.grammar):
+                return Transcript(found.text, heard, 1.0 - mean, per_token)
+        return Transcript(text, heard if not looped else said, 1.0 - mean, per_token)
+
+    def _decode(self, decoder: _Decoder, max_tokens: int) -> tuple[list[int], list[float], float]:
+        """Greedy decoding: the tokens (without start and end), each one's log-probability,
+        and the whole text's (its end included), natural log."""
+        rows = decoder.first()
+        tokens: list[int] = []
+        log_probs: list[float] = []
+        for _ in range(max_tokens):
+            token = int(np.argmax(rows[0]))
+            log_probs.append(float(rows[0][token]))
             if token == END_TOKEN:
-                probabilities.pop()
-                break
+                return tokens, log_probs[:-1], sum(log_probs)
             tokens.append(token)
-            for name, value in zip(self._outputs[1:], outputs[1:], strict=True):
-                past = "past_key_values." + name.removeprefix("present.")
-                if step == 0 or ".decoder." in past:  # the encoder's part is computed once
-                    cache[past] = value
-        return tokens, probabilities
+            rows = decoder.then(np.zeros(1, dtype=np.int64), np.array([token], dtype=np.int64))
+        return tokens, log_probs, sum(log_probs)
 
     def _words(self, tokens: list[int], probabilities: list[float]) -> tuple[Word, ...]:
         """The words the tokens spell, each with its tokens' mean probability."""

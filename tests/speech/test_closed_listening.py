@@ -1,0 +1,181 @@
+"""Issue 24: when Moonshine's words hold none of the dialogs' phrases, it hears the audio
+again allowed to write only those phrases, and the phrase is kept only when the audio
+bears it out.
+
+The search's stories use a scripted decoder (a fake: it gives each next piece the
+log-probability its script says), so they are exact; the last stories hear real speech
+with the real model."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+import pytest
+
+from engine.dialogs.model import Dialog
+from engine.media.audio import Audio
+from engine.speech.hearing import hear
+from engine.speech.phrase_search import (
+    CLOSE_ENOUGH_NATS,
+    Found,
+    PhraseGrammar,
+    bears_out,
+    closest_phrase,
+    left_out,
+)
+from engine.speech.recognizer import Recognizer
+from engine.speech.vad import SileroVad
+
+END = 2
+PIECES = ["", "", "", " Do", " you", " like", " dog", " it", "?", " dogs", " How", " are"]
+PIECES += [" kitten"]
+IMPOSSIBLE = -np.inf
+
+
+class ScriptedDecoder:
+    """Gives the pieces its script names for the text so far their log-probabilities
+    (the end: ``"</s>"``); every other piece is impossible."""
+
+    def __init__(self, script: dict[str, dict[str, float]]) -> None:
+        self.script = script
+        self.texts: list[str] = []
+        self.steps = 0
+
+    def first(self) -> np.ndarray:
+        self.texts = [""]
+        return self._rows()
+
+    def then(self, parents: np.ndarray, tokens: np.ndarray) -> np.ndarray:
+        self.steps += 1
+        self.texts = [self.texts[p] + PIECES[t] for p, t in zip(parents, tokens, strict=True)]
+        return self._rows()
+
+    def _rows(self) -> np.ndarray:
+        rows = np.full((len(self.texts), len(PIECES)), IMPOSSIBLE)
+        for row, text in enumerate(self.texts):
+            for piece, log_prob in self.script.get(text, {}).items():
+                rows[row, END if piece == "</s>" else PIECES.index(piece)] = log_prob
+        return rows
+
+
+GRAMMAR = PhraseGrammar(["do you like dog", "do you like kitten", "how are you"])
+
+
+def search(script: dict[str, dict[str, float]]) -> Found | None:
+    return closest_phrase(ScriptedDecoder(script), GRAMMAR, PIECES, end_token=END, max_tokens=8)
+
+
+def test_a_word_heard_wrong_is_written_as_the_phrase_the_model_finds_likeliest() -> None:
+    # Free, the model writes "Do you like it?"; "dogs" is its second choice, "kitten" far off
+    script = {
+        "": {" Do": -0.1},
+        " Do": {" you": -0.1},
+        " Do you": {" like": -0.1},
+        " Do you like": {" it": -0.5, " dogs": -1.5, " kitten": -6.0},
+        " Do you like dogs": {"?": -0.2, "</s>": -1.0},
+        " Do you like dogs?": {"</s>": -0.1},
+        " Do you like kitten": {"</s>": -0.1},
+    }
+    found = search(script)
+    assert found is not None
+    assert found.text == "do you like dogs"  # a phrase's word in the plural, "?" aside
+    assert found.log_prob == pytest.approx(-0.1 * 3 - 1.5 - 0.2 - 0.1)
+
+
+def test_a_search_writes_nothing_it_cannot_finish_as_a_phrase() -> None:
+    # "Do you" could become a phrase, but the model never ends it as one
+    script = {"": {" Do": -0.1}, " Do": {" you": -0.1}, " Do you": {"</s>": -0.1}}
+    assert search(script) is None
+
+
+def test_the_search_stops_once_no_text_can_beat_the_phrase_it_has() -> None:
+    script = {
+        "": {" How": -0.1, " Do": -9.0},
+        " How": {" are": -0.1},
+        " How are": {" you": -0.1},
+        " How are you": {"</s>": -0.1},
+        " Do": {" you": -0.1},
+    }
+    decoder = ScriptedDecoder(script)
+    found = closest_phrase(decoder, GRAMMAR, PIECES, end_token=END, max_tokens=8)
+    assert found == Found("how are you", pytest.approx(-0.4))
+    assert decoder.steps == 3  # the "Do ..." text (-9) was never carried further
+
+
+def words_heard(text: str, probability: float = 0.9) -> list[tuple[str, float]]:
+    return [(word, probability) for word in text.split()]
+
+
+def test_a_phrase_nearly_as_likely_as_the_free_transcript_with_a_word_misheard_is_kept() -> None:
+    found = Found("how hot is it", -4.0)
+    assert bears_out(found, -1.5, words_heard("How art is it?"), GRAMMAR)
+
+
+def test_a_phrase_much_less_likely_than_the_free_transcript_is_not() -> None:
+    found = Found("how are you", -1.0 - CLOSE_ENOUGH_NATS - 0.1)
+    assert not bears_out(found, -1.0, words_heard("How old are you?", 0.3), GRAMMAR)
+
+
+def test_a_word_clearly_heard_that_the_phrase_leaves_out_means_another_question() -> None:
+    found = Found("how are you", -2.0)
+    assert not bears_out(found, -1.0, words_heard("How tall are you?"), GRAMMAR)
+    # heard unsure, the same word may be noise
+    assert bears_out(found, -1.0, words_heard("How tall are you?", 0.4), GRAMMAR)
+
+
+def test_a_word_of_another_phrase_heard_more_likely_than_not_is_never_overruled() -> None:
+    grammar = PhraseGrammar(["what is your name", "what is your favorite color"])
+    heard = [("What", 0.7), ("in", 0.4), ("your", 0.99), ("amber", 0.47), ("color?", 0.58)]
+    assert not bears_out(Found("what is your name", -4.0), -1.0, heard, grammar)
+
+
+def test_words_left_out_are_those_the_phrase_has_nothing_in_place_of() -> None:
+    heard = words_heard("how tall are you")
+    assert left_out(heard, ["how", "are", "you"]) == [("tall", 0.9)]
+    assert left_out(words_heard("my word"), ["my", "bird"]) == []  # in place of "bird"
+    assert left_out(words_heard("yes yes"), ["yes"]) == []  # said twice
+
+
+def test_the_grammar_reads_phrases_as_spelled_whatever_the_case_and_marks() -> None:
+    assert GRAMMAR.allows(" Do you lik")
+    assert GRAMMAR.complete(" How are you?")
+    assert not GRAMMAR.allows(" How are you doing")
+    assert not GRAMMAR.complete(" Do you like")
+
+
+# -- the real model --------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("said", "voice", "speed", "rule"),
+    [
+        ("how hot is it", "hibari", 1.0, "temperature"),  # freely: "How hard is it?"
+        ("hi there", "joe", 0.85, "greeting"),  # freely: "Hide there,"
+    ],
+)
+def test_a_phrase_moonshine_writes_wrong_is_heard_right_through_the_phrases(
+    said: str,
+    voice: str,
+    speed: float,
+    rule: str,
+    spoken: Callable[..., Audio],
+    vad: SileroVad,
+    recognizer: Recognizer,
+    default_dialog: Dialog,
+) -> None:
+    hearing = hear(spoken(said, voice, speed), vad, recognizer, default_dialog)
+    assert hearing.verdict is not None and hearing.verdict.match is not None, hearing
+    assert hearing.verdict.match.rule.id == rule
+
+
+@pytest.mark.parametrize("sentence", ["how old are you", "are you a robot", "how tall are you"])
+def test_a_question_no_rule_means_is_not_taken_for_the_phrase_it_sounds_like(
+    sentence: str,
+    spoken: Callable[..., Audio],
+    vad: SileroVad,
+    recognizer: Recognizer,
+    default_dialog: Dialog,
+) -> None:
+    hearing = hear(spoken(sentence, "joe", 0.85), vad, recognizer, default_dialog)
+    assert hearing.verdict is not None and hearing.verdict.match is None, hearing
