@@ -1,6 +1,6 @@
 """Speech: accuracy, latency, real-time factors and idle CPU, on the real models.
 
-Run: ``.venv/bin/python bench/bench_speech.py`` (``--help``); about 6 minutes on 2 cores
+Run: ``.venv/bin/python bench/bench_speech.py`` (``--help``); about 18 minutes on 2 cores
 (``--quick``, a short run that only shows it still works: under a minute).
 
 Clip set (not the tests' clips): every phrase of every rule of dialogs/default.yaml, all

@@ -209,13 +209,12 @@ class MoonshineRecognizer:
         said = self._words(tokens, probabilities)
         heard = said_once(said)
         mean = sum(probabilities) / len(probabilities) if probabilities else 0.0
-        per_token = free_log_prob / max(1, len(tokens))
+        per_token = sum(log_probs) / max(1, len(tokens))
         looped = len(without_loop(tokens)) < len(tokens) or said_in_a_loop(
             " ".join(w.text for w in said)
         )
-        text = "" if looped else " ".join(w.text for w in heard)
-        if not text or mean < DOUBTED_BELOW:
-            text = ""
+        doubted = looped or mean < DOUBTED_BELOW
+        text = "" if doubted else " ".join(w.text for w in heard)
         if self.grammar and not (text and self.grammar.holds_a_phrase(text)):
             self.closed_listenings += 1
             found = closest_phrase(
