@@ -84,7 +84,8 @@ def load_dialog_named(folder: Path | None, name: str) -> tuple[DialogLibrary, Di
     library = DialogLibrary.from_folder(found, default_catalogue())
     dialog = library.get(name)
     if dialog is None:
-        raise ConfigError(f"no dialog {name!r} in {found}; dialogs: {', '.join(library.names)}")
+        have = ", ".join(library.names) or "none: no dialog files (*.yaml) in it"
+        raise ConfigError(f"no dialog {name!r} in {found}; dialogs: {have}")
     return library, dialog
 
 

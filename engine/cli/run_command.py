@@ -5,9 +5,10 @@ through the simulated vest (examples/robots/sim.yaml): the scenario moves regist
 chip models that the real drivers read. --hardware CONFIG names a robot config; on a robot
 (e.g. examples/robots/hbs2.yaml) the same drivers read the real chips.
 Speech goes through the real models: a scenario's hear: is spoken into the simulated
-room, heard by Silero VAD and Whisper, and the answers are synthesized (--audio-out DIR
-keeps a WAV per utterance, replacing those of an earlier run); --speech text skips the
-models, hands the trees the text and gives each spoken word 0.3 s.
+room, heard by Silero VAD and the recognizer (Moonshine by default), and the answers
+are synthesized (--audio-out DIR keeps a WAV per utterance, replacing those of an
+earlier run); --speech text skips the models, hands the trees the text and gives each
+spoken word 0.3 s.
 --fast runs on a virtual clock as fast as the machine allows; --json prints the session
 as JSON lines, one object per event the timeline tells: {"t": seconds, "event": "action",
 "tree": name, "action": ..., "args": {...}}, and how actions ended, turns, safety, presses,

@@ -100,6 +100,8 @@ def dialogs_folder(given: Path | None) -> Path | None:
     if given is None:
         folder = found(DEFAULT_DIALOGS)
         return folder if folder.is_dir() else None
+    if given.is_file():
+        raise ConfigError(f"--dialogs {given}: a file; give the folder that holds it")
     if not given.is_dir():
         raise ConfigError(f"--dialogs {given}: no such folder")
     return given

@@ -230,7 +230,25 @@ def _rules(
         problems.add(raw_rules.mark, "'rules' is empty", "add a hear/say rule")
         return ()
     rules = (_rule(raw, concepts, ctx, problems, budget, depth, parent) for raw in raw_rules)
-    return tuple(rule for rule in rules if rule is not None)
+    kept = tuple(rule for rule in rules if rule is not None)
+    _check_shared_phrases(kept, problems)
+    return kept
+
+
+def _check_shared_phrases(rules: tuple[DialogRule, ...], problems: Problems) -> None:
+    """A phrase two rules of one conversation both listen for fits both whenever it is
+    said, and two rules that fit cancel out: neither would ever answer it."""
+    holder: dict[tuple[str, ...], DialogRule] = {}
+    for rule in rules:
+        for phrase in rule.phrases:
+            first = holder.setdefault(phrase.words, rule)
+            if first is not rule:
+                problems.add(
+                    rule.mark or Mark("", 1, 1),
+                    f"rules {first.id!r} (line {first.line}) and {rule.id!r} both listen for "
+                    f"{phrase.text!r}: said, it fits both and neither answers",
+                    "keep the phrase in one rule",
+                )
 
 
 def _check_ids(rules: tuple[DialogRule, ...], problems: Problems) -> None:

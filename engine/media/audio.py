@@ -155,6 +155,11 @@ def wav_from_bytes(data: bytes, name: str) -> Audio:
                 taken += frames
                 chunks.append(_mono(raw[: frames * width * channels], dtypes[width], channels))
     except (wave.Error, EOFError) as error:
+        if "unknown format: 3" in str(error):  # WAVE_FORMAT_IEEE_FLOAT
+            raise AudioFileError(
+                f"{name}: 32-bit float samples; use 8, 16 or 32-bit PCM (e.g. sox {name} "
+                "-b 16 -e signed-integer out.wav)"
+            ) from None
         raise AudioFileError(f"{name}: not a WAV file ({error or 'cut short'})") from None
     if taken > most:
         raise AudioFileError(f"{name}: more than {MAX_WAV_S:.0f} s of audio")

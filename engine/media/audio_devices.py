@@ -61,7 +61,10 @@ def _start(command: list[str], role: str, device: str) -> subprocess.Popen[bytes
     except subprocess.TimeoutExpired:
         return process  # still running: the device opened
     why = (process.stderr.read().decode(errors="replace") if process.stderr else "").strip()
-    raise AudioDeviceError(f"{role} {device!r} cannot be opened: {_first_line(why)}")
+    raise AudioDeviceError(
+        f"{role} {device!r} cannot be opened: {_first_line(why)} (`vest devices` lists the "
+        "sound devices; name one with --device or in the robot config)"
+    )
 
 
 def _first_line(text: str) -> str:

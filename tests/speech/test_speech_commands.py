@@ -84,7 +84,7 @@ def test_hear_refuses_a_file_that_is_not_a_wav(
     assert f"{text}: not a WAV file" in capsys.readouterr().err
 
 
-def test_dialogs_check_finds_a_phrase_another_rule_takes(
+def test_dialogs_check_refuses_a_phrase_two_rules_share_before_hearing_anything(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     (tmp_path / "play.yaml").write_text(
@@ -101,9 +101,8 @@ rules:
         encoding="utf-8",
     )
     assert main(["dialogs", "check", str(tmp_path), "--quick"]) == 1
-    out = capsys.readouterr().out
-    assert "rule 'play': phrase 'let us play' as written -> ambiguous" in out
-    assert "problem(s)" in out.splitlines()[-1]
+    err = capsys.readouterr().err
+    assert "rules 'play' (line 3) and 'play_ball' both listen for 'let us play'" in err
 
 
 def test_dialogs_check_passes_the_default_dialog_quickly(

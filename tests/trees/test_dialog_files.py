@@ -304,3 +304,32 @@ def test_follow_up_rules_without_ids_are_named_under_their_question(tmp_path: Pa
         "do you like animals/yes",
         "do you like music/yes",
     ]
+
+
+def test_a_phrase_two_rules_listen_for_is_refused_before_it_silently_answers_nothing(
+    tmp_path: Path,
+) -> None:
+    problems = dialog_problems(
+        tmp_path,
+        """\
+        dialog: d
+        concepts:
+          pet: ["dog", "cat"]
+        rules:
+          - id: name
+            hear: ["what is your name"]
+            say: "Robot"
+          - id: pets
+            hear: ["do you like ~pet", "what is your name"]
+            say: "Yes"
+            then:
+              rules:
+                - hear: ["do you like dog"]
+                  say: "Dogs!"
+        """,
+    )
+    # a follow-up is another conversation: its own rules may share the top level's phrases
+    assert problems == [
+        "d.yaml:8:5: rules 'name' (line 5) and 'pets' both listen for 'what is your name': "
+        "said, it fits both and neither answers (keep the phrase in one rule)"
+    ]
