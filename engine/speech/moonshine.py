@@ -33,7 +33,13 @@ import numpy as np
 from engine.dialogs.words import words
 from engine.media.audio import SPEECH_RATE_HZ, Audio
 from engine.speech.onnx_folding import folded_model
-from engine.speech.phrase_search import PhraseGrammar, bears_out, closest_phrase, log_softmax
+from engine.speech.phrase_search import (
+    PhraseGrammar,
+    bears_out,
+    closest_phrase,
+    log_softmax,
+    sure_of,
+)
 from engine.speech.recognizer import RecognizerError, Transcript, Word, said_in_a_loop
 
 MODEL_PACKAGE = "moonshine_cpp"
@@ -215,6 +221,7 @@ class MoonshineRecognizer:
         )
         doubted = looped or mean < DOUBTED_BELOW
         text = "" if doubted else " ".join(w.text for w in heard)
+        unconfirmed = ""
         if self.grammar and not (text and self.grammar.holds_a_phrase(text)):
             self.closed_listenings += 1
             found = closest_phrase(
@@ -226,8 +233,10 @@ class MoonshineRecognizer:
             )
             words_heard = [(w.text, w.probability) for w in heard]
             if found is not None and bears_out(found, free_log_prob, words_heard, self.grammar):
-                return Transcript(found.text, heard, 1.0 - mean, per_token)
-        return Transcript(text, heard if not looped else said, 1.0 - mean, per_token)
+                if sure_of(found, words_heard):
+                    return Transcript(found.text, heard, 1.0 - mean, per_token)
+                unconfirmed = found.text
+        return Transcript(text, heard if not looped else said, 1.0 - mean, per_token, unconfirmed)
 
     def _decode(self, decoder: _Decoder, max_tokens: int) -> tuple[list[int], list[float], float]:
         """Greedy decoding: the tokens (without start and end), each one's log-probability,

@@ -21,7 +21,10 @@ bears it out (:func:`bears_out`):
   not (:data:`KEYWORD_HEARD`) ("what in your amber with *color*" is not "what is your name").
 
 Otherwise the utterance is heard as what Moonshine wrote, which holds no phrase: the
-robot says it did not understand rather than answer a guess. bench/bench_speech.py
+robot says it did not understand rather than answer a guess. A phrase borne out but not
+*sure* (:func:`sure_of`: a short sound forced into "yes", a long mumble into a short
+phrase) is left for a careful recognizer to hear again
+(:class:`~engine.speech.recognizers.SecondOpinion`). bench/bench_speech.py
 measures the thresholds' effect on 662 clips (right, wrong, stray sentences accepted).
 """
 
@@ -48,6 +51,7 @@ __all__ = [
     "closest_phrase",
     "left_out",
     "log_softmax",
+    "sure_of",
 ]
 
 CLOSE_ENOUGH_NATS = 5.0
@@ -61,6 +65,12 @@ not what was said."""
 KEYWORD_HEARD = 0.5
 """A word of one of the dialogs' phrases written more likely than not was said: a phrase
 without it is not what was said."""
+SURE_PER_WORD = -2.0
+"""A phrase borne out is *sure* when the model gives it at least this log-probability per
+word (and its end) on average, it has two words or more, and Moonshine wrote some words
+of its own: otherwise a careful recognizer hears the utterance again. A short sound
+("mm", "oh", a laugh) forced into "yes", "no" or "hi", or a long mumble into a short
+phrase, is borne out relative to a doubtful transcript but never sure."""
 BEAM = 4
 """Texts kept at each step of the search."""
 TOP_TOKENS = 50
@@ -216,6 +226,13 @@ def bears_out(
         probability >= CLEARLY_HEARD and not is_function_word(word)
         for word, probability in left_out(said, phrase)
     )
+
+
+def sure_of(found: Found, heard: Sequence[tuple[str, float]]) -> bool:
+    """Whether a phrase :func:`bears_out` accepted needs no second opinion (see
+    :data:`SURE_PER_WORD`)."""
+    said = words(found.text)
+    return bool(heard) and len(said) >= 2 and found.log_prob / (len(said) + 1) >= SURE_PER_WORD
 
 
 def left_out(heard: Sequence[tuple[str, float]], phrase: Sequence[str]) -> list[tuple[str, float]]:

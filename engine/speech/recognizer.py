@@ -90,6 +90,9 @@ class Transcript:
     words: tuple[Word, ...] = ()
     no_speech: float = 0.0
     log_prob: float = 0.0
+    unconfirmed: str = ""
+    """A phrase the recognizer found the audio may hold but is not sure of: for a careful
+    recognizer to hear again (empty when none)."""
 
     @property
     def unsure(self) -> list[str]:

@@ -4,8 +4,11 @@
 every utterance in about a seventh of Whisper's time; when none of the dialogs' phrases
 is in what it wrote (a word it got wrong, a sentence no rule means), it hears the
 utterance again allowed to write only those phrases, and keeps the phrase when the audio
-bears it out (:mod:`engine.speech.phrase_search`, a tenth of a second). It replaced
-Whisper's second opinion (0.8 s), and answers more of bench/bench_speech.py's clips right.
+bears it out (:mod:`engine.speech.phrase_search`, a tenth of a second). A phrase it is not
+sure of (a short sound forced into "yes", a long mumble into a short phrase) is heard again
+by Whisper tiny.en, prompted with the phrases, whose transcript counts
+(:class:`SecondOpinion`): about one utterance in twenty-five on bench/bench_speech.py's
+clips, where Whisper once heard every utterance Moonshine's words did not hold.
 "whisper" is Whisper tiny.en alone, prompted with the phrases, and the fallback where
 Moonshine's package is not installed (its wheels are x86_64 only). A profile chooses
 with ``recognizer:``; ``vest hear`` and ``vest dialogs check`` with ``--recognizer``.
@@ -13,21 +16,50 @@ with ``recognizer:``; ``vest hear`` and ``vest dialogs check`` with ``--recogniz
 
 from __future__ import annotations
 
-from engine.speech.recognizer import Recognizer, RecognizerError
+from collections.abc import Iterable
+
+from engine.media.audio import Audio
+from engine.speech.recognizer import Recognizer, RecognizerError, Transcript
 from engine.speech.settings import RECOGNIZER_NAMES
 
 DEFAULT_RECOGNIZER = "moonshine"
 
 
+class SecondOpinion:
+    """A fast recognizer, and a careful one that hears again the utterances whose phrase
+    the fast one found but is not sure of (:attr:`Transcript.unconfirmed`): the careful
+    recognizer's transcript is the one told."""
+
+    def __init__(self, fast: Recognizer, careful: Recognizer) -> None:
+        self.fast = fast
+        self.careful = careful
+        fast_name, careful_name = getattr(fast, "name", "fast"), getattr(careful, "name", "careful")
+        self.name = f"{fast_name}, {careful_name} when unsure"
+        self.second_opinions = 0
+        """Utterances the careful recognizer heard again (for the benchmarks)."""
+
+    def listen_for(self, phrases: Iterable[str]) -> None:
+        listened = list(phrases)
+        self.fast.listen_for(listened)
+        self.careful.listen_for(listened)
+
+    def transcribe(self, audio: Audio) -> Transcript:
+        heard = self.fast.transcribe(audio)
+        if not heard.unconfirmed:
+            return heard
+        self.second_opinions += 1
+        return self.careful.transcribe(audio)
+
+
 def load_recognizer(name: str) -> Recognizer:
     """The recognizer called ``name``; RecognizerError saying why it cannot hear."""
+    from engine.speech.recognizer import WhisperRecognizer
+
     if name == "moonshine":
         from engine.speech.moonshine import MoonshineRecognizer
 
-        return MoonshineRecognizer()
+        return SecondOpinion(MoonshineRecognizer(), WhisperRecognizer())
     if name == "whisper":
-        from engine.speech.recognizer import WhisperRecognizer
-
         return WhisperRecognizer()
     raise RecognizerError(f"no recognizer {name!r}; recognizers: {', '.join(RECOGNIZER_NAMES)}")
 

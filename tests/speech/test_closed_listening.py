@@ -8,7 +8,7 @@ with the real model."""
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 
 import numpy as np
 import pytest
@@ -23,8 +23,10 @@ from engine.speech.phrase_search import (
     bears_out,
     closest_phrase,
     left_out,
+    sure_of,
 )
-from engine.speech.recognizer import Recognizer
+from engine.speech.recognizer import Recognizer, Transcript
+from engine.speech.recognizers import SecondOpinion
 from engine.speech.vad import SileroVad
 
 END = 2
@@ -99,7 +101,8 @@ def test_the_search_stops_once_no_text_can_beat_the_phrase_it_has() -> None:
     }
     decoder = ScriptedDecoder(script)
     found = closest_phrase(decoder, GRAMMAR, PIECES, end_token=END, max_tokens=8)
-    assert found == Found("how are you", pytest.approx(-0.4))
+    assert found is not None and found.text == "how are you"
+    assert found.log_prob == pytest.approx(-0.4)
     assert decoder.steps == 3  # the "Do ..." text (-9) was never carried further
 
 
@@ -135,6 +138,41 @@ def test_words_left_out_are_those_the_phrase_has_nothing_in_place_of() -> None:
     assert left_out(heard, ["how", "are", "you"]) == [("tall", 0.9)]
     assert left_out(words_heard("my word"), ["my", "bird"]) == []  # in place of "bird"
     assert left_out(words_heard("yes yes"), ["yes"]) == []  # said twice
+
+
+def test_a_phrase_is_sure_when_likely_word_by_word_long_enough_and_something_was_written() -> None:
+    heard = words_heard("How hard is it?")
+    assert sure_of(Found("how hot is it", -4.0), heard)  # -0.8 a word and its end
+    assert not sure_of(Found("how hot is it", -12.0), heard)  # a long mumble forced in
+    assert not sure_of(Found("yes", -0.5), words_heard("Mm."))  # one word: never sure
+    assert not sure_of(Found("how hot is it", -1.0), [])  # Moonshine wrote nothing
+
+
+class SaysRecognizer:
+    """Says what it is told to, and counts what it heard."""
+
+    name = "says"
+
+    def __init__(self, transcript: Transcript) -> None:
+        self.transcript = transcript
+        self.heard = 0
+
+    def listen_for(self, phrases: Iterable[str]) -> None:
+        pass
+
+    def transcribe(self, audio: Audio) -> Transcript:
+        self.heard += 1
+        return self.transcript
+
+
+def test_whisper_hears_again_only_a_phrase_closed_listening_is_not_sure_of() -> None:
+    fast = SaysRecognizer(Transcript("how hot is it"))
+    careful = SaysRecognizer(Transcript("Mm."))
+    both = SecondOpinion(fast, careful)
+    assert both.transcribe(Audio.silence(1.0)).text == "how hot is it"
+    fast.transcript = Transcript("", unconfirmed="yes")  # "mm" forced into "yes"
+    assert both.transcribe(Audio.silence(1.0)).text == "Mm."
+    assert (fast.heard, careful.heard, both.second_opinions) == (2, 1, 1)
 
 
 def test_the_grammar_reads_phrases_as_spelled_whatever_the_case_and_marks() -> None:
@@ -179,3 +217,25 @@ def test_a_question_no_rule_means_is_not_taken_for_the_phrase_it_sounds_like(
 ) -> None:
     hearing = hear(spoken(sentence, "joe", 0.85), vad, recognizer, default_dialog)
     assert hearing.verdict is not None and hearing.verdict.match is None, hearing
+
+
+@pytest.mark.parametrize("sound", ["mmm", "oh", "ha ha ha"])
+def test_a_sound_after_the_robot_s_question_is_not_taken_for_yes_or_no(
+    sound: str,
+    spoken: Callable[..., Audio],
+    vad: SileroVad,
+    recognizer: Recognizer,
+    default_dialog: Dialog,
+) -> None:
+    pets = next(rule for rule in default_dialog.rules if rule.id == "pets")
+    hearing = hear(spoken(sound, "hibari"), vad, recognizer, default_dialog, pets.follow_up)
+    assert hearing.verdict is None or hearing.verdict.match is None, hearing
+
+
+def test_a_sentence_played_backwards_is_not_taken_for_a_phrase(
+    spoken: Callable[..., Audio], vad: SileroVad, recognizer: Recognizer, default_dialog: Dialog
+) -> None:
+    forwards = spoken("hello my name is sam and i am seven years old", "hibari")
+    backwards = Audio(forwards.samples[::-1].copy(), forwards.rate_hz)
+    hearing = hear(backwards, vad, recognizer, default_dialog)
+    assert hearing.verdict is None or hearing.verdict.match is None, hearing
