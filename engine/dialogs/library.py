@@ -42,6 +42,7 @@ from engine.dialogs.model import (
     FollowUp,
     Phrase,
 )
+from engine.dialogs.rule_checks import check_ids, check_shared_phrases
 from engine.dialogs.words import normalize
 from engine.files.problems import LoadError, Mark, Problems
 from engine.files.yaml_source import (
@@ -142,7 +143,7 @@ def check_dialog(
     concepts = _concepts(document.get("concepts"), problems)
     budget = _Budget()
     rules = _rules(document.get("rules"), document.mark, concepts, ctx, problems, budget, 0)
-    _check_ids(rules, problems)
+    check_ids(rules, problems)
     fallback = None
     raw_fallback = document.get("fallback")
     if raw_fallback is not None:
@@ -231,41 +232,8 @@ def _rules(
         return ()
     rules = (_rule(raw, concepts, ctx, problems, budget, depth, parent) for raw in raw_rules)
     kept = tuple(rule for rule in rules if rule is not None)
-    _check_shared_phrases(kept, problems)
+    check_shared_phrases(kept, problems)
     return kept
-
-
-def _check_shared_phrases(rules: tuple[DialogRule, ...], problems: Problems) -> None:
-    """A phrase two rules of one conversation both listen for fits both whenever it is
-    said, and two rules that fit cancel out: neither would ever answer it."""
-    holder: dict[tuple[str, ...], DialogRule] = {}
-    for rule in rules:
-        for phrase in rule.phrases:
-            first = holder.setdefault(phrase.words, rule)
-            if first is not rule:
-                problems.add(
-                    rule.mark or Mark("", 1, 1),
-                    f"rules {first.id!r} (line {first.line}) and {rule.id!r} both listen for "
-                    f"{phrase.text!r}: said, it fits both and neither answers",
-                    "keep the phrase in one rule",
-                )
-
-
-def _check_ids(rules: tuple[DialogRule, ...], problems: Problems) -> None:
-    """Rule ids are unique in a dialog, follow-ups included (`vest hear` names rules by id)."""
-    seen: dict[str, DialogRule] = {}
-    pending = list(rules)
-    while pending:
-        rule = pending.pop(0)
-        if rule.id in seen:
-            problems.add(
-                rule.mark or Mark("", 1, 1),
-                f"two rules have the id {rule.id!r} (also line {seen[rule.id].line})",
-                "give one of them another 'id:'",
-            )
-        seen.setdefault(rule.id, rule)
-        if rule.follow_up is not None:
-            pending.extend(rule.follow_up.rules)
 
 
 def _number(

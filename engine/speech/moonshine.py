@@ -37,7 +37,6 @@ from engine.speech.phrase_search import (
     PhraseGrammar,
     bears_out,
     closest_phrase,
-    log_softmax,
     sure_of,
 )
 from engine.speech.recognizer import RecognizerError, Transcript, Word, said_in_a_loop
@@ -111,6 +110,14 @@ def without_loop(tokens: list[int]) -> list[int]:
             ):
                 return tokens[: start + size]
     return tokens
+
+
+def log_softmax(logits: np.ndarray) -> np.ndarray:
+    """Natural-log probabilities of each row of ``logits``."""
+    top = logits.max(axis=-1, keepdims=True)
+    shifted: np.ndarray = logits - top
+    result: np.ndarray = shifted - np.log(np.exp(shifted).sum(axis=-1, keepdims=True))
+    return result
 
 
 class _Decoder:

@@ -50,7 +50,6 @@ __all__ = [
     "bears_out",
     "closest_phrase",
     "left_out",
-    "log_softmax",
     "sure_of",
 ]
 
@@ -266,11 +265,3 @@ def left_out(heard: Sequence[tuple[str, float]], phrase: Sequence[str]) -> list[
         else:
             col -= 1
     return [heard[k] for k in extra if not any(same_word(heard[k][0], w) for w in phrase)]
-
-
-def log_softmax(logits: np.ndarray) -> np.ndarray:
-    """Natural-log probabilities of each row of ``logits``."""
-    top = logits.max(axis=-1, keepdims=True)
-    shifted: np.ndarray = logits - top
-    result: np.ndarray = shifted - np.log(np.exp(shifted).sum(axis=-1, keepdims=True))
-    return result
