@@ -26,6 +26,7 @@ from engine.dialogs.library import DialogLibrary, load_dialog
 from engine.dialogs.model import Dialog, DialogRule
 from engine.errors import ConfigError
 from engine.speech.hearing import hear, spoken
+from engine.speech.phrase_search import PhraseGrammar
 from engine.speech.recognizers import default_recognizer
 from engine.speech.settings import RECOGNIZER_NAMES
 from engine.speech.vad import SileroVad
@@ -118,7 +119,9 @@ def main(args: argparse.Namespace) -> int:
     recognizer, instead = default_recognizer(args.recognizer)
     if instead:
         print(f"vest dialogs check: {instead}", file=sys.stderr)
-    recognizer.listen_for(library.phrases())
+    phrases = library.phrases()
+    recognizer.listen_for(phrases)
+    whole_turn = PhraseGrammar(phrases).is_a_phrase
     vad = SileroVad()
     tried = notes = 0
     progress = sys.stderr.isatty()
@@ -136,7 +139,7 @@ def main(args: argparse.Namespace) -> int:
                     audio = spoken(
                         voices[variant.voice], phrase.text, variant.speed, variant.snr_db
                     )
-                    hearing = hear(audio, vad, recognizer, dialog, context)
+                    hearing = hear(audio, vad, recognizer, dialog, context, whole_turn)
                     match = hearing.verdict.match if hearing.verdict is not None else None
                     if match is not None and match.rule.id == rule.id:
                         continue

@@ -31,6 +31,7 @@ from engine.dialogs.model import Dialog
 from engine.errors import ConfigError, UsageError
 from engine.media.audio import read_wav
 from engine.speech.hearing import Hearing, conversation, spoken
+from engine.speech.phrase_search import PhraseGrammar
 from engine.speech.recognizers import default_recognizer
 from engine.speech.settings import RECOGNIZER_NAMES
 from engine.speech.voice_models import DEFAULT_VOICE, load_voice
@@ -126,14 +127,16 @@ def main(args: argparse.Namespace) -> int:
     recognizer, instead = default_recognizer(args.recognizer)
     if instead:
         print(f"vest hear: {instead}", file=sys.stderr)
-    recognizer.listen_for(library.phrases())
+    phrases = library.phrases()
+    recognizer.listen_for(phrases)
+    whole_turn = PhraseGrammar(phrases).is_a_phrase
     vad = SileroVad()
     if args.mic:
         from engine.cli.hear_live import listen_live
 
-        return listen_live(args, recognizer, dialog, RealClock())
+        return listen_live(args, recognizer, dialog, RealClock(), whole_turn)
     for name, recording in audio:
-        for hearing in conversation(recording, vad, recognizer, dialog):
+        for hearing in conversation(recording, vad, recognizer, dialog, whole_turn):
             if args.json:
                 print(json.dumps(hearing.as_json(name), ensure_ascii=False))
             else:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import json
+from collections.abc import Callable
 
 from engine.clock import Clock
 from engine.dialogs.model import Dialog
@@ -15,7 +16,11 @@ from engine.speech.vad import SileroVad, SpeechDetector
 
 
 def listen_live(
-    args: argparse.Namespace, recognizer: Recognizer, dialog: Dialog, clock: Clock
+    args: argparse.Namespace,
+    recognizer: Recognizer,
+    dialog: Dialog,
+    clock: Clock,
+    whole_turn: Callable[[str], bool],
 ) -> int:
     config = load_robot_config(args.hardware) if args.hardware is not None else None
     device = args.device or (config.audio.microphone if config else None) or "default"
@@ -43,7 +48,7 @@ def listen_live(
                 flush=True,
             )
 
-    listener = Listener(SpeechDetector(SileroVad()), recognizer, clock, show)
+    listener = Listener(SpeechDetector(SileroVad()), recognizer, clock, show, whole_turn=whole_turn)
     microphone = AlsaMicrophone(device, lambda audio: listener.hear(audio, clock.now()))
     microphone.start()  # AudioDeviceError names the missing card: exit 3
     print(f"listening on {device!r}; Ctrl-C stops", flush=True)

@@ -27,6 +27,7 @@ from engine.media.audio import Audio, read_wav, with_noise, write_wav
 from engine.media.audio_devices import AlsaMicrophone, AlsaSpeaker, AudioDeviceError
 from engine.sim.room import RoomSpeaker, SimulatedRoom
 from engine.speech.listener import Heard, Listener, NotListenedListener
+from engine.speech.phrase_search import PhraseGrammar
 from engine.speech.recognizer import RecognizerError
 from engine.speech.recognizers import default_recognizer
 from engine.speech.settings import SPEECH_PROFILE_PARAMS
@@ -309,7 +310,8 @@ def build_speech(
         recognizer, instead = default_recognizer(recognizer_name)
         if instead:
             problems["recognizer"] = instead
-        recognizer.listen_for(phrases)
+        listened = list(phrases)
+        recognizer.listen_for(listened)
         listener = Listener(
             SpeechDetector(SileroVad()),
             recognizer,
@@ -317,6 +319,7 @@ def build_speech(
             on_heard,
             self_hearing=self_hearing,
             settling=settling,
+            whole_turn=PhraseGrammar(listened).is_a_phrase,
         )
     except (RecognizerError, ImportError) as error:
         problems["recognizer"] = str(error)

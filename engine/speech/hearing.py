@@ -7,6 +7,7 @@ without the threads.
 from __future__ import annotations
 
 import string
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 
 from engine.clock import stopwatch
@@ -41,9 +42,10 @@ class Hearing:
     """The answer (fields shown as ``[name]``), or the fallback; None for neither."""
     latency_s: float | None = None
     """Seconds from the end of speech (its last voiced frame) to the intent, as the robot
-    would live on this machine: the silence it waits to be sure the speaker is done, or,
-    when longer, the short pause after which it starts recognizing the speech so far plus
-    the recognizer and the matcher (measured here). None when nothing was heard."""
+    would live on this machine: the silence it waits to be sure the speaker is done (shorter
+    after a whole turn), or, when longer, the short pause after which it starts recognizing
+    the speech so far plus the recognizer and the matcher (measured here). None when nothing
+    was heard."""
 
     def as_json(self, name: str) -> dict[str, object]:
         match = self.verdict.match if self.verdict is not None else None
@@ -59,38 +61,104 @@ class Hearing:
 
 @dataclass(frozen=True)
 class Part:
-    """One utterance as the live robot hears it: the audio it recognizes (the draft's,
-    when the draft held all of it) and when that recognition starts (seconds of quiet
-    after the last voiced frame)."""
+    """One utterance as the live robot hears it, on the recording's timeline (seconds from
+    its start): its text, where its last voiced frame was, when the robot took it as ended,
+    and when its text was ready (recognition timed on this machine)."""
 
     utterance: Utterance
-    heard: Audio
-    starts_after_s: float
+    text: str
+    spoken_until_s: float
+    ended_s: float
+    ready_s: float
+
+    @property
+    def latency_s(self) -> float:
+        """Seconds from the last voiced frame to the text."""
+        return self.ready_s - self.spoken_until_s
 
 
 def utterances(audio: Audio, vad: SpeechProbability) -> list[Utterance]:
-    """The utterances Silero finds in ``audio``."""
-    return [part.utterance for part in parts(audio, vad)]
+    """The utterances Silero finds in ``audio`` (the full wait for silence after each)."""
+    vad.reset()
+    detector = SpeechDetector(vad)
+    found = detector.feed(
+        audio.resampled(SPEECH_RATE_HZ).then(Audio.silence(TRAILING_SILENCE_S)).samples
+    )
+    last = detector.flush()
+    return found + ([last] if last is not None else [])
 
 
-def parts(audio: Audio, vad: SpeechProbability) -> list[Part]:
-    """The utterances in ``audio``, each with the audio the robot would recognize."""
+class _LiveTimeline:
+    """The listener's worker on a recording's timeline: one recognition at a time, each
+    starting when its audio was told and the worker was free, taking as long as it takes
+    here; a draft that is a whole turn tells the detector when its text is ready."""
+
+    def __init__(
+        self,
+        detector: SpeechDetector,
+        recognizer: Recognizer,
+        whole_turn: Callable[[str], bool] | None,
+    ) -> None:
+        self.detector = detector
+        self.recognizer = recognizer
+        self.whole_turn = whole_turn
+        self.free_s = 0.0
+        self.draft: tuple[Utterance, str, float] | None = None  # draft, text, ready
+        self.whole_at_s: float | None = None
+
+    def at(self, now_s: float) -> None:
+        """Time has reached ``now_s``: a whole turn found by then is told."""
+        if self.whole_at_s is not None and self.whole_at_s <= now_s and self.draft:
+            self.detector.whole_turn(self.draft[0])
+            self.whole_at_s = None
+
+    def drafted(self, draft: Utterance) -> None:
+        text, ready_s = self._recognized(draft)
+        self.draft = (draft, text, ready_s)
+        whole = bool(text) and self.whole_turn is not None and self.whole_turn(text)
+        self.whole_at_s = ready_s if whole else None
+
+    def ended(self, utterance: Utterance) -> Part:
+        ended_s = utterance.end_sample / SPEECH_RATE_HZ
+        if utterance.drafted and self.draft is not None:
+            text, ready_s = self.draft[1], max(ended_s, self.draft[2])
+        else:
+            text, ready_s = self._recognized(utterance)
+        self.draft, self.whole_at_s = None, None
+        return Part(utterance, text, ended_s - utterance.quiet_s, ended_s, ready_s)
+
+    def _recognized(self, utterance: Utterance) -> tuple[str, float]:
+        begins_s = max(self.free_s, utterance.end_sample / SPEECH_RATE_HZ)
+        started = stopwatch()
+        text = self.recognizer.transcribe(utterance.audio).text
+        self.free_s = begins_s + stopwatch() - started
+        return text, self.free_s
+
+
+def heard_live(
+    audio: Audio,
+    vad: SpeechProbability,
+    recognizer: Recognizer,
+    whole_turn: Callable[[str], bool] | None = None,
+) -> list[Part]:
+    """Each utterance in ``audio`` as the live :class:`~engine.speech.listener.Listener`
+    hears it: drafts recognized during the wait for silence, a whole turn (``whole_turn``)
+    ending it sooner, one recognition at a time, at this machine's speed."""
     vad.reset()
     drafts: list[Utterance] = []
     detector = SpeechDetector(vad, on_pause=drafts.append)
+    live = _LiveTimeline(detector, recognizer, whole_turn)
     samples = audio.resampled(SPEECH_RATE_HZ).then(Audio.silence(TRAILING_SILENCE_S)).samples
     found: list[Part] = []
-    for at in range(0, len(samples), FRAME_SAMPLES):  # a frame at a time: each its draft
+    for at in range(0, len(samples), FRAME_SAMPLES):  # a frame at a time, as a microphone
+        live.at(at / SPEECH_RATE_HZ)
         ended = detector.feed(samples[at : at + FRAME_SAMPLES])
-        found += [_part(utterance, drafts) for utterance in ended]
+        for draft in drafts:
+            live.drafted(draft)
+        drafts.clear()
+        found += [live.ended(utterance) for utterance in ended]
     last = detector.flush()
-    return found + ([_part(last, drafts)] if last is not None else [])
-
-
-def _part(utterance: Utterance, drafts: list[Utterance]) -> Part:
-    if utterance.drafted and drafts:
-        return Part(utterance, drafts[-1].audio, drafts[-1].quiet_s)
-    return Part(utterance, utterance.audio, utterance.quiet_s)
+    return found + ([live.ended(last)] if last is not None else [])
 
 
 def hear(
@@ -99,9 +167,11 @@ def hear(
     recognizer: Recognizer,
     dialog: Dialog | None,
     follow_up: FollowUp | None = None,
+    whole_turn: Callable[[str], bool] | None = None,
 ) -> Hearing:
-    """What the robot hears in ``audio`` and how ``dialog`` answers it."""
-    texts = [recognizer.transcribe(part.heard).text for part in parts(audio, vad)]
+    """What the robot hears in ``audio`` and how ``dialog`` answers it (``whole_turn``: as
+    for :func:`heard_live`)."""
+    texts = [part.text for part in heard_live(audio, vad, recognizer, whole_turn)]
     heard = " ".join(t for t in texts if t) or None
     if heard is None or dialog is None:
         return Hearing(heard, None, None)
@@ -118,21 +188,23 @@ def _judged(heard: str, dialog: Dialog, follow_up: FollowUp | None) -> Hearing:
 
 
 def conversation(
-    audio: Audio, vad: SpeechProbability, recognizer: Recognizer, dialog: Dialog
+    audio: Audio,
+    vad: SpeechProbability,
+    recognizer: Recognizer,
+    dialog: Dialog,
+    whole_turn: Callable[[str], bool] | None = None,
 ) -> list[Hearing]:
     """Each utterance in ``audio`` heard and answered in turn, as the robot would: when an
     answer asked a question (``then:``), the next utterance is heard as its reply. A
     recording without speech is one Hearing of nothing."""
     hearings: list[Hearing] = []
     follow_up: FollowUp | None = None
-    for part in parts(audio, vad):
-        started = stopwatch()
-        text = recognizer.transcribe(part.heard).text
-        if not text:
+    for part in heard_live(audio, vad, recognizer, whole_turn):
+        if not part.text:
             continue
-        hearing = _judged(text, dialog, follow_up)
-        working_s = part.starts_after_s + stopwatch() - started
-        hearing = replace(hearing, latency_s=max(part.utterance.quiet_s, working_s))
+        started = stopwatch()
+        hearing = _judged(part.text, dialog, follow_up)
+        hearing = replace(hearing, latency_s=part.latency_s + stopwatch() - started)
         hearings.append(hearing)
         match = hearing.verdict.match if hearing.verdict is not None else None
         follow_up = match.rule.follow_up if match is not None else None

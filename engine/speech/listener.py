@@ -6,7 +6,9 @@ each finished utterance is recognized in the listener's worker, never in a tick,
 ``on_heard`` gets the text. The worker starts on an utterance before the robot's wait
 for silence is over: on the detector's draft (the speech so far, after a short pause);
 when the utterance ends with nothing said after the draft, the draft's text is the
-utterance's and is told at once (a draft that fell short is forgotten).
+utterance's and is told at once (a draft that fell short is forgotten). A draft whose text
+is a whole turn (``whole_turn``: one of the dialogs' phrases) shortens the wait for
+silence (:meth:`~engine.speech.vad.SpeechDetector.whole_turn`).
 
 While the robot speaks, the microphone is ignored
 (:class:`~engine.speech.speaker.SelfHearing`): it never answers its own voice. Someone who
@@ -62,7 +64,10 @@ class Listener:
         self_hearing: SelfHearing | None = None,
         settling: Settling | None = None,
         on_not_listened: NotListenedListener | None = None,
+        whole_turn: Callable[[str], bool] | None = None,
     ) -> None:
+        """``whole_turn(text)``: whether a draft's text is all a person means to say (None:
+        the robot always waits ``detector.end_silence_s``)."""
         self.detector = detector
         self.recognizer = recognizer
         self.clock = clock
@@ -78,6 +83,7 @@ class Listener:
         self.ignored_s = 0.0
         """Seconds of microphone audio ignored because the robot was speaking."""
         self.on_not_listened = on_not_listened
+        self.whole_turn = whole_turn
         detector.on_pause = self._draft
         self._deaf_since_s: float | None = None
         self._listening_since_s: float | None = None
@@ -159,6 +165,8 @@ class Listener:
             try:
                 if ended_s is None:
                     self._draft_text = text
+                    if text and self.whole_turn is not None and self.whole_turn(text):
+                        self.detector.whole_turn(utterance)
                 else:
                     self.on_heard(Heard(text, ended_s, self.clock.now()))
             except Exception:  # whoever listens must not stop the robot hearing

@@ -38,7 +38,7 @@ from typing import Protocol
 
 import numpy as np
 
-from engine.dialogs.words import is_function_word, same_word, words
+from engine.dialogs.words import is_function_word, normalize, same_word, words
 
 __all__ = [
     "CLEARLY_HEARD",
@@ -110,6 +110,11 @@ class PhraseGrammar:
 
     def complete(self, text: str) -> bool:
         return spelled(text).rstrip() in self.texts
+
+    def is_a_phrase(self, text: str) -> bool:
+        """Whether ``text`` says one of the phrases and nothing more (case, punctuation,
+        contractions and plurals aside: "What's your name?"): a whole turn."""
+        return normalize(text) in self.texts
 
     def holds_a_phrase(self, text: str) -> bool:
         """Whether ``text`` holds every meaning word of one of the phrases, or all the words

@@ -14,11 +14,17 @@ has passed, with the utterance so far (a draft), and the listener recognizes the
 while the wait goes on. When the utterance ends with no voiced frame since the draft, the
 draft held all of it (``drafted``) and its text is the utterance's: the answer is ready
 when the wait ends, instead of a recognition later.
+
+The wait may end sooner when the draft is a whole turn: when its text is one of the
+phrases the robot listens for (:meth:`SpeechDetector.whole_turn`, told by the listener),
+``whole_turn_silence_s`` of quiet ends the utterance. A pause after "do you like" still
+waits the whole ``end_silence_s``; a pause after "hello" of more than 0.2 s ends the turn.
 """
 
 from __future__ import annotations
 
 import math
+import threading
 from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -115,6 +121,8 @@ class SpeechDetector:
     max_utterance_s: float = 15.0
     draft_after_s: float = 0.096
     """Quiet after speech (3 frames) before the utterance so far is told to ``on_pause``."""
+    whole_turn_silence_s: float = 0.2
+    """The wait for silence after a draft that is a whole turn (:meth:`whole_turn`)."""
     on_pause: Callable[[Utterance], None] | None = None
     """Told each draft (None: no drafts)."""
     noise_floor: NoiseFloor | None = field(default_factory=NoiseFloor)
@@ -128,6 +136,9 @@ class SpeechDetector:
         self._voiced_frames = 0
         self._quiet_frames = 0
         self._drafted = False
+        self._draft: Utterance | None = None  # the draft told last
+        self._whole = False  # the draft holds all of the speech so far and is a whole turn
+        self._lock = threading.Lock()  # whole_turn comes from the listener's worker
         self._below_floor = 0  # frames in a row the noise floor kept from the VAD
         self.position = 0
         """Samples taken so far."""
@@ -143,7 +154,18 @@ class SpeechDetector:
         self._history.clear()
         self._speech = []
         self._voiced_frames = self._quiet_frames = 0
-        self._drafted = False
+        self._forget_draft()
+
+    def whole_turn(self, draft: Utterance) -> None:
+        """``draft`` (told to ``on_pause``) is a whole turn: if no speech came after it,
+        the utterance ends after :attr:`whole_turn_silence_s` of quiet (any thread)."""
+        with self._lock:
+            if draft is self._draft and self._drafted:
+                self._whole = True
+
+    def _forget_draft(self) -> None:
+        with self._lock:
+            self._drafted, self._whole, self._draft = False, False, None
 
     def feed(self, samples: Samples) -> list[Utterance]:
         """Take more of the stream; every utterance that ended in it."""
@@ -174,12 +196,14 @@ class SpeechDetector:
         if probability >= self.end_threshold:
             self._voiced_frames += 1
             self._quiet_frames = 0
-            self._drafted = False  # speech went on: the draft fell short
+            if self._drafted:
+                self._forget_draft()  # speech went on: the draft fell short
         else:
             self._quiet_frames += 1
             if self._quiet_frames == max(1, round(self.draft_after_s / FRAME_S)):
-                self._draft()
-        if self._quiet_frames * FRAME_S >= self.end_silence_s:
+                self._tell_draft()
+        quiet_s = self._quiet_frames * FRAME_S
+        if quiet_s >= self.end_silence_s or (self._whole and quiet_s >= self.whole_turn_silence_s):
             return self._end()
         if len(self._speech) * FRAME_S >= self.max_utterance_s:
             return self._end()
@@ -196,18 +220,20 @@ class SpeechDetector:
         self._below_floor = 0
         return self.vad(frame)
 
-    def _draft(self) -> None:
+    def _tell_draft(self) -> None:
         if self.on_pause is None or self._voiced_frames * FRAME_S < self.min_speech_s:
             return
         audio = Audio(np.concatenate(self._speech), SPEECH_RATE_HZ)
-        self._drafted = True
-        self.on_pause(Utterance(audio, self.position, self._quiet_frames * FRAME_S))
+        draft = Utterance(audio, self.position, self._quiet_frames * FRAME_S)
+        with self._lock:
+            self._drafted, self._draft = True, draft
+        self.on_pause(draft)
 
     def _end(self) -> Utterance | None:
         speech, voiced, quiet = self._speech, self._voiced_frames, self._quiet_frames
         drafted = self._drafted
         self._speech, self._voiced_frames, self._quiet_frames = [], 0, 0
-        self._drafted = False
+        self._forget_draft()
         self._history.clear()
         if voiced * FRAME_S < self.min_speech_s:
             return None  # a click or a cough

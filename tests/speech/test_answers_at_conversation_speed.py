@@ -18,7 +18,7 @@ from engine.speech.listener import Heard, Listener
 from engine.speech.moonshine import said_once, without_loop
 from engine.speech.phrase_search import PhraseGrammar
 from engine.speech.recognizer import Transcript, Word, said_in_a_loop
-from engine.speech.vad import FRAME_S, SpeechDetector
+from engine.speech.vad import FRAME_S, SpeechDetector, Utterance
 
 
 class LoudnessVad:
@@ -34,6 +34,8 @@ class LoudnessVad:
 class CountingRecognizer:
     """Hears the length of what it is given (so a draft and its utterance differ), and
     counts its work."""
+
+    name = "counting"
 
     def __init__(self, says: str = "") -> None:
         self.says = says
@@ -84,6 +86,80 @@ def test_a_click_is_no_draft_and_no_utterance() -> None:
     recognizer = CountingRecognizer()
     assert listened(speech(0.1).then(Audio.silence(1.0)), recognizer) == []
     assert recognizer.heard == []
+
+
+class SaysInTurn:
+    """Hears, in turn, each of ``texts`` (then the last one again)."""
+
+    name = "says in turn"
+
+    def __init__(self, *texts: str) -> None:
+        self.texts = list(texts)
+        self.heard: list[float] = []
+
+    def listen_for(self, phrases: Iterable[str]) -> None:
+        pass
+
+    def transcribe(self, audio: Audio) -> Transcript:
+        self.heard.append(audio.seconds)
+        return Transcript(self.texts.pop(0) if len(self.texts) > 1 else self.texts[0])
+
+
+def listened_live(audio: Audio, recognizer: SaysInTurn, *phrases: str) -> list[Heard]:
+    """``audio`` from a microphone in 32 ms pieces, the worker done with each before the
+    next (as when recognition is quick); a draft that says one of ``phrases`` is a whole
+    turn."""
+    told: list[Heard] = []
+    turns = PhraseGrammar(phrases).is_a_phrase if phrases else None
+    listener = Listener(
+        SpeechDetector(LoudnessVad()), recognizer, VirtualClock(), told.append, whole_turn=turns
+    )
+    for at in range(0, len(audio.samples), 512):
+        piece = Audio(audio.samples[at : at + 512], SPEECH_RATE_HZ)
+        listener.hear(piece, (at + len(piece.samples)) / SPEECH_RATE_HZ)
+        assert listener.settling.wait(listener.settled)
+    listener.close()
+    return told
+
+
+def test_a_whole_phrase_is_answered_after_a_shorter_wait_for_silence() -> None:
+    audio = Audio.silence(0.5).then(speech(0.8)).then(Audio.silence(1.0))
+    (quick,) = listened_live(audio, SaysInTurn("Hello."), "hello")
+    (waited,) = listened_live(audio, SaysInTurn("Hello."))
+    assert quick.text == waited.text == "Hello."
+    # the speech ends at 1.3 s: 0.2 s of quiet after a whole phrase, 0.3 s otherwise
+    assert 1.3 + 0.2 <= quick.ended_s < 1.3 + 0.2 + 2 * FRAME_S
+    assert 1.3 + 0.3 <= waited.ended_s < 1.3 + 0.3 + 2 * FRAME_S
+
+
+def test_a_pause_after_half_a_phrase_waits_the_whole_wait() -> None:
+    pause = Audio.silence(0.25)  # longer than the short wait, shorter than the whole one
+    audio = speech(0.6).then(pause).then(speech(0.5)).then(Audio.silence(1.0))
+    recognizer = SaysInTurn("Do you like", "Do you like dogs?")
+    told = listened_live(audio, recognizer, "hello", "do you like dogs")
+    assert [heard.text for heard in told] == ["Do you like dogs?"]
+
+
+def test_a_pause_after_a_whole_phrase_ends_the_turn() -> None:
+    """The price of the shorter wait: "hello", a quarter-second pause, "what is your
+    name" are two turns (the robot answers the first while the second is said)."""
+    pause = Audio.silence(0.25)
+    audio = speech(0.5).then(pause).then(speech(0.8)).then(Audio.silence(1.0))
+    recognizer = SaysInTurn("Hello.", "What is your name?")
+    told = listened_live(audio, recognizer, "hello", "what is your name")
+    assert [heard.text for heard in told] == ["Hello.", "What is your name?"]
+
+
+def test_a_whole_turn_told_for_a_draft_that_fell_short_changes_nothing() -> None:
+    detector = SpeechDetector(LoudnessVad())
+    drafts: list[Utterance] = []
+    detector.on_pause = drafts.append
+    loud, quiet = speech(0.5).samples, Audio.silence(0.15).samples
+    assert detector.feed(np.concatenate([loud, quiet, loud])) == []
+    detector.whole_turn(drafts[0])  # too late: speech went on after that draft
+    assert detector.feed(Audio.silence(0.26).samples) == []  # still waiting the whole 0.3 s
+    (utterance,) = detector.feed(Audio.silence(0.1).samples)
+    assert len(drafts) == 2 and utterance.drafted  # the second draft held all of it
 
 
 PHRASES = PhraseGrammar(["do you like dog", "how are you", "what is your name"])

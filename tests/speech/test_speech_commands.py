@@ -39,8 +39,9 @@ def test_hear_says_what_it_heard_the_rule_and_the_answer_per_file(
     capsys.readouterr()
     assert main(["hear", "--json", str(question), str(silence)]) == 0
     first, second = (json.loads(line) for line in capsys.readouterr().out.splitlines())
-    latency_s = first.pop("latency_s")  # this machine's: the 0.3 s wait, then recognizing
-    assert isinstance(latency_s, float) and latency_s >= 0.3
+    # this machine's: at least the 0.2 s wait after a whole phrase, or recognizing it
+    latency_s = first.pop("latency_s")
+    assert isinstance(latency_s, float) and latency_s >= 0.2
     assert first == {
         "file": str(question),
         "heard": "What is the temperature?",
