@@ -34,6 +34,7 @@ from engine.dialogs.words import words
 from engine.media.audio import SPEECH_RATE_HZ, Audio
 from engine.speech.onnx_folding import folded_model
 from engine.speech.phrase_search import (
+    CLOSE_ENOUGH_NATS,
     PhraseGrammar,
     bears_out,
     closest_phrase,
@@ -237,6 +238,7 @@ class MoonshineRecognizer:
                 self._texts,
                 end_token=END_TOKEN,
                 max_tokens=max_tokens,
+                at_least=free_log_prob - CLOSE_ENOUGH_NATS,  # less likely is not borne out
             )
             words_heard = [(w.text, w.probability) for w in heard]
             if found is not None and bears_out(found, free_log_prob, words_heard, self.grammar):

@@ -31,6 +31,7 @@ measures the thresholds' effect on 662 clips (right, wrong, stray sentences acce
 from __future__ import annotations
 
 import itertools
+import math
 import re
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
@@ -177,10 +178,13 @@ def closest_phrase(
     *,
     end_token: int,
     max_tokens: int,
+    at_least: float = -math.inf,
 ) -> Found | None:
     """The likeliest phrase of ``grammar`` the decoder writes (a beam of :data:`BEAM`
-    texts), or None when none is finished within ``max_tokens``. ``pieces[token]`` is the
-    text a token writes ("" for tokens that write none)."""
+    texts), or None when none is finished within ``max_tokens`` or as likely as
+    ``at_least`` (natural log: a phrase less likely is of no use, so the search drops the
+    texts that fall below it). ``pieces[token]`` is the text a token writes ("" for tokens
+    that write none)."""
     beams: list[tuple[str, float]] = [("", 0.0)]
     rows = decoding.first()
     top = min(TOP_TOKENS, rows.shape[1])
@@ -191,7 +195,7 @@ def closest_phrase(
             log_probs = rows[row]
             if grammar.complete(text):
                 ended = score + float(log_probs[end_token])
-                if best is None or ended > best.log_prob:
+                if ended >= at_least and (best is None or ended > best.log_prob):
                     best = Found(spelled(text).strip(), ended)
             for token in np.argpartition(-log_probs, top - 1)[:top]:
                 piece = pieces[int(token)]
@@ -199,7 +203,8 @@ def closest_phrase(
                     options.append((score + float(log_probs[token]), row, int(token), text + piece))
         options.sort(reverse=True)
         # a text's score only falls as it grows: one below the best phrase never passes it
-        kept = [o for o in options[:BEAM] if best is None or o[0] > best.log_prob]
+        floor = at_least if best is None else max(at_least, best.log_prob)
+        kept = [o for o in options[:BEAM] if o[0] > floor]
         if not kept:
             break
         rows = decoding.then(

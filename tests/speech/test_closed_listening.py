@@ -106,6 +106,24 @@ def test_the_search_stops_once_no_text_can_beat_the_phrase_it_has() -> None:
     assert decoder.steps == 3  # the "Do ..." text (-9) was never carried further
 
 
+def test_a_search_gives_up_on_texts_less_likely_than_a_phrase_can_be_of_use() -> None:
+    # the free transcript was likely (-1 nat): a phrase 5 nats below it is not borne out
+    script = {
+        "": {" Do": -0.1},
+        " Do": {" you": -3.0},
+        " Do you": {" like": -3.0},
+        " Do you like": {" dog": -0.1},
+        " Do you like dog": {"</s>": -0.1},
+    }
+    decoder = ScriptedDecoder(script)
+    floor = -1.0 - CLOSE_ENOUGH_NATS
+    found = closest_phrase(decoder, GRAMMAR, PIECES, end_token=END, max_tokens=8, at_least=floor)
+    assert found is None
+    assert decoder.steps == 2  # "Do you like" (-6.1) fell below the floor: not decoded on
+    unbounded = search(script)  # without a floor: found, and only then judged
+    assert unbounded is not None and unbounded.log_prob == pytest.approx(-6.3)
+
+
 def words_heard(text: str, probability: float = 0.9) -> list[tuple[str, float]]:
     return [(word, probability) for word in text.split()]
 
