@@ -27,7 +27,8 @@ of its API), in the order Pololu's library distils it:
 ``tests/drivers/test_vl53l0x_bring_up.py`` holds these register writes against those of
 Adafruit's CircuitPython driver on the simulated chip. Not done: ST's reference SPAD
 management (a calibration on a target, for a chip whose NVM is invalid: such a chip is
-refused), offset and cross-talk calibration, and continuous ranging.
+refused), offset and cross-talk calibration, and timed continuous ranging (back-to-back
+continuous ranging is: :meth:`VL53L0X.start_continuous`).
 """
 
 from __future__ import annotations
@@ -39,8 +40,9 @@ from collections.abc import Callable, Iterable, Iterator
 from engine.clock import Clock
 from engine.drivers import vl53l0x_registers as reg
 from engine.drivers.bus_protocols import I2CBus
-from engine.drivers.device_errors import ImplausibleReadingError, device_error, i2c_place
+from engine.drivers.device_errors import device_error, i2c_place
 from engine.drivers.forwarding_bus import write_each
+from engine.drivers.vl53l0x_results import CHIP, distance_in
 from engine.drivers.vl53l0x_spads import (
     SPAD_MAP_BYTES,
     ReferenceSpads,
@@ -56,18 +58,10 @@ from engine.drivers.vl53l0x_timing import (
 from engine.drivers.vl53l0x_tuning import DEFAULT_TUNING, TUNING_SIGNAL_RATE_LIMIT
 from engine.errors import DeviceError
 
-CHIP = "VL53L0X"
 DEFAULT_ADDRESS = reg.POWER_ON_ADDRESS
 # What the chip kind probes with (engine.hardware.chips.vl53l0x):
 IDENTIFICATION_MODEL_ID = reg.IDENTIFICATION_MODEL_ID  # the first identity register
 IDENTITY = reg.IDENTITY  # 0xC0..0xC2
-
-DEVICE_RANGE_STATUS_VALID = reg.DEVICE_RANGE_STATUS_VALID
-DEVICE_RANGE_STATUS_TOO_CLOSE = frozenset({8, 10})
-"""Device range statuses of a target closer than the chip can range ("min range fail")."""
-RANGE_OUT_OF_RANGE_MM = reg.RANGE_OUT_OF_RANGE_MM
-RANGE_CODE_MAX = 8191  # the range field never holds more
-MAX_RANGE_MM = 2000  # the chip's reach (long-range mode); a valid range beyond it is garbled
 
 BOOT_TIME_S = 0.002  # after XSHUT rises, with a margin over tBOOT (reg.TBOOT_MAX_S)
 POLL_INTERVAL_S = 0.002
@@ -86,26 +80,6 @@ def signal_rate_limit_to_register(limit_mcps: float) -> int:
     return round(limit_mcps * (1 << 7))
 
 
-def device_range_status(status_byte: int) -> int:
-    """The device range status (bits 6:3) of RESULT_RANGE_STATUS; 11 is a valid range."""
-    return (status_byte >> reg.DEVICE_RANGE_STATUS_SHIFT) & 0x0F
-
-
-def decode_range(status_byte: int, range_mm: int) -> int | None:
-    """The distance in mm, or ``None`` when the chip found nothing valid in range. A
-    target too close to range (the device's "min range" statuses, 8 and 10: a hand over
-    the sensor) is 0 mm: something is right there, the worst case for whoever relies on
-    it."""
-    status = device_range_status(status_byte)
-    if status in DEVICE_RANGE_STATUS_TOO_CLOSE:
-        return 0
-    if range_mm >= RANGE_OUT_OF_RANGE_MM:
-        return None
-    if status != DEVICE_RANGE_STATUS_VALID:
-        return None
-    return range_mm
-
-
 def check_address(address: int) -> int:
     """A usable 7-bit address for a VL53L0X (0x08..0x77), or ValueError."""
     if not 0x08 <= address <= 0x77:
@@ -114,7 +88,8 @@ def check_address(address: int) -> int:
 
 
 class VL53L0X:
-    """One VL53L0X, checked and brought up as ST does on construction; single-shot ranging.
+    """One VL53L0X, checked and brought up as ST does on construction; single-shot ranging,
+    or back to back (:meth:`start_continuous`).
 
     ``timeout_s`` bounds one measurement (start to result, on ``clock``), and each wait of
     the bring-up; a chip that does not finish in time raises :class:`DeviceError`, as does
@@ -141,6 +116,7 @@ class VL53L0X:
         self._check_identity()
         self._stop_variable = 0
         self._timing_budget_us = 0
+        self._continuous = False
         self._init(signal_rate_limit_to_register(signal_rate_limit_mcps), io_2v8)
 
     @property
@@ -348,48 +324,85 @@ class VL53L0X:
             self._clock.sleep(POLL_INTERVAL_S)
 
     def read_range_mm(self) -> int | None:
-        """One single-shot measurement: the distance in mm, or ``None`` if out of range.
+        """The distance in mm, or ``None`` if nothing is in range: one single-shot
+        measurement, or, ranging continuously (:meth:`start_continuous`), the latest.
 
-        Takes the chip's timing budget (~33 ms) on the clock. Raises :class:`DeviceError`
-        when the chip does not finish within ``timeout_s``, ``OSError`` on bus errors, and
+        A single shot takes the chip's timing budget (~33 ms) on the clock; ranging
+        continuously, a measurement is ready at once unless none came since the last read
+        (then it waits for the next). Raises :class:`DeviceError` when the chip does not
+        finish within ``timeout_s``, ``OSError`` on bus errors, and
         :class:`~engine.drivers.device_errors.ImplausibleReadingError` for a valid range
         beyond the chip's ~2 m, or a range field above 8191.
         """
         with self._lock:
-            with self._off_main_page():
-                self._write_all(
-                    (
-                        *reg.ENTER_PRIVATE_PAGE,
-                        (reg.STOP_VARIABLE, self._stop_variable),
-                        *reg.LEAVE_PRIVATE_PAGE,
-                        # a stale result must not pass for ours
-                        (reg.SYSTEM_INTERRUPT_CLEAR, 0x01),
-                        (reg.SYSRANGE_START, reg.SYSRANGE_START_SINGLESHOT),
-                    )
+            if self._continuous:
+                result = self._next_continuous_result()
+            else:
+                result = self._single_shot_result()
+        return distance_in(result, i2c_place(self._address))
+
+    def _start_ranging(self, mode: int) -> None:
+        with self._off_main_page():
+            self._write_all(
+                (
+                    *reg.ENTER_PRIVATE_PAGE,
+                    (reg.STOP_VARIABLE, self._stop_variable),
+                    *reg.LEAVE_PRIVATE_PAGE,
+                    # a stale result must not pass for ours
+                    (reg.SYSTEM_INTERRUPT_CLEAR, 0x01),
+                    (reg.SYSRANGE_START, mode),
                 )
-            started = self._clock.now()
-            deadline = started + self.timeout_s
-            self._wait_for(self._start_bit_clear, deadline, "start of ranging")
-            self._clock.sleep_until(started + FIRST_LOOK * self.timing_budget_s)
-            self._wait_for(self._interrupt_raised, deadline, "ranging")
-            result = self._bus.read_i2c_block_data(
-                self._address, reg.RESULT_RANGE_STATUS, reg.RESULT_BLOCK_LENGTH
             )
-            self._write(reg.SYSTEM_INTERRUPT_CLEAR, 0x01)
-        offset = reg.RESULT_RANGE_MM_OFFSET
-        range_mm = (result[offset] << 8) | result[offset + 1]
-        distance_mm = decode_range(result[0], range_mm)
-        if range_mm > RANGE_CODE_MAX or (distance_mm is not None and distance_mm > MAX_RANGE_MM):
-            valid = device_range_status(result[0]) == DEVICE_RANGE_STATUS_VALID
-            raise ImplausibleReadingError(
-                chip=CHIP,
-                place=i2c_place(self._address),
-                what="range with a valid status" if valid else "range",
-                value=f"{range_mm} mm",
-                plausible=f"0..{MAX_RANGE_MM} mm, or {RANGE_OUT_OF_RANGE_MM}..{RANGE_CODE_MAX} "
-                "for nothing in range",
+
+    def _single_shot_result(self) -> bytes:
+        self._start_ranging(reg.SYSRANGE_START_SINGLESHOT)
+        started = self._clock.now()
+        deadline = started + self.timeout_s
+        self._wait_for(self._start_bit_clear, deadline, "start of ranging")
+        self._clock.sleep_until(started + FIRST_LOOK * self.timing_budget_s)
+        self._wait_for(self._interrupt_raised, deadline, "ranging")
+        result = self._read_block(reg.RESULT_RANGE_STATUS, reg.RESULT_BLOCK_LENGTH)
+        self._write(reg.SYSTEM_INTERRUPT_CLEAR, 0x01)
+        return result
+
+    def _next_continuous_result(self) -> bytes:
+        """The interrupt status and the result in one read; when no measurement came
+        since the last, asked again every ``POLL_INTERVAL_S`` until one does."""
+        deadline = self._clock.now() + self.timeout_s
+        while True:
+            block = self._read_block(reg.RESULT_INTERRUPT_STATUS, 1 + reg.RESULT_BLOCK_LENGTH)
+            if block[0] & reg.RESULT_INTERRUPT_MASK:
+                break
+            if self._clock.now() >= deadline:
+                raise DeviceError(
+                    f"{self._where()}: ranging continuously, no measurement came within "
+                    f"{self.timeout_s} s"
+                )
+            self._clock.sleep(POLL_INTERVAL_S)
+        self._write(reg.SYSTEM_INTERRUPT_CLEAR, 0x01)
+        return block[1:]
+
+    def start_continuous(self) -> None:
+        """Range back to back, a measurement every timing budget, until
+        :meth:`stop_continuous` (as Adafruit's and Pololu's drivers do): a read then takes
+        two bus transfers and no wait, where a single shot takes six and the budget."""
+        with self._lock:
+            self._start_ranging(reg.SYSRANGE_START_BACK_TO_BACK)
+            self._continuous = True
+
+    def stop_continuous(self) -> None:
+        """Back to single-shot ranging."""
+        with self._lock, self._off_main_page():
+            self._write_all(
+                (
+                    (reg.SYSRANGE_START, 0x00),
+                    *reg.ENTER_PRIVATE_PAGE,
+                    (reg.STOP_VARIABLE, 0x00),
+                    *reg.LEAVE_PRIVATE_PAGE,
+                    (reg.SYSTEM_INTERRUPT_CLEAR, 0x01),
+                )
             )
-        return distance_mm
+            self._continuous = False
 
     def set_address(self, new_address: int) -> None:
         """Move the chip to ``new_address`` (kept until power-off or XSHUT low)."""

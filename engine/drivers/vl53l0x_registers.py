@@ -11,6 +11,7 @@ POWER_ON_ADDRESS = 0x29  # and again after every boot (XSHUT high)
 
 SYSRANGE_START = 0x00
 SYSRANGE_START_SINGLESHOT = 0x01  # bit 0: start; clears itself once ranging has begun
+SYSRANGE_START_BACK_TO_BACK = 0x02  # bit 1: range continuously, one after another
 SYSTEM_SEQUENCE_CONFIG = 0x01
 SYSTEM_INTERRUPT_CONFIG_GPIO = 0x0A
 INTERRUPT_NEW_SAMPLE_READY = 0x04

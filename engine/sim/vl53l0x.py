@@ -21,20 +21,25 @@ What it models, as the chip behaves on the wire:
   budget (~33 ms by default) and then "new sample ready" (0x04) until SYSTEM_INTERRUPT_CLEAR
   is written; RESULT_RANGE_STATUS holds device status 11 (valid) and the range in mm at
   +10, or 8190 and a failure status when nothing is within ``max_range_mm``;
+* back-to-back continuous ranging: writing bit 1 of SYSRANGE_START (0x02) starts it; a
+  measurement completes every timing budget, each raising "new sample ready" and holding
+  its result until the next (whether or not the last was cleared); writing SYSRANGE_START
+  without bit 1 ends it (bit 0 then starts a single shot, as before);
 * reference calibrations (SYSRANGE_START with SYSTEM_SEQUENCE_CONFIG 0x01 or 0x02): they
   raise the same interrupt after ``CALIBRATION_TIME_S``;
 * I2C_SLAVE_DEVICE_ADDRESS (0x8A): the chip moves to the new address on its bus;
 * XSHUT: low puts the chip in hardware standby: it leaves the bus (no answer at all) and
   forgets its address and every register; high boots it at 0x29, NACKing for tBOOT.
 
-Simplified: the distance is sampled when ranging starts; there is no noise, no signal rate,
-no SPAD or tuning effect (the chip ranges the same with or without the full ST init, and
-takes ``timing_budget_s`` whatever its timing registers say); an NVM read completes at
-once; back-to-back and timed continuous modes are not modelled; a calibration's duration is
-a stand-in (ST does not publish it). The "no target" status is MSRC no-target (4); a real
-chip may report another failure code, which the driver treats alike. ST documents none of
-the NVM registers: their behaviour here is what ST's API and Adafruit's driver expect of
-them.
+Simplified: the distance is sampled when ranging starts (ranging continuously: when the
+chip is next read or written after a measurement completes); there is no noise, no signal
+rate, no SPAD or tuning effect (the chip ranges the same with or without the full ST init,
+and takes ``timing_budget_s`` whatever its timing registers say); an NVM read completes at
+once; timed continuous ranging (an inter-measurement period) is not modelled; a
+calibration's duration is a stand-in (ST does not publish it). The "no target" status is
+MSRC no-target (4); a real chip may report another failure code, which the driver treats
+alike. ST documents none of the NVM registers: their behaviour here is what ST's API and
+Adafruit's driver expect of them.
 
 Two chips cannot share an address on a :class:`SimI2CBus`, so a collision that real
 hardware would turn into garbled answers raises ``ValueError`` here (a wiring mistake in
@@ -80,6 +85,8 @@ from engine.drivers.vl53l0x_registers import (
     SEQUENCE_VHV_CALIBRATION,
     STOP_VARIABLE,
     SYSRANGE_START,
+    SYSRANGE_START_BACK_TO_BACK,
+    SYSRANGE_START_SINGLESHOT,
     SYSTEM_INTERRUPT_CLEAR,
     SYSTEM_SEQUENCE_CONFIG,
     TBOOT_MAX_S,
@@ -221,6 +228,8 @@ class SimVL53L0X(SimI2CDevice):
         self._pointer = 0
         self._interrupt_status = 0
         self._busy_until_s: float | None = None
+        self._continuous_since_s: float | None = None  # ranging back to back since then
+        self._continuous_done = 0  # measurements completed since
         self._calibrating = False
         self._sampled_mm: float | None = None
         self.address = POWER_ON_ADDRESS
@@ -247,12 +256,24 @@ class SimVL53L0X(SimI2CDevice):
         self._sampled_mm = self._distance_mm
 
     def _update(self) -> None:
+        if self._continuous_since_s is not None:
+            done = int((self._clock.now() - self._continuous_since_s) / self.timing_budget_s)
+            if done > self._continuous_done:
+                self.measurements += done - self._continuous_done - 1
+                self._continuous_done = done
+                self._interrupt_status = INTERRUPT_NEW_SAMPLE_READY
+                self._sampled_mm = self._distance_mm
+                self._result()
+            return
         if self._busy_until_s is None or self._clock.now() < self._busy_until_s:
             return
         self._busy_until_s = None
         self._interrupt_status = INTERRUPT_NEW_SAMPLE_READY
-        if self._calibrating:
-            return
+        if not self._calibrating:
+            self._result()
+
+    def _result(self) -> None:
+        """A measurement of the distance sampled completes: its result registers."""
         self.measurements += 1
         distance = self._sampled_mm
         if distance is None or distance > self.max_range_mm:
@@ -291,7 +312,11 @@ class SimVL53L0X(SimI2CDevice):
         if register in _READ_ONLY:
             return
         if register == SYSRANGE_START:
-            if value & 0x01:
+            self._update()  # a measurement already complete is kept
+            self._continuous_since_s = None
+            if value & SYSRANGE_START_BACK_TO_BACK:
+                self._continuous_since_s, self._continuous_done = self._clock.now(), 0
+            elif value & SYSRANGE_START_SINGLESHOT:
                 self._start()
             self._registers[register] = value & ~0x01  # the start bit clears once begun
         elif register == SYSTEM_INTERRUPT_CLEAR:

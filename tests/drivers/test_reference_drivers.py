@@ -178,6 +178,25 @@ def test_vl53l0x_driver_comes_up_through_sts_nvm_handshake_and_ranges(
     assert sensor.range == 8190  # the chip's "nothing in range"
 
 
+def test_vl53l0x_driver_ranges_back_to_back_on_the_chip_model(
+    bus: SimI2CBus, clock: VirtualClock, i2c: ReferenceI2C, reference: Reference
+) -> None:
+    """Adafruit's continuous mode (Pololu's startContinuous) on the chip model that ours
+    uses: each reading is the distance of a new measurement, one every timing budget."""
+    chip = SimVL53L0X(clock, bus)
+    sensor = reference("adafruit_vl53l0x").VL53L0X(i2c)
+    sensor.start_continuous()
+    for distance in (900, 500, 300):
+        chip.distance_mm = distance
+        clock.advance(0.1)
+        started = clock.now()
+        assert sensor.range == distance
+        assert clock.now() - started < 0.005  # a measurement was ready: bus time only
+    sensor.stop_continuous()  # and a single shot after it, as the driver does
+    chip.distance_mm = 700
+    assert sensor.range == 700
+
+
 def test_vl53l0x_driver_enables_the_reference_spads_the_nvm_names(
     bus: SimI2CBus, clock: VirtualClock, i2c: ReferenceI2C, reference: Reference
 ) -> None:

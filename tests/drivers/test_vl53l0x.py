@@ -8,12 +8,8 @@ from typing import Any
 import pytest
 
 from engine.clock import VirtualClock
-from engine.drivers.vl53l0x import (
-    VL53L0X,
-    decode_range,
-    device_range_status,
-    signal_rate_limit_to_register,
-)
+from engine.drivers.vl53l0x import VL53L0X, signal_rate_limit_to_register
+from engine.drivers.vl53l0x_results import decode_range, device_range_status
 from engine.errors import DeviceError
 from engine.sim.i2c_bus import SimI2CBus, SimI2CDevice
 from engine.sim.vl53l0x import SimVL53L0X
@@ -256,3 +252,73 @@ def test_a_reading_through_the_bus_manager_is_five_transactions_with_every_write
     # the writes (page, stop variable, page back, clear, start), the start bit, the
     # interrupt, the result, the clear
     assert handle.stats().transactions - before == 5
+
+
+# -- ranging back to back (issue 24: a poll that does not wait for a measurement) -------------
+def managed(clock: VirtualClock, bus: SimI2CBus) -> tuple[VL53L0X, Any]:
+    from engine.drivers.bus_manager import BusManager
+    from engine.hardware.managed_buses import ManagedI2C
+
+    manager: BusManager[SimI2CBus] = BusManager(bus, name="1", clock=clock, threaded=False)
+    handle = manager.claim("tof", 0x29)
+    return VL53L0X(ManagedI2C(handle), clock=clock), handle
+
+
+def test_ranging_back_to_back_a_poll_reads_the_latest_distance_at_once_in_two_transactions(
+    clock: VirtualClock, bus: SimI2CBus, chip: SimVL53L0X
+) -> None:
+    sensor, handle = managed(clock, bus)
+    chip.distance_mm = 800
+    sensor.start_continuous()
+    assert sensor.read_range_mm() == 800  # the first waits for the first measurement
+    for distance in (650, 400, None):  # someone walks up, then away
+        chip.distance_mm = distance
+        clock.advance(0.1)  # the poller's period
+        started, before = clock.now(), handle.stats().transactions
+        assert sensor.read_range_mm() == distance
+        assert clock.now() == started  # no wait: a measurement was ready
+        assert handle.stats().transactions - before == 2  # status with result, the clear
+
+
+def test_ranging_back_to_back_a_second_read_waits_for_a_new_measurement(
+    clock: VirtualClock, bus: SimI2CBus, chip: SimVL53L0X
+) -> None:
+    sensor = VL53L0X(bus, clock=clock)
+    chip.distance_mm = 500
+    sensor.start_continuous()
+    sensor.read_range_mm()
+    chip.distance_mm = 300
+    started = clock.now()
+    assert sensor.read_range_mm() == 300  # never the measurement already read
+    assert 0 < clock.now() - started <= chip.timing_budget_s + 0.002
+
+
+def test_a_chip_that_stops_ranging_back_to_back_times_out_naming_the_address(
+    clock: VirtualClock, bus: SimI2CBus, chip: SimVL53L0X
+) -> None:
+    """A chip reset by a glitch ranges no more: the poll fails (the device goes offline
+    and is brought up again), it never passes on an old distance."""
+    sensor = VL53L0X(bus, clock=clock)
+    chip.distance_mm = 500
+    sensor.start_continuous()
+    assert sensor.read_range_mm() == 500
+    bus.write_byte_data(0x29, 0x00, 0x00)  # SYSRANGE_START: ranging stopped
+    clock.advance(0.5)
+    with pytest.raises(DeviceError, match=r"VL53L0X at 0x29: ranging continuously, no meas"):
+        sensor.read_range_mm()
+
+
+def test_stopping_back_to_back_ranging_returns_to_single_shots(
+    clock: VirtualClock, bus: SimI2CBus, chip: SimVL53L0X
+) -> None:
+    sensor = VL53L0X(bus, clock=clock)
+    sensor.start_continuous()
+    sensor.read_range_mm()
+    sensor.stop_continuous()
+    counted = chip.measurements
+    clock.advance(1.0)
+    assert chip.peek(0x13) == 0 and chip.measurements == counted  # not ranging
+    chip.distance_mm = 250
+    started = clock.now()
+    assert sensor.read_range_mm() == 250
+    assert clock.now() - started >= chip.timing_budget_s  # a single shot again

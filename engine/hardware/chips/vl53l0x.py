@@ -89,17 +89,22 @@ def _poll(setup: PollSetup) -> PollParts:
     address = setup.address
 
     def connect() -> VL53L0X:
+        """The chip brought up and ranging back to back: a poll then reads the latest
+        measurement (at most a timing budget old) without waiting for one."""
         try:
-            return VL53L0X(ManagedI2C(handle), address=address, clock=clock, **device.options)
+            driver = VL53L0X(ManagedI2C(handle), address=address, clock=clock, **device.options)
         except OSError:
             # Not at its address: power-cycled (back at 0x29), or left in standby at start-up.
             if chain is None or not chain.may_reboot(device.name):
                 raise
-        chain.reboot(device.name)
-        # Ahead of the polls, which the bus manager refuses while it has the chip offline.
-        bus = ManagedI2C(handle, priority=Priority.REQUEST)
-        driver = VL53L0X(bus, address=address, clock=clock, **device.options)
-        bus.priority = Priority.POLL
+            chain.reboot(device.name)
+            # Ahead of the polls, which the bus manager refuses while it has the chip offline.
+            bus = ManagedI2C(handle, priority=Priority.REQUEST)
+            driver = VL53L0X(bus, address=address, clock=clock, **device.options)
+            driver.start_continuous()
+            bus.priority = Priority.POLL
+            return driver
+        driver.start_continuous()
         return driver
 
     def read(driver: VL53L0X) -> list[Staged]:
