@@ -215,7 +215,7 @@ def hear_clips(
     by_way: dict[str, list[int]] = {}
     examples: list[str] = []
     timed = TimedRecognizer(recognizer, timing)
-    whole_turn = PhraseGrammar(dialog.phrases).is_a_phrase
+    whole_turn = PhraseGrammar(dialog.phrases).is_a_whole_turn
     for clip in clips:
         asked = getattr(recognizer, "second_opinions", 0)
         found = heard_live(clip.audio, vad, timed, whole_turn)

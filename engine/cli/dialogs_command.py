@@ -121,7 +121,7 @@ def main(args: argparse.Namespace) -> int:
         print(f"vest dialogs check: {instead}", file=sys.stderr)
     phrases = library.phrases()
     recognizer.listen_for(phrases)
-    whole_turn = PhraseGrammar(phrases).is_a_phrase
+    whole_turn = PhraseGrammar(phrases).is_a_whole_turn
     vad = SileroVad()
     tried = notes = 0
     progress = sys.stderr.isatty()

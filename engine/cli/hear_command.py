@@ -129,7 +129,7 @@ def main(args: argparse.Namespace) -> int:
         print(f"vest hear: {instead}", file=sys.stderr)
     phrases = library.phrases()
     recognizer.listen_for(phrases)
-    whole_turn = PhraseGrammar(phrases).is_a_phrase
+    whole_turn = PhraseGrammar(phrases).is_a_whole_turn
     vad = SileroVad()
     if args.mic:
         from engine.cli.hear_live import listen_live

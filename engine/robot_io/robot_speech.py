@@ -319,7 +319,7 @@ def build_speech(
             on_heard,
             self_hearing=self_hearing,
             settling=settling,
-            whole_turn=PhraseGrammar(listened).is_a_phrase,
+            whole_turn=PhraseGrammar(listened).is_a_whole_turn,
         )
     except (RecognizerError, ImportError) as error:
         problems["recognizer"] = str(error)

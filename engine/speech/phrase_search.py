@@ -39,7 +39,7 @@ from typing import Protocol
 
 import numpy as np
 
-from engine.dialogs.words import is_function_word, normalize, same_word, words
+from engine.dialogs.words import is_function_word, same_word, words
 
 __all__ = [
     "CLEARLY_HEARD",
@@ -100,6 +100,8 @@ class PhraseGrammar:
         self.keywords = {
             word for phrase in self.phrases for word in phrase if not is_function_word(word)
         }
+        begins = {phrase[:end] for phrase in self.phrases for end in range(1, len(phrase))}
+        self._whole_turns = set(self.phrases) - begins
 
     def __bool__(self) -> bool:
         return bool(self.texts)
@@ -112,10 +114,12 @@ class PhraseGrammar:
     def complete(self, text: str) -> bool:
         return spelled(text).rstrip() in self.texts
 
-    def is_a_phrase(self, text: str) -> bool:
+    def is_a_whole_turn(self, text: str) -> bool:
         """Whether ``text`` says one of the phrases and nothing more (case, punctuation,
-        contractions and plurals aside: "What's your name?"): a whole turn."""
-        return normalize(text) in self.texts
+        contractions and plurals aside: "What's your name?", "Do you like puppies?"), and
+        no other phrase goes on from it: "i do" is not a whole turn beside "i do not", nor
+        "yes" beside "yes i have a dog", for a person who pauses after it may go on."""
+        return words(text) in self._whole_turns
 
     def holds_a_phrase(self, text: str) -> bool:
         """Whether ``text`` holds every meaning word of one of the phrases, or all the words

@@ -16,9 +16,11 @@ draft held all of it (``drafted``) and its text is the utterance's: the answer i
 when the wait ends, instead of a recognition later.
 
 The wait may end sooner when the draft is a whole turn: when its text is one of the
-phrases the robot listens for (:meth:`SpeechDetector.whole_turn`, told by the listener),
-``whole_turn_silence_s`` of quiet ends the utterance. A pause after "do you like" still
-waits the whole ``end_silence_s``; a pause after "hello" of more than 0.2 s ends the turn.
+phrases the robot listens for and no other phrase goes on from it
+(:meth:`SpeechDetector.whole_turn`, told by the listener), ``whole_turn_silence_s`` of
+quiet ends the utterance. A pause after "do you like", or after "i do" beside "i do not",
+still waits the whole ``end_silence_s``; a pause of more than 0.2 s after "what is your
+name" ends the turn.
 """
 
 from __future__ import annotations

@@ -110,7 +110,7 @@ def listened_live(audio: Audio, recognizer: SaysInTurn, *phrases: str) -> list[H
     next (as when recognition is quick); a draft that says one of ``phrases`` is a whole
     turn."""
     told: list[Heard] = []
-    turns = PhraseGrammar(phrases).is_a_phrase if phrases else None
+    turns = PhraseGrammar(phrases).is_a_whole_turn if phrases else None
     listener = Listener(
         SpeechDetector(LoudnessVad()), recognizer, VirtualClock(), told.append, whole_turn=turns
     )
@@ -148,6 +148,36 @@ def test_a_pause_after_a_whole_phrase_ends_the_turn() -> None:
     recognizer = SaysInTurn("Hello.", "What is your name?")
     told = listened_live(audio, recognizer, "hello", "what is your name")
     assert [heard.text for heard in told] == ["Hello.", "What is your name?"]
+
+
+def test_a_pause_after_a_phrase_another_phrase_goes_on_from_waits_the_whole_wait() -> None:
+    """From a breaker: "I do ... not" was answered as "I do" (has a pet), the opposite of
+    what the child said. "i do" begins "i do not", so it is no whole turn."""
+    pause = Audio.silence(0.25)
+    audio = speech(0.5).then(pause).then(speech(0.3)).then(Audio.silence(1.0))
+    recognizer = SaysInTurn("I do", "I do not.")
+    told = listened_live(audio, recognizer, "i do", "i do not", "yes", "yes i have a dog")
+    assert [heard.text for heard in told] == ["I do not."]
+
+
+@pytest.mark.parametrize(
+    ("said", "whole"),
+    [
+        ("What's your name?", True),  # a contraction
+        ("Do you like puppies?", True),  # a plural in -ies
+        ("I do not.", True),
+        ("I do", False),  # "i do not" goes on from it
+        ("Yes.", False),  # "yes i have a dog" goes on from it
+        ("Yes, I have a dog.", True),
+        ("Do you like", False),  # half a phrase
+        ("Do you like dogs and cats?", False),  # more than a phrase
+    ],
+)
+def test_a_whole_turn_is_a_phrase_no_other_phrase_goes_on_from(said: str, whole: bool) -> None:
+    turns = PhraseGrammar(
+        ["what is your name", "do you like puppy", "i do", "i do not", "yes", "yes i have a dog"]
+    )
+    assert turns.is_a_whole_turn(said) is whole
 
 
 def test_a_whole_turn_told_for_a_draft_that_fell_short_changes_nothing() -> None:
