@@ -7,8 +7,10 @@ answer that asks a question (then:) hears the next utterance as its reply. --jso
 one object per utterance (per file, for a file of one question):
 {"file": ..., "heard": text or null, "rule": rule id or null, "score": ..., "answer": ...,
 "latency_s": ...}: latency_s is the seconds from the end of speech (its last voiced frame)
-to the intent, as the robot would live on this machine (the silence it waits to be sure,
-then recognizing and matching, measured here).
+to the intent, as the robot would live on this machine: it recognizes the speech so far
+during its wait for silence (0.3 s, or 0.2 s after a whole phrase, counted in 32 ms
+frames), so this is the wait or the recognition, whichever ends later (measured here). A
+file is heard whole: the live robot does not hear speech while it answers.
 --mic listens on the microphone instead (the robot config's, or --device) until Ctrl-C.
 --text "do you like dogs" hears a typed phrase as the robot would hear it spoken: said by
 the robot's voice (hibari, natural speed), then through the same hearing (its "file" is the

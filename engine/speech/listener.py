@@ -7,8 +7,8 @@ each finished utterance is recognized in the listener's worker, never in a tick,
 for silence is over: on the detector's draft (the speech so far, after a short pause);
 when the utterance ends with nothing said after the draft, the draft's text is the
 utterance's and is told at once (a draft that fell short is forgotten). A draft whose text
-is a whole turn (``whole_turn``: one of the dialogs' phrases) shortens the wait for
-silence (:meth:`~engine.speech.vad.SpeechDetector.whole_turn`).
+is a whole turn (``whole_turn``: one of the dialogs' phrases, and none goes on from it)
+shortens the wait for silence (:meth:`~engine.speech.vad.SpeechDetector.whole_turn`).
 
 While the robot speaks, the microphone is ignored
 (:class:`~engine.speech.speaker.SelfHearing`): it never answers its own voice. Someone who
