@@ -158,7 +158,9 @@ def steady_window(run: Run, skip_s: float) -> tuple[float, float, float] | None:
     """
     began = run.running[0] if run.running else 0.0
     ended = run.running[1] if len(run.running) == 2 else math.inf
-    window = [(t, cpu) for t, cpu in run.readings if began + skip_s <= t <= ended]
+    # the reading taken when the end showed in the output already holds some of the
+    # shutdown (halting the trees, closing the pollers): the window stops before it
+    window = [(t, cpu) for t, cpu in run.readings if began + skip_s <= t < ended]
     if len(window) < 2 or window[-1][0] <= window[0][0]:
         return None
     (t0, cpu0), (t1, cpu1) = window[0], window[-1]
