@@ -255,7 +255,10 @@ def hear_clips(
     fast = getattr(recognizer, "fast", None)
     closed = getattr(fast, "closed_listenings", None)
     if closed is not None:
-        print(f"  heard again against the phrases: {closed} of {len(timing['work'])} utterances")
+        print(
+            f"  heard again against the phrases: {closed} of {len(timing['work'])} "
+            "recognitions (drafts included)"
+        )
         asked = getattr(recognizer, "second_opinions", 0)
         print(f"  of which Whisper heard again (a phrase not sure): {asked}")
     return timing

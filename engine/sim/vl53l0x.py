@@ -316,6 +316,7 @@ class SimVL53L0X(SimI2CDevice):
             self._continuous_since_s = None
             if value & SYSRANGE_START_BACK_TO_BACK:
                 self._continuous_since_s, self._continuous_done = self._clock.now(), 0
+                self._busy_until_s = None  # a single shot under way gives way
             elif value & SYSRANGE_START_SINGLESHOT:
                 self._start()
             self._registers[register] = value & ~0x01  # the start bit clears once begun
