@@ -89,7 +89,9 @@ def test_a_recording_holds_no_header_and_no_phrase_and_another_machine_cannot_re
     run(story, record, "kid-17")
     raw = record.read_bytes()
     assert not raw.startswith(b"SQLite format 3")
-    for phrase in (b"Lina", b"dogs", b"kid-17", b"My name is", b"hug"):
+    # phrases of six bytes or more: random ciphertext holds a given 3-byte string (the
+    # tree name "hug") once in 16 MB, so this 120 kB recording did in about one run in 140
+    for phrase in (b"Lina and I like dogs", b"kid-17", b"My name is", b"I love hugs!"):
         assert phrase not in raw
     elsewhere = tmp_path / "another-machine"
     shutil.copy(record, elsewhere.with_suffix(".vest"))
