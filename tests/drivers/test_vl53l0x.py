@@ -234,18 +234,23 @@ def test_a_garbled_timing_register_is_a_device_error_never_a_budget(
         VL53L0X(bus, clock=clock)
 
 
+def managed(clock: VirtualClock, bus: SimI2CBus) -> tuple[VL53L0X, Any]:
+    """A driver on the bus manager, as a poller makes it, and its device handle."""
+    from engine.drivers.bus_manager import BusManager
+    from engine.hardware.managed_buses import ManagedI2C
+
+    manager: BusManager[SimI2CBus] = BusManager(bus, name="1", clock=clock, threaded=False)
+    handle = manager.claim("tof", 0x29)
+    return VL53L0X(ManagedI2C(handle), clock=clock), handle
+
+
 def test_a_reading_through_the_bus_manager_is_five_transactions_with_every_write_in_order(
     clock: VirtualClock, bus: SimI2CBus, chip: SimVL53L0X
 ) -> None:
     """Issue 24 (an idle robot): the writes before a measurement go as one transaction of
     the bus manager, and the chip is first asked about the measurement near the end of its
     timing budget; the chip sees the same register writes, in the same order."""
-    from engine.drivers.bus_manager import BusManager
-    from engine.hardware.managed_buses import ManagedI2C
-
-    manager: BusManager[SimI2CBus] = BusManager(bus, name="1", clock=clock, threaded=False)
-    handle = manager.claim("tof", 0x29)
-    sensor = VL53L0X(ManagedI2C(handle), clock=clock)
+    sensor, handle = managed(clock, bus)
     chip.distance_mm = 420
     before = handle.stats().transactions
     assert sensor.read_range_mm() == 420
@@ -255,15 +260,6 @@ def test_a_reading_through_the_bus_manager_is_five_transactions_with_every_write
 
 
 # -- ranging back to back (issue 24: a poll that does not wait for a measurement) -------------
-def managed(clock: VirtualClock, bus: SimI2CBus) -> tuple[VL53L0X, Any]:
-    from engine.drivers.bus_manager import BusManager
-    from engine.hardware.managed_buses import ManagedI2C
-
-    manager: BusManager[SimI2CBus] = BusManager(bus, name="1", clock=clock, threaded=False)
-    handle = manager.claim("tof", 0x29)
-    return VL53L0X(ManagedI2C(handle), clock=clock), handle
-
-
 def test_ranging_back_to_back_a_poll_reads_the_latest_distance_at_once_in_two_transactions(
     clock: VirtualClock, bus: SimI2CBus, chip: SimVL53L0X
 ) -> None:
