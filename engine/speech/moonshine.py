@@ -87,11 +87,18 @@ def read_tokens(path: Path) -> list[bytes]:
 
 def said_once(said: tuple[Word, ...]) -> tuple[Word, ...]:
     """``said`` without the beginning said again: Moonshine goes on after a short utterance
-    by repeating it ("Hello. Hello.", "How are you? How are you? How are"). The words are
+    by repeating it ("Hello. Hello.", "How are you? How are you? How are"), the last word
+    of it sometimes cut ("Sure I have a rabbit. Sure I have a rabb"). The words are
     compared as the matcher reads them (case and marks aside)."""
-    spoken = [words(word.text) for word in said]
+    spoken = [" ".join(words(word.text)) for word in said]
+    last = len(said) - 1
+
+    def again(k: int, length: int) -> bool:
+        first = spoken[k % length]
+        return spoken[k] == first or (k == last and bool(spoken[k]) and first.startswith(spoken[k]))
+
     for length in range(1, len(said) // 2 + 1):  # said whole at least twice
-        if all(spoken[k] == spoken[k % length] for k in range(length, len(said))):
+        if all(again(k, length) for k in range(length, len(said))):
             return said[:length]
     return said
 
@@ -232,12 +239,16 @@ class MoonshineRecognizer:
         unconfirmed = ""
         if self.grammar and not (text and self.grammar.holds_a_phrase(text)):
             self.closed_listenings += 1
+            if not tokens:
+                # it wrote nothing: a phrase is weighed against the likeliest words it would
+                # have written, not against silence, which the VAD already ruled out
+                free_log_prob = self._decode(decoder, max_tokens, words_first=True)[2]
             found = closest_phrase(
                 decoder,
                 self.grammar,
                 self._texts,
                 end_token=END_TOKEN,
-                max_tokens=max_tokens,
+                max_tokens=self.grammar.longest + 1,  # a token writes a character or more
                 at_least=free_log_prob - CLOSE_ENOUGH_NATS,  # less likely is not borne out
             )
             words_heard = [(w.text, w.probability) for w in heard]
@@ -247,14 +258,21 @@ class MoonshineRecognizer:
                 unconfirmed = found.text
         return Transcript(text, heard if not looped else said, 1.0 - mean, per_token, unconfirmed)
 
-    def _decode(self, decoder: _Decoder, max_tokens: int) -> tuple[list[int], list[float], float]:
+    def _decode(
+        self, decoder: _Decoder, max_tokens: int, *, words_first: bool = False
+    ) -> tuple[list[int], list[float], float]:
         """Greedy decoding: the tokens (without start and end), each one's log-probability,
-        and the whole text's (its end included), natural log."""
+        and the whole text's (its end included), natural log. ``words_first``: the first
+        token is the likeliest that is not the end (the words it would write at all)."""
         rows = decoder.first()
         tokens: list[int] = []
         log_probs: list[float] = []
-        for _ in range(max_tokens):
-            token = int(np.argmax(rows[0]))
+        for step in range(max_tokens):
+            choices = rows[0]
+            if words_first and step == 0:
+                choices = choices.copy()
+                choices[END_TOKEN] = -np.inf
+            token = int(np.argmax(choices))
             log_probs.append(float(rows[0][token]))
             if token == END_TOKEN:
                 return tokens, log_probs[:-1], sum(log_probs)

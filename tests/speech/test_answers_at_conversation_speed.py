@@ -225,6 +225,14 @@ def said(*texts: str) -> tuple[Word, ...]:
             said("How", "are", "you?"),
         ),
         (said("Hi", "hi"), said("Hi")),
+        (
+            said("Sure", "I", "have", "a", "rabbit.", "Sure", "I", "have", "a", "rabb"),
+            said("Sure", "I", "have", "a", "rabbit."),
+        ),
+        (
+            said("I", "have", "a", "cat", "I", "have", "a", "dog"),
+            said("I", "have", "a", "cat", "I", "have", "a", "dog"),
+        ),
         (said("I", "have", "a", "dog"), said("I", "have", "a", "dog")),
         (said("yes", "I", "do", "yes"), said("yes", "I", "do", "yes")),
     ],

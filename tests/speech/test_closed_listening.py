@@ -225,6 +225,33 @@ def test_a_phrase_moonshine_writes_wrong_is_heard_right_through_the_phrases(
     assert hearing.verdict.match.rule.id == rule
 
 
+@pytest.mark.parametrize(
+    ("said", "speed", "snr_db", "rule"),
+    [
+        # Moonshine writes nothing: the phrase is weighed against the words it would write
+        ("yep i have a puppy", 1.0, None, "has_pet"),
+        ("yeah i have a puppy", 1.0, None, "has_pet"),
+        # "L meet your name": a beam of four texts lost "tell" to likelier first pieces
+        ("tell me your name", 0.9, 10.0, "name"),
+    ],
+)
+def test_the_fallback_voice_is_heard_where_moonshine_writes_nothing_or_nonsense(
+    said: str,
+    speed: float,
+    snr_db: float | None,
+    rule: str,
+    spoken: Callable[..., Audio],
+    vad: SileroVad,
+    recognizer: Recognizer,
+    default_dialog: Dialog,
+) -> None:
+    pets = next(rule for rule in default_dialog.rules if rule.id == "pets")
+    context = pets.follow_up if rule == "has_pet" else None
+    hearing = hear(spoken(said, "espeak", speed, snr_db), vad, recognizer, default_dialog, context)
+    assert hearing.verdict is not None and hearing.verdict.match is not None, hearing
+    assert hearing.verdict.match.rule.id == rule
+
+
 @pytest.mark.parametrize("sentence", ["how old are you", "are you a robot", "how tall are you"])
 def test_a_question_no_rule_means_is_not_taken_for_the_phrase_it_sounds_like(
     sentence: str,
