@@ -7,7 +7,7 @@ utterance again allowed to write only those phrases, and keeps the phrase when t
 bears it out (:mod:`engine.speech.phrase_search`, a tenth of a second). A phrase it is not
 sure of (a short sound forced into "yes", a long mumble into a short phrase) is heard again
 by Whisper tiny.en, prompted with the phrases, whose transcript counts
-(:class:`SecondOpinion`): about one utterance in twenty-five on bench/bench_speech.py's
+(:class:`SecondOpinion`): about one utterance in twenty on bench/bench_speech.py's
 clips, where Whisper once heard every utterance Moonshine's words did not hold.
 "whisper" is Whisper tiny.en alone, prompted with the phrases, and the fallback where
 Moonshine's package is not installed (its wheels are x86_64 only). A profile chooses
