@@ -56,8 +56,9 @@ class Poller(Generic[D]):
 
     ``connect()`` makes the driver (identity check and init); ``read(driver)`` reads it and
     returns the writes to stage; ``rest`` are the writes that say "this device senses
-    nothing", staged when it stops working. ``offline_after`` failed polls in a row mark the
-    device not ok even when the bus still answers (a chip answering nonsense).
+    nothing", staged when it stops working; ``release(driver)``, where given, lets the chip
+    rest when the robot stops (:meth:`release`). ``offline_after`` failed polls in a row
+    mark the device not ok even when the bus still answers (a chip answering nonsense).
     """
 
     def __init__(
@@ -71,6 +72,7 @@ class Poller(Generic[D]):
         connect: Callable[[], D],
         read: Callable[[D], Sequence[Staged]],
         rest: Sequence[Staged] = (),
+        release: Callable[[D], None] | None = None,
         offline_after: int = 3,
     ) -> None:
         if not rate_hz > 0:
@@ -83,6 +85,7 @@ class Poller(Generic[D]):
         self._connect = connect
         self._read = read
         self.rest = tuple(rest)
+        self._release = release
         self.offline_after = offline_after
         self.driver: D | None = None
         self.origin_s: float | None = None  # the first poll sets the phase
@@ -158,6 +161,19 @@ class Poller(Generic[D]):
         with self._lock:
             if self.driver is None:
                 self.driver = self._connect()
+
+    def release(self) -> None:
+        """Let the chip rest as the robot stops (a range sensor stops ranging back to back)
+        and drop the driver: a later poll connects again. A chip that cannot be told (it
+        no longer answers) is left as it is, and said in the log."""
+        with self._lock:
+            driver, self.driver = self.driver, None
+            if driver is None or self._release is None:
+                return
+            try:
+                self._release(driver)
+            except Exception as error:  # stopping must go on whatever one chip does
+                _log.warning("%s: not released at stop: %s", self.name, describe_exception(error))
 
     def read_now(self, *, fresh: bool = False) -> list[Staged]:
         """Read once without staging (for ``vest devices``); raises what the read raised.
@@ -286,11 +302,11 @@ def make_poller(
     kind = (chips or default_chips()).get(device.chip)
     if kind is None or kind.poll is None or device.rate_hz is None:
         raise ValueError(f"device {device.name!r} ({device.chip}) is not polled")
-    connect, read, rest = kind.poll(PollSetup(device, handle, clock, chain))
+    parts = kind.poll(PollSetup(device, handle, clock, chain))
 
     def read_counted(driver: Any) -> Sequence[Staged]:
         try:
-            return read(driver)
+            return parts.read(driver)
         except ImplausibleReadingError as error:  # found after the bus transactions
             handle.note_implausible(error)
             raise
@@ -301,7 +317,8 @@ def make_poller(
         clock=clock,
         blackboard=blackboard,
         health=health,
-        connect=connect,
+        connect=parts.connect,
         read=read_counted,
-        rest=rest,
+        rest=parts.rest,
+        release=parts.release,
     )

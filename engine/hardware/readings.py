@@ -1,8 +1,9 @@
 """What a poll makes: the blackboard writes of one reading, and how a chip is polled.
 
 A chip kind that is polled (:mod:`engine.hardware.chips`) gives the three parts of a poller
-(:data:`PollParts`): how to connect its driver, how one reading becomes writes, and the
-writes that say "this device senses nothing" while it is offline.
+(:class:`PollParts`): how to connect its driver, how one reading becomes writes, the
+writes that say "this device senses nothing" while it is offline, and what its driver does
+when the robot stops.
 """
 
 from __future__ import annotations
@@ -26,9 +27,19 @@ class Staged:
     event: bool = False
 
 
-PollParts = tuple[Callable[[], Any], Callable[[Any], Sequence[Staged]], Sequence[Staged]]
-"""(connect, read, rest): the driver made on the device's handle, one reading as writes,
-and the writes staged while the device is offline."""
+@dataclass(frozen=True)
+class PollParts:
+    """How a chip kind is polled."""
+
+    connect: Callable[[], Any]
+    """The driver made on the device's handle (identity check and init)."""
+    read: Callable[[Any], Sequence[Staged]]
+    """One reading as writes."""
+    rest: Sequence[Staged]
+    """The writes staged while the device is offline."""
+    release: Callable[[Any], None] | None = None
+    """What the driver does when the robot stops, so the chip does not go on working for
+    nobody (a range sensor stops ranging back to back); None: nothing to do."""
 
 
 @dataclass(frozen=True)

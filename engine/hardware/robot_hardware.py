@@ -129,11 +129,14 @@ class Hardware:
         raise KeyError(f"no poller for device {name!r}")
 
     def close(self) -> None:
-        """Stop pollers and bus workers; close what was opened here (never the sim vest)."""
+        """Stop pollers, let their chips rest (range sensors stop ranging), stop bus workers;
+        close what was opened here (never the sim vest)."""
         if self._closed:
             return
         self._closed = True
         self.stop()
+        for poller in self.pollers:  # while the bus workers still run
+            poller.release()
         for manager in self.managers.values():
             manager.close()
         for thing in reversed(self._owned):

@@ -185,6 +185,12 @@ class SimVL53L0X(SimI2CDevice):
             raise ValueError(f"a distance cannot be negative, got {value} mm")
         self._distance_mm = value
 
+    @property
+    def ranging_back_to_back(self) -> bool:
+        """Whether the chip is ranging continuously (SYSRANGE_START bit 1 written, not
+        stopped since)."""
+        return self._continuous_since_s is not None
+
     def set_xshut(self, high: bool) -> None:
         """Drive the XSHUT pin: low = hardware standby and off the bus, high = boot at 0x29."""
         if high == self._xshut_high:

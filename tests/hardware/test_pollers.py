@@ -319,3 +319,36 @@ def test_a_driver_bug_is_logged_once_per_failure_streak_not_at_every_poll(
     errors = [record.getMessage() for record in caplog.records if record.levelno >= logging.ERROR]
     assert errors == ["touch: poll failed with ZeroDivisionError: division by zero"] * 2
     assert poller.failures == 15 and health.ok is False
+
+
+def test_a_chip_that_cannot_be_released_at_stop_is_logged_and_the_stop_goes_on(
+    bench: Bench, caplog: pytest.LogCaptureFixture
+):
+    released: list[object] = []
+
+    def release(driver: object) -> None:
+        released.append(driver)
+        raise OSError(121, "Remote I/O error")  # unplugged since its last poll
+
+    health = DeviceHealth("range_left", bench.board)  # type: ignore[arg-type]
+    poller: Poller[object] = Poller(
+        "range_left",
+        rate_hz=10.0,
+        clock=bench.clock,
+        blackboard=bench.board,  # type: ignore[arg-type]
+        health=health,
+        connect=object,
+        read=lambda driver: [Staged("/sensors/range/left_mm", 250.0)],
+        release=release,
+    )
+    poller.release()  # never connected: nothing to tell
+    bench.run(poller, 0.1)
+    driver = poller.driver
+    with caplog.at_level(logging.WARNING, logger="vest.pollers"):
+        poller.release()
+        poller.release()  # once only: the driver is gone
+
+    assert released == [driver] and poller.driver is None
+    assert [record.getMessage() for record in caplog.records] == [
+        "range_left: not released at stop: Remote I/O error (EREMOTEIO, errno 121)"
+    ]

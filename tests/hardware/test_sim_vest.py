@@ -209,6 +209,23 @@ def test_three_range_sensors_at_0x29_behind_a_multiplexer_each_see_their_side(tm
         vest.close()
 
 
+def test_the_range_sensors_stop_ranging_when_the_robot_stops(sim_config: RobotConfig):
+    clock = VirtualClock()
+    board = Blackboard(default_catalogue(), clock)
+    vest = build_sim_vest(sim_config, World(range_mm={"left": 250.0}), clock)
+    hardware = build_hardware(sim_config, clock, board, vest=vest)
+    chips = [vest.chips[p.name] for p in hardware.pollers if p.name.startswith("range")]
+    try:
+        for poller in hardware.pollers:
+            poller(clock.now())
+        assert chips and all(chip.ranging_back_to_back for chip in chips)
+    finally:
+        hardware.close()
+        vest.close()
+
+    assert not any(chip.ranging_back_to_back for chip in chips)
+
+
 def test_fault_events_must_name_a_device_the_simulation_can_fail(sim_config: RobotConfig):
     here = Mark("demo.yaml", 4, 5)
     events = [

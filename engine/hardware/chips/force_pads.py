@@ -203,7 +203,7 @@ def force_poll(device: DeviceConfig, connect: Callable[[], ForceReader]) -> Poll
                 squeezed[pad.name] = False
         return writes + events
 
-    return reconnect, read, [Staged(pad.key, 0.0) for pad in device.pads]
+    return PollParts(reconnect, read, [Staged(pad.key, 0.0) for pad in device.pads])
 
 
 def show_forces(device: DeviceConfig, writes: Sequence[Staged]) -> str:

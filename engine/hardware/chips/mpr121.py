@@ -58,7 +58,7 @@ def _poll(setup: PollSetup) -> PollParts:
         return writes
 
     nothing: list[str] = []
-    return connect, read, _fed(keys, pads=[False] * PADS, any=False, touched=nothing)
+    return PollParts(connect, read, _fed(keys, pads=[False] * PADS, any=False, touched=nothing))
 
 
 def _fed(keys: dict[str, str], **values: Any) -> list[Staged]:

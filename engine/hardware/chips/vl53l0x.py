@@ -111,7 +111,7 @@ def _poll(setup: PollSetup) -> PollParts:
         distance_mm = driver.read_range_mm()
         return [Staged(key, None if distance_mm is None else float(distance_mm))]
 
-    return connect, read, [Staged(key, None)]
+    return PollParts(connect, read, [Staged(key, None)], release=VL53L0X.stop_continuous)
 
 
 def _show(device: DeviceConfig, writes: Sequence[Staged]) -> str:

@@ -72,7 +72,7 @@ def _poll(setup: PollSetup) -> PollParts:
             return []
         return [Staged(key, names.get(gesture, gesture), event=True)]
 
-    return connect, read, []
+    return PollParts(connect, read, [])
 
 
 def _show(device: DeviceConfig, writes: Sequence[Staged]) -> str:
