@@ -57,7 +57,10 @@ QUICK = VARIANTS[:1]
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     actions = parser.add_subparsers(dest="action", metavar="ACTION", required=True)
     check = actions.add_parser(
-        "check", help="check every phrase of every dialog", description=__doc__
+        "check",
+        help="check every phrase of every dialog",
+        description=__doc__,
+        formatter_class=argparse.RawDescriptionHelpFormatter,  # the docstring's own lines
     )
     check.add_argument(
         "folder",

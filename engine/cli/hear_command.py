@@ -76,7 +76,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--dialog", default="default", help="which dialog answers (default: default)"
     )
-    parser.add_argument("--json", action="store_true", help="one JSON object per file")
+    parser.add_argument("--json", action="store_true", help="one JSON object per utterance")
 
 
 def load_dialog_named(folder: Path | None, name: str) -> tuple[DialogLibrary, Dialog]:

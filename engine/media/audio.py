@@ -160,7 +160,7 @@ def wav_from_bytes(data: bytes, name: str) -> Audio:
                 f"{name}: 32-bit float samples; use 8, 16 or 32-bit PCM (e.g. sox {name} "
                 "-b 16 -e signed-integer out.wav)"
             ) from None
-        raise AudioFileError(f"{name}: not a WAV file ({error or 'cut short'})") from None
+        raise AudioFileError(f"{name}: not a WAV file ({str(error) or 'cut short'})") from None
     if taken > most:
         raise AudioFileError(f"{name}: more than {MAX_WAV_S:.0f} s of audio")
     samples = np.concatenate(chunks) if chunks else np.zeros(0, dtype=np.float32)

@@ -83,6 +83,9 @@ def test_hear_refuses_a_file_that_is_not_a_wav(
     text.write_text("not audio")
     assert main(["hear", str(text)]) == 1
     assert f"{text}: not a WAV file" in capsys.readouterr().err
+    text.write_text("hello\n")  # too short for the header: the reason is still said
+    assert main(["hear", str(text)]) == 1
+    assert f"{text}: not a WAV file (cut short)" in capsys.readouterr().err
 
 
 def test_dialogs_check_refuses_a_phrase_two_rules_share_before_hearing_anything(
