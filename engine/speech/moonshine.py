@@ -26,6 +26,7 @@ from __future__ import annotations
 import importlib.util
 import math
 from collections.abc import Iterable
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -35,6 +36,7 @@ from engine.media.audio import SPEECH_RATE_HZ, Audio
 from engine.speech.onnx_folding import folded_model
 from engine.speech.phrase_search import (
     CLOSE_ENOUGH_NATS,
+    Found,
     PhraseGrammar,
     bears_out,
     closest_phrase,
@@ -172,6 +174,17 @@ class _Decoder:
         return log_softmax(outputs[0][:, -1].astype(np.float64))
 
 
+@dataclass(frozen=True)
+class _Heard:
+    """One utterance's encoder output (in its decoder) and free transcript."""
+
+    decoder: _Decoder
+    max_tokens: int
+    tokens: list[int]
+    log_probs: list[float]  # natural log, of each token
+    free_log_prob: float  # of the whole transcript, its end included
+
+
 class MoonshineRecognizer:
     """Moonshine Base English on ONNX Runtime, one utterance at a time."""
 
@@ -219,44 +232,79 @@ class MoonshineRecognizer:
         self.grammar = PhraseGrammar(phrases)
 
     def transcribe(self, audio: Audio) -> Transcript:
+        heard = self._hear(audio)
+        if heard is None:
+            return Transcript("")
+        probabilities = [math.exp(p) for p in heard.log_probs]
+        mean = sum(probabilities) / len(probabilities) if probabilities else 0.0
+        per_token = sum(heard.log_probs) / max(1, len(heard.tokens))
+        said = self._words(heard.tokens, probabilities)
+        once = said_once(said)
+        looped = len(without_loop(heard.tokens)) < len(heard.tokens) or said_in_a_loop(
+            " ".join(w.text for w in said)
+        )
+        doubted = looped or mean < DOUBTED_BELOW
+        text = "" if doubted else " ".join(w.text for w in once)
+        unconfirmed = ""
+        if self.grammar and not (text and self.grammar.holds_a_phrase(text)):
+            self.closed_listenings += 1
+            words_heard = [(w.text, w.probability) for w in once]
+            found = self._borne_out(heard, self.grammar, words_heard)
+            if found is not None:
+                if sure_of(found, words_heard):
+                    return Transcript(found.text, once, 1.0 - mean, per_token)
+                unconfirmed = found.text
+        return Transcript(text, once if not looped else said, 1.0 - mean, per_token, unconfirmed)
+
+    def finds(self, audio: Audio, phrases: Iterable[str]) -> bool:
+        """Whether the audio bears out one of ``phrases`` (as closed listening would find
+        it): how another recognizer's phrase is checked against this one's hearing."""
+        heard = self._hear(audio)
+        if heard is None:
+            return False
+        said = said_once(self._words(heard.tokens, [math.exp(p) for p in heard.log_probs]))
+        words_heard = [(w.text, w.probability) for w in said]
+        return self._borne_out(heard, PhraseGrammar(phrases), words_heard) is not None
+
+    def _hear(self, audio: Audio) -> _Heard | None:
+        """The encoder's output and the free transcript; None for audio too short."""
         samples = audio.resampled(SPEECH_RATE_HZ).samples.astype(np.float32)
         if len(samples) < SPEECH_RATE_HZ // 10:  # shorter than the encoder's window
-            return Transcript("")
+            return None
         hidden = self.encoder.run(None, {"input_values": samples[None, :]})[0]
         max_tokens = int(len(samples) / SPEECH_RATE_HZ * TOKENS_PER_S) + 4
         decoder = _Decoder(self, hidden)
         tokens, log_probs, free_log_prob = self._decode(decoder, max_tokens)
-        probabilities = [math.exp(p) for p in log_probs]
-        said = self._words(tokens, probabilities)
-        heard = said_once(said)
-        mean = sum(probabilities) / len(probabilities) if probabilities else 0.0
-        per_token = sum(log_probs) / max(1, len(tokens))
-        looped = len(without_loop(tokens)) < len(tokens) or said_in_a_loop(
-            " ".join(w.text for w in said)
+        return _Heard(decoder, max_tokens, tokens, log_probs, free_log_prob)
+
+    def _borne_out(
+        self, heard: _Heard, grammar: PhraseGrammar, words_heard: list[tuple[str, float]]
+    ) -> Found | None:
+        """The phrase of ``grammar`` the audio bears out, or None (see the module's
+        docstring and :func:`~engine.speech.phrase_search.bears_out`)."""
+        found = self._closest(heard.decoder, grammar, heard.free_log_prob)
+        if found is not None and bears_out(found, heard.free_log_prob, words_heard, grammar):
+            return found
+        if heard.tokens:
+            return None
+        # It wrote nothing for what the VAD took for speech: a phrase of words is weighed
+        # against the likeliest words it would have written, not against silence. A single
+        # word is not: a sound ("huh", a laugh) bears out "hello" or "yeah" against such
+        # words as well as a word does.
+        written = self._decode(heard.decoder, heard.max_tokens, words_first=True)[2]
+        return self._closest(heard.decoder, grammar.sentences, written)
+
+    def _closest(self, decoder: _Decoder, grammar: PhraseGrammar, free: float) -> Found | None:
+        """The likeliest phrase of ``grammar`` at most :data:`CLOSE_ENOUGH_NATS` less likely
+        than ``free`` (natural log), or None."""
+        return closest_phrase(
+            decoder,
+            grammar,
+            self._texts,
+            end_token=END_TOKEN,
+            max_tokens=grammar.longest + 1,  # a token writes a character or more
+            at_least=free - CLOSE_ENOUGH_NATS,  # less likely is not borne out
         )
-        doubted = looped or mean < DOUBTED_BELOW
-        text = "" if doubted else " ".join(w.text for w in heard)
-        unconfirmed = ""
-        if self.grammar and not (text and self.grammar.holds_a_phrase(text)):
-            self.closed_listenings += 1
-            if not tokens:
-                # it wrote nothing: a phrase is weighed against the likeliest words it would
-                # have written, not against silence, which the VAD already ruled out
-                free_log_prob = self._decode(decoder, max_tokens, words_first=True)[2]
-            found = closest_phrase(
-                decoder,
-                self.grammar,
-                self._texts,
-                end_token=END_TOKEN,
-                max_tokens=self.grammar.longest + 1,  # a token writes a character or more
-                at_least=free_log_prob - CLOSE_ENOUGH_NATS,  # less likely is not borne out
-            )
-            words_heard = [(w.text, w.probability) for w in heard]
-            if found is not None and bears_out(found, free_log_prob, words_heard, self.grammar):
-                if sure_of(found, words_heard):
-                    return Transcript(found.text, heard, 1.0 - mean, per_token)
-                unconfirmed = found.text
-        return Transcript(text, heard if not looped else said, 1.0 - mean, per_token, unconfirmed)
 
     def _decode(
         self, decoder: _Decoder, max_tokens: int, *, words_first: bool = False

@@ -30,6 +30,7 @@ measures the thresholds' effect on 662 clips (right, wrong, stray sentences acce
 
 from __future__ import annotations
 
+import functools
 import itertools
 import math
 import re
@@ -97,7 +98,9 @@ class PhraseGrammar:
 
     def __init__(self, phrases: Iterable[str]) -> None:
         listened = {spelled(phrase).strip() for phrase in phrases} - {""}
-        self.phrases = [words(text) for text in sorted(listened)]
+        self.spellings = sorted(listened)
+        """Each phrase as :func:`spelled`."""
+        self.phrases = [words(text) for text in self.spellings]
         self.texts = {said for text in listened for said in with_plurals(text)}
         self.longest = max((len(text) for text in self.texts), default=0)
         """Characters of the longest text."""
@@ -110,6 +113,11 @@ class PhraseGrammar:
 
     def __bool__(self) -> bool:
         return bool(self.texts)
+
+    @functools.cached_property
+    def sentences(self) -> PhraseGrammar:
+        """The phrases of two words or more."""
+        return PhraseGrammar(text for text in self.spellings if len(text.split()) >= 2)
 
     def allows(self, text: str) -> bool:
         """Whether ``text`` is on the way to a phrase, or is one (trailing marks aside)."""

@@ -6,8 +6,8 @@ is in what it wrote (a word it got wrong, a sentence no rule means), it hears th
 utterance again allowed to write only those phrases, and keeps the phrase when the audio
 bears it out (:mod:`engine.speech.phrase_search`, a tenth of a second). A phrase it is not
 sure of (a short sound forced into "yes", a long mumble into a short phrase) is heard again
-by Whisper tiny.en, prompted with the phrases, whose transcript counts
-(:class:`SecondOpinion`): about one utterance in twenty on bench/bench_speech.py's
+by Whisper tiny.en, prompted with the phrases, whose transcript counts where the two
+agree (:class:`SecondOpinion`): about one utterance in twenty on bench/bench_speech.py's
 clips, where Whisper once heard every utterance Moonshine's words did not hold.
 "whisper" is Whisper tiny.en alone, prompted with the phrases, and the fallback where
 Moonshine's package is not installed (its wheels are x86_64 only). A profile chooses
@@ -17,7 +17,9 @@ with ``recognizer:``; ``vest hear`` and ``vest dialogs check`` with ``--recogniz
 from __future__ import annotations
 
 from collections.abc import Iterable
+from typing import Protocol
 
+from engine.dialogs.words import same_word, words
 from engine.media.audio import Audio
 from engine.speech.recognizer import Recognizer, RecognizerError, Transcript
 from engine.speech.settings import RECOGNIZER_NAMES
@@ -25,30 +27,60 @@ from engine.speech.settings import RECOGNIZER_NAMES
 DEFAULT_RECOGNIZER = "moonshine"
 
 
+class FindsPhrases(Recognizer, Protocol):
+    """A recognizer that can tell whether an utterance bears out given phrases."""
+
+    def finds(self, audio: Audio, phrases: Iterable[str]) -> bool:
+        """Whether ``audio`` bears out one of ``phrases``."""
+        ...
+
+
 class SecondOpinion:
     """A fast recognizer, and a careful one that hears again the utterances whose phrase
-    the fast one found but is not sure of (:attr:`Transcript.unconfirmed`): the careful
-    recognizer's transcript is the one told."""
+    the fast one found but is not sure of (:attr:`Transcript.unconfirmed`). The careful
+    transcript is the one told when the two agree: it says that phrase too (its words in
+    order, as the matcher reads them: "Yeah, I have a puppy?" says "yeah"), or the fast
+    recognizer finds in the audio a phrase the careful one wrote ("Yeah?" where it had
+    "yes"). Otherwise they disagree and the utterance is heard as nothing (the robot says it
+    did not understand): a "huh" that Moonshine finds nearest to "yeah" and prompted
+    Whisper writes as "Hello?" is neither."""
 
-    def __init__(self, fast: Recognizer, careful: Recognizer) -> None:
+    def __init__(self, fast: FindsPhrases, careful: Recognizer) -> None:
         self.fast = fast
         self.careful = careful
         fast_name, careful_name = getattr(fast, "name", "fast"), getattr(careful, "name", "careful")
         self.name = f"{fast_name}, {careful_name} when unsure"
         self.second_opinions = 0
         """Utterances the careful recognizer heard again (for the benchmarks)."""
+        self.phrases: list[str] = []
 
     def listen_for(self, phrases: Iterable[str]) -> None:
-        listened = list(phrases)
-        self.fast.listen_for(listened)
-        self.careful.listen_for(listened)
+        self.phrases = list(phrases)
+        self.fast.listen_for(self.phrases)
+        self.careful.listen_for(self.phrases)
 
     def transcribe(self, audio: Audio) -> Transcript:
         heard = self.fast.transcribe(audio)
         if not heard.unconfirmed:
             return heard
         self.second_opinions += 1
-        return self.careful.transcribe(audio)
+        careful = self.careful.transcribe(audio)
+        if says(careful.text, heard.unconfirmed):
+            return careful
+        written = [phrase for phrase in self.phrases if says(careful.text, phrase)]
+        if written and self.fast.finds(audio, written):
+            return careful
+        return Transcript("", careful.words, careful.no_speech, careful.log_prob)
+
+
+def says(text: str, phrase: str) -> bool:
+    """Whether ``text`` holds the words of ``phrase`` in order (others between and around
+    them), as the matcher reads words: "Yeah, I have a puppy?" says "yeah"."""
+    wanted = list(words(phrase))
+    for word in words(text):
+        if wanted and same_word(word, wanted[0]):
+            wanted.pop(0)
+    return bool(words(phrase)) and not wanted
 
 
 def load_recognizer(name: str) -> Recognizer:

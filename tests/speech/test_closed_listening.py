@@ -28,6 +28,7 @@ from engine.speech.phrase_search import (
 from engine.speech.recognizer import Recognizer, Transcript
 from engine.speech.recognizers import SecondOpinion
 from engine.speech.vad import SileroVad
+from engine.speech.voices import Voice
 
 END = 2
 PIECES = ["", "", "", " Do", " you", " like", " dog", " it", "?", " dogs", " How", " are"]
@@ -167,13 +168,16 @@ def test_a_phrase_is_sure_when_likely_word_by_word_long_enough_and_something_was
 
 
 class SaysRecognizer:
-    """Says what it is told to, and counts what it heard."""
+    """Says what it is told to, finds the phrases it is told it would find, and counts
+    what it heard."""
 
     name = "says"
 
-    def __init__(self, transcript: Transcript) -> None:
+    def __init__(self, transcript: Transcript, *, would_find: Iterable[str] = ()) -> None:
         self.transcript = transcript
+        self.would_find = set(would_find)
         self.heard = 0
+        self.asked: list[list[str]] = []
 
     def listen_for(self, phrases: Iterable[str]) -> None:
         pass
@@ -182,15 +186,56 @@ class SaysRecognizer:
         self.heard += 1
         return self.transcript
 
+    def finds(self, audio: Audio, phrases: Iterable[str]) -> bool:
+        self.asked.append(sorted(phrases))
+        return bool(self.would_find & set(self.asked[-1]))
+
+
+PETS = ["yes", "yeah", "yeah i have a puppy", "i have a puppy", "hello", "no"]
+
 
 def test_whisper_hears_again_only_a_phrase_closed_listening_is_not_sure_of() -> None:
     fast = SaysRecognizer(Transcript("how hot is it"))
-    careful = SaysRecognizer(Transcript("Mm."))
+    careful = SaysRecognizer(Transcript("Yes."))
     both = SecondOpinion(fast, careful)
+    both.listen_for(PETS)
     assert both.transcribe(Audio.silence(1.0)).text == "how hot is it"
-    fast.transcript = Transcript("", unconfirmed="yes")  # "mm" forced into "yes"
-    assert both.transcribe(Audio.silence(1.0)).text == "Mm."
+    fast.transcript = Transcript("", unconfirmed="yes")  # a short "yes", or "mm"?
+    assert both.transcribe(Audio.silence(1.0)).text == "Yes."
     assert (fast.heard, careful.heard, both.second_opinions) == (2, 1, 1)
+
+
+def test_whisper_s_transcript_counts_where_it_says_the_phrase_moonshine_was_unsure_of() -> None:
+    fast = SaysRecognizer(Transcript("", unconfirmed="yeah"))
+    both = SecondOpinion(fast, SaysRecognizer(Transcript("Yeah, I have a puppy?")))
+    both.listen_for(PETS)
+    assert both.transcribe(Audio.silence(1.0)).text == "Yeah, I have a puppy?"
+
+
+def test_whisper_writing_another_phrase_counts_only_where_moonshine_finds_it_too() -> None:
+    fast = SaysRecognizer(Transcript("", unconfirmed="yes"), would_find=["yeah"])
+    both = SecondOpinion(fast, SaysRecognizer(Transcript("Yeah?")))
+    both.listen_for(PETS)
+    assert both.transcribe(Audio.silence(1.0)).text == "Yeah?"
+    assert fast.asked == [["yeah"]]
+
+
+def test_a_sound_the_two_recognizers_hear_as_different_phrases_is_heard_as_nothing() -> None:
+    # "huh": Moonshine finds "yeah" nearest, Whisper prompted with the phrases "Hello?"
+    fast = SaysRecognizer(Transcript("Huh?", unconfirmed="yeah"))
+    careful = SaysRecognizer(Transcript("Hello?"))
+    both = SecondOpinion(fast, careful)
+    both.listen_for(PETS)
+    assert both.transcribe(Audio.silence(1.0)).text == ""
+    assert fast.asked == [["hello"]]
+    careful.transcript = Transcript("Mm.")  # no phrase at all: nothing to ask
+    assert both.transcribe(Audio.silence(1.0)).text == ""
+    assert fast.asked == [["hello"]]
+
+
+def test_where_moonshine_writes_nothing_only_phrases_of_words_are_looked_for() -> None:
+    grammar = PhraseGrammar(["Hello!", "yes", "how are you", "do you like dog"])
+    assert grammar.sentences.spellings == ["do you like dog", "how are you"]
 
 
 def test_the_grammar_reads_phrases_as_spelled_whatever_the_case_and_marks() -> None:
@@ -274,6 +319,17 @@ def test_a_sound_after_the_robot_s_question_is_not_taken_for_yes_or_no(
 ) -> None:
     pets = next(rule for rule in default_dialog.rules if rule.id == "pets")
     hearing = hear(spoken(sound, "hibari"), vad, recognizer, default_dialog, pets.follow_up)
+    assert hearing.verdict is None or hearing.verdict.match is None, hearing
+
+
+def test_a_huh_is_not_taken_for_a_greeting(
+    voices: dict[str, Voice], vad: SileroVad, recognizer: Recognizer, default_dialog: Dialog
+) -> None:
+    # a breaker's recording: Moonshine wrote "Huh?" and found "yeah" nearest among the
+    # phrases (not sure of it); prompted Whisper wrote "Hello?"
+    huh = voices["hibari"].synthesize("huh").resampled(16000)
+    audio = Audio.silence(0.5, 16000).then(huh).then(Audio.silence(1.0, 16000))
+    hearing = hear(audio, vad, recognizer, default_dialog)
     assert hearing.verdict is None or hearing.verdict.match is None, hearing
 
 
