@@ -43,7 +43,10 @@ class SecondOpinion:
     recognizer finds in the audio a phrase the careful one wrote ("Yeah?" where it had
     "yes"). Otherwise they disagree and the utterance is heard as nothing (the robot says it
     did not understand): a "huh" that Moonshine finds nearest to "yeah" and prompted
-    Whisper writes as "Hello?" is neither."""
+    Whisper writes as "Hello?" is neither. Where the careful recognizer doubted what it
+    wrote (Whisper checks a transcript of function words only, like "who are you",
+    against a decoding without the phrases), three words or more that say exactly the
+    fast one's phrase count: two recognizers that each wrote them."""
 
     def __init__(self, fast: FindsPhrases, careful: Recognizer) -> None:
         self.fast = fast
@@ -67,6 +70,13 @@ class SecondOpinion:
         careful = self.careful.transcribe(audio)
         if says(careful.text, heard.unconfirmed):
             return careful
+        doubted = " ".join(word.text for word in careful.words)
+        if (
+            not careful.text
+            and len(words(heard.unconfirmed)) >= 3
+            and words(doubted) == words(heard.unconfirmed)
+        ):
+            return Transcript(doubted, careful.words, careful.no_speech, careful.log_prob)
         written = [phrase for phrase in self.phrases if says(careful.text, phrase)]
         if written and self.fast.finds(audio, written):
             return careful

@@ -25,7 +25,7 @@ from engine.speech.phrase_search import (
     left_out,
     sure_of,
 )
-from engine.speech.recognizer import Recognizer, Transcript
+from engine.speech.recognizer import Recognizer, Transcript, Word
 from engine.speech.recognizers import SecondOpinion
 from engine.speech.vad import SileroVad
 from engine.speech.voices import Voice
@@ -218,6 +218,20 @@ def test_whisper_writing_another_phrase_counts_only_where_moonshine_finds_it_too
     both.listen_for(PETS)
     assert both.transcribe(Audio.silence(1.0)).text == "Yeah?"
     assert fast.asked == [["yeah"]]
+
+
+def test_three_words_both_recognizers_wrote_are_heard_though_whisper_doubted_them() -> None:
+    # espeak's "who are you": Moonshine borne out but not sure; prompted Whisper wrote
+    # "Who are you?" (its first word at 0.02) and, unprompted, "Thank you."
+    doubted = Transcript("", (Word("Who", 0.02), Word("are", 0.68), Word("you?", 0.98)))
+    fast = SaysRecognizer(Transcript("", unconfirmed="who are you"))
+    both = SecondOpinion(fast, SaysRecognizer(doubted))
+    both.listen_for(["who are you", "hi"])
+    assert both.transcribe(Audio.silence(1.0)).text == "Who are you?"
+    # a shorter phrase so written is no agreement: a sound is forced into "hi" by both
+    fast.transcript = Transcript("", unconfirmed="hi")
+    both.careful = SaysRecognizer(Transcript("", (Word("Hi?", 0.03),)))
+    assert both.transcribe(Audio.silence(1.0)).text == ""
 
 
 def test_a_sound_the_two_recognizers_hear_as_different_phrases_is_heard_as_nothing() -> None:
