@@ -256,9 +256,21 @@ def bears_out(
 
 def sure_of(found: Found, heard: Sequence[tuple[str, float]]) -> bool:
     """Whether a phrase :func:`bears_out` accepted needs no second opinion (see
-    :data:`SURE_PER_WORD`)."""
+    :data:`SURE_PER_WORD`). Nor is a phrase sure that only adds meaning words to what was
+    written ("What is your", trailing off, is not surely "what is your name")."""
     said = words(found.text)
-    return bool(heard) and len(said) >= 2 and found.log_prob / (len(said) + 1) >= SURE_PER_WORD
+    if not heard or len(said) < 2 or found.log_prob / (len(said) + 1) < SURE_PER_WORD:
+        return False
+    added: list[str] = []
+    at = 0
+    for word in (word for text, _ in heard for word in words(text)):
+        while at < len(said) and not same_word(word, said[at]):
+            added.append(said[at])
+            at += 1
+        if at == len(said):
+            return True  # a word written that the phrase has nothing for: heard wrong
+        at += 1
+    return all(is_function_word(word) for word in [*added, *said[at:]])
 
 
 def left_out(heard: Sequence[tuple[str, float]], phrase: Sequence[str]) -> list[tuple[str, float]]:

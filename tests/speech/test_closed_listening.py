@@ -167,6 +167,13 @@ def test_a_phrase_is_sure_when_likely_word_by_word_long_enough_and_something_was
     assert not sure_of(Found("how hot is it", -1.0), [])  # Moonshine wrote nothing
 
 
+def test_a_phrase_that_only_adds_a_meaning_word_to_what_was_written_is_not_sure() -> None:
+    trailing_off = words_heard("What is your")
+    assert not sure_of(Found("what is your name", -2.0), trailing_off)
+    assert sure_of(Found("do you like dogs", -2.0), words_heard("you like dogs"))  # "do"
+    assert sure_of(Found("what is your name", -2.0), words_heard("What is your aim?"))
+
+
 class SaysRecognizer:
     """Says what it is told to, finds the phrases it is told it would find, and counts
     what it heard."""
