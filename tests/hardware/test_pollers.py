@@ -77,6 +77,27 @@ class Bench:
         poller.connect()  # as at start-up: a chip calibrates on what it senses then
         return poller
 
+    def pretend(
+        self,
+        name: str,
+        read: Callable[[object], list[Staged]],
+        *,
+        release: Callable[[object], None] | None = None,
+    ) -> Poller[object]:
+        """A 10 Hz poller of a pretend device whose reads ``read`` answers (its health in
+        :attr:`health`)."""
+        self.health[name] = DeviceHealth(name, self.board)  # type: ignore[arg-type]
+        return Poller(
+            name,
+            rate_hz=10.0,
+            clock=self.clock,
+            blackboard=self.board,  # type: ignore[arg-type]
+            health=self.health[name],
+            connect=object,
+            read=read,
+            release=release,
+        )
+
     def run(self, poller: Poller[Any], seconds: float, step_s: float = 0.01) -> None:
         """Call the hook now and every ``step_s`` for ``seconds``, as a scheduler would."""
         end = self.base.now() + seconds
@@ -299,16 +320,7 @@ def test_a_driver_bug_is_logged_once_per_failure_streak_not_at_every_poll(
             raise ZeroDivisionError("division by zero")  # a bug, not a bus error
         return [Staged("/sensors/touch/any", False)]
 
-    health = DeviceHealth("touch", bench.board)  # type: ignore[arg-type]
-    poller: Poller[object] = Poller(
-        "touch",
-        rate_hz=10.0,
-        clock=bench.clock,
-        blackboard=bench.board,  # type: ignore[arg-type]
-        health=health,
-        connect=object,
-        read=read,
-    )
+    poller = bench.pretend("touch", read)
     with caplog.at_level(logging.INFO, logger="vest.pollers"):
         bench.run(poller, 1.0)  # ten polls, all failing
         broken = False
@@ -318,7 +330,7 @@ def test_a_driver_bug_is_logged_once_per_failure_streak_not_at_every_poll(
 
     errors = [record.getMessage() for record in caplog.records if record.levelno >= logging.ERROR]
     assert errors == ["touch: poll failed with ZeroDivisionError: division by zero"] * 2
-    assert poller.failures == 15 and health.ok is False
+    assert poller.failures == 15 and bench.health["touch"].ok is False
 
 
 def test_a_chip_that_cannot_be_released_at_stop_is_logged_and_the_stop_goes_on(
@@ -330,16 +342,8 @@ def test_a_chip_that_cannot_be_released_at_stop_is_logged_and_the_stop_goes_on(
         released.append(driver)
         raise OSError(121, "Remote I/O error")  # unplugged since its last poll
 
-    health = DeviceHealth("range_left", bench.board)  # type: ignore[arg-type]
-    poller: Poller[object] = Poller(
-        "range_left",
-        rate_hz=10.0,
-        clock=bench.clock,
-        blackboard=bench.board,  # type: ignore[arg-type]
-        health=health,
-        connect=object,
-        read=lambda driver: [Staged("/sensors/range/left_mm", 250.0)],
-        release=release,
+    poller = bench.pretend(
+        "range_left", lambda driver: [Staged("/sensors/range/left_mm", 250.0)], release=release
     )
     poller.release()  # never connected: nothing to tell
     bench.run(poller, 0.1)

@@ -9,7 +9,7 @@ import pytest
 
 from engine.blackboard.catalogue import default_catalogue
 from engine.dialogs.library import load_dialog
-from engine.dialogs.model import Dialog
+from engine.dialogs.model import Dialog, FollowUp
 from engine.media.audio import Audio, with_noise
 from engine.speech.recognizer import Recognizer, WhisperRecognizer
 from engine.speech.recognizers import DEFAULT_RECOGNIZER, load_recognizer
@@ -23,6 +23,14 @@ ROOT = Path(__file__).resolve().parents[2]
 @pytest.fixture(scope="session")
 def default_dialog() -> Dialog:
     return load_dialog(ROOT / "dialogs" / "default.yaml", default_catalogue())
+
+
+@pytest.fixture(scope="session")
+def pets_answers(default_dialog: Dialog) -> FollowUp:
+    """The answers the default dialog listens for after "Do you have a pet?"."""
+    pets = next(rule for rule in default_dialog.rules if rule.id == "pets")
+    assert pets.follow_up is not None
+    return pets.follow_up
 
 
 @pytest.fixture(scope="session")

@@ -7,7 +7,7 @@ from collections.abc import Callable
 
 import pytest
 
-from engine.dialogs.model import Dialog
+from engine.dialogs.model import Dialog, FollowUp
 from engine.media.audio import Audio
 from engine.speech.hearing import hear
 from engine.speech.recognizer import Recognizer
@@ -74,12 +74,12 @@ def test_the_answer_to_the_robot_s_question_is_heard_as_the_follow_up(
     vad: SileroVad,
     recognizer: Recognizer,
     default_dialog: Dialog,
+    pets_answers: FollowUp,
 ) -> None:
-    pets = next(rule for rule in default_dialog.rules if rule.id == "pets")
-    hearing = hear(spoken("yes, I have a dog"), vad, recognizer, default_dialog, pets.follow_up)
+    hearing = hear(spoken("yes, I have a dog"), vad, recognizer, default_dialog, pets_answers)
     assert hearing.verdict is not None and hearing.verdict.match is not None
     assert hearing.verdict.match.rule.id == "has_pet"
-    hearing = hear(spoken("no"), vad, recognizer, default_dialog, pets.follow_up)
+    hearing = hear(spoken("no"), vad, recognizer, default_dialog, pets_answers)
     assert hearing.verdict is not None and hearing.verdict.match is not None
     assert hearing.verdict.match.rule.id == "no_pet"
 
