@@ -13,10 +13,16 @@ from __future__ import annotations
 
 import logging
 import threading
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from typing import Any
 
-from engine.blackboard.catalogue import KeyCatalogue
+from engine.blackboard.catalogue import (
+    NOTHING,
+    VARIABLES_PREFIX,
+    Carries,
+    KeyCatalogue,
+    captures_of,
+)
 from engine.blackboard.events import EventLog
 from engine.clock import Clock
 
@@ -53,6 +59,8 @@ class Blackboard:
         self._last_staged: dict[str, Any] = {}
         self._changed: set[str] = set()
         self._committing = False
+        self._carries: dict[str, Carries] = {}
+        """What of a person each ``/vars/`` key's value was made from (its writer said)."""
 
     # -- producers (any thread) ---------------------------------------------------------
     def stage(self, key: str, value: Any) -> None:
@@ -117,8 +125,15 @@ class Blackboard:
         """How many times ``watcher`` has raised while told of a commit."""
         return self._watcher_failures.get(id(watcher), 0)
 
-    def set(self, key: str, value: Any) -> None:
-        """Write now (a tree node during its tick, or a test). Event keys get an event."""
+    def set(self, key: str, value: Any, *, carries: Carries = NOTHING) -> None:
+        """Write now (a tree node during its tick, or a test). Event keys get an event.
+        ``carries``: what of a person the value was made from (a ``/vars/`` key holding
+        what was heard carries words; see :func:`carried_by`)."""
+        if key.startswith(VARIABLES_PREFIX):
+            if carries:
+                self._carries[key] = carries
+            else:
+                self._carries.pop(key, None)
         spec = self.catalogue.lookup(key)
         if spec is not None and spec.kind == "event":
             self._append_event(key, value)
@@ -131,6 +146,14 @@ class Blackboard:
 
     def get(self, key: str, default: Any = None) -> Any:
         return self._values.get(key, default)
+
+    def carried_by(self, keys: Iterable[str]) -> Carries:
+        """What of a person the values of ``keys`` are or were made from, together: a
+        sensor's readings, what was heard, and what a tree's variable was made from."""
+        found: set[str] = set()
+        for key in keys:
+            found |= self._carries.get(key, NOTHING) or captures_of(key)
+        return frozenset(found) if found else NOTHING
 
     def event_log(self, key: str) -> EventLog:
         log = self._values.get(key)
@@ -152,6 +175,7 @@ class Blackboard:
         self._changed.clear()
         self._updated_s.clear()
         self._values.clear()
+        self._carries.clear()
 
     def _write(self, key: str, value: Any) -> None:
         if key in self.wake_keys and not _same(self._values.get(key, _NONE), value):

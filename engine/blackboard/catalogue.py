@@ -44,6 +44,34 @@ HAND_FINGERS = "/vision/hand/fingers"
 HAND_CONFIDENCE = "/vision/hand/confidence"
 HAND_SHOWN = "/vision/hand/shown"
 HAND_HELD = "/vision/hand/held"
+VISION_PREFIX = "/vision/"
+SPEECH_PREFIX = "/speech/"
+
+# -- what of a person a key's value is (the names a consent record covers) --------------------
+READINGS = "sensors"
+"""A sensor reading or what the camera saw: consent's ``sensors``."""
+WORDS = "speech_text"
+"""What a person said, as text: consent's ``speech_text``."""
+Carries = frozenset[str]
+"""What of a person a value holds or was made from: some of :data:`READINGS` and
+:data:`WORDS` (empty: nothing of anyone, the robot's own)."""
+NOTHING: Carries = frozenset()
+
+
+def captures_of(key: str) -> Carries:
+    """What of a person ``key``'s value is, by where it lives: ``/sensors/`` and
+    ``/vision/`` hold readings, ``/speech/`` what was said (but ``not_listened``, which
+    holds only when); a tree's ``/vars/`` hold what their writer made them from (the
+    blackboard knows: :meth:`~engine.blackboard.board.Blackboard.carried_by`)."""
+    if key.startswith((SENSORS_PREFIX, VISION_PREFIX)):
+        return _READINGS
+    if key.startswith(SPEECH_PREFIX) and key != SPEECH_NOT_LISTENED:
+        return _WORDS
+    return NOTHING
+
+
+_READINGS: Carries = frozenset({READINGS})
+_WORDS: Carries = frozenset({WORDS})
 
 
 def force_key(pad: str) -> str:

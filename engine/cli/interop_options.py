@@ -10,6 +10,7 @@ import stat
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from engine.blackboard.catalogue import READINGS
 from engine.cli.output import tell
 from engine.cli.view_options import port_number
 from engine.errors import UsageError
@@ -104,7 +105,7 @@ def tell_ros2(bridge: Ros2Bridge) -> None:
     )
     sent = (
         "sensor readings too (consent covers sensors and cloud_telemetry)"
-        if bridge.readings_leave
+        if READINGS in bridge.commands.gate.allowed
         else "the robot's own account only, no reading and no heard word (no consent to "
         "sensors and cloud_telemetry)"
     )

@@ -47,6 +47,7 @@ from engine.errors import ConfigError, UsageError
 from engine.files.problems import LoadError
 from engine.files.yaml_source import read_text
 from engine.loader.tree_checks import spoken_quote_warnings
+from engine.privacy.consent import of_a_simulation
 from engine.privacy.site import Site
 from engine.recording.session_file import check_new
 from engine.robot_io.robot_speech import RobotSpeech, audio_folder, build_speech, speech_settings
@@ -251,11 +252,16 @@ def _run_for_site(
         tell(f"finished erasing {erased.person} (cut off earlier)")
     for purged in site.purge():  # kept as long as the site said, no longer
         tell(f"purged {purged.path} (older than {site.settings.keep_sessions_days:g} days)")
-    consent = site.consent_of(args.person or "")
+    consent = (
+        site.consent_of(args.person)
+        if args.person or config.senses_people
+        else of_a_simulation()  # scripted on the simulated vest: nobody's data
+    )
     if args.record is not None:
         check_new(args.record, site.key)  # before anything starts: never over a session
     ros2 = ros2_plan(args)
-    if args.record is not None or args.cloud is not None or ros2 is not None:
+    leaving = args.record is not None or args.cloud is not None or ros2 is not None
+    if leaving or consent.left_out:  # what the timeline and the pages leave out, and why
         tell(f"privacy: {consent.describe()}")
     link = _cloud_link(args)
     clock: Clock = VirtualClock() if args.fast else RealClock()
@@ -317,7 +323,7 @@ def _run_for_site(
         )
     )
     assembled = running.assembled
-    robot, session = assembled.robot, assembled.robot.session
+    robot = assembled.robot
     try:
         timeline = Timeline(sys.stdout, start_s=running.start_s, as_json=args.json)
         warnings = turn_warnings(behaviors.trees) + spoken_quote_warnings(behaviors.trees)
@@ -333,7 +339,7 @@ def _run_for_site(
             tell(f"speech: {assembled.speech.describe()}")
             for part, why in assembled.speech.problems.items():
                 tell(f"warning: speech {part}: {shown(why)}")
-        session.subscribe(timeline, TOLD_KINDS)  # every reader reads the one session stream
+        running.gates.kept.subscribe(timeline, TOLD_KINDS)  # behind the consent gate
         timeline.on_closed = robot.scheduler.stop
         # a signal that came during start-up stops the run before its first tick
         args.stop_signals.on_stop(robot.scheduler.stop)

@@ -12,14 +12,13 @@ number is written as null.
 
 from __future__ import annotations
 
-import dataclasses
 import json
 from collections.abc import Callable
 from typing import Any, TextIO
 
 from engine.cli.output import discard, finite_json, reason, shown, tell
 from engine.runtime.scheduler import RunningTree
-from engine.session.events import ActionEnded, DeviceChanged, SessionEvent
+from engine.session.events import ActionEnded, DeviceChanged, SessionEvent, told_fields
 from engine.session.sentences import TOLD_KINDS, event_line
 
 
@@ -33,7 +32,7 @@ def event_json(event: SessionEvent, start_s: float) -> dict[str, Any] | None:
     if isinstance(event, DeviceChanged) and event.first:
         return None  # the first report at start-up
     fields: dict[str, Any] = {"t": round(event.t_s - start_s, 3), "event": event.kind}
-    for name in (field.name for field in dataclasses.fields(event)):
+    for name in told_fields(event):
         value = getattr(event, name)
         if name in ("t_s", "action_id"):
             continue

@@ -28,6 +28,7 @@ from engine.errors import ConfigError
 from engine.hardware.config import RobotConfig
 from engine.interop.ros2_plan import Ros2Plan
 from engine.privacy.consent import Consent, without_record
+from engine.privacy.consent_gate import ConsentGates
 from engine.privacy.sealed_sqlite import Error as SealedError
 from engine.privacy.site import Site
 from engine.recording.recorder import SessionRecorder
@@ -105,10 +106,13 @@ class SessionPlan:
 
 @dataclass
 class RunningSession:
-    """A robot built by :func:`build_session`, with what runs beside it."""
+    """A robot built by :func:`build_session`, with what runs beside it. Every reader of
+    the session reads one of the consent gate's exits (``gates.kept``: the site's disks
+    and screens; ``gates.sent``: off the robot), never the robot's own stream."""
 
     assembled: AssembledRobot
     start_s: float
+    gates: ConsentGates
     wizard: Wizard | None = None
     view: ViewServer | None = None
     recorder: SessionRecorder | None = None
@@ -154,7 +158,8 @@ def build_session(plan: SessionPlan) -> RunningSession:
 def _around(assembled: AssembledRobot, plan: SessionPlan) -> RunningSession:
     robot, session, lifecycle = assembled.robot, assembled.robot.session, assembled.lifecycle
     start_s = plan.clock.now()  # after start-up, which takes simulated time too
-    running = RunningSession(assembled, start_s)
+    gates = ConsentGates(session, plan.consent)  # the one gate; every reader is behind it
+    running = RunningSession(assembled, start_s, gates)
     if plan.buttons is not None:  # priority 100: ticks before the behaviors
         running.wizard = Wizard(plan.buttons, robot)
         robot.scheduler.add_hook(running.wizard)
@@ -162,7 +167,7 @@ def _around(assembled: AssembledRobot, plan: SessionPlan) -> RunningSession:
     if plan.view is not None:
         hub = ViewHub(plan.clock, device_stats=assembled.hardware.stats)
         hub.begin(start_s, robot.trees)
-        session.subscribe(hub)
+        gates.kept.subscribe(hub)
         robot.scheduler.add_hook(hub.stats_hook)
         view = ViewServer(
             LiveSource(hub),
@@ -175,7 +180,7 @@ def _around(assembled: AssembledRobot, plan: SessionPlan) -> RunningSession:
         lifecycle.add("view", start=_telling(view.start, view, plan.on_view_up), stop=view.stop)
     if plan.record is not None:
         record, consent = plan.record, plan.consent
-        recorder = SessionRecorder(record.path, plan.clock, record.site.key, consent)
+        recorder = SessionRecorder(record.path, plan.clock, record.site.key)
         running.recorder = recorder
 
         def close_recording() -> None:
@@ -192,13 +197,13 @@ def _around(assembled: AssembledRobot, plan: SessionPlan) -> RunningSession:
             **plan.facts,
             person=consent.person,
             kept=",".join(sorted(consent.covers)),
-            left_out=recorder.keeps.left_out(),
+            left_out=gates.keeping.left_out(),
         )
         recorder.begin(start_s)
         record.site.session_started(
             record.path, consent.person, plan.facts.get("profile", ""), tuple(consent.covers)
         )
-        session.subscribe(recorder)
+        gates.kept.subscribe(recorder)
     if plan.foxglove_port is not None:
         from engine.interop.foxglove_live import FoxgloveLive  # the foxglove extra
 
@@ -207,7 +212,7 @@ def _around(assembled: AssembledRobot, plan: SessionPlan) -> RunningSession:
         running.foxglove = live
         start_live = _telling(live.start, live, plan.on_foxglove_up)
         lifecycle.add("foxglove", start=start_live, stop=live.stop)
-        session.subscribe(live)
+        gates.kept.subscribe(live)
     if plan.ros2 is not None:
         from engine.interop.ros2_bridge import Ros2Bridge  # the ros2 extra
 
@@ -219,7 +224,7 @@ def _around(assembled: AssembledRobot, plan: SessionPlan) -> RunningSession:
 
         started = float(plan.facts.get("started", "0") or 0)
         bridge = Ros2Bridge(
-            plan.ros2, plan.clock, started - start_s, plan.consent, assembled.blackboard.catalogue
+            plan.ros2, plan.clock, started - start_s, gates.sending, assembled.blackboard.catalogue
         )
         running.ros2 = bridge
 
@@ -229,7 +234,7 @@ def _around(assembled: AssembledRobot, plan: SessionPlan) -> RunningSession:
         lifecycle.add(
             "ros2", start=_telling(start_bridge, bridge, plan.on_ros2_up), stop=bridge.stop
         )
-        session.subscribe(bridge)
+        gates.sent.subscribe(bridge)
     player = ScenarioPlayer(
         plan.scenario, assembled.world, start_s=start_s, on_event=_world_events(session)
     )
@@ -250,11 +255,8 @@ def _around(assembled: AssembledRobot, plan: SessionPlan) -> RunningSession:
     if plan.link is not None:
         link = plan.link
 
-        if not plan.consent.allows("cloud_telemetry"):
-            link.telemetry.devices_only()
-
         def start_link() -> None:
-            link.bind(assembled.blackboard, session)
+            link.bind(assembled.blackboard, gates.sent, gates.sending)
             link.start()
 
         lifecycle.add("cloud link", start=start_link, stop=link.stop)

@@ -282,6 +282,14 @@ class RobotConfig:
     camera: CameraConfig | None = None
     safety: SafetyConfig = field(default_factory=SafetyConfig)
 
+    @property
+    def senses_people(self) -> bool:
+        """Whether anything of a real person can reach the robot: real chips, a
+        microphone, a real camera (a simulated vest in its simulated room senses only
+        what a scenario scripts)."""
+        camera = self.camera is not None and not self.camera.simulated
+        return not self.simulated or self.audio.microphone is not None or camera
+
     def device(self, name: str) -> DeviceConfig:
         """The device called ``name``; ConfigError naming the nearest and the known ones."""
         try:

@@ -20,6 +20,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from engine.blackboard.board import Blackboard
+from engine.blackboard.catalogue import NOTHING, READINGS, Carries
 from engine.colors import parse_color
 from engine.errors import ServiceError
 from engine.hardware.config import RobotConfig, SafetyConfig
@@ -38,7 +39,11 @@ from engine.session.stream import SessionStream
 
 class SafetyRefusedError(ServiceError):
     """The safety envelope refused an action; the message says which rule and why (it
-    starts with ``safety``)."""
+    starts with ``safety``), quoting the readings that decided (``carries``)."""
+
+    def __init__(self, message: str, carries: Carries = NOTHING) -> None:
+        super().__init__(message)
+        self.carries = carries
 
 
 @dataclass(frozen=True)
@@ -51,6 +56,11 @@ class Verdict:
     devices: tuple[str, ...]
     why: str
     unsure: bool = False
+
+    @property
+    def carries(self) -> Carries:
+        """A rule that read sensors quotes what they read (a force, a distance)."""
+        return frozenset({READINGS}) if self.devices else NOTHING
 
 
 class SafetyEnvelope:
@@ -221,7 +231,9 @@ class SafetyEnvelope:
         if self.stream is not None:
             now = self.blackboard.clock.now()
             self.stream.publish(
-                SafetyAction(now, action, joint, verdict.rule, verdict.devices, verdict.why)
+                SafetyAction(
+                    now, action, joint, verdict.rule, verdict.devices, verdict.why, verdict.carries
+                )
             )
 
 
@@ -255,8 +267,8 @@ class StoppableMove:
         self.speed_dps = speed_dps
         self.stopped: SafetyRefusedError | None = None
 
-    def stop(self, why: str) -> None:
-        self.stopped = SafetyRefusedError(f"safety stopped it: {why}")
+    def stop(self, why: str, carries: Carries = NOTHING) -> None:
+        self.stopped = SafetyRefusedError(f"safety stopped it: {why}", carries)
         self.job.cancel()
 
     def done(self) -> bool:
@@ -327,7 +339,8 @@ class EnvelopedServos:
             return rest
         if refused is not None:
             self.envelope.tell("refused", joint, refused)
-            return ImmediateJob(error=SafetyRefusedError(f"safety: {refused.why}"))
+            refusal = SafetyRefusedError(f"safety: {refused.why}", refused.carries)
+            return ImmediateJob(error=refusal)
         speed, slowed = self.envelope.speed_dps(joint, speed_dps)
         started = self.inner.move(joint, angle_deg, speed_dps=speed)
         if slowed is not None:
@@ -391,6 +404,6 @@ class EnvelopeWatcher:
         for joint, move in moving:
             self.servos.stop(joint)
             self.servos.moving.pop(joint)
-            move.stop(verdict.why)
+            move.stop(verdict.why, verdict.carries)
             self.stops += 1
             self.envelope.tell("stopped", joint, verdict)

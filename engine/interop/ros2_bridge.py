@@ -13,11 +13,12 @@ installed. It publishes:
   ``vest replay --to mcap`` (``/vest/actions``, ``/vest/actions/outcome``, ``/vest/world``,
   ``/vest/events``) as ``std_msgs/String`` holding the same JSON.
 
-What leaves the robot follows the person's consent, as the cloud's telemetry does: without
-``cloud_telemetry`` (or without ``sensors``) only the robot's own account: its trees'
-statuses, which actions it took and how they ended (not their arguments: what it said or
-where it looked can tell a reading), its devices; never a reading, a heard word, the
-world's or the session's events. With both, what a recording of the person keeps.
+It reads the consent gate's ``sent`` exit (:mod:`engine.privacy.consent_gate`), as the
+cloud's telemetry does: without ``cloud_telemetry`` only the robot's own account leaves
+(its trees' statuses, which actions it took and how they ended, its devices; an action's
+arguments and a turn's words only where they were made of nothing of the person: where it
+looked, a Say that fills in a reading or what was heard, are withheld); never a reading,
+a heard word, the world's events. With it, what a recording of the person keeps.
 
 Commands, only when asked for (``--ros2-commands``: a ROS 2 graph has no accounts, so
 anyone on it may then command the robot), go the cloud's way
@@ -29,7 +30,6 @@ A session reader: the scheduler's thread only hands each event over
 
 from __future__ import annotations
 
-import dataclasses
 import json
 import logging
 import threading
@@ -38,7 +38,13 @@ from typing import Any
 import zenoh
 
 from engine.blackboard.board import Blackboard
-from engine.blackboard.catalogue import DEVICES_PREFIX, SENSORS_PREFIX, KeyCatalogue
+from engine.blackboard.catalogue import (
+    DEVICES_PREFIX,
+    SENSORS_PREFIX,
+    SPEECH_PREFIX,
+    VISION_PREFIX,
+    KeyCatalogue,
+)
 from engine.blackboard.events import EventLog
 from engine.clock import Clock
 from engine.errors import ConfigError
@@ -56,24 +62,21 @@ from engine.interop.ros2_wire import (
 )
 from engine.interop.session_topics import NodePaths, live_message
 from engine.periodic import Periodic
-from engine.privacy.consent import Consent
-from engine.recording.kept_by_consent import VISION_PREFIX, KeptByConsent
+from engine.privacy.consent_gate import ConsentGate
 from engine.services.telemetry import json_safe
 from engine.session.events import (
-    ActionEnded,
     ActionStarted,
     KeyChanged,
     NodeStatus,
     SessionEvent,
     TreeStarted,
-    TurnTaken,
 )
 from engine.session.handoff import Handoff
 
 log = logging.getLogger(__name__)
 CAPACITY = 50_000
 """Events the queue holds before it drops (seconds of the busiest session)."""
-PUBLISHED_KEYS = (SENSORS_PREFIX, VISION_PREFIX, "/speech/", DEVICES_PREFIX)
+PUBLISHED_KEYS = (SENSORS_PREFIX, VISION_PREFIX, SPEECH_PREFIX, DEVICES_PREFIX)
 COMMAND_TOPIC, RESULT_TOPIC = "/vest/command", "/vest/command/result"
 STRING, BOOL = "std_msgs/msg/String", "std_msgs/msg/Bool"
 FLOAT, INTEGER = "std_msgs/msg/Float64", "std_msgs/msg/Int64"
@@ -92,16 +95,14 @@ class Ros2Bridge:
         plan: Ros2Plan,
         clock: Clock,
         epoch_offset_s: float,
-        consent: Consent,
+        gate: ConsentGate,
         catalogue: KeyCatalogue,
     ) -> None:
         """``plan``: where the graph is and whether commands are taken; ``epoch_offset_s``
-        turns the clock's seconds into seconds since the epoch (ROS time)."""
+        turns the clock's seconds into seconds since the epoch (ROS time); ``gate``: the
+        consent gate's exit off the robot (a command's result passes it too)."""
         self.plan, self.clock, self.epoch_offset_s = plan, clock, epoch_offset_s
         self.catalogue = catalogue
-        self.readings_leave = consent.allows("cloud_telemetry") and consent.allows("sensors")
-        """Whether readings (and, with speech_text, heard words) may leave the robot."""
-        self._keeps = KeptByConsent(consent)
         self.node = NodeName("vest")
         self.wire = Wire()
         self._session: zenoh.Session | None = None
@@ -114,7 +115,7 @@ class Ros2Bridge:
         self._lock = threading.Lock()  # the publishers: two threads publish
         self._entities = 0  # the node's publishers and subscriptions, numbered
         self._handoff = Handoff("ros2", self._send, capacity=CAPACITY)
-        self.commands = GraphCommands(clock, self._tell, readings_may_leave=self.readings_leave)
+        self.commands = GraphCommands(clock, self._tell, gate=gate)
         self._sweep = Periodic(clock, 1.0, self.commands.sweep, name="ros2-commands")
 
     # -- lifecycle -----------------------------------------------------------------------
@@ -168,46 +169,28 @@ class Ros2Bridge:
     # -- publishing (the bridge's thread) --------------------------------------------------
     def _send(self, events: list[SessionEvent]) -> bool:
         logs: dict[str, list[dict[str, Any]]] = {}
-        for event in events:
+        for event in events:  # what the consent gate let leave the robot
             if isinstance(event, ActionStarted) and event.action == "report":
                 self.commands.reported(event)
-            kept = self._leaving(event)
-            if kept is None:
-                continue
-            if isinstance(kept, TreeStarted):
-                for node in kept.nodes:
-                    self._paths[(kept.tree, kept.version, node.index)] = (node.path, node.type)
-            elif isinstance(kept, NodeStatus):
-                logs.setdefault(kept.tree, []).append(self._status_change(kept))
-            elif isinstance(kept, KeyChanged):
-                if kept.key.startswith(PUBLISHED_KEYS):
-                    self._key(kept)
+            if isinstance(event, TreeStarted):
+                for node in event.nodes:
+                    self._paths[(event.tree, event.version, node.index)] = (node.path, node.type)
+            elif isinstance(event, NodeStatus):
+                logs.setdefault(event.tree, []).append(self._status_change(event))
+            elif isinstance(event, KeyChanged):
+                if event.key.startswith(PUBLISHED_KEYS):
+                    self._key(event)
             else:
-                found = live_message(kept, self._paths)
+                found = live_message(event, self._paths)
                 if found is not None:
                     topic, _, message = found
-                    self._publish(topic, STRING, {"data": json.dumps(message)}, kept.t_s)
+                    self._publish(topic, STRING, {"data": json.dumps(message)}, event.t_s)
         now_s = self.clock.now()
         for tree, changes in logs.items():
             stamp = ros_time(now_s + self.epoch_offset_s)
             topic = ros_name(f"/vest/trees/{tree}/log")
             self._publish(topic, TREE_LOG, {"timestamp": stamp, "event_log": changes}, now_s)
         return True
-
-    def _leaving(self, event: SessionEvent) -> SessionEvent | None:
-        """What of ``event`` may leave the robot (None: nothing), by the person's consent."""
-        kept = self._keeps.kept(event)
-        if kept is None or self.readings_leave:
-            return kept
-        if isinstance(kept, ActionStarted):  # the act, not what it carried
-            return dataclasses.replace(kept, args={})
-        if isinstance(kept, ActionEnded):
-            return dataclasses.replace(kept, args={}, why="")
-        if isinstance(kept, TreeStarted | NodeStatus | TurnTaken):
-            return kept
-        if isinstance(kept, KeyChanged) and kept.key.startswith(DEVICES_PREFIX):
-            return kept
-        return None
 
     def _status_change(self, event: NodeStatus) -> dict[str, Any]:
         where = (event.tree, event.version, event.node)

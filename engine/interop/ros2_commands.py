@@ -26,8 +26,9 @@ from typing import Any
 from engine.blackboard.board import Blackboard
 from engine.blackboard.catalogue import IOT_INBOX
 from engine.clock import Clock
+from engine.privacy.consent_gate import RESULT_WITHHELD, ConsentGate
 from engine.remote_commands import COMMAND_TYPES, command_problem
-from engine.services.telemetry import WITHHELD, carries_sensor_values, json_safe
+from engine.services.telemetry import json_safe
 from engine.session.events import ActionStarted
 
 log = logging.getLogger(__name__)
@@ -105,9 +106,10 @@ def _depth(text: str) -> int:
 class GraphCommands:
     """The commands taken from the graph and not yet answered."""
 
-    def __init__(self, clock: Clock, tell: Tell, *, readings_may_leave: bool) -> None:
+    def __init__(self, clock: Clock, tell: Tell, *, gate: ConsentGate) -> None:
+        """``gate``: what may leave the robot (a result made of readings, say)."""
         self.clock, self._tell = clock, tell
-        self.readings_may_leave = readings_may_leave
+        self.gate = gate
         self.blackboard: Blackboard | None = None
         self._waiting: dict[str, float] = {}  # our id -> when it was staged (clock s)
         self._lock = threading.Lock()
@@ -154,8 +156,8 @@ class GraphCommands:
                 return  # the cloud's, or a scenario's
         result = event.args.get("result")
         status = str(event.args.get("status", "")).upper()
-        if not self.readings_may_leave and carries_sensor_values(result):
-            status, result = "FAILED", {"error": WITHHELD}
+        if not self.gate.lets_result_out(result, event.carries):
+            status, result = "FAILED", {"error": RESULT_WITHHELD}
         self._tell(command_id.removeprefix(PREFIX), status, json_safe(result))
 
     def sweep(self) -> None:

@@ -4,7 +4,6 @@ the ROS 2 bridge so a layout made on one works on the others."""
 
 from __future__ import annotations
 
-import dataclasses
 from typing import Any
 
 from engine.recording.recorder import KEPT_AS_EVENTS
@@ -16,6 +15,7 @@ from engine.session.events import (
     NodeStatus,
     SessionEvent,
     WorldEvent,
+    told_fields,
 )
 
 NodePaths = dict[tuple[str, int, int], tuple[str, str]]
@@ -59,4 +59,4 @@ def live_message(event: SessionEvent, paths: NodePaths) -> tuple[str, str, dict[
 
 
 def vars_of(event: SessionEvent) -> dict[str, Any]:
-    return {field.name: getattr(event, field.name) for field in dataclasses.fields(event)}
+    return {name: getattr(event, name) for name in told_fields(event)}

@@ -35,6 +35,7 @@ from typing import Any, ClassVar
 import py_trees
 from py_trees.common import Status
 
+from engine.blackboard.catalogue import Carries
 from engine.nodes.context import TreeContext
 from engine.nodes.spec import NodeType
 from engine.services.jobs import Job
@@ -78,7 +79,8 @@ class Leaf(py_trees.behaviour.Behaviour):
         super().__init__(name)
         self.args = args
         self.ctx = ctx
-        _, write_keys = leaf_type(type(self)).keys(vars(args))
+        read_keys, write_keys = leaf_type(type(self)).keys(vars(args))
+        self.read_keys = tuple(dict.fromkeys(read_keys))
         self.write_keys = frozenset(write_keys)
 
     @classmethod
@@ -92,15 +94,25 @@ class Leaf(py_trees.behaviour.Behaviour):
         it has none yet."""
         return self.ctx.blackboard.get(key, default)
 
-    def write(self, key: str, value: Any) -> None:
+    def write(self, key: str, value: Any, *, carries: Carries | None = None) -> None:
         """Write one of this tree's variables (``/vars/...``) now: only a key the node
-        declared it writes (in ``writes`` or a write ``Key`` parameter)."""
+        declared it writes (in ``writes`` or a write ``Key`` parameter). ``carries``: what
+        of a person ``value`` was made from; by default what the node reads
+        (:meth:`carries`), which is never less than the truth."""
         if key not in self.write_keys:
             raise PermissionError(
                 f"{type(self).__name__} writes {key!r} but does not declare it "
                 f"(it declares {sorted(self.write_keys) or 'no writes'})"
             )
-        self.ctx.blackboard.set(key, value)
+        made_of = self.carries() if carries is None else carries
+        self.ctx.blackboard.set(key, value, carries=made_of)
+
+    def carries(self) -> Carries:
+        """What of a person this node's outputs (its writes, its actions' arguments, its
+        feedback) may hold: what the keys it reads hold now (a sensor's readings, what
+        was heard, a variable made from either). A node that knows better passes
+        ``carries`` to :meth:`write` or to its action."""
+        return self.ctx.blackboard.carried_by(self.read_keys)
 
     def now(self) -> float:
         """The engine clock, in seconds."""
@@ -147,12 +159,14 @@ def _guard_initialise(method: Callable[[Leaf], None]) -> Callable[[Leaf], None]:
         if self._guarding:  # a subclass's initialise calls super's
             return method(self)
         self._guarding = True
+        self.ctx.actions.acting = self  # its actions are made of what it reads
         try:
             method(self)
         except Exception as error:
             self._failed_to_start = error  # update() then answers FAILURE
         finally:
             self._guarding = False
+            self.ctx.actions.acting = None
 
     return initialise
 
@@ -167,6 +181,7 @@ def _guard_update(method: Callable[[Leaf], Any]) -> Callable[[Leaf], Status]:
             self._report(failed)
             return Status.FAILURE
         self._guarding = True
+        self.ctx.actions.acting = self
         try:
             status = method(self)
             if not isinstance(status, Status):  # py_trees would make it INVALID, silently
@@ -177,6 +192,7 @@ def _guard_update(method: Callable[[Leaf], Any]) -> Callable[[Leaf], Status]:
             return Status.FAILURE
         finally:
             self._guarding = False
+            self.ctx.actions.acting = None
 
     return update
 
@@ -187,12 +203,14 @@ def _guard_terminate(method: Callable[[Leaf, Status], None]) -> Callable[[Leaf, 
         if self._guarding:
             return method(self, new_status)
         self._guarding = True
+        self.ctx.actions.acting = self
         try:
             method(self, new_status)
         except Exception as error:  # a failing terminate() must not stop the tick either
             self._report(error)
         finally:
             self._guarding = False
+            self.ctx.actions.acting = None
 
     return terminate
 

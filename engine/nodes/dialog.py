@@ -99,7 +99,9 @@ class Reply(Leaf):
         except (KeyError, ValueError) as error:  # a field with no value, or a bad value
             self.job = ImmediateJob(error=ServiceError(str(error).strip("'\"")))
             return
-        self.job = self.ctx.actions.say(text)
+        # the answer is the robot's own words, with what its fields fill in (a reading,
+        # or what was heard when the dialog echoes it): not the utterance that chose it
+        self.job = self.ctx.actions.say(text, carries=self.ctx.blackboard.carried_by(template.keys))
 
     def update(self) -> Status:
         if self.job is None:

@@ -11,7 +11,7 @@ from typing import Any, ClassVar
 
 from py_trees.common import Status
 
-from engine.blackboard.catalogue import IOT_CANCELED
+from engine.blackboard.catalogue import IOT_CANCELED, NOTHING, READINGS, Carries
 from engine.blackboard.events import EventLog
 from engine.nodes.base import ServiceAction
 from engine.nodes.event_reader import EventReader
@@ -25,6 +25,7 @@ from engine.remote_commands import (
 from engine.services.jobs import ImmediateJob, Job
 from engine.values.param_problems import CheckContext
 from engine.values.params import SECONDS, Key, Param
+from engine.values.templates import CompiledTemplate
 
 
 class CarryOut(ServiceAction):
@@ -48,10 +49,13 @@ class CarryOut(ServiceAction):
     def __init__(self, *a: Any) -> None:
         super().__init__(*a)
         self.cancels = EventReader(self, IOT_CANCELED, None)
+        self.made_of: Carries = NOTHING
+        """What of a person the command's action and result are made from: a read's
+        result is readings; a say's text what its fields fill in; the rest nothing."""
 
     def initialise(self) -> None:
         if self.save_result_as:
-            self.write(self.save_result_as, None)
+            self.write(self.save_result_as, None, carries=NOTHING)
         self.started_s = self.now()
         self.cancels.skip_past()  # only a cancel of this command, from now on, counts
         super().initialise()
@@ -68,6 +72,7 @@ class CarryOut(ServiceAction):
                 return True
 
     def start(self) -> Job:
+        self.made_of = NOTHING
         command = self.read(self.command)
         try:
             if not isinstance(command, Mapping):
@@ -93,16 +98,19 @@ class CarryOut(ServiceAction):
 
     def _say(self, args: Mapping[str, Any]) -> Job:
         values = self._check("say", args)
-        return self.ctx.actions.say(values["text"].fill(self.read), volume=values["volume"])
+        text: CompiledTemplate = values["text"]
+        self.made_of = self.ctx.blackboard.carried_by(text.keys)
+        said = text.fill(self.read)
+        return self.ctx.actions.say(said, volume=values["volume"], carries=self.made_of)
 
     def _led(self, args: Mapping[str, Any]) -> Job:
         values = self._check("led", args)
-        return self.ctx.actions.set_led(values["color"], seconds=values["seconds"])
+        return self.ctx.actions.set_led(values["color"], seconds=values["seconds"], carries=NOTHING)
 
     def _move(self, args: Mapping[str, Any]) -> Job:
         values = self._check("move", args)
         return self.ctx.actions.move_servo(
-            values["joint"], values["angle_deg"], speed_dps=values["speed_dps"]
+            values["joint"], values["angle_deg"], speed_dps=values["speed_dps"], carries=NOTHING
         )
 
     def _read(self, args: Mapping[str, Any]) -> Job:
@@ -111,6 +119,7 @@ class CarryOut(ServiceAction):
             raise CommandError(f"'sensor' must be non-empty text, got {_shown(sensor)}")
         if set(args) - {"sensor"}:
             raise CommandError(f"read takes only 'sensor', got {', '.join(map(str, args))}")
+        self.made_of = frozenset({READINGS})
         if sensor in ("temperature", "ultrasound"):
             return self.ctx.actions.read_sensor(sensor)
         keys = POLLED_READINGS.get(sensor)
@@ -137,7 +146,7 @@ class CarryOut(ServiceAction):
     def finished(self, job: Job) -> Status:
         result = job.result()  # a reading is staged by the sensor service, not written here
         if self.save_result_as:
-            self.write(self.save_result_as, result)
+            self.write(self.save_result_as, result, carries=self.made_of)
         return Status.SUCCESS
 
     def update(self) -> Status:
@@ -147,7 +156,8 @@ class CarryOut(ServiceAction):
         if status == Status.RUNNING and self.now() - self.started_s > self.timeout_s:
             status = self._cut(f"timed out after {self.timeout_s:g} s")
         if status == Status.FAILURE and self.save_result_as:
-            self.write(self.save_result_as, {"error": self.feedback_message})
+            error = {"error": self.feedback_message}  # which may quote the command's text
+            self.write(self.save_result_as, error, carries=self.made_of)
         return status
 
 

@@ -73,6 +73,8 @@ class Consent:
     def describe(self) -> str:
         """One line for the timeline and ``vest data consent``."""
         kept = ", ".join(CAPTURES[name] for name in CAPTURES if name in self.covers) or "nothing"
+        if self.given_by == SIMULATION:
+            return "no person named, on the simulated vest: nobody's data, everything is kept"
         if self.given_on is None:
             who = f"{self.person}: no consent record" if self.person else "no person named"
             return f"{who}: keeps {kept} (and the robot's actions)"
@@ -83,8 +85,19 @@ class Consent:
         )
 
 
+SIMULATION = "simulation"
+"""Who "gave" the consent of a session that senses nobody (:func:`of_a_simulation`)."""
+
+
 def without_record(person: str) -> Consent:
     return Consent(person, WITHOUT_CONSENT)
+
+
+def of_a_simulation() -> Consent:
+    """What is kept of a session with no person named, on a simulated vest in its
+    simulated room (no microphone, no real camera): everything in it was scripted, so it
+    holds nobody's data and everything is kept and shown."""
+    return Consent("", frozenset(CAPTURES), given_by=SIMULATION)
 
 
 class ConsentBook:

@@ -4,16 +4,16 @@ A reader of the session stream (:mod:`engine.session.events`): the scheduler's t
 only turns each event into a row (a tree version, a node's status, a blackboard change, an
 action and how it ended, a scenario event, a turn, a safety decision, a press...) and puts
 it on a bounded queue; a writer thread beside it stores the rows in the SQLite file
-(:mod:`engine.recording.session_file`, encrypted with the site's key) in batches. Only
-what the person consented to is kept (:mod:`engine.recording.kept_by_consent`); the file
-says what was left out (``meta``: ``person``, ``kept``, ``left_out``).
+(:mod:`engine.recording.session_file`, encrypted with the site's key) in batches. It
+reads the consent gate's kept exit (:mod:`engine.privacy.consent_gate`), so only what the
+person consented to reaches it; the file says what was left out (``meta``: ``person``,
+``kept``, ``left_out``).
 Should the disk fall so far behind that the queue fills, notes are dropped and counted,
 never waited for: the robot's ticks come first, and the file says how many were lost.
 """
 
 from __future__ import annotations
 
-import dataclasses
 import hashlib
 import json
 import logging
@@ -21,10 +21,8 @@ from pathlib import Path
 from typing import Any
 
 from engine.clock import Clock
-from engine.privacy.consent import Consent
 from engine.privacy.sealed_sqlite import Error
 from engine.privacy.site_data import SiteKey
-from engine.recording.kept_by_consent import KeptByConsent
 from engine.recording.session_file import create
 from engine.session.events import (
     ActionEnded,
@@ -34,6 +32,7 @@ from engine.session.events import (
     SessionEvent,
     TreeStarted,
     WorldEvent,
+    told_fields,
 )
 from engine.session.handoff import Handoff
 
@@ -49,22 +48,20 @@ their own, or are kept as the blackboard keys they came from)."""
 
 
 class SessionRecorder:
-    """Records one session into ``path``, encrypted with ``key``, keeping what ``consent``
-    allows: a session reader (``on_event``); times are clock seconds minus ``start_s``."""
+    """Records one session into ``path``, encrypted with ``key``: a reader of the consent
+    gate's kept exit (``on_event``); times are clock seconds minus ``start_s``."""
 
     def __init__(
         self,
         path: Path,
         clock: Clock,
         key: SiteKey,
-        consent: Consent,
         *,
         capacity: int = CAPACITY,
     ) -> None:
         self.path = path
         self.clock = clock
         self.start_s = clock.now()
-        self.keeps = KeptByConsent(consent)
         self._connection: Any = create(path, key)
         self._seq = 0  # the order of the session's events across tables
         self.length_s: float | None = None
@@ -94,11 +91,6 @@ class SessionRecorder:
 
     # -- as the robot runs (the scheduler's thread) ---------------------------------------
     def on_event(self, event: SessionEvent) -> None:
-        kept = self.keeps.kept(event)
-        if kept is not None:
-            self._keep(kept)
-
-    def _keep(self, event: SessionEvent) -> None:
         if isinstance(event, NodeStatus):
             self._note(
                 "INSERT INTO statuses VALUES (?, ?, ?, ?, ?, ?, ?)",
@@ -157,7 +149,7 @@ class SessionRecorder:
         elif event.kind in KEPT_AS_EVENTS:
             data = {
                 name: getattr(event, name)
-                for name in (field.name for field in dataclasses.fields(event))
+                for name in told_fields(event)
                 if name not in ("t_s", "tree")
             }
             for name in ("from_s", "until_s"):

@@ -12,7 +12,6 @@ among them), what was heard and seen, devices.
 
 from __future__ import annotations
 
-import dataclasses
 import re
 from typing import Any
 
@@ -35,6 +34,7 @@ from engine.session.events import (
     TreeReloaded,
     TurnTaken,
     WorldEvent,
+    told_fields,
 )
 
 _PRESS = re.compile(r"presses the button '(?P<label>.*)'$")
@@ -58,7 +58,7 @@ def _typed(kind: str, at_s: float, tree: str, fields: dict[str, Any]) -> Session
     event_type = _FROM_EVENTS_TABLE.get(kind)
     if event_type is None:
         return None  # a kind a later vest keeps: not told here
-    names = {field.name for field in dataclasses.fields(event_type)} - {"t_s"}
+    names = set(told_fields(event_type)) - {"t_s"}
     values = {name: fields[name] for name in names if name in fields}
     if "tree" in names:
         values["tree"] = tree

@@ -176,7 +176,8 @@ class Robot:
         """Who has the speaker, the face LEDs and each joint."""
         self.tree_news = TreeNews(self.session)
         self.scheduler.after_tick.append(self.tree_news)
-        blackboard.watchers.append(BlackboardNews(self.session, blackboard.catalogue, clock))
+        news = BlackboardNews(self.session, blackboard.catalogue, clock, blackboard.carried_by)
+        blackboard.watchers.append(news)
         self._staged = with_staged_readings(services, blackboard)  # readings reach every tree
         self._node_errors = on_node_error or NodeErrorLog()  # one count per node and error
         for definition in behaviors.trees:

@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 
 import py_trees
 
+from engine.blackboard.catalogue import NOTHING, Carries
 from engine.loader.tree_definition import TreeDefinition
 from engine.loader.tree_drawing import dot_source, label, preorder
 from engine.nodes.base import node_path
@@ -130,6 +131,16 @@ class TreeNews:
             self._publish_tree(watched, self.stream.clock.now())
         at = tree.next_deadline_s  # the statuses hold from the tick's deadline
         for index, status, feedback in changes:
+            carries = _carried_by(watched.nodes[index]) if feedback else NOTHING
             self.stream.publish(
-                NodeStatus(at, tree.name, watched.version, watched.ticks, index, status, feedback)
+                NodeStatus(
+                    at, tree.name, watched.version, watched.ticks, index, status, feedback, carries
+                )
             )
+
+
+def _carried_by(node: py_trees.behaviour.Behaviour) -> Carries:
+    """What of a person a node's feedback may quote: what it reads (a leaf says), else
+    nothing (a composite's or decorator's message tells of its children)."""
+    carries = getattr(node, "carries", None)
+    return carries() if callable(carries) else NOTHING

@@ -13,8 +13,9 @@ from __future__ import annotations
 import logging
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Protocol
 
+from engine.blackboard.catalogue import NOTHING, Carries
 from engine.clock import Clock
 from engine.services.interfaces import Services
 from engine.services.jobs import ImmediateJob, Job
@@ -49,6 +50,8 @@ class ActionRecord:
     error: str | None = None
     outcome: Outcome | None = None
     action_id: int = 0
+    carries: Carries = NOTHING
+    """What of a person ``args`` were made from."""
 
     @property
     def failed(self) -> bool:
@@ -71,11 +74,26 @@ class ActionLog:
         self.records.append(record)
         if self.stream is not None:
             self.stream.publish(
-                ActionStarted(record.t, record.action_id, record.tree, record.action, record.args)
+                ActionStarted(
+                    record.t,
+                    record.action_id,
+                    record.tree,
+                    record.action,
+                    record.args,
+                    record.carries,
+                )
             )
 
-    def ended(self, record: ActionRecord, outcome: Outcome, at_s: float, why: str = "") -> None:
-        """``record``'s job ended (first time only): done, failed (``why``) or cut."""
+    def ended(
+        self,
+        record: ActionRecord,
+        outcome: Outcome,
+        at_s: float,
+        why: str = "",
+        why_carries: Carries = NOTHING,
+    ) -> None:
+        """``record``'s job ended (first time only): done, failed (``why``, quoting
+        ``why_carries`` of a person) or cut."""
         if record.outcome is not None:
             return
         record.outcome = outcome
@@ -92,6 +110,8 @@ class ActionLog:
                     record.t,
                     outcome,
                     why,
+                    record.carries,
+                    why_carries,
                 )
             )
 
@@ -118,7 +138,9 @@ class _WatchedJob:
         error = self._job.error()
         now = self._actions.clock.now()
         if error is not None:
-            self._log.ended(self._record, "failed", now, str(error) or type(error).__name__)
+            why = str(error) or type(error).__name__
+            quotes: Carries = getattr(error, "carries", NOTHING)  # a safety refusal's reading
+            self._log.ended(self._record, "failed", now, why, quotes)
         else:
             self._log.ended(self._record, "done", now)
 
@@ -143,6 +165,14 @@ class _WatchedJob:
         self._job.cancel()
 
 
+class Acting(Protocol):
+    """The node acting now (a tree's leaf, in its tick)."""
+
+    def carries(self) -> Carries:
+        """What of a person the node's actions may be made from (what it reads)."""
+        ...
+
+
 @dataclass(frozen=True)
 class TurnTaking:
     """How one tree takes turns with the others (see :mod:`engine.services.turns`):
@@ -164,6 +194,11 @@ class TreeActions:
     is recorded when it starts. A free resource goes to the highest tree waiting for it. A
     tree gives way for a resource once: while that turn lasts, asking for it again (a hug
     still going on) fails at once, unsaid; its other actions go on as usual.
+
+    Each call says what of a person its arguments were made from (``carries``: a Say
+    filling in what was heard carries words); a call that does not say carries what the
+    node acting reads (:attr:`acting`, set by the node's lifecycle), so a plugin's node
+    that fills in a reading is never taken for the robot's own words.
     """
 
     def __init__(
@@ -184,6 +219,8 @@ class TreeActions:
         self._lit = False
         self.stop_reason = ""
         """Why the tree is being halted, while it is (its cut actions say so)."""
+        self.acting: Acting | None = None
+        """The node whose lifecycle method runs now (its reads decide a call's carries)."""
         self._gave_way: dict[str, Turn] = {}
         """The turn each resource was last given way to: while it lasts, asking for that
         resource again fails at once, without waiting or saying so again (no stutter)."""
@@ -195,9 +232,12 @@ class TreeActions:
         start: Callable[[], Job],
         uses: tuple[str, ...] = (),
         what: str = "",
+        carries: Carries | None = None,
     ) -> Job:
+        made_of = carries if carries is not None else self._acting_carries()
+
         def begin() -> Job:
-            record = ActionRecord(self.clock.now(), self.tree, action, args)
+            record = ActionRecord(self.clock.now(), self.tree, action, args, carries=made_of)
             self.log.add(record)
             try:
                 job = start()
@@ -227,12 +267,13 @@ class TreeActions:
             return job
         resource, turn = blocked  # said once; the tree acts again once all are free
         if taking.wait_for_turn_s <= 0:
-            return ImmediateJob(error=let_go(turns, self.tree, what, resource, turn))
+            return ImmediateJob(error=let_go(turns, self.tree, what, resource, turn, made_of))
         turns.tell(self.tree, "waits", resource, turn.tree)
         deadline_s = self.clock.now() + taking.wait_for_turn_s
-        return WaitingJob(turns, begin, uses, self.tree, priority, deadline_s, what)
+        return WaitingJob(turns, begin, uses, self.tree, priority, deadline_s, what, made_of)
 
-    def say(self, text: str, *, volume: float | None = None) -> Job:
+    def say(self, text: str, *, volume: float | None = None, carries: Carries | None = None) -> Job:
+        """Speak ``text`` (made from ``carries`` of a person; None: what the node reads)."""
         args: dict[str, Any] = {"text": text}
         if volume is not None:
             args["volume"] = volume
@@ -242,6 +283,7 @@ class TreeActions:
             lambda: self.services.speech.say(text, volume=volume),
             (SPEAKER,),
             f"saying {text!r}",
+            carries,
         )
 
     def settle(self, *, lights: bool = True) -> list[Job]:
@@ -257,10 +299,11 @@ class TreeActions:
                 args = {"joint": joint, "angle_deg": angle_deg, "rest": True}
                 if speed_dps is not None:
                     args["speed_dps"] = speed_dps
-                jobs.append(self._call("servo", args, self._mover(joint, angle_deg, speed_dps)))
+                mover = self._mover(joint, angle_deg, speed_dps)
+                jobs.append(self._call("servo", args, mover, carries=NOTHING))
         if lights and self._lit and self._last_user(FACE_LEDS):
             off = lambda: self.services.leds.set_color("off")  # noqa: E731
-            jobs.append(self._call("led", {"color": "off", "rest": True}, off))
+            jobs.append(self._call("led", {"color": "off", "rest": True}, off, carries=NOTHING))
         self.forget()
         return jobs
 
@@ -276,7 +319,9 @@ class TreeActions:
         """Whether this tree used ``resource`` last (always, without turn-taking)."""
         return self.taking is None or self.taking.turns.last_user(resource) in (None, self.tree)
 
-    def set_led(self, color: str, *, seconds: float | None = None) -> Job:
+    def set_led(
+        self, color: str, *, seconds: float | None = None, carries: Carries | None = None
+    ) -> Job:
         self._lit = color != "off"
         args: dict[str, Any] = {"color": color}
         if seconds is not None:
@@ -287,9 +332,17 @@ class TreeActions:
             lambda: self.services.leds.set_color(color, seconds=seconds),
             (FACE_LEDS,),
             f"lighting the face {color}",
+            carries,
         )
 
-    def move_servo(self, joint: str, angle_deg: float, *, speed_dps: float | None = None) -> Job:
+    def move_servo(
+        self,
+        joint: str,
+        angle_deg: float,
+        *,
+        speed_dps: float | None = None,
+        carries: Carries | None = None,
+    ) -> Job:
         args: dict[str, Any] = {"joint": joint, "angle_deg": angle_deg}
         if speed_dps is not None:
             args["speed_dps"] = speed_dps
@@ -299,16 +352,29 @@ class TreeActions:
             lambda: self.services.servos.move(joint, angle_deg, speed_dps=speed_dps),
             (joint_resource(joint),),
             f"turning {joint} to {angle_deg:g} deg",
+            carries,
         )
         if getattr(job, "waiting", False) or not (job.done() and job.error() is not None):
             self._moved.add(joint)  # a move refused at once moved nothing to bring back
         return job
 
     def read_sensor(self, sensor: str) -> Job:
-        return self._call("read", {"sensor": sensor}, lambda: self.services.sensors.read(sensor))
+        """Ask ``sensor`` for a reading (the call names the sensor: nothing of anyone)."""
+        start = lambda: self.services.sensors.read(sensor)  # noqa: E731
+        return self._call("read", {"sensor": sensor}, start, carries=NOTHING)
 
-    def report_result(self, command_id: str, status: str, result: Any = None) -> Job:
+    def report_result(
+        self, command_id: str, status: str, result: Any = None, *, carries: Carries | None = None
+    ) -> Job:
+        """Tell the cloud how a command ended, with ``result`` (made from ``carries``)."""
         args = {"id": command_id, "status": status, "result": result}
+        made_of = carries if carries is not None else self._acting_carries()
         return self._call(
-            "report", args, lambda: self.services.iot.report(command_id, status, result)
+            "report",
+            args,
+            lambda: self.services.iot.report(command_id, status, result, carries=made_of),
+            carries=made_of,
         )
+
+    def _acting_carries(self) -> Carries:
+        return self.acting.carries() if self.acting is not None else NOTHING

@@ -7,9 +7,14 @@ Three worker threads, none of them in a tick:
 - the *reporter* sends each result (``report``, the :class:`IotResults` service) until the
   service has it, in order, retrying the same way;
 - the *telemetry* thread pushes the sensor and device keys about once a second: the
-  latest values as the scheduler committed them, handed over by a session reader
-  (:class:`TelemetrySnapshot`), never read from the live blackboard on this thread. A push
-  that fails is logged (once per streak) and counted (``telemetry_failures``).
+  latest values as the scheduler committed them, handed over by a reader of the consent
+  gate's ``sent`` exit (:class:`TelemetrySnapshot`: readings only with the person's
+  consent), never read from the live blackboard on this thread. A push that fails is
+  logged (once per streak) and counted (``telemetry_failures``).
+
+A command's result leaves the robot only when the consent gate lets it
+(:meth:`~engine.privacy.consent_gate.ConsentGate.lets_result_out`): a read's values
+without the person's consent are reported FAILED, saying why.
 
 While the robot carries a command out it tells the service so every few seconds; when the
 operator has canceled it meanwhile, the command's id is staged on ``/iot/canceled``: the
@@ -33,16 +38,13 @@ from typing import Any
 import requests
 
 from engine.blackboard.board import Blackboard
-from engine.blackboard.catalogue import IOT_CANCELED, IOT_INBOX
+from engine.blackboard.catalogue import IOT_CANCELED, IOT_INBOX, NOTHING, Carries
 from engine.clock import Clock
+from engine.privacy.consent import without_record
+from engine.privacy.consent_gate import RESULT_WITHHELD, ConsentGate, Exit
 from engine.services.done_commands import DoneCommands
 from engine.services.jobs import ImmediateJob, Job
-from engine.services.telemetry import (
-    WITHHELD,
-    TelemetrySnapshot,
-    carries_sensor_values,
-    json_safe,
-)
+from engine.services.telemetry import TelemetrySnapshot, json_safe
 from engine.session.events import KeyChanged
 from engine.session.stream import SessionStream
 
@@ -91,6 +93,8 @@ class CloudLink:
         self.http.headers["Authorization"] = f"Bearer {token}"
         self.done = DoneCommands(done_file)
         self.blackboard: Blackboard | None = None
+        self.gate = ConsentGate(without_record(""), Exit.SENT)
+        """What may leave the robot (until bound: nothing of anyone)."""
         self.telemetry = TelemetrySnapshot()
         self.telemetry_failures = 0
         """Pushes of telemetry that failed (the service unreachable or refusing)."""
@@ -109,15 +113,17 @@ class CloudLink:
         self._lease_s = DEFAULT_LEASE_S
         self.reachable = False
 
-    def bind(self, blackboard: Blackboard, session: SessionStream) -> None:
-        """The blackboard commands are staged on, and the session whose committed sensor
-        and device values are pushed as telemetry."""
+    def bind(self, blackboard: Blackboard, sent: SessionStream, gate: ConsentGate) -> None:
+        """The blackboard commands are staged on; ``sent``, the consent gate's exit off
+        the robot, whose committed sensor and device values are pushed as telemetry; and
+        ``gate``, which says whether a command's result may leave."""
         self.blackboard = blackboard
-        self.telemetry_from(session)
+        self.gate = gate
+        self.telemetry_from(sent)
 
-    def telemetry_from(self, session: SessionStream) -> None:
-        """Push the sensor and device values ``session`` tells as committed."""
-        session.subscribe(self.telemetry, (KeyChanged.kind,))
+    def telemetry_from(self, sent: SessionStream) -> None:
+        """Push the sensor and device values ``sent`` tells as committed."""
+        sent.subscribe(self.telemetry, (KeyChanged.kind,))
 
     def start(self) -> None:
         for name, target in (
@@ -139,12 +145,15 @@ class CloudLink:
             thread.join(timeout=5.0 if thread.name == "cloud-report" else 0.5)
 
     # -- IotResults ------------------------------------------------------------------------
-    def report(self, command_id: str, status: str, result: Any = None) -> Job:
+    def report(
+        self, command_id: str, status: str, result: Any = None, *, carries: Carries = NOTHING
+    ) -> Job:
         """Queue the report (it is sent, and retried, by the reporter); done at once. A
-        command that did not come from the cloud (a scenario's, say) is not reported there."""
+        command that did not come from the cloud (a scenario's, say) is not reported there;
+        a result made from ``carries`` of a person goes only with their consent."""
         report = {"status": status.upper(), "result": json_safe(result)}
-        if not self.telemetry.sensors_allowed and carries_sensor_values(result):
-            report = {"status": "FAILED", "result": {"error": WITHHELD}}  # consent: no sensors
+        if not self.gate.lets_result_out(result, carries):
+            report = {"status": "FAILED", "result": {"error": RESULT_WITHHELD}}
         with self._carrying_out:
             if command_id not in self._from_cloud:
                 log.debug("command %s did not come from the cloud; not reported there", command_id)

@@ -8,6 +8,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any, Protocol
 
+from engine.blackboard.catalogue import NOTHING, Carries
 from engine.services.jobs import Job
 
 
@@ -52,8 +53,12 @@ class Sensors(Protocol):
 
 
 class IotResults(Protocol):
-    def report(self, command_id: str, status: str, result: Any = None) -> Job:
-        """Tell the cloud how remote command ``command_id`` ended (succeeded / failed)."""
+    def report(
+        self, command_id: str, status: str, result: Any = None, *, carries: Carries = NOTHING
+    ) -> Job:
+        """Tell the cloud how remote command ``command_id`` ended (succeeded / failed);
+        ``carries``: what of a person ``result`` was made from (consent decides whether
+        it may leave the robot)."""
         ...
 
 

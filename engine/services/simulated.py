@@ -10,7 +10,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
-from engine.blackboard.catalogue import TEMPERATURE_C, TEMPERATURE_F
+from engine.blackboard.catalogue import NOTHING, TEMPERATURE_C, TEMPERATURE_F, Carries
 from engine.clock import Clock
 from engine.errors import ServiceError
 from engine.services.interfaces import Services
@@ -147,7 +147,9 @@ class SimulatedSensors(_Recording):
 class SimulatedIot(_Recording):
     """Keeps reported results in ``calls`` as (command_id, status, result)."""
 
-    def report(self, command_id: str, status: str, result: Any = None) -> Job:
+    def report(
+        self, command_id: str, status: str, result: Any = None, *, carries: Carries = NOTHING
+    ) -> Job:
         self.calls.append((command_id, status, result))
         return self._refused() or ImmediateJob()
 

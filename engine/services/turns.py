@@ -19,6 +19,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
+from engine.blackboard.catalogue import NOTHING, Carries
 from engine.clock import Clock
 from engine.errors import ServiceError
 from engine.services.jobs import ImmediateJob, Job
@@ -122,10 +123,20 @@ class Turns:
         turn = self._held.get(resource)
         return turn.tree if turn is not None else None
 
-    def tell(self, tree: str, turn: TurnKind, resource: str, other: str, what: str = "") -> None:
-        """Publish one turn event (``tree`` interrupts, waits for, yields...)."""
+    def tell(
+        self,
+        tree: str,
+        turn: TurnKind,
+        resource: str,
+        other: str,
+        what: str = "",
+        carries: Carries = NOTHING,
+    ) -> None:
+        """Publish one turn event (``tree`` interrupts, waits for, yields... ``what``, made
+        from ``carries`` of a person)."""
         if self.stream is not None:
-            self.stream.publish(TurnTaken(self.clock.now(), tree, turn, resource, other, what))
+            now = self.clock.now()
+            self.stream.publish(TurnTaken(now, tree, turn, resource, other, what, carries))
 
 
 class WaitingJob:
@@ -142,8 +153,10 @@ class WaitingJob:
         priority: int,
         deadline_s: float,
         what: str,
+        carries: Carries = NOTHING,
     ) -> None:
         self._turns = turns
+        self._carries = carries
         self._start = start
         self.resources = resources
         self.tree = tree
@@ -179,7 +192,7 @@ class WaitingJob:
             place = blocked if blocked is not None else ahead
             assert place is not None
             resource, turn = place
-            self._error = let_go(turns, self.tree, self._what, resource, turn)
+            self._error = let_go(turns, self.tree, self._what, resource, turn, self._carries)
             return True
         return False
 
@@ -198,8 +211,10 @@ class WaitingJob:
             self._error = TurnYieldedError("stopped while waiting for its turn")
 
 
-def let_go(turns: Turns, tree: str, what: str, resource: str, turn: Turn) -> TurnYieldedError:
-    """Tell that ``tree`` lets ``what`` go because ``turn`` has ``resource``; the error
-    its node fails with."""
-    turns.tell(tree, "yields", resource, turn.tree, what)
+def let_go(
+    turns: Turns, tree: str, what: str, resource: str, turn: Turn, carries: Carries = NOTHING
+) -> TurnYieldedError:
+    """Tell that ``tree`` lets ``what`` (made from ``carries`` of a person) go because
+    ``turn`` has ``resource``; the error its node fails with."""
+    turns.tell(tree, "yields", resource, turn.tree, what, carries)
     return TurnYieldedError(f"{turn.tree} has the {resource} (priority {turn.priority})")

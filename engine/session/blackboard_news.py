@@ -10,14 +10,17 @@ someone it could not listen to, a device going offline or coming back.
 from __future__ import annotations
 
 import json
+from collections.abc import Callable, Iterable
 from typing import Any
 
 from engine.blackboard.catalogue import (
     DEVICES_PREFIX,
     HAND_SHOWN,
+    NOTHING,
     SPEECH_HEARD,
     SPEECH_NOT_LISTENED,
     VARIABLES_PREFIX,
+    Carries,
     KeyCatalogue,
 )
 from engine.clock import Clock
@@ -62,8 +65,16 @@ def device_of(key: str) -> str | None:
 class BlackboardNews:
     """A blackboard watcher publishing what each committed write means on ``stream``."""
 
-    def __init__(self, stream: SessionStream, catalogue: KeyCatalogue, clock: Clock) -> None:
+    def __init__(
+        self,
+        stream: SessionStream,
+        catalogue: KeyCatalogue,
+        clock: Clock,
+        carried_by: Callable[[Iterable[str]], Carries] = lambda keys: NOTHING,
+    ) -> None:
+        """``carried_by``: what of a person keys' values are (the blackboard's)."""
         self.stream = stream
+        self.carried_by = carried_by
         self.catalogue = catalogue
         self.clock = clock
         self._changed = ChangedKeys(catalogue)
@@ -76,7 +87,8 @@ class BlackboardNews:
             news = self._changed.news(key, value)
             if news is not None:
                 text, event = news
-                publish(KeyChanged(now, key, value, text, event, self._writer(key)))
+                carries = self.carried_by((key,))
+                publish(KeyChanged(now, key, value, text, event, self._writer(key), carries))
         if key == SPEECH_HEARD:
             publish(Heard(now, str(value)))
         elif key == HAND_SHOWN and isinstance(value, int):

@@ -10,14 +10,19 @@ they show or keep. Nobody keeps a second account of what happened.
 
 Every event is immutable and carries ``t_s``, the clock time it happened (seconds; a
 node's status holds from its tick's deadline). Its ``kind`` names it on the wire and in
-recordings.
+recordings. An event whose free text may hold what a person said or what a sensor read
+says so in ``carries`` (:data:`~engine.blackboard.catalogue.Carries`): the consent gate
+(:mod:`engine.privacy.consent_gate`) reads it and never travels further.
 """
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, ClassVar, Literal
+
+from engine.blackboard.catalogue import NOTHING, Carries
 
 
 @dataclass(frozen=True, slots=True)
@@ -61,6 +66,8 @@ class NodeStatus:
     node: int
     status: str
     feedback: str
+    carries: Carries = NOTHING
+    """What of a person the node's feedback may quote (what the node reads)."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -74,6 +81,8 @@ class ActionStarted:
     tree: str
     action: str
     args: dict[str, Any]
+    carries: Carries = NOTHING
+    """What of a person ``args`` were made from (a Say that fills in what was heard)."""
 
 
 Outcome = Literal["done", "failed", "cut"]
@@ -95,6 +104,10 @@ class ActionEnded:
     started_s: float
     outcome: Outcome
     why: str = ""
+    carries: Carries = NOTHING
+    """As its :class:`ActionStarted`'s (``why`` may quote the arguments too)."""
+    why_carries: Carries = NOTHING
+    """What of a person ``why`` quotes besides (a safety refusal's distance or force)."""
 
 
 TurnKind = Literal["interrupts", "waits", "yields", "tries_again"]
@@ -112,6 +125,8 @@ class TurnTaken:
     resource: str
     other: str
     what: str = ""
+    carries: Carries = NOTHING
+    """What of a person ``what`` (the action let go, in words) was made from."""
 
     @property
     def text(self) -> str:
@@ -146,6 +161,8 @@ class SafetyAction:
     rule: str
     devices: tuple[str, ...]
     why: str
+    carries: Carries = NOTHING
+    """What of a person ``why`` quotes (the force or distance that decided)."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -258,6 +275,8 @@ class KeyChanged:
     text: str
     event: bool
     writer: str
+    carries: Carries = NOTHING
+    """What of a person the value is or was made from (its key's, or its writer's)."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -308,3 +327,15 @@ EVENT_TYPES: tuple[type[SessionEvent], ...] = (
     SessionEnded,
 )
 KINDS = tuple(event_type.kind for event_type in EVENT_TYPES)
+
+
+GATE_ONLY = frozenset({"carries", "why_carries"})
+"""Fields only the consent gate reads: never told further (no wire, file or page has them)."""
+
+
+def told_fields(event_type: type[SessionEvent] | SessionEvent) -> tuple[str, ...]:
+    """The fields of an event type that readers tell (on the wire, in a file, on a
+    page): all but :data:`GATE_ONLY`."""
+    return tuple(
+        field.name for field in dataclasses.fields(event_type) if field.name not in GATE_ONLY
+    )

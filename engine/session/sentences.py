@@ -49,18 +49,24 @@ def describe_action(action: str, args: dict[str, Any]) -> str:
     if action == "led" and args["color"] == "off":
         return "turns the face LEDs off" + (" (back to rest)" if args.get("rest") else "")
     if action == "led":
-        seconds = f" for {args['seconds']:g} s" if args.get("seconds") else ""
+        seconds = f" for {_number(args['seconds'])} s" if args.get("seconds") else ""
         return f"lights the face {args['color']}{seconds}"
     if action == "servo":
-        speed = f" at {args['speed_dps']:g} deg/s" if args.get("speed_dps") else ""
+        speed = f" at {_number(args['speed_dps'])} deg/s" if args.get("speed_dps") else ""
         rest = " (back to rest)" if args.get("rest") else ""
-        return f"turns {args['joint']} to {args['angle_deg']:g} deg{speed}{rest}"
+        return f"turns {args['joint']} to {_number(args['angle_deg'])} deg{speed}{rest}"
     if action == "read":
         return f"reads the {args['sensor']} sensor"
     if action == "report":
         result = f": {args['result']}" if args.get("result") is not None else ""
         return f"reports {args.get('id')} {args.get('status')}{result}"
     return f"{action} {args}"
+
+
+def _number(value: Any) -> str:
+    """A number as the timeline writes it (``30``, ``1.5``); a value the consent gate
+    withheld as it says."""
+    return f"{value:g}" if isinstance(value, int | float) else str(value)
 
 
 def event_line(event: SessionEvent) -> tuple[str, str] | None:

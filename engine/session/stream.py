@@ -28,27 +28,57 @@ class SessionObserver(Protocol):
 
 
 class _Subscription:
-    def __init__(self, observer: SessionObserver, kinds: frozenset[str] | None) -> None:
+    def __init__(
+        self, observer: SessionObserver, kinds: frozenset[str] | None, relay: bool
+    ) -> None:
         self.observer = observer
         self.kinds = kinds
+        self.relay = relay
         self.failures = 0
 
 
 class SessionStream:
     """Where a session's events go; ``start_s`` is the clock time the session started
-    (the first tick), from which readers count."""
+    (the first tick), from which readers count. A stream may have branches
+    (:meth:`branch`): streams of their own, fed by a relay subscribed here (the consent
+    gate), that count from the same start."""
 
-    def __init__(self, clock: Clock) -> None:
+    def __init__(self, clock: Clock, *, source: SessionStream | None = None) -> None:
         self.clock = clock
-        self.start_s = clock.now()
+        self._start_s = clock.now()
+        self._source = source
         self._subscriptions: list[_Subscription] = []
+        self._branches: list[SessionStream] = []
         self._wanted: set[str] = set()
         self._everything = False
 
-    def subscribe(self, observer: SessionObserver, kinds: Iterable[str] | None = None) -> None:
-        """Tell ``observer`` every event (or those of ``kinds``) from now on."""
+    @property
+    def start_s(self) -> float:
+        return self._source.start_s if self._source is not None else self._start_s
+
+    @start_s.setter
+    def start_s(self, value: float) -> None:
+        self._start_s = value
+
+    def branch(self) -> SessionStream:
+        """A stream of its own that counts from this one's start, fed by a relay
+        subscribed here (``subscribe(relay, relay=True)``): this stream wants what the
+        branch's readers want."""
+        branch = SessionStream(self.clock, source=self)
+        self._branches.append(branch)
+        return branch
+
+    def subscribe(
+        self,
+        observer: SessionObserver,
+        kinds: Iterable[str] | None = None,
+        *,
+        relay: bool = False,
+    ) -> None:
+        """Tell ``observer`` every event (or those of ``kinds``) from now on. A ``relay``
+        is told every event, but wants only what the branches' readers want."""
         chosen = None if kinds is None else frozenset(kinds)
-        self._subscriptions.append(_Subscription(observer, chosen))
+        self._subscriptions.append(_Subscription(observer, chosen, relay))
         self._remember_wanted()
 
     def unsubscribe(self, observer: SessionObserver) -> None:
@@ -56,12 +86,21 @@ class SessionStream:
         self._remember_wanted()
 
     def _remember_wanted(self) -> None:
-        self._everything = any(s.kinds is None for s in self._subscriptions)
-        self._wanted = set().union(*(s.kinds or () for s in self._subscriptions))
+        readers = [s for s in self._subscriptions if not s.relay]
+        self._everything = any(s.kinds is None for s in readers)
+        self._wanted = set().union(*(s.kinds or () for s in readers))
 
     def wants(self, kind: str) -> bool:
-        """Whether any reader wants events of ``kind`` (a producer may skip costly work)."""
-        return self._everything or kind in self._wanted
+        """Whether any reader (here or on a branch) wants events of ``kind`` (a producer
+        may skip costly work)."""
+        if self._everything or kind in self._wanted:
+            return True
+        return any(branch.wants(kind) for branch in self._branches)
+
+    @property
+    def readers(self) -> list[SessionObserver]:
+        """Who is subscribed here, relays included (an architecture test asks)."""
+        return [s.observer for s in self._subscriptions]
 
     def publish(self, event: SessionEvent) -> None:
         """Tell every reader that wants it, in the order they subscribed."""

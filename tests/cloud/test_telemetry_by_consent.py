@@ -12,7 +12,7 @@ import pytest
 
 from cloud.settings import Settings
 from engine.cli import main
-from engine.services.telemetry import WITHHELD
+from engine.privacy.consent_gate import RESULT_WITHHELD as WITHHELD
 
 ROOT = Path(__file__).resolve().parents[2]
 SQUEEZES = """\

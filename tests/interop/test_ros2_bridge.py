@@ -35,13 +35,16 @@ from engine.interop.ros2_bridge import Ros2Bridge  # noqa: E402
 from engine.interop.ros2_plan import Ros2Plan  # noqa: E402
 from engine.interop.ros2_wire import Wire, attachment, session_config  # noqa: E402
 from engine.privacy.consent import Consent  # noqa: E402
+from engine.privacy.consent_gate import ConsentGates  # noqa: E402
 from engine.session.events import (  # noqa: E402
     ActionStarted,
     KeyChanged,
     NodeInfo,
     NodeStatus,
+    SessionEvent,
     TreeStarted,
 )
+from engine.session.stream import SessionStream  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[2]
 VEST = [sys.executable, "-c", "import sys; from engine.cli import main; sys.exit(main())"]
@@ -125,16 +128,33 @@ def lab() -> Iterator[Lab]:
     graph.close()
 
 
+class GatedBridge:
+    """The bridge behind the consent gate, as a session builds it: an event told here
+    is published on the robot's stream and reaches the bridge through the gate."""
+
+    def __init__(self, bridge: Ros2Bridge, stream: SessionStream) -> None:
+        self.bridge, self.stream = bridge, stream
+
+    def on_event(self, event: SessionEvent) -> None:
+        self.stream.publish(event)
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self.bridge, name)
+
+
 def bridge_on(
     lab: Lab, *covers: str, commands: bool = False
-) -> tuple[Ros2Bridge, Blackboard, VirtualClock]:
+) -> tuple[GatedBridge, Blackboard, VirtualClock]:
     clock = VirtualClock()
     catalogue = default_catalogue()
-    consent = Consent("kid-17", frozenset(covers))
-    bridge = Ros2Bridge(Ros2Plan(lab.endpoint, 0, commands), clock, 1.7e9, consent, catalogue)
+    stream = SessionStream(clock)
+    gates = ConsentGates(stream, Consent("kid-17", frozenset(covers)))
+    plan = Ros2Plan(lab.endpoint, 0, commands)
+    bridge = Ros2Bridge(plan, clock, 1.7e9, gates.sending, catalogue)
+    gates.sent.subscribe(bridge)
     board = Blackboard(catalogue, clock)
     bridge.start(board)
-    return bridge, board, clock
+    return GatedBridge(bridge, stream), board, clock
 
 
 HUG = TreeStarted(
