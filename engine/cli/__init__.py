@@ -177,8 +177,8 @@ EXTRAS = {
         "uvicorn",
         "sqlcipher3",
         "mcap",
+        "websockets",
     ),
-    "foxglove": ("foxglove",),
     "ros2": ("zenoh", "rosbags"),
     "cloud": (
         "sqlalchemy",

@@ -12,7 +12,6 @@ asked; a robot running `vest run` on the folder picks the change up by hot reloa
 from __future__ import annotations
 
 import argparse
-import secrets
 from pathlib import Path
 
 from engine.cli.edit_checks import ValidateChecks
@@ -27,7 +26,6 @@ from engine.editor.workspace import Workspace
 from engine.errors import UsageError
 from engine.files.problems import LoadError, Problems
 from engine.nodes.registry import default_registry
-from engine.web.guard import is_loopback
 
 DEFAULT_PORT = 8766
 
@@ -52,7 +50,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--host",
         default="127.0.0.1",
         metavar="ADDRESS",
-        help="default loopback; another address (a tablet) gets a token in the address",
+        help="default loopback; another address serves a tablet (the address carries the "
+        "token, as on loopback)",
     )
     parser.add_argument(
         "--hardware",
@@ -77,7 +76,6 @@ def main(args: argparse.Namespace) -> int:
         tell(f"note: no robot config ({hardware}): pads, joints and devices are not checked")
     registry = default_registry()
     workspace = Workspace(folder, registry, ValidateChecks(folder.resolve(), registry, config))
-    token = None if is_loopback(args.host) else secrets.token_urlsafe(18)
     offered = palette(registry, config, robot_catalogue(config, registry))
     try_out = TryOnSimulatedVest(folder.resolve(), hardware if config else None, offered["pads"])
     server = EditorServer(
@@ -85,7 +83,6 @@ def main(args: argparse.Namespace) -> int:
         offered,
         host=args.host,
         port=args.port,
-        token=token,
         try_out=try_out,
         hear_check=HearCheck(),
         watch=try_out.watch,

@@ -26,6 +26,17 @@ _ENDPOINT = re.compile(
 )
 """A router's endpoint: protocol/host:port (an IPv6 host in brackets)."""
 CONFIG_AT_MOST_BYTES = 1_000_000
+_ORIGIN = re.compile(r"(https?|file)://[A-Za-z0-9.\-]*(\[[0-9A-Fa-f:.]+\])?(:\d{1,5})?/?")
+
+
+def web_origin(text: str) -> str:
+    """An origin as a browser sends it: scheme://host[:port], nothing after."""
+    if not _ORIGIN.fullmatch(text):
+        raise argparse.ArgumentTypeError(
+            f"an origin is scheme://host[:port] with no path, e.g. https://app.foxglove.dev; "
+            f"got {text!r}"
+        )
+    return text.rstrip("/")
 
 
 def add_interop_arguments(parser: argparse.ArgumentParser) -> None:
@@ -36,9 +47,19 @@ def add_interop_arguments(parser: argparse.ArgumentParser) -> None:
         const=8766,
         default=None,
         metavar="PORT",
-        help="serve the live session to Foxglove (its WebSocket, protocol foxglove.sdk.v1) on "
-        "127.0.0.1:PORT (default 8766, beside the view's 8765; 0: any free port); needs "
-        "pip install 'vest-engine[foxglove]'",
+        help="serve the live session to Foxglove and Lichtblick (their WebSocket protocol) on "
+        "127.0.0.1:PORT (default 8766, beside the view's 8765; 0: any free port); the address "
+        "vest prints carries its token",
+    )
+    parser.add_argument(
+        "--foxglove-origin",
+        type=web_origin,
+        action="append",
+        default=[],
+        metavar="ORIGIN",
+        help="a web page's origin that may connect to --foxglove with its token, e.g. "
+        "https://app.foxglove.dev for Foxglove's web app (the desktop apps need none); again "
+        "for more",
     )
     parser.add_argument(
         "--ros2",

@@ -257,6 +257,12 @@ def _run_for_site(
         if args.person or config.senses_people
         else of_a_simulation()  # scripted on the simulated vest: nobody's data
     )
+    if args.audio_out is not None and not consent.covers >= {"speech_text", "sensors"}:
+        raise ConfigError(  # a Say may fill in what the person said, or a reading
+            f"--audio-out {args.audio_out}: keeps the robot's every sentence, which may quote "
+            f"what was heard or read; {consent.describe()}, so the files are not written "
+            "(consent to speech_text and sensors allows them)"
+        )
     if args.record is not None:
         check_new(args.record, site.key)  # before anything starts: never over a session
     ros2 = ros2_plan(args)
@@ -317,6 +323,7 @@ def _run_for_site(
             },
             reload=not args.fast,
             foxglove_port=args.foxglove,
+            foxglove_origins=tuple(args.foxglove_origin),
             on_foxglove_up=tell_foxglove,
             ros2=ros2,
             on_ros2_up=tell_ros2,

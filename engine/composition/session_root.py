@@ -55,7 +55,7 @@ Part = TypeVar("Part")
 
 @dataclass(frozen=True)
 class ViewPlan:
-    """The live view's address (port 0: any free one) and its token (None on loopback)."""
+    """The live view's address (port 0: any free one) and its token (None: a new one)."""
 
     host: str
     port: int
@@ -96,6 +96,8 @@ class SessionPlan:
     reload: bool = False
     foxglove_port: int | None = None
     """Serve the session to Foxglove and Lichtblick on this loopback port (0: any free one)."""
+    foxglove_origins: tuple[str, ...] = ()
+    """Other sites' pages that may connect to it (with its token): Foxglove's web app."""
     on_foxglove_up: Callable[[FoxgloveLive], None] | None = None
     """Told once Foxglove's server listens (to say its address)."""
     ros2: Ros2Plan | None = None
@@ -208,7 +210,13 @@ def _around(assembled: AssembledRobot, plan: SessionPlan) -> RunningSession:
         from engine.interop.foxglove_live import FoxgloveLive  # the foxglove extra
 
         started = float(plan.facts.get("started", "0") or 0)  # seconds since the epoch
-        live = FoxgloveLive("127.0.0.1", plan.foxglove_port, plan.clock, started - start_s)
+        live = FoxgloveLive(
+            "127.0.0.1",
+            plan.foxglove_port,
+            plan.clock,
+            started - start_s,
+            origins=plan.foxglove_origins,
+        )
         running.foxglove = live
         start_live = _telling(live.start, live, plan.on_foxglove_up)
         lifecycle.add("foxglove", start=start_live, stop=live.stop)

@@ -17,8 +17,8 @@ stack (:mod:`engine.web`), in a thread of its own.
 - ``POST /api/hear`` ``{"file", "outline", "version"}`` a dialog's phrases said and heard
   as the robot hears them (vest dialogs check --quick).
 
-Bodies are JSON from the page's own origin; on loopback (the default) no token is asked, on
-any other address every request carries the token ``vest edit`` prints.
+Bodies are JSON; every request asks for the token in the address ``vest edit`` prints, on
+loopback too, and a page of another site is refused (:mod:`engine.web.guard`).
 """
 
 from __future__ import annotations
@@ -27,7 +27,6 @@ import json
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
-from urllib.parse import urlparse
 
 from starlette.applications import Starlette
 from starlette.concurrency import run_in_threadpool
@@ -43,8 +42,8 @@ from engine.editor.workspace import MAX_FILE_BYTES, EditRefused, Workspace
 from engine.errors import ConfigError
 from engine.loader.tree_drawing import dot_source, svg_of, without_title_and_legend
 from engine.web.body_limit import BodyLimit
-from engine.web.guard import LoopbackOrToken, SecurityHeaders, check_listening
-from engine.web.serving import SHARED, ServerThread, address_of, listening_socket, shared_files
+from engine.web.guard import SecurityHeaders, TokenGuard, new_token
+from engine.web.serving import ServerThread, address_of, listening_socket, shared_files
 
 WEB = Path(__file__).parent / "web"
 STATIC = {"/": "editor.html", "/editor.js": "editor.js", "/editor.css": "editor.css"}
@@ -64,8 +63,8 @@ check's lines; a ValueError saying why not."""
 
 class EditorServer:
     """Serves ``workspace`` with ``palette`` on ``host``:``port`` (0: any free port); a
-    ConfigError when it cannot listen there or would listen beyond loopback without a
-    token."""
+    ConfigError when it cannot listen there. Every request needs ``token`` (None: a new
+    one)."""
 
     def __init__(
         self,
@@ -79,20 +78,19 @@ class EditorServer:
         hear_check: HearCheck | None = None,
         watch: Watch | None = None,
     ) -> None:
-        check_listening(host, token, "the editor")
         self.try_out, self.hear_check, self.watch = try_out, hear_check, watch
-        self.workspace, self.palette, self.host, self.token = workspace, palette, host, token
+        self.workspace, self.palette, self.host = workspace, palette, host
+        self.token = token or new_token()
         try:
             sock = listening_socket(host, port, named=f"the editor on {host}:{port}")
         except ConfigError as error:
             raise ConfigError(f"{error}; choose another with --port (0: any free one)") from None
+        self.port = int(sock.getsockname()[1])
         self._server = ServerThread(self.app(), sock, "editor")
-        self.port = self._server.port
 
     @property
     def url(self) -> str:
-        query = f"?token={self.token}" if self.token else ""
-        return address_of(self.host, self.port, "/") + query
+        return address_of(self.host, self.port, "/") + f"?token={self.token}"
 
     def start(self) -> None:
         self._server.start()
@@ -121,11 +119,7 @@ class EditorServer:
             middleware=[
                 Middleware(SecurityHeaders),
                 Middleware(
-                    LoopbackOrToken,
-                    host=self.host,
-                    token=self.token,
-                    open_paths=STATIC,
-                    open_folders=[SHARED],
+                    TokenGuard, host=self.host, token=self.token, cookie=f"vest-{self.port}"
                 ),
                 Middleware(BodyLimit, max_bytes=2 * MAX_FILE_BYTES, read_timeout_s=READ_TIMEOUT_S),
             ],
@@ -227,9 +221,6 @@ class EditorServer:
     async def _body(self, request: Request) -> dict[str, Any]:
         """The page's JSON body naming a file and holding an outline; EditRefused (400,
         403) for one that is not the page's."""
-        origin = request.headers.get("origin")
-        if origin is not None and urlparse(origin).netloc != request.headers.get("host"):
-            raise EditRefused(403, "changes come from the editor's page only")
         kind = request.headers.get("content-type", "").split(";")[0].strip().lower()
         if kind != "application/json":
             raise EditRefused(400, 'send JSON: {"file": ..., "outline": ...}')

@@ -14,11 +14,12 @@ beside the robot:
 - ``GET /api/events`` (live) server-sent events, one JSON change each;
 - with buttons (``vest run --buttons``): ``GET /buttons`` the therapist's page,
   ``GET /api/buttons`` the buttons and what shows, ``GET /api/buttons/events`` the shown
-  set as it changes, ``POST /api/press`` ``{"button": N}`` presses one (JSON only, from the
-  page's own origin: another site cannot press for the therapist).
+  set as it changes, ``POST /api/press`` ``{"button": N}`` presses one (JSON only; the
+  guard refuses another site's page: it cannot press for the therapist).
 
-On loopback (the default) no token is asked; on any other address every request must
-carry ``?token=...`` (the address ``vest run --view`` prints has it).
+Every request asks for the server's token, on loopback too (:mod:`engine.web.guard`): the
+address ``vest run --view`` prints carries it, and opening it keeps the browser in with a
+cookie; a page of another site is refused.
 """
 
 from __future__ import annotations
@@ -31,7 +32,6 @@ import threading
 from collections.abc import AsyncIterator
 from pathlib import Path
 from typing import Any, Protocol
-from urllib.parse import urlparse
 
 from starlette.applications import Starlette
 from starlette.middleware import Middleware
@@ -45,8 +45,8 @@ from engine.loader.tree_drawing import svg_of, without_title_and_legend
 from engine.view.hub import Change, ViewHub
 from engine.web.body_limit import BodyLimit
 from engine.web.broadcast import Reader
-from engine.web.guard import LoopbackOrToken, SecurityHeaders, check_listening
-from engine.web.serving import SHARED, ServerThread, address_of, listening_socket, shared_files
+from engine.web.guard import SecurityHeaders, TokenGuard, new_token
+from engine.web.serving import ServerThread, address_of, listening_socket, shared_files
 from engine.web.sse import CONNECTED, KEEPALIVE, KEEPALIVE_S, event_stream, frame
 
 log = logging.getLogger(__name__)
@@ -100,7 +100,7 @@ class LiveSource:
 class ViewServer:
     """Serves ``source`` (and the therapist's buttons, when given a ``wizard``) on
     ``host``:``port`` (0: any free port) in a thread of its own; a ConfigError when it
-    cannot listen there or would listen beyond loopback without a token."""
+    cannot listen there. Every request needs ``token`` (None: a new one)."""
 
     def __init__(
         self,
@@ -108,12 +108,11 @@ class ViewServer:
         *,
         host: str = "127.0.0.1",
         port: int = 8765,
-        token: str | None,
+        token: str | None = None,
         wizard: Wizard | None = None,
     ) -> None:
-        check_listening(host, token, "the view")
         self.source = source
-        self.token = token
+        self.token = token or new_token()
         self.wizard = wizard
         self._svg: dict[tuple[str, int], bytes] = {}
         self._svg_lock = threading.Lock()
@@ -124,8 +123,8 @@ class ViewServer:
             hint = "choose another with --view-port (0: any free one)"
             raise ConfigError(f"{error}; {hint}") from None
         self.host = host
+        self.port = int(sock.getsockname()[1])
         self._server = ServerThread(self.app(), sock, "view")
-        self.port = self._server.port
 
     @property
     def url(self) -> str:
@@ -133,9 +132,8 @@ class ViewServer:
         return self.page_url("/")
 
     def page_url(self, page: str) -> str:
-        """The address of ``page`` (``/``, ``/buttons``), with the token when one is needed."""
-        query = f"?token={self.token}" if self.token else ""
-        return address_of(self.host, self.port, page) + query
+        """The address of ``page`` (``/``, ``/buttons``), with the token."""
+        return address_of(self.host, self.port, page) + f"?token={self.token}"
 
     def start(self) -> None:
         self._server.start()
@@ -149,7 +147,7 @@ class ViewServer:
         self._server.stop()
 
     def app(self) -> Starlette:
-        """The Starlette app: the routes above, behind the loopback-or-token rule."""
+        """The Starlette app: the routes above, behind the token guard."""
         files = [path for path in STATIC if self.wizard is not None or "buttons" not in path]
         routes: list[BaseRoute] = [Route(path, self._file) for path in files]
         routes.append(shared_files())
@@ -172,11 +170,7 @@ class ViewServer:
             middleware=[
                 Middleware(SecurityHeaders),
                 Middleware(
-                    LoopbackOrToken,
-                    host=self.host,
-                    token=self.token,
-                    open_paths=STATIC,
-                    open_folders=[SHARED],
+                    TokenGuard, host=self.host, token=self.token, cookie=f"vest-{self.port}"
                 ),
                 Middleware(
                     BodyLimit, max_bytes=MAX_PRESS_BYTES, read_timeout_s=PRESS_READ_TIMEOUT_S
@@ -264,9 +258,6 @@ class ViewServer:
     async def _press(self, request: Request) -> Response:
         wizard = self.wizard
         assert wizard is not None
-        origin = request.headers.get("origin")
-        if origin is not None and urlparse(origin).netloc != request.headers.get("host"):
-            return PlainTextResponse("presses come from the buttons page only\n", 403)
         kind = request.headers.get("content-type", "").split(";")[0].strip()
         if kind != "application/json":
             return PlainTextResponse('send JSON: {"button": N}\n', status_code=400)

@@ -1,12 +1,8 @@
-// A page's requests to its own server: the token the page was opened with (a page served
-// beyond loopback is opened with ?token=...) travels on every request. Every page of the
-// robot (the view, the buttons, the editor) asks through here.
-
-const token = new URLSearchParams(location.search).get("token");
+// A page's requests to its own server. The browser's cookie carries the server's token
+// (opening the address vest printed set it), so a request names only its path and query.
+// Every page of the robot (the view, the buttons, the editor) asks through here.
 
 export function api(path, params = {}) {
-  const query = new URLSearchParams(params);
-  if (token) query.set("token", token);
-  const text = query.toString();
+  const text = new URLSearchParams(params).toString();
   return text ? `${path}?${text}` : path;
 }
