@@ -39,8 +39,9 @@ ROW = re.compile(r"^(\w+)\s+\d+/s\s+(\d+)\s+([\d.]+)ms\s+([\d.]+)ms\s+([\d.]+)ms
 
 
 def read_changes(address: str, counted: list[int], stop: threading.Event) -> None:
-    """A page: reads every change the view sends."""
-    with requests.get(address + "api/events", stream=True, timeout=60) as response:
+    """A page: reads every change the view sends (with the token the address carries)."""
+    base, _, query = address.partition("?")
+    with requests.get(f"{base}api/events?{query}", stream=True, timeout=60) as response:
         for line in response.iter_lines():
             if stop.is_set():
                 return

@@ -9,6 +9,7 @@ import socket
 from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import TYPE_CHECKING
+from urllib.parse import parse_qs, urlsplit
 
 import pytest
 
@@ -107,6 +108,21 @@ def _content_length(head: bytes) -> int | None:
         if name.strip().lower() == b"content-length":
             return int(value)
     return None
+
+
+def with_token(url: str, path: str) -> str:
+    """The address of ``path`` on the server vest printed as ``url``, carrying its token
+    (as a script sends it; a browser that opened ``url`` carries it in a cookie)."""
+    parts = urlsplit(url)
+    token = parse_qs(parts.query)["token"][0]
+    joined = "&" if "?" in path else "?"
+    return f"{parts.scheme}://{parts.netloc}{path}{joined}token={token}"
+
+
+@pytest.fixture
+def at() -> Callable[[str, str], str]:
+    """:func:`with_token`, for tests that ask a page's server as a script does."""
+    return with_token
 
 
 @pytest.fixture

@@ -8,7 +8,9 @@ import os
 import signal
 import subprocess
 import sys
+import urllib.error
 import urllib.request
+from collections.abc import Callable
 from pathlib import Path
 
 import pytest
@@ -19,7 +21,9 @@ ROOT = Path(__file__).resolve().parents[2]
 VEST = "import sys; from engine.cli import main; sys.exit(main())"
 
 
-def test_vest_edit_prints_its_address_and_serves_the_folder(project: Path) -> None:
+def test_vest_edit_prints_its_address_and_serves_the_folder(
+    project: Path, at: Callable[[str, str], str]
+) -> None:
     process = subprocess.Popen(
         [sys.executable, "-c", VEST, "edit", str(project), "--port", "0"],
         cwd=ROOT,
@@ -33,9 +37,12 @@ def test_vest_edit_prints_its_address_and_serves_the_folder(project: Path) -> No
         line = process.stdout.readline()
         assert line.startswith("editor: http://127.0.0.1:"), line
         address = line.split()[1]
-        with urllib.request.urlopen(address + "api/files", timeout=10) as answer:
+        assert "?token=" in address  # on loopback too
+        with urllib.request.urlopen(at(address, "/api/files"), timeout=10) as answer:
             files = json.load(answer)
         assert {"file": "trees/hug.yaml", "kind": "tree"} in files
+        with pytest.raises(urllib.error.HTTPError, match="403"):
+            urllib.request.urlopen(address.split("?")[0] + "api/files", timeout=10)
     finally:
         process.send_signal(signal.SIGTERM)
         process.wait(timeout=30)

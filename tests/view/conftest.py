@@ -24,7 +24,7 @@ def replay(tmp_path: Path, monkeypatch, capsys, the_site_key: SiteKey) -> Iterat
     assert main(["run", "--fast", "--speech", "text", "--record", str(recorded)]) == 0
     capsys.readouterr()
     recording = Recording.open(recorded, the_site_key)
-    server = ViewServer(ReplaySource(recording), port=0, token=None)
+    server = ViewServer(ReplaySource(recording), port=0)
     server.start()
     yield server.url
     server.stop()

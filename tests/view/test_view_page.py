@@ -14,7 +14,6 @@ from pathlib import Path
 import pytest
 from playwright.sync_api import Page, expect
 
-from engine.errors import ConfigError
 from engine.view.server import ViewServer
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -100,28 +99,48 @@ def test_the_replay_slider_shows_the_robot_at_a_moment(page: Page, replay: str) 
     expect(press).to_contain_text("therapist: presses the button 'Well done'")
 
 
-def test_a_view_on_another_address_needs_its_token(page: Page) -> None:
-    """A token is asked on any address but loopback; a guarded page refuses a request without it."""
-    with pytest.raises(ConfigError, match=r"the view on 0\.0\.0\.0 needs a token"):
-        ViewServer(EmptySource(), host="0.0.0.0", port=0, token=None)
-    guarded = ViewServer(EmptySource(), port=0, token="s3cret")
+def test_every_request_needs_the_view_s_token_on_loopback_too(page: Page) -> None:
+    """Another account on the machine reaches loopback as easily as the therapist: the
+    page, its data and its streams all ask for the token the printed address carries; the
+    browser that opened it is kept in by a cookie, and the token leaves the address bar."""
+    guarded = ViewServer(EmptySource(), port=0, token="s3cret-" + "x" * 25)
     guarded.start()
-    base = guarded.url.removesuffix("?token=s3cret")
+    base = guarded.url.split("?")[0]
     try:
-        for path in ("api/snapshot", "api/info", "api/events", "api/svg/hug/1"):
+        for path in ("", "view.js", "api/snapshot", "api/info", "api/events", "api/svg/hug/1"):
             refused = page.goto(base + path)
             assert refused is not None and refused.status == 403, path
+            assert "open the address vest printed" in refused.text(), path
             wrong = page.goto(base + path + "?token=%C3%A9")  # not ASCII: refused, not a crash
             assert wrong is not None and wrong.status == 403, path
-        page.goto(guarded.url)  # the page itself loads, and asks with the token
+        page.goto(guarded.url)
         expect(page.locator("body")).to_have_attribute("data-ready", "true")
         expect(page.locator("#mode")).to_contain_text("replay of -")
+        assert page.url == base  # the token is no longer in the address bar nor the history
+        cookie = next(c for c in page.context.cookies() if c["name"] == f"vest-{guarded.port}")
+        assert cookie["httpOnly"] and cookie["sameSite"] == "Strict"
+        answered = page.goto(base + "api/info")  # the cookie carries it from now on
+        assert answered is not None and answered.status == 200
     finally:
         guarded.stop()
 
 
+def test_another_site_s_page_cannot_read_or_press(
+    replay: str, at: Callable[[str, str], str]
+) -> None:
+    import requests
+
+    for path in ("/api/snapshot", "/api/events", "/api/press"):
+        evil = requests.post if path == "/api/press" else requests.get
+        answer = evil(at(replay, path), headers={"Origin": "https://evil.example"}, timeout=10)
+        assert answer.status_code == 403 and "another site" in answer.text, path
+    cross = requests.get(at(replay, "/api/snapshot"), headers={"Sec-Fetch-Site": "cross-site"})
+    assert cross.status_code == 403
+
+
 def test_odd_requests_are_answered_not_crashed_on(page: Page, replay: str) -> None:
-    base = replay.rstrip("/")
+    page.goto(replay)  # kept in by its cookie
+    base = replay.split("?")[0].rstrip("/")
     for path, status in [
         ("/api/snapshot?at=nan", 400),
         ("/api/snapshot?at=1e999", 400),
@@ -158,10 +177,12 @@ def test_a_tree_name_cannot_smuggle_a_link_into_its_drawing() -> None:
     assert escape("two\nlines") == "two\\nlines"
 
 
-def test_on_loopback_only_a_page_opened_as_loopback_may_ask(replay: str) -> None:
+def test_on_loopback_only_a_page_opened_as_loopback_may_ask(
+    replay: str, at: Callable[[str, str], str]
+) -> None:
     import requests
 
-    snapshot = replay.rstrip("/") + "/api/snapshot"
+    snapshot = at(replay, "/api/snapshot")
     assert requests.get(snapshot, timeout=10).status_code == 200
     rebound = requests.get(snapshot, headers={"Host": "attacker.example:80"}, timeout=10)
     assert rebound.status_code == 403

@@ -15,19 +15,22 @@ from engine.view.server import MAX_STREAMS, LiveSource, ViewServer
 
 @pytest.fixture
 def view() -> Iterator[ViewServer]:
-    server = ViewServer(LiveSource(ViewHub(VirtualClock())), port=0, token=None)
+    server = ViewServer(LiveSource(ViewHub(VirtualClock())), port=0)
     server.start()
     yield server
     server.stop()
 
 
 @pytest.fixture
-def open_stream(http_answer: Callable[..., str]) -> Callable[[int], tuple[socket.socket, str]]:
+def open_stream(
+    http_answer: Callable[..., str], view: ViewServer
+) -> Callable[[int], tuple[socket.socket, str]]:
     """A page's stream on ``port``, and what came first on it (or the whole refusal)."""
 
     def opened(port: int) -> tuple[socket.socket, str]:
         page = socket.create_connection(("127.0.0.1", port), timeout=10)
-        page.sendall(b"GET /api/events HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n")
+        asked = f"GET /api/events HTTP/1.1\r\nHost: 127.0.0.1\r\nCookie: vest-{port}={view.token}"
+        page.sendall(asked.encode() + b"\r\n\r\n")
         return page, http_answer(page, stream_until=b"resync")
 
     return opened
