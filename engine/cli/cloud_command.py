@@ -22,11 +22,11 @@ from __future__ import annotations
 
 import argparse
 import datetime as dt
-import getpass
 import json
 import re
 from typing import TYPE_CHECKING, Any
 
+from engine.cli.who import acting_user
 from engine.clock import EpochClock
 from engine.errors import UsageError
 
@@ -186,11 +186,7 @@ def _shell_user() -> Actor:
     """Who runs `vest cloud` here, as the audit log names them."""
     from cloud.store.audit import Actor
 
-    try:
-        user = getpass.getuser()
-    except (OSError, KeyError):  # no name for this user id (a bare container)
-        user = "unknown"
-    return Actor(f"shell:{user}"[:64], "admin", "local")
+    return Actor(f"shell:{acting_user()}"[:64], "admin", "local")
 
 
 def _since(text: str | None, now_s: float) -> float | None:

@@ -189,10 +189,19 @@ def _add_consent(site: Site, args: argparse.Namespace) -> int:
 def _purge(site: Site, args: argparse.Namespace) -> int:
     purged = site.purge()
     days = site.settings.keep_sessions_days
-    for entry in purged:
+    for entry in purged.sessions:
         print(f"purged {entry.path} ({entry.person or 'no person'}, {when(entry.started)})")
-    print(f"{_count(len(purged), 'session')} older than {days:g} days removed")
-    return 0
+    for output in purged.outputs:
+        print(f"removed {output} (it held a purged session)")
+    print(f"{_count(len(purged.sessions), 'session')} older than {days:g} days removed")
+    return told_not_removed(purged.not_removed)
+
+
+def told_not_removed(not_removed: list[tuple[Path, str]]) -> int:
+    """Says, by name, each file that could not be removed and why (1), or nothing (0)."""
+    for path, why in not_removed:
+        tell(f"could not remove {path} ({why}): remove it by hand; vest tries again next time")
+    return 1 if not_removed else 0
 
 
 def _count(number: int, thing: str) -> str:

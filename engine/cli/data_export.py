@@ -57,7 +57,8 @@ def export(site: Site, args: argparse.Namespace) -> int:
         folder.chmod(0o700)
     except OSError as error:
         raise ConfigError(f"-o {folder}: cannot make it ({error.strerror or error})") from None
-    site.output_written(folder, person, "export")  # listed first: an erasure finds it
+    held = [entry.path for entry in sessions]  # listed first: an erasure or purge finds it
+    site.output_written(folder, person, "export", held)
     missing = 0
     for number, entry in enumerate(sessions, 1):
         if not entry.path.is_file():
@@ -136,6 +137,11 @@ def erase(site: Site, args: argparse.Namespace) -> int:
     erased = site.erase(person)
     for path in erased.already_gone:
         tell(f"already gone: {path}")
+    if erased.not_removed:
+        for path, why in erased.not_removed:
+            tell(f"could not remove {path} ({why}): remove it by hand")
+        tell(f"the erasure of {person} is not finished: vest finishes it on its next run")
+        return 1
     files = f"{len(erased.removed)} file{'' if len(erased.removed) == 1 else 's'}"
     consent = " and consent record" if has_consent else ""
     kept = "the audit keeps one line"

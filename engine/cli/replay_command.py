@@ -135,7 +135,7 @@ def _converted(recording: Recording, site: Site | None, args: argparse.Namespace
         raise
     if site is not None:
         person = site.person_of(args.recording)
-        site.output_written(output, person, args.to, source=args.recording)
+        site.output_written(output, person, args.to, [args.recording])
     tell(f"{output}: {said}")
     return _whole(recording)
 

@@ -39,7 +39,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         type=Path,
         default=None,
         metavar="REPORT.html",
-        help="default: FILE with .html, or PSEUDONYM-progress.html",
+        help="default: FILE with .html; a progress report goes into the site's data folder "
+        "(reports/PSEUDONYM-progress.html), never the current folder",
     )
 
 
@@ -47,7 +48,7 @@ def main(args: argparse.Namespace) -> int:
     if (args.recording is None) == (args.person is None):
         raise UsageError("name a recording FILE, or --person PSEUDONYM for their progress")
     if args.person is not None:
-        return _progress(args.person, args.output or Path(f"{args.person}-progress.html"))
+        return _progress(args.person, args.output)
     recording, site = open_recording(args.recording, "report")
     try:
         output = args.output or args.recording.with_suffix(".html")
@@ -57,7 +58,7 @@ def main(args: argparse.Namespace) -> int:
         write_file(output, page.encode("utf-8"), f"{output}", "the report", private=True)
         if site is not None:  # a report names the person in the clear: erased with them
             person = site.person_of(args.recording)
-            site.output_written(output, person, "report", source=args.recording)
+            site.output_written(output, person, "report", [args.recording])
     finally:
         recording.close()
         if site is not None:
@@ -89,9 +90,10 @@ def check_replaceable(output: Path, site: Site | None) -> None:
     )
 
 
-def _progress(person: str, output: Path) -> int:
+def _progress(person: str, given: Path | None) -> int:
     site = open_site(create=False)
     try:
+        output = given or site.reports_folder() / f"{person}-progress.html"
         check_replaceable(output, site)
         entries = site.records.sessions(person)
         if not entries:
@@ -111,7 +113,8 @@ def _progress(person: str, output: Path) -> int:
             site.audit("report", person, str(entry.path))
         page = progress_html(person, summaries, gone)
         write_file(output, page.encode("utf-8"), f"{output}", "the report", private=True)
-        site.output_written(output, person, "report")
+        held = [entry.path for entry in entries if entry.path not in gone]
+        site.output_written(output, person, "progress report", held)
     finally:
         site.close()
     sessions = f"{len(summaries)} session{'' if len(summaries) == 1 else 's'}"

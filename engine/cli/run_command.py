@@ -250,8 +250,13 @@ def _run_for_site(
     behaviors, config = inputs.behaviors, inputs.config
     for erased in site.finish_erasures():
         tell(f"finished erasing {erased.person} (cut off earlier)")
-    for purged in site.purge():  # kept as long as the site said, no longer
-        tell(f"purged {purged.path} (older than {site.settings.keep_sessions_days:g} days)")
+    purged = site.purge()  # kept as long as the site said, no longer
+    for entry in purged.sessions:
+        tell(f"purged {entry.path} (older than {site.settings.keep_sessions_days:g} days)")
+    for output in purged.outputs:
+        tell(f"purged {output} (it held a purged session)")
+    for path, why in purged.not_removed:
+        tell(f"warning: could not remove {path} ({why}): it is past the site's keeping")
     consent = (
         site.consent_of(args.person)
         if args.person or config.senses_people

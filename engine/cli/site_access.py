@@ -4,11 +4,11 @@ own), opened with its key (:mod:`engine.privacy.site`), and the recordings it re
 from __future__ import annotations
 
 import argparse
-import getpass
 import os
 from pathlib import Path
 
 from engine.cli.output import tell
+from engine.cli.who import acting_user
 from engine.clock import EpochClock
 from engine.errors import ConfigError
 from engine.privacy.consent import PSEUDONYM
@@ -28,14 +28,6 @@ def pseudonym(text: str) -> str:
             "(e.g. kid-17), never a person's name"
         )
     return text
-
-
-def acting_user() -> str:
-    """Who is acting, for the audit trail: the system user's name, else their number."""
-    try:
-        return getpass.getuser()
-    except (KeyError, OSError):
-        return f"uid {os.getuid()}"
 
 
 def open_site(*, create: bool = True) -> Site:

@@ -16,7 +16,8 @@ import contextlib
 import datetime
 import fcntl
 import os
-from dataclasses import dataclass
+from collections.abc import Sequence
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from engine.clock import Clock
@@ -68,12 +69,24 @@ class SiteSettings:
 
 @dataclass(frozen=True)
 class Erased:
-    """What an erasure removed: files (recordings, reports, exports) and those that were
-    already gone."""
+    """What an erasure removed: files (recordings, reports, exports), those that were
+    already gone, and those it could not remove (with why: remove them by hand)."""
 
     person: str
     removed: list[Path]
     already_gone: list[Path]
+    not_removed: list[tuple[Path, str]] = field(default_factory=list)
+
+
+@dataclass
+class Purged:
+    """What a purge removed: the sessions older than the site keeps them, every report,
+    progress report, export and conversion that held one of them, and what it could not
+    remove (with why: remove it by hand; the next purge tries again)."""
+
+    sessions: list[SessionEntry] = field(default_factory=list)
+    outputs: list[Path] = field(default_factory=list)
+    not_removed: list[tuple[Path, str]] = field(default_factory=list)
 
 
 class Site:
@@ -128,15 +141,23 @@ class Site:
         self.records.end_session(path.resolve(), length_s)
 
     def output_written(
-        self, path: Path, person: str, kind: str, source: Path | None = None
+        self, path: Path, person: str, kind: str, sources: Sequence[Path] = ()
     ) -> None:
-        """Notes a report or export written in the clear about ``person`` (from the
-        recording ``source``, None for one about the person as a whole): removed when
-        that recording is purged, and when the person is erased."""
+        """Notes a report, progress report, export or conversion written in the clear about
+        ``person``, holding the recordings ``sources``: removed when any of them is purged,
+        and when the person is erased."""
         where = path.resolve()
-        origin = source.resolve() if source is not None else None
-        self.records.add_output(where, person, kind, self.clock.now(), origin)
+        held = [source.resolve() for source in sources]
+        self.records.add_output(where, person, kind, self.clock.now(), held)
         self.audit(f"{kind} written", person, str(where))
+
+    def reports_folder(self) -> Path:
+        """Where reports about a person go unless told otherwise: ``reports/`` in the data
+        folder (its owner's alone; never the current folder, where ``git add -A`` or a
+        shared drive would take a child's report)."""
+        folder = self.folder / "reports"
+        folder.mkdir(mode=0o700, exist_ok=True)
+        return folder
 
     def check_belongs(self, recording: Path, person_in_file: str) -> None:
         """ConfigError when the index lists ``recording`` as another person's than the
@@ -158,19 +179,30 @@ class Site:
         return entry.person if entry is not None else ""
 
     # -- retention ----------------------------------------------------------------------
-    def purge(self) -> list[SessionEntry]:
-        """Removes every session older than the site keeps them (file, the reports written
-        from it, index entry; each audited); returns them."""
+    def purge(self) -> Purged:
+        """Removes every session older than the site keeps them: its file, its index entry,
+        and every report, progress report, export and conversion that holds it (each
+        audited); says what it could not remove."""
         oldest = self.clock.now() - self.settings.keep_sessions_days * DAY_S
-        purged = [entry for entry in self.records.sessions() if entry.started < oldest]
-        for entry in purged:
-            for output in self.records.outputs_from(entry.path):  # its reports go with it
-                _remove(output)
+        purged = Purged([entry for entry in self.records.sessions() if entry.started < oldest])
+        days = self.settings.keep_sessions_days
+        for entry in purged.sessions:
+            failed = False
+            for output in self.records.outputs_holding(entry.path):
+                why = _removed(output)
+                if why is not None:
+                    purged.not_removed.append((output, why))
+                    failed = True
+                    continue
                 self.records.forget_output(output)
-            _remove(entry.path)
-            self.records.forget_session(entry.path)
-            days = self.settings.keep_sessions_days
-            self.audit("purge", entry.person, f"{entry.path} (older than {days:g} days)")
+                purged.outputs.append(output)
+                self.audit("purge", entry.person, f"{output} (it held {entry.path})")
+            why = _removed(entry.path)
+            if why is not None:
+                purged.not_removed.append((entry.path, why))
+            elif not failed:  # else still listed: the next purge tries its copies again
+                self.records.forget_session(entry.path)
+                self.audit("purge", entry.person, f"{entry.path} (older than {days:g} days)")
         return purged
 
     # -- erasure ------------------------------------------------------------------------
@@ -186,16 +218,22 @@ class Site:
         return [self._erase(person) for person in self.records.unfinished_erasures()]
 
     def _erase(self, person: str) -> Erased:
-        removed: list[Path] = []
-        gone: list[Path] = []
+        erased = Erased(person, [], [])
         paths = [e.path for e in self.records.sessions(person)]
         paths += [path for path, _ in self.records.outputs(person)]
         for path in paths:
-            (removed if _remove(path) else gone).append(path)
+            there = path.exists() or path.is_symlink()
+            why = _removed(path)
+            if why is not None:
+                erased.not_removed.append((path, why))
+            else:
+                (erased.removed if there else erased.already_gone).append(path)
+        if erased.not_removed:  # marked still: the next vest data or vest run tries again
+            return erased
         self.consents.forget(self.folder, person)
-        what = f"{len(removed)} files removed"
+        what = f"{len(erased.removed)} files removed"
         self.records.finish_erasing(person, (self.clock.now(), self.who, what))
-        return Erased(person, removed, gone)
+        return erased
 
     # -- the key ------------------------------------------------------------------------
     def rekey(self, *, drop_missing: bool = False) -> tuple[list[Path], list[Path]]:
@@ -304,9 +342,19 @@ EXPORT_FILES = (
 folder when nothing else is left in it)."""
 
 
+def _removed(path: Path) -> str | None:
+    """Removes ``path`` (:func:`_remove`); None when it is gone, else why it could not."""
+    try:
+        _remove(path)
+    except OSError as error:
+        return error.strerror or str(error)
+    return None
+
+
 def _remove(path: Path) -> bool:
     """Removes a file (and its SQLite journal), or what an export wrote in a folder (the
-    folder too when nothing else is in it); False when it was not there."""
+    folder too when nothing else is in it); False when it was not there, OSError when it
+    cannot be removed."""
     if path.is_dir() and not path.is_symlink():
         for pattern in EXPORT_FILES:
             for written in path.glob(pattern):

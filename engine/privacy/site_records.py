@@ -4,9 +4,9 @@ data folder.
 - ``sessions``: every recording vest made here (its path, the pseudonym it belongs to or
   '' for none, when it started, how long it lasted in seconds, the profile, what consent
   let it keep), wherever the file was written;
-- ``outputs``: what was written from those sessions in the clear (reports, exports), and
-  from which recording ('' for one about the person as a whole), so an erasure and the
-  purge of that recording find them;
+- ``outputs``: what was written from those sessions in the clear (reports, progress
+  reports, exports, conversions), and every recording each holds (``source``: a JSON
+  list), so an erasure, and the purge of any of those recordings, find them;
 - ``erasing``: a person whose erasure began and has not finished (it finishes on the next
   run of any ``vest data`` command or ``vest run``);
 - ``audit``: who recorded, replayed, reported, exported, erased what and when. Append-only:
@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import hashlib
 import json
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
@@ -50,7 +50,7 @@ CREATE TRIGGER IF NOT EXISTS audit_is_not_deleted BEFORE DELETE ON audit
 BEGIN SELECT RAISE(ABORT, 'the audit trail is append-only'); END;
 """
 FIRST_LINK = "0" * 64
-SCHEMA_VERSION = 1
+SCHEMA_VERSION = 2
 
 
 @dataclass(frozen=True)
@@ -102,6 +102,14 @@ class SiteRecords:
                 self._connection.execute(
                     "ALTER TABLE outputs ADD COLUMN source TEXT NOT NULL DEFAULT ''"
                 )
+        if version < 2:  # one recording ('' for none) -> every recording it holds
+            rows = self._connection.execute("SELECT path, source FROM outputs").fetchall()
+            for path, source in rows:
+                held = json.dumps([source] if source else [])
+                self._connection.execute(
+                    "UPDATE outputs SET source = ? WHERE path = ?", (held, path)
+                )
+        if version < SCHEMA_VERSION:
             self._connection.execute(f"PRAGMA user_version = {SCHEMA_VERSION}")
 
     def close(self) -> None:
@@ -162,12 +170,14 @@ class SiteRecords:
             db.execute("DELETE FROM sessions WHERE path = ?", (str(path),))
 
     def add_output(
-        self, path: Path, person: str, kind: str, made: float, source: Path | None
+        self, path: Path, person: str, kind: str, made: float, sources: Sequence[Path]
     ) -> None:
+        """Notes ``path``, written about ``person``, holding the recordings ``sources``."""
+        held = json.dumps([str(source) for source in sources])
         with self.transaction() as db:
             db.execute(
                 "INSERT OR REPLACE INTO outputs VALUES (?, ?, ?, ?, ?)",
-                (str(path), person, kind, made, str(source) if source is not None else ""),
+                (str(path), person, kind, made, held),
             )
 
     def is_output(self, path: Path) -> bool:
@@ -177,12 +187,11 @@ class SiteRecords:
         ).fetchone()
         return row is not None
 
-    def outputs_from(self, source: Path) -> list[Path]:
-        """What was written in the clear from the recording ``source``."""
-        rows = self._connection.execute(
-            "SELECT path FROM outputs WHERE source = ? ORDER BY made", (str(source),)
-        ).fetchall()
-        return [Path(path) for (path,) in rows]
+    def outputs_holding(self, source: Path) -> list[Path]:
+        """What was written in the clear that holds the recording ``source`` (its report,
+        a progress report or an export of its person, a conversion of it)."""
+        rows = self._connection.execute("SELECT path, source FROM outputs ORDER BY made").fetchall()
+        return [Path(path) for path, held in rows if str(source) in json.loads(held or "[]")]
 
     def forget_output(self, path: Path) -> None:
         with self.transaction() as db:

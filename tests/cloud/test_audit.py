@@ -109,3 +109,20 @@ def test_a_bad_since_is_named(tmp_path: Path, capsys: pytest.CaptureFixture[str]
         main(["cloud", "audit", "--since", "last week", "--db", f"sqlite:///{tmp_path}/c.db"]) == 2
     )
     assert "--since 'last week': use a date or time" in capsys.readouterr().err
+
+
+def test_the_shell_s_account_is_the_operating_system_s_not_a_variable(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import os
+    import pwd
+
+    monkeypatch.setenv("LOGNAME", "mallory")
+    monkeypatch.setenv("USER", "mallory")
+    db = ["--db", f"sqlite:///{tmp_path / 'c.db'}"]
+    assert main(["cloud", "add-account", "ana", "--role", "admin", *db]) == 0
+    capsys.readouterr()
+    assert main(["cloud", "audit", "--json", *db]) == 0
+    actor = json.loads(capsys.readouterr().out.splitlines()[0])["actor"]
+    uid = os.geteuid()
+    assert actor == f"shell:{pwd.getpwuid(uid).pw_name} (uid {uid})"

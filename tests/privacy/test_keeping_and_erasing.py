@@ -110,15 +110,69 @@ def test_sessions_older_than_the_site_keeps_them_are_purged(
     (site_data / "site.yaml").write_text("keep_sessions_days: 30\n")
     started = Site.open(site_data, clock=Calendar(0), who="ana").records.sessions()[0].started
     site = Site.open(site_data, clock=Calendar(started + 29 * DAY_S), who="ana")
-    assert site.purge() == []
+    assert site.purge().sessions == []
     report = recorded[0].with_suffix(".html")  # a.vest's report, in the clear
     assert report.exists() and report.stat().st_mode & 0o077 == 0  # its owner's alone
     site.clock = Calendar(started + 31 * DAY_S)
-    assert sorted(entry.path.name for entry in site.purge()) == ["a.vest", "b.vest", "c.vest"]
+    purged = site.purge()
+    assert sorted(entry.path.name for entry in purged.sessions) == ["a.vest", "b.vest", "c.vest"]
     assert not any(path.exists() for path in recorded) and not report.exists()
-    assert site.records.sessions() == []
-    assert [line.action for line in site.records.audit_lines()][-3:] == ["purge"] * 3
+    assert site.records.sessions() == [] and purged.not_removed == []
+    assert [line.action for line in site.records.audit_lines()][-4:] == ["purge"] * 4
     site.close()
+
+
+def test_a_purge_removes_every_copy_that_held_a_purged_session(
+    recorded: list[Path],
+    site_data: Path,
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """An export and a progress report hold every session of the person: past the site's
+    keeping, they go with the sessions; a progress report is never left in the current
+    folder, where `git add -A` would commit a child's report."""
+    monkeypatch.chdir(tmp_path)
+    assert main(["report", "--person", "kid-17"]) == 0
+    progress = site_data / "reports" / "kid-17-progress.html"
+    assert progress.is_file() and not list(tmp_path.glob("*progress*"))
+    assert str(progress) in capsys.readouterr().out
+    exported = tmp_path / "kid-17-export"
+    assert main(["data", "export", "--person", "kid-17", "-o", str(exported)]) == 0
+    mcap = tmp_path / "b.mcap"
+    assert main(["replay", str(recorded[1]), "--to", "mcap", "-o", str(mcap)]) == 0
+    (site_data / "site.yaml").write_text("keep_sessions_days: 0.0001\n")  # about 9 s
+    monkeypatch.setattr("engine.cli.site_access.EpochClock", lambda: Calendar(4e9))
+    capsys.readouterr()
+    assert main(["data", "purge"]) == 0
+    said = capsys.readouterr().out
+    for copy in (progress, exported, mcap):
+        assert not copy.exists() and f"removed {copy.resolve()}" in said, copy
+    assert "3 sessions older than" in said
+
+
+def test_what_a_purge_cannot_remove_is_named_and_tried_again(
+    recorded: list[Path],
+    site_data: Path,
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    held = tmp_path / "held"
+    held.mkdir()
+    exported = held / "kid-17-export"
+    assert main(["data", "export", "--person", "kid-17", "-o", str(exported)]) == 0
+    stuck = exported / "sessions" / "999-notes.json"  # a folder where vest wrote files
+    stuck.mkdir()
+    (site_data / "site.yaml").write_text("keep_sessions_days: 0.0001\n")
+    monkeypatch.setattr("engine.cli.site_access.EpochClock", lambda: Calendar(4e9))
+    capsys.readouterr()
+    assert main(["data", "purge"]) == 1
+    said = capsys.readouterr().err
+    assert f"could not remove {exported.resolve()}" in said and "by hand" in said
+    stuck.rmdir()
+    assert main(["data", "purge"]) == 0  # still listed: tried again
+    assert not exported.exists()
 
 
 def test_a_site_setting_with_a_mistake_is_named(site_data: Path) -> None:
@@ -171,3 +225,19 @@ def test_a_recording_of_an_earlier_vest_is_read_and_can_be_sealed(
     connect_sealed(kept, the_site_key, read_only=True).close()
     assert main(["replay", str(kept), "--at", "4.5"]) == 0
     assert "/devices/touch/ok = false" in capsys.readouterr().out
+
+
+def test_the_audit_trail_names_the_operating_system_s_account_not_a_variable(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    import os
+    import pwd
+
+    monkeypatch.setenv("LOGNAME", "mallory")
+    monkeypatch.setenv("USER", "mallory")
+    assert main(["data", "consent", "kid-9", "--given-by", "guardian", "--covers", "sensors"]) == 0
+    capsys.readouterr()
+    assert main(["data", "audit", "--json"]) == 0
+    who = json.loads(capsys.readouterr().out.splitlines()[-1])["who"]
+    uid = os.geteuid()
+    assert who == f"{pwd.getpwuid(uid).pw_name} (uid {uid})" and "mallory" not in who

@@ -134,8 +134,29 @@ def test_a_site_db_of_an_earlier_vest_is_brought_up_to_date(
     db.commit()
     db.close()
     site = Site.open(site_data, clock=Calendar(1e9), who="ana")
-    site.output_written(tmp_path / "new.html", "kid-1", "report", source=tmp_path / "s.vest")
+    site.output_written(tmp_path / "new.html", "kid-1", "report", [tmp_path / "s.vest"])
     assert [path.name for path, _ in site.records.outputs("kid-1")] == ["r.html", "new.html"]
+    assert site.records.outputs_holding((tmp_path / "s.vest").resolve()) == [
+        (tmp_path / "new.html").resolve()
+    ]
+    site.close()
+
+
+def test_a_report_listed_by_the_vest_before_is_still_purged_with_its_recording(
+    site_data: Path, the_site_key: SiteKey, tmp_path: Path
+) -> None:
+    """site.db of schema 1 named one recording per output (or none)."""
+    site = Site.open(site_data, clock=Calendar(1e9), who="ana")
+    site.close()
+    db = connect_sealed(site_data / "site.db", the_site_key)
+    db.execute("INSERT INTO outputs VALUES ('/r.html', 'kid-1', 'report', 1.0, '/a.vest')")
+    db.execute("INSERT INTO outputs VALUES ('/p.html', 'kid-1', 'report', 1.0, '')")
+    db.execute("PRAGMA user_version = 1")
+    db.commit()
+    db.close()
+    site = Site.open(site_data, clock=Calendar(1e9), who="ana")
+    assert site.records.outputs_holding(Path("/a.vest")) == [Path("/r.html")]
+    assert len(site.records.outputs("kid-1")) == 2
     site.close()
 
 
