@@ -1,16 +1,19 @@
 """The checks `vest edit` shows as a therapist types: those of `vest validate`, on the text
 being edited in its file's place among the folder's others (its subtrees, the trees that
-use it, its dialogs, the robot's pads and joints), without writing it anywhere."""
+use it and run beside it, its dialogs, the robot's pads and joints), without writing it
+anywhere. Only files inside the folder are read: a subtree that leads out of it (to the
+site's consent.yaml, say) is a problem named by its path, never read."""
 
 from __future__ import annotations
 
 from pathlib import Path
 
 from engine.cli.run_inputs import robot_catalogue
-from engine.cli.validate_command import Validator, kind_of
+from engine.cli.validate_command import Validator, folder_kind_problem, kind_of
 from engine.dialogs.library import check_dialog
+from engine.editor.workspace import OUTSIDE
 from engine.files.parsed_files import ParsedFiles
-from engine.files.problems import LoadError, Problem, Problems
+from engine.files.problems import LoadError, Mark, Problem, Problems
 from engine.files.yaml_source import YValue, parse_yaml, resolved
 from engine.hardware.config import RobotConfig
 from engine.loader.tree_checks import variable_problems
@@ -20,15 +23,19 @@ from engine.nodes.registry import NodeRegistry
 
 
 class _Overlaid(ParsedFiles):
-    """The folder's files, but one of them read from the text being edited."""
+    """The folder's files, but one of them read from the text being edited, and none
+    read from outside ``folder``."""
 
-    def __init__(self, path: Path, text: str) -> None:
+    def __init__(self, folder: Path, path: Path, text: str) -> None:
         super().__init__()
-        self.path, self.text = resolved(path), text
+        self.folder, self.path, self.text = resolved(folder), resolved(path), text
 
     def load(self, path: Path, shown: str | None = None) -> YValue | None:
-        if resolved(path) == self.path:
+        where = resolved(path)
+        if where == self.path:
             return parse_yaml(self.text, shown or str(path))
+        if not where.is_relative_to(self.folder):  # a link, ../ or an absolute path out
+            raise LoadError([Problem(Mark(shown or str(path), 1, 1), OUTSIDE, "keep it inside")])
         return super().load(path, shown)
 
 
@@ -54,20 +61,27 @@ class ValidateChecks:
             document = parse_yaml(text, shown_path(path))
         except LoadError as error:
             return error.problems, None
-        if kind_of(document) == "dialog":  # checked from the text, not the folder's copy
+        kind = kind_of(document)
+        where = document.mark if document is not None else Mark(shown_path(path), 1, 1)
+        misplaced = folder_kind_problem(path, kind, where)
+        if misplaced is not None:
+            return [misplaced], None
+        if kind == "dialog":  # checked from the text, not the folder's copy
             try:
                 check_dialog(document, shown_path(path), self.catalogue, default_name=path.stem)
             except LoadError as error:
                 return error.problems, None
             return [], None
         validator = Validator(self.registry, self.config, None, problems)
-        validator.files = _Overlaid(path, text)
+        validator.files = _Overlaid(self.folder, path, text)
         dialogs = self.folder / "dialogs"
         validator.default_dialogs = dialogs if dialogs.is_dir() else None
         validator.check(path)
         edited = validator.trees[0] if validator.trees else None
-        for other in self._trees_beside(path):  # a subtree's change is checked where it is used
+        beside = self._trees_beside(path)
+        for other in beside:  # a subtree's change is checked where it is used
             validator.check(other)
+        validator.check_tree_names([*beside, path])  # trees run together: their names differ
         run_together = [tree for tree in validator.trees if tree.path.parent.name != "parts"]
         problems.extend(variable_problems(run_together, self.catalogue))
         return list(dict.fromkeys(problems.items)), edited

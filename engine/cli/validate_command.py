@@ -110,6 +110,29 @@ def kind_of(document: object) -> str | None:
     return None
 
 
+FOLDER_KINDS = {
+    "trees": "tree",
+    "parts": "tree",
+    "profiles": "profile",
+    "buttons": "buttons",
+    "dialogs": "dialog",
+}
+"""What ``vest run`` reads every file of a folder so named as."""
+
+
+def folder_kind_problem(path: Path, kind: str | None, where: Mark) -> Problem | None:
+    """A file whose kind is not what ``vest run`` reads its folder as (a tree saved into
+    dialogs/, a dialog into trees/), or None."""
+    expected = FOLDER_KINDS.get(path.parent.name)
+    if expected is None or kind == expected or kind is None:
+        return None
+    return Problem(
+        where,
+        f"a {kind} in {path.parent.name}/: vest run reads every file there as a {expected}",
+        f"move it where {kind}s go" if kind != "tree" else "move it to trees/",
+    )
+
+
 class Validator:
     """Checks files one by one with the checks ``vest run`` makes (engine.cli.run_inputs)."""
 
@@ -182,6 +205,11 @@ class Validator:
             self.problems.extend(error.problems)
             return
         kind = kind_of(document)
+        where = document.mark if document is not None else Mark(shown_path(path), 1, 1)
+        misplaced = folder_kind_problem(path, kind, where)
+        if misplaced is not None:
+            self.problems.add(misplaced.mark, misplaced.message, misplaced.hint)
+            return  # read as what it is not, it says nothing more worth reading
         try:
             if kind == "tree":
                 definition = self.loader_for(path).load(path)

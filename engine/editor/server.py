@@ -196,7 +196,7 @@ class EditorServer:
 
     def _tried(self, body: dict[str, Any]) -> dict[str, Any]:
         assert self.try_out is not None
-        name, text = self._text_of(body)
+        name, text = self._runnable(body)
         try:
             return {"timeline": self.try_out(name, text, body.get("event"))}
         except ValueError as why:
@@ -204,7 +204,7 @@ class EditorServer:
 
     def _watched(self, body: dict[str, Any]) -> dict[str, Any]:
         assert self.watch is not None
-        name, text = self._text_of(body)
+        name, text = self._runnable(body)
         try:
             return {"url": self.watch(name, text, body.get("event"), self.host)}
         except ValueError as why:
@@ -233,6 +233,14 @@ class EditorServer:
         if not isinstance(body.get("outline"), dict):
             raise EditRefused(400, "outline: the tree or dialog as the page holds it")
         return body
+
+    def _runnable(self, body: dict[str, Any]) -> tuple[str, str]:
+        """:meth:`_text_of`, refused (400) when running it would read outside the folder."""
+        name, text = self._text_of(body)
+        why = self.workspace.leads_outside(name, text)
+        if why is not None:
+            raise EditRefused(400, why)
+        return name, text
 
     def _text_of(self, body: dict[str, Any]) -> tuple[str, str]:
         """The file named and the text the body's outline makes of the file as it is."""

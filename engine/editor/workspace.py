@@ -9,7 +9,11 @@ Only files inside the folder are read or written (a name that leads out of it, t
   folder's other files (its subtrees, its dialogs, the robot's pads and joints); a text
   with problems is never saved over a file without them unless the person said so;
 - the text is written whole or not at all (a temporary file beside it, then renamed), so a
-  robot running ``vest run`` on the folder reloads either the old tree or the new one.
+  robot running ``vest run`` on the folder reloads either the old tree or the new one;
+- a file is compared and written under a lock of its own: of saves sent at once from one
+  version, one is written and the others are told the file changed (409);
+- nothing outside the folder is read by the checks, nor by a try (a subtree that leads
+  out of it is a problem, named by the path written, never read).
 """
 
 from __future__ import annotations
@@ -18,6 +22,7 @@ import contextlib
 import hashlib
 import os
 import tempfile
+import threading
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Protocol
@@ -27,6 +32,8 @@ from engine.files.yaml_source import read_bytes, resolved
 from engine.loader.tree_definition import TreeDefinition
 from engine.nodes.registry import NodeRegistry
 
+OUTSIDE = "outside the folder the editor works in: not read"
+"""The problem of a file a text leads to (a subtree) outside the folder."""
 LISTED = ("trees", "dialogs")
 """The folders listed when the folder holds them (a project); else the folder itself."""
 MAX_FILE_BYTES = 1_000_000
@@ -76,6 +83,8 @@ class Workspace:
         self.checks = checks
         mask = os.umask(0)  # read once, at the start, before any thread writes
         os.umask(mask)
+        self._locks: dict[Path, threading.Lock] = {}
+        self._locks_lock = threading.Lock()
         self.new_mode = 0o666 & ~mask
         """A new file's permissions: what the person's umask gives (0644 as a rule)."""
 
@@ -133,14 +142,31 @@ class Workspace:
         found = [_described(p, path, self.folder) for p in dict.fromkeys(problems)]
         return found, tree if not found else None
 
+    def leads_outside(self, name: str, text: str) -> str | None:
+        """Why ``text`` cannot be run as ``name`` (a subtree outside the folder), or None."""
+        for problem in self.check(name, text):
+            if problem["message"] == OUTSIDE:
+                return f"{problem['file']}: {OUTSIDE} (keep subtrees inside the folder)"
+        return None
+
+    def _lock_of(self, path: Path) -> threading.Lock:
+        with self._locks_lock:
+            return self._locks.setdefault(path, threading.Lock())
+
     def save(
         self, name: str, text: str, version: str | None, *, over_problems: bool = False
     ) -> Saved:
         """Write ``text`` to ``name`` if the file is still at ``version`` (None: a new
         file, which must not exist yet); EditRefused (409) when it changed meanwhile, or
         when ``text`` has problems the file on disk has not and ``over_problems`` is
-        False."""
+        False. Compared and written under the file's lock."""
         path = self.path_of(name)
+        with self._lock_of(path):
+            return self._save(path, name, text, version, over_problems)
+
+    def _save(
+        self, path: Path, name: str, text: str, version: str | None, over_problems: bool
+    ) -> Saved:
         on_disk: str | None
         try:
             on_disk, current = self.read(name)
