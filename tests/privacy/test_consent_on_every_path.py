@@ -260,3 +260,34 @@ def test_what_leaves_by_each_exit_is_what_the_child_s_consent_allows(
         read = READINGS.findall(found)
         assert bool(heard) == (exit_ in words_in), (exit_, heard[:3])
         assert bool(read) == (exit_ in readings_in), (exit_, read[:3])
+
+
+def test_the_consent_gate_is_the_only_reader_of_the_robot_s_own_stream(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, graph: Graph
+) -> None:
+    """Every way out is behind the gate: a session with all of them open has the gate as
+    the one reader of what the robot tells, the others read its exits."""
+    from engine.cli import main
+    from engine.composition.session_root import RunningSession
+
+    readers: dict[str, list[str]] = {}
+    close = RunningSession.close
+
+    def noting(running: RunningSession) -> None:  # as it stops, every part still there
+        def names(stream: Any) -> list[str]:
+            return sorted(type(reader).__name__ for reader in stream.readers)
+
+        readers["robot"] = names(running.assembled.robot.session)
+        readers["kept"] = names(running.gates.kept)
+        readers["sent"] = names(running.gates.sent)
+        close(running)
+
+    monkeypatch.setattr(RunningSession, "close", noting)
+    monkeypatch.chdir(ROOT)
+    args = ["run", "--fast", "--speech", "text", "--duration", "2", "--json"]
+    args += ["--record", str(tmp_path / "s.vest"), "--view", "--view-port", "0"]
+    args += ["--foxglove", "0", "--ros2", graph.endpoint]
+    assert main(args) == 0
+    assert readers["robot"] == ["ConsentGates"]
+    assert readers["kept"] == ["FoxgloveLive", "SessionRecorder", "Timeline", "ViewHub"]
+    assert readers["sent"] == ["Ros2Bridge"]
