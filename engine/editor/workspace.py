@@ -184,8 +184,9 @@ class Workspace:
                 raise EditRefused(
                     409,
                     f"{name}: the change has {len(problems)} problem"
-                    f"{'s' if len(problems) != 1 else ''}; saving would replace a file "
-                    "without any (save anyway to keep it unfinished)",
+                    f"{'s' if len(problems) != 1 else ''} ({problems[0]['message']}"
+                    f"{', ...' if len(problems) > 1 else ''}), which would keep vest run "
+                    "from starting with this folder (save anyway to keep it unfinished)",
                     problems,
                 )
         data = text.encode("utf-8")

@@ -156,7 +156,8 @@ class ConsentGate:
             carries = event.carries | _captured_in(event.args)  # a result of readings, too
             if self.allows(carries):
                 return event
-            return dataclasses.replace(event, args=self._act_only(event.args, carries))
+            withheld = self._act_only(event.args, carries)
+            return dataclasses.replace(event, args=withheld, carries=carries)
         if isinstance(event, ActionEnded):
             return self._ended(event)
         if isinstance(event, TurnTaken):
@@ -180,7 +181,7 @@ class ConsentGate:
             why = self.withheld(event.why_carries)
         if args is event.args and why is event.why:
             return event
-        return dataclasses.replace(event, args=args, why=why)
+        return dataclasses.replace(event, args=args, why=why, carries=carries)
 
     def _act_only(self, args: dict[str, Any], carries: Carries) -> dict[str, Any]:
         """An action's arguments with what was made of a person withheld: which act it was

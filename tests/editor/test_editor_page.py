@@ -77,7 +77,7 @@ def test_a_bad_value_is_refused_with_the_validator_s_message(
 
     page.get_by_role("button", name="Save").click()  # asked first: the file has no problem
     expect(page.locator("#confirm")).to_be_visible()
-    expect(page.locator("#confirm-text")).to_contain_text("saving would replace a file without any")
+    expect(page.locator("#confirm-text")).to_contain_text("would keep vest run from starting")
     page.get_by_role("button", name="Keep editing").click()
     assert path.read_text() == before
 

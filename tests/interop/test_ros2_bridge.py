@@ -280,7 +280,8 @@ def test_a_read_without_telemetry_consent_answers_failed_never_the_reading(lab: 
         bridge.stop()
     assert results[1]["status"] == "FAILED" and "12.5" not in json.dumps(results[1])
     assert "consent does not cover" in results[1]["result"]["error"]
-    assert json.loads(actions[0].data)["args"] == {}  # what the robot did, not what it read
+    action = json.loads(actions[0].data)["args"]  # what the robot did, not what it read
+    assert action["id"] == "ros2:r1" and "12.5" not in actions[0].data
 
 
 def test_telemetry_consent_without_sensors_sends_no_reading_either(lab: Lab) -> None:
