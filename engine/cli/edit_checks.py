@@ -10,8 +10,7 @@ from pathlib import Path
 
 from engine.cli.run_inputs import robot_catalogue
 from engine.cli.validate_command import Validator, folder_kind_problem, kind_of
-from engine.dialogs.library import check_dialog
-from engine.editor.workspace import OUTSIDE
+from engine.dialogs.library import OUTSIDE, check_dialog
 from engine.files.parsed_files import ParsedFiles
 from engine.files.problems import LoadError, Mark, Problem, Problems
 from engine.files.yaml_source import YValue, parse_yaml, resolved
@@ -22,20 +21,30 @@ from engine.loader.tree_file import shown_path
 from engine.nodes.registry import NodeRegistry
 
 
-class _Overlaid(ParsedFiles):
-    """The folder's files, but one of them read from the text being edited, and none
-    read from outside ``folder``."""
+class _InTheFolder(ParsedFiles):
+    """The folder's files, none read from outside ``folder`` (a link, ``../``, an absolute
+    path out: a problem named by its path)."""
 
-    def __init__(self, folder: Path, path: Path, text: str) -> None:
+    def __init__(self, folder: Path) -> None:
         super().__init__()
-        self.folder, self.path, self.text = resolved(folder), resolved(path), text
+        self.folder = resolved(folder)
 
     def load(self, path: Path, shown: str | None = None) -> YValue | None:
-        where = resolved(path)
-        if where == self.path:
-            return parse_yaml(self.text, shown or str(path))
-        if not where.is_relative_to(self.folder):  # a link, ../ or an absolute path out
+        if not resolved(path).is_relative_to(self.folder):
             raise LoadError([Problem(Mark(shown or str(path), 1, 1), OUTSIDE, "keep it inside")])
+        return super().load(path, shown)
+
+
+class _Overlaid(_InTheFolder):
+    """The folder's files, but one of them read from the text being edited."""
+
+    def __init__(self, folder: Path, path: Path, text: str) -> None:
+        super().__init__(folder)
+        self.path, self.text = resolved(path), text
+
+    def load(self, path: Path, shown: str | None = None) -> YValue | None:
+        if resolved(path) == self.path:
+            return parse_yaml(self.text, shown or str(path))
         return super().load(path, shown)
 
 
@@ -45,7 +54,7 @@ class ValidateChecks:
 
     def __init__(self, folder: Path, registry: NodeRegistry, config: RobotConfig | None) -> None:
         self.folder, self.registry, self.config = folder, registry, config
-        self.files = ParsedFiles()
+        self.files = _InTheFolder(folder)
         self.catalogue = robot_catalogue(config, registry)
 
     def kind_of(self, path: Path) -> str:
@@ -72,10 +81,9 @@ class ValidateChecks:
             except LoadError as error:
                 return error.problems, None
             return [], None
-        validator = Validator(self.registry, self.config, None, problems)
+        validator = Validator(self.registry, self.config, self.folder / "dialogs", problems)
         validator.files = _Overlaid(self.folder, path, text)
-        dialogs = self.folder / "dialogs"
-        validator.default_dialogs = dialogs if dialogs.is_dir() else None
+        validator.inside = self.folder  # its dialogs too: a link out is a problem, not read
         validator.check(path)
         edited = validator.trees[0] if validator.trees else None
         beside = self._trees_beside(path)
@@ -95,5 +103,7 @@ class ValidateChecks:
         return [
             other
             for other in sorted(trees.glob("*.y*ml"))
-            if resolved(other) != resolved(path) and self.kind_of(other) == "tree"
+            if resolved(other) != resolved(path)
+            and resolved(other).is_relative_to(self.folder)
+            and self.kind_of(other) == "tree"
         ]

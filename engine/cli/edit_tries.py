@@ -139,20 +139,12 @@ class TryOnSimulatedVest:
     def _command(
         self, scratch: Path, name: str, text: str, event: dict[str, object], seconds: float
     ) -> list[str]:
-        """``vest run`` of ``text`` (the file ``name``) in a copy of the folder's trees in
-        ``scratch`` (its subtrees; a link leading out of the folder is not followed), on a
-        scenario of ``seconds`` with ``event``, the folder's dialogs and the robot config."""
+        """``vest run`` of ``text`` (the file ``name``) in a copy of the folder's trees and
+        dialogs in ``scratch`` (a link leading out of the folder is not followed), on a
+        scenario of ``seconds`` with ``event`` and the robot config."""
         copy = scratch / "folder"
-        trees = self.folder / "trees"
-        if trees.is_dir():
-            inside = resolved(self.folder)
-            shutil.copytree(
-                trees,
-                copy / "trees",
-                ignore=lambda at, names: [
-                    name for name in names if not resolved(Path(at) / name).is_relative_to(inside)
-                ],
-            )
+        for part in ("trees", "dialogs"):
+            _copy_inside(self.folder / part, copy / part, resolved(self.folder))
         tried = copy / name
         tried.parent.mkdir(parents=True, exist_ok=True)
         tried.write_text(text, encoding="utf-8")
@@ -162,11 +154,24 @@ class TryOnSimulatedVest:
         )
         command = [sys.executable, "-c", VEST, "run", "--speech", "text"]
         command += ["--trees", str(tried), "--scenario", str(scenario)]
-        if (self.folder / "dialogs").is_dir():
-            command += ["--dialogs", str(self.folder / "dialogs")]
+        if (copy / "dialogs").is_dir():
+            command += ["--dialogs", str(copy / "dialogs")]
         if self.hardware is not None:
             command += ["--hardware", str(self.hardware)]
         return command
+
+
+def _copy_inside(source: Path, to: Path, inside: Path) -> None:
+    """``source``'s files into ``to``, but those that lead out of ``inside`` (links)."""
+    if not source.is_dir():
+        return
+    shutil.copytree(
+        source,
+        to,
+        ignore=lambda at, names: [
+            name for name in names if not resolved(Path(at) / name).is_relative_to(inside)
+        ],
+    )
 
 
 def _drain(stream: IO[str]) -> None:

@@ -134,7 +134,7 @@ def _converted(recording: Recording, site: Site | None, args: argparse.Namespace
         output.unlink(missing_ok=True)
         raise
     if site is not None:
-        person = site.person_of(args.recording)
+        person = site.person_of(args.recording, recording.meta.get("person", ""))
         site.output_written(output, person, args.to, [args.recording])
     tell(f"{output}: {said}")
     return _whole(recording)

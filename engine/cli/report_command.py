@@ -57,7 +57,7 @@ def main(args: argparse.Namespace) -> int:
         cut = recording.cut_short
         write_file(output, page.encode("utf-8"), f"{output}", "the report", private=True)
         if site is not None:  # a report names the person in the clear: erased with them
-            person = site.person_of(args.recording)
+            person = site.person_of(args.recording, recording.meta.get("person", ""))
             site.output_written(output, person, "report", [args.recording])
     finally:
         recording.close()

@@ -6,8 +6,9 @@ chip models that the real drivers read. --hardware CONFIG names a robot config; 
 (e.g. examples/robots/hbs2.yaml) the same drivers read the real chips.
 Speech goes through the real models: a scenario's hear: is spoken into the simulated
 room, heard by Silero VAD and the recognizer (Moonshine by default), and the answers
-are synthesized (--audio-out DIR keeps a WAV per utterance, replacing those of an
-earlier run); --speech text skips the models, hands the trees the text and gives each
+are synthesized (--audio-out DIR keeps a WAV per utterance, NNN-robot.wav, replacing
+those of an earlier run, listed as written about --person: erased and purged with the
+session); --speech text skips the models, hands the trees the text and gives each
 spoken word 0.3 s.
 --fast runs on a virtual clock as fast as the machine allows; --json prints the session
 as JSON lines, one object per event the timeline tells: {"t": seconds, "event": "action",
@@ -270,6 +271,9 @@ def _run_for_site(
         )
     if args.record is not None:
         check_new(args.record, site.key)  # before anything starts: never over a session
+    if args.audio_out is not None and args.person:  # the robot's voice may quote them
+        held = [args.record] if args.record is not None else []
+        site.output_written(args.audio_out, args.person, "robot's voice", held)
     ros2 = ros2_plan(args)
     leaving = args.record is not None or args.cloud is not None or ros2 is not None
     if leaving or consent.left_out:  # what the timeline and the pages leave out, and why

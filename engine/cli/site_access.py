@@ -64,11 +64,22 @@ def open_recording(path: Path, action: str) -> tuple[Recording, Site | None]:
             f"vest data seal {path} encrypts it"
         )
     if site is not None:
+        said = recording.meta.get("person", "")
+        person = site.person_of(path, said)
         try:
-            site.check_belongs(path, recording.meta.get("person", ""))
+            site.check_belongs(path, said)
+            site.check_not_erased(path, person, _started(recording))
         except ConfigError:
             recording.close()
             site.close()
             raise
-        site.audit(action, site.person_of(path), str(path.resolve()))
+        site.audit(action, person, str(path.resolve()))
     return recording, site
+
+
+def _started(recording: Recording) -> float:
+    """When the session began (seconds since the epoch; 0 when the file does not say)."""
+    try:
+        return float(recording.meta.get("started", "0") or 0)
+    except ValueError:
+        return 0.0

@@ -165,12 +165,18 @@ class Validator:
         default)."""
         self.trees: list[TreeDefinition] = []
         """The trees checked, to find those that would take turns by chance."""
+        self.inside: Path | None = None
+        """Files outside this folder are never read (the editor's folder), None: any."""
 
     def dialogs_for(self, path: Path) -> DialogLibrary | None:
         """The dialogs a tree at ``path`` uses (none when there is no dialogs folder, as in
         ``vest run``), or None when they have problems of their own (told once)."""
         folder = self.dialogs_dir or find_dialogs_folder(path) or self.default_dialogs
-        return self.dialog_library(folder) if folder is not None else DialogLibrary()
+        if folder is None or (
+            self.inside is not None and not folder.resolve().is_relative_to(self.inside.resolve())
+        ):
+            return DialogLibrary()  # none, or above the folder being edited: not read
+        return self.dialog_library(folder)
 
     def dialog_library(self, folder: Path) -> DialogLibrary | None:
         """The folder's dialogs loaded as ``vest run`` loads them (so two dialogs with one
@@ -178,7 +184,9 @@ class Validator:
         key = folder.resolve()
         if key not in self._dialogs:
             try:
-                self._dialogs[key] = DialogLibrary.from_folder(folder, self.catalogue)
+                self._dialogs[key] = DialogLibrary.from_folder(
+                    folder, self.catalogue, inside=self.inside
+                )
             except LoadError as error:
                 self.problems.extend(error.problems)
                 self._dialogs[key] = None

@@ -79,6 +79,10 @@ def find_dialogs_folder(path: Path) -> Path | None:
     return None
 
 
+OUTSIDE = "outside the folder the editor works in: not read"
+"""The problem of a file that leads out of the folder being edited (``vest edit``)."""
+
+
 class DialogLibrary:
     """Dialogs by name, loaded from ``*.yaml`` files in a folder."""
 
@@ -86,11 +90,17 @@ class DialogLibrary:
         self.dialogs = dialogs or {}
 
     @classmethod
-    def from_folder(cls, folder: Path, catalogue: KeyCatalogue) -> DialogLibrary:
-        """Every dialog in ``folder``; LoadError listing all problems of all files."""
+    def from_folder(
+        cls, folder: Path, catalogue: KeyCatalogue, *, inside: Path | None = None
+    ) -> DialogLibrary:
+        """Every dialog in ``folder``; LoadError listing all problems of all files. With
+        ``inside``, a file that leads out of that folder (a link) is a problem, never read."""
         problems = Problems()
         dialogs: dict[str, Dialog] = {}
         for path in sorted(folder.glob("*.yaml")):
+            if inside is not None and not resolved(path).is_relative_to(resolved(inside)):
+                problems.add(Mark(str(path), 1, 1), OUTSIDE, "keep dialogs inside it")
+                continue
             try:
                 dialog = load_dialog(path, catalogue)
             except LoadError as error:

@@ -27,13 +27,12 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Protocol
 
+from engine.dialogs.library import OUTSIDE
 from engine.files.problems import LoadError, Problem
 from engine.files.yaml_source import read_bytes, resolved
 from engine.loader.tree_definition import TreeDefinition
 from engine.nodes.registry import NodeRegistry
 
-OUTSIDE = "outside the folder the editor works in: not read"
-"""The problem of a file a text leads to (a subtree) outside the folder."""
 LISTED = ("trees", "dialogs")
 """The folders listed when the folder holds them (a project); else the folder itself."""
 MAX_FILE_BYTES = 1_000_000

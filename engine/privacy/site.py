@@ -173,10 +173,27 @@ class Site:
                 f"as {listed}'s (a recording copied over another?); not read"
             )
 
-    def person_of(self, recording: Path) -> str:
-        """The pseudonym a recording belongs to ('' for none or one not in the index)."""
+    def person_of(self, recording: Path, person_in_file: str = "") -> str:
+        """The pseudonym a recording belongs to: the index's, else (a copy moved or copied
+        away from where it was recorded) the one the file says, sealed with the site's key
+        ('' for none)."""
         entry = self.records.session_at(recording.resolve())
-        return entry.person if entry is not None else ""
+        if entry is not None:
+            return entry.person
+        return person_in_file if PSEUDONYM.fullmatch(person_in_file) else ""
+
+    def check_not_erased(self, recording: Path, person: str, started: float) -> None:
+        """ConfigError when ``person`` was erased after ``recording`` (started at
+        ``started``, seconds since the epoch) began: a copy the erasure could not find."""
+        if not person:
+            return
+        for line in self.records.audit_lines():
+            if line.action == "erase" and line.person == person and line.at >= started:
+                raise ConfigError(
+                    f"{recording}: a copy of a session of {person}, whose data was erased "
+                    f"on {_day(line.at)}; not read (remove it; vest data rekey makes every "
+                    "copy made with the old key unreadable)"
+                )
 
     # -- retention ----------------------------------------------------------------------
     def purge(self) -> Purged:
@@ -298,6 +315,10 @@ class _SiteLock:
         self._file.close()
 
 
+def _day(at_s: float) -> str:
+    return datetime.datetime.fromtimestamp(at_s, datetime.UTC).strftime("%Y-%m-%d")
+
+
 def site_key_in_rotation(folder: Path) -> SiteKey:
     """The new key of a rotation under way (``site.key.new``), made when there is none."""
     path = folder / NEW_KEY_FILE
@@ -337,9 +358,11 @@ EXPORT_FILES = (
     "audit.json",
     "sessions/*.json",
     "reports/*.html",
+    "[0-9][0-9][0-9]-robot.wav",
 )
-"""What ``vest data export`` writes into its folder (an erasure removes these, and the
-folder when nothing else is left in it)."""
+"""What vest writes into a folder about a person (``vest data export``; ``vest run
+--audio-out``: the robot's voice): an erasure or purge removes these, and the folder
+when nothing else is left in it."""
 
 
 def _removed(path: Path) -> str | None:

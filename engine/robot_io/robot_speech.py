@@ -9,6 +9,7 @@ without a speaker its answers fail with the reason.
 from __future__ import annotations
 
 import logging
+import os
 import threading
 from collections import deque
 from collections.abc import Callable, Iterable
@@ -341,10 +342,11 @@ def build_speech(
 
 
 def audio_folder(folder: Path) -> Callable[[Utterance], None]:
-    """Keeps each utterance as ``NNN-first-words.wav`` in ``folder`` (made if missing);
+    """Keeps each utterance as ``NNN-robot.wav`` in ``folder`` (made if missing), its
+    owner's alone (a sentence may quote what a person said: never in a file's name);
     ConfigError when it cannot be made."""
     try:
-        folder.mkdir(parents=True, exist_ok=True)
+        folder.mkdir(mode=0o700, parents=True, exist_ok=True)
     except OSError as error:
         raise ConfigError(
             f"--audio-out {folder}: cannot make it ({error.strerror or error})"
@@ -353,9 +355,10 @@ def audio_folder(folder: Path) -> Callable[[Utterance], None]:
 
     def keep(utterance: Utterance) -> None:
         count[0] += 1
-        words = "-".join("".join(c for c in w if c.isalnum()) for w in utterance.text.split()[:5])
-        path = folder / f"{count[0]:03d}-{words.lower() or 'utterance'}.wav"
+        path = folder / f"{count[0]:03d}-robot.wav"
         try:
+            os.close(os.open(path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600))
+            path.chmod(0o600)  # one of an earlier run, made with another mode
             write_wav(path, utterance.audio)
         except OSError as error:
             log.warning("could not write %s: %s", path, error)

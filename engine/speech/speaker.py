@@ -211,7 +211,8 @@ class Speaker:
             except CancelledError as error:
                 job.finish(error)
             except Exception as error:  # a voice or a sound card that failed
-                log.warning("could not say %r: %s", job.text, error)
+                words = len(job.text.split())  # never the words: they may quote a person
+                log.warning("could not say a sentence of %d words: %s", words, error)
                 job.finish(ServiceError(str(error)))
             else:
                 job.finish()

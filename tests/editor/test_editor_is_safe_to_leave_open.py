@@ -4,6 +4,7 @@ outside the folder is read (nor quoted) by its checks and tries, and a save that
 
 from __future__ import annotations
 
+import json
 import threading
 from collections.abc import Callable
 from pathlib import Path
@@ -12,7 +13,8 @@ import pytest
 import requests
 
 from engine.cli import main
-from engine.editor.workspace import OUTSIDE, EditRefused, Workspace
+from engine.dialogs.library import OUTSIDE
+from engine.editor.workspace import EditRefused, Workspace
 
 Address = Callable[[str, str], str]
 CONSENT = "kid-17:\n  given_by: guardian\n  given_on: 2026-11-20\n  covers: [sensors]\n"
@@ -112,3 +114,36 @@ def _outline_of(workspace: Workspace, text: str) -> dict[str, object]:
     outline = TreeText(text, workspace.registry).outline()
     assert outline is not None
     return outline
+
+
+def test_a_link_among_the_dialogs_to_a_file_outside_is_never_read_nor_quoted(
+    workspace: Workspace, editor: str, at: Address, site_data: Path, tmp_path: Path
+) -> None:
+    site_data.mkdir(parents=True, exist_ok=True)
+    (site_data / "consent.yaml").write_text(CONSENT)
+    (workspace.folder / "dialogs" / "consent.yaml").symlink_to(site_data / "consent.yaml")
+    secret = tmp_path / "secret.yaml"
+    secret.write_text(
+        'dialog: secret\nrules:\n  - hear: ["hello"]\n    say: "OUTSIDE my brother hits me"\n'
+    )
+    (workspace.folder / "dialogs" / "secret.yaml").symlink_to(secret)
+    text = (
+        "name: talk\nrate_hz: 10\nwake_on: [/speech/heard]\nroot:\n  Sequence:\n"
+        "    - OnEvent: {key: /speech/heard, save_as: /vars/talk}\n"
+        "    - Reply: {heard: /vars/talk, dialog: secret}\n"
+    )
+    problems = workspace.check("trees/talk.yaml", text)
+    told = json.dumps(problems)
+    assert "kid-17" not in told and "OUTSIDE" not in told and "brother" not in told
+    assert any(problem["message"] == OUTSIDE for problem in problems)
+    tried = requests.post(
+        at(editor, "/api/try"),
+        json={
+            "file": "trees/talk.yaml",
+            "outline": _outline_of(workspace, text),
+            "version": None,
+            "event": {"kind": "say", "text": "hello"},
+        },
+        timeout=60,
+    )
+    assert tried.status_code == 400 and "brother" not in tried.text and "kid-17" not in tried.text

@@ -241,3 +241,27 @@ def test_the_audit_trail_names_the_operating_system_s_account_not_a_variable(
     who = json.loads(capsys.readouterr().out.splitlines()[-1])["who"]
     uid = os.geteuid()
     assert who == f"{pwd.getpwuid(uid).pw_name} (uid {uid})" and "mallory" not in who
+
+
+def test_copies_made_from_a_moved_recording_and_the_robot_s_voice_are_erased_too(
+    recorded: list[Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A breaker's find: a recording moved away from where it was recorded still made
+    reports the erasure did not know of, and `--audio-out` kept what the robot said (a
+    sentence may quote the child) in files named with its words."""
+    moved = tmp_path / "usb" / "a-copy.vest"
+    moved.parent.mkdir()
+    recorded[0].rename(moved)
+    assert main(["report", str(moved), "-o", str(tmp_path / "usb" / "copy.html")]) == 0
+    voice = tmp_path / "voice"
+    args = ["run", "--fast", "--speech", "text", "--duration", "2", "--person", "kid-17"]
+    assert main([*args, "--audio-out", str(voice)]) == 0
+    voice.mkdir(exist_ok=True)  # with the speech models, --audio-out writes a file a sentence
+    (voice / "001-robot.wav").write_bytes(b"RIFF")
+    (voice / "notes.txt").write_text("the therapist's own")
+    capsys.readouterr()
+    assert main(["data", "erase", "--person", "kid-17", "--yes"]) == 0
+    assert not (tmp_path / "usb" / "copy.html").exists()
+    assert not (voice / "001-robot.wav").exists() and (voice / "notes.txt").exists()
+    assert main(["replay", str(moved)]) == 1  # the copy the erasure could not find
+    assert "whose data was erased" in capsys.readouterr().err
