@@ -160,12 +160,20 @@ def _consent(site: Site, args: argparse.Namespace) -> int:
 def _add_consent(site: Site, args: argparse.Namespace) -> int:
     if args.person is None or args.given_by is None or args.covers is None:
         raise UsageError("vest data consent PERSON --given-by ROLE --covers LIST: all three")
-    if not ROLE.fullmatch(args.given_by):
-        raise UsageError(f"--given-by {args.given_by!r}: a role (guardian, parent), never a name")
+    if not ROLE.fullmatch(args.given_by) or args.given_by != args.given_by.lower():
+        raise UsageError(
+            f"--given-by {args.given_by!r}: a role in lower case (guardian, parent, self), "
+            "never a name"
+        )
+    given_on = args.on or site.today()
+    if args.until is not None and args.until < given_on:
+        raise UsageError(
+            f"--until {args.until.isoformat()}: before the day consent was given "
+            f"({given_on.isoformat()})"
+        )
     path = site.folder / CONSENT_FILE
     if args.person in site.consents.records:
         raise ConfigError(f"{path}: {args.person} has a record already; change it in that file")
-    given_on = args.on or site.today()
     lines = [
         f"{args.person}:",
         f"  given_by: {args.given_by}",
@@ -179,7 +187,11 @@ def _add_consent(site: Site, args: argparse.Namespace) -> int:
     partial = path.with_name(path.name + ".partial")
     partial.write_text(before + separator + "\n".join(lines) + "\n", encoding="utf-8")
     partial.chmod(0o600)
-    ConsentBook.load_file(partial)  # never saved unless it reads back whole
+    try:
+        ConsentBook.load_file(partial)  # never saved unless it reads back whole
+    except BaseException:
+        partial.unlink(missing_ok=True)
+        raise
     os.replace(partial, path)
     site.audit("consent", args.person, f"given by {args.given_by}: {', '.join(args.covers)}")
     print(f"{path}: added {args.person}")

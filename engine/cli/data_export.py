@@ -111,7 +111,8 @@ def export(site: Site, args: argparse.Namespace) -> int:
     day = site.today().isoformat()
     text = README.format(person=person, day=day, consent=consent.describe())
     write_file(folder / "README.txt", text.encode(), str(folder), "the export", private=True)
-    print(f"exported {len(sessions) - missing} sessions of {person} to {folder}")
+    count = len(sessions) - missing
+    print(f"exported {count} session{'' if count == 1 else 's'} of {person} to {folder}")
     return 0
 
 

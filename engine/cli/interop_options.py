@@ -44,11 +44,12 @@ def add_interop_arguments(parser: argparse.ArgumentParser) -> None:
         "--foxglove",
         type=port_number,
         nargs="?",
-        const=8766,
+        const=8767,
         default=None,
         metavar="PORT",
         help="serve the live session to Foxglove and Lichtblick (their WebSocket protocol) on "
-        "127.0.0.1:PORT (default 8766, beside the view's 8765; 0: any free port); the address "
+        "127.0.0.1:PORT (default 8767, beside the view's 8765 and the editor's 8766; 0: any "
+        "free port); the address "
         "vest prints carries its token",
     )
     parser.add_argument(

@@ -157,8 +157,9 @@ class Workspace:
     ) -> Saved:
         """Write ``text`` to ``name`` if the file is still at ``version`` (None: a new
         file, which must not exist yet); EditRefused (409) when it changed meanwhile, or
-        when ``text`` has problems the file on disk has not and ``over_problems`` is
-        False. Compared and written under the file's lock."""
+        when ``text`` makes problems the folder did not have (in this file, or a new
+        file's in itself) and ``over_problems`` is False. Compared and written under the
+        file's lock."""
         path = self.path_of(name)
         with self._lock_of(path):
             return self._save(path, name, text, version, over_problems)
@@ -174,19 +175,25 @@ class Workspace:
                 raise
             on_disk, current = None, None
         if current != version:
-            said = "exists already" if version is None else "changed on disk since it was opened"
-            raise EditRefused(409, f"{name}: {said}; open it again to see the change")
+            if version is None:
+                why = "there is a file of that name already: open it, or give the new one another"
+                raise EditRefused(409, f"{name}: {why}")
+            why = "changed on disk since it was opened; open it again to see the change"
+            raise EditRefused(409, f"{name}: {why}")
         problems = self.check(name, text)
         if problems and not over_problems:
-            was_valid = on_disk is None or not self.check(name, on_disk)
-            if was_valid:
+            before = (
+                {p["text"] for p in self.check(name, on_disk)} if on_disk is not None else set()
+            )
+            made = [p for p in problems if p["text"] not in before and (on_disk or p["here"])]
+            if made:  # what this change would break, not what was broken before it
                 raise EditRefused(
                     409,
-                    f"{name}: the change has {len(problems)} problem"
-                    f"{'s' if len(problems) != 1 else ''} ({problems[0]['message']}"
-                    f"{', ...' if len(problems) > 1 else ''}), which would keep vest run "
-                    "from starting with this folder (save anyway to keep it unfinished)",
-                    problems,
+                    f"{name}: the change has {len(made)} problem"
+                    f"{'s' if len(made) != 1 else ''} ({made[0]['text']}"
+                    f"{', ...' if len(made) > 1 else ''}), which would keep vest run from "
+                    "starting with this folder (save anyway to keep it unfinished)",
+                    made,
                 )
         data = text.encode("utf-8")
         path.parent.mkdir(parents=True, exist_ok=True)

@@ -39,7 +39,7 @@ from engine.services.telemetry import json_safe
 from engine.session.events import SessionEvent, TreeStarted
 from engine.session.handoff import Handoff
 from engine.web.broadcast import Broadcast
-from engine.web.guard import TokenGuard, is_loopback, new_token
+from engine.web.guard import TokenGuard, is_loopback, new_token, refuse_websocket
 from engine.web.serving import ServerThread, listening_socket
 
 log = logging.getLogger(__name__)
@@ -170,8 +170,13 @@ class FoxgloveLive:
     async def _client(self, websocket: WebSocket) -> None:
         offered = websocket.scope.get("subprotocols") or []
         chosen = next((name for name in SUBPROTOCOLS if name in offered), None)
-        if chosen is None or self._clients >= MAX_CLIENTS:
-            await websocket.close(code=1002 if chosen is None else 1013)
+        if chosen is None:
+            why = f"ask for Foxglove's WebSocket protocol: {' or '.join(SUBPROTOCOLS)}"
+            await refuse_websocket(websocket.scope, websocket.send, 400, why)
+            return
+        if self._clients >= MAX_CLIENTS:
+            why = f"{MAX_CLIENTS} clients are watching this robot already; close one"
+            await refuse_websocket(websocket.scope, websocket.send, 503, why)
             return
         await websocket.accept(subprotocol=chosen)
         self._clients += 1

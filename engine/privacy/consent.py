@@ -61,6 +61,8 @@ class Consent:
     given_by: str = ""
     given_on: datetime.date | None = None
     until: datetime.date | None = None
+    ended_on: datetime.date | None = None
+    """The last day of a record that has ended (what it kept no longer holds)."""
 
     def allows(self, capture: str) -> bool:
         return capture in self.covers
@@ -75,6 +77,11 @@ class Consent:
         kept = ", ".join(CAPTURES[name] for name in CAPTURES if name in self.covers) or "nothing"
         if self.given_by == SIMULATION:
             return "no person named, on the simulated vest: nobody's data, everything is kept"
+        if self.ended_on is not None:
+            return (
+                f"{self.person}: their consent ended on {self.ended_on.isoformat()} (renew it "
+                f"with vest data consent): keeps {kept} (and the robot's actions)"
+            )
         if self.given_on is None:
             who = f"{self.person}: no consent record" if self.person else "no person named"
             return f"{who}: keeps {kept} (and the robot's actions)"
@@ -110,8 +117,10 @@ class ConsentBook:
         """What ``person`` consented to on ``today``: their record while it holds, else
         :data:`WITHOUT_CONSENT`."""
         record = self.records.get(person)
-        if record is None or (record.until is not None and today > record.until):
+        if record is None:
             return without_record(person)
+        if record.until is not None and today > record.until:
+            return Consent(person, WITHOUT_CONSENT, ended_on=record.until)
         return record
 
     def forget(self, folder: Path, person: str) -> None:

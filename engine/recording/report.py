@@ -134,6 +134,28 @@ def _started(epoch: str | None) -> str:
     return stamp.strftime("%d %B %Y, %H:%M UTC")
 
 
+LEFT_OUT_MEANS = {
+    "sensor readings": "touches, squeezes, distances, gestures, temperatures and what the "
+    "camera counted are not in this report, nor the sensors' charts",
+    "speech as text": "what the person said is not in this report: only that they spoke",
+}
+"""What a therapist must know is missing from a report, by what consent left out."""
+
+
+def _left_out(meta: dict[str, str]) -> str:
+    """A paragraph saying what the person's consent kept out of the recording ('' when
+    nothing that a report shows was left out)."""
+    left = [part.strip() for part in meta.get("left_out", "").split(",") if part.strip()]
+    missing = [LEFT_OUT_MEANS[part] for part in left if part in LEFT_OUT_MEANS]
+    if not missing:
+        return ""
+    said = "; ".join(missing)
+    return (
+        f'<p class="warning">Consent: not kept of this person: {html.escape(", ".join(left))}. '
+        f"So {html.escape(said)}. What is missing did still happen.</p>"
+    )
+
+
 REPORT_HEAD = '<!doctype html>\n<html lang="en"><head><meta charset="utf-8">'
 """How every report vest writes begins (a file that does may be written over)."""
 STYLE = (Path(__file__).resolve().parent / "report.css").read_text
@@ -228,6 +250,7 @@ def report_html(recording: Recording) -> str:
             f'<p class="meta">{when} &middot; {person} &middot; {end:.1f} s &middot; '
             f"{html.escape(profile)} &middot; robot {robot} &middot; {recorded}</p>",
             f"<p>{html.escape(summary)}</p>",
+            _left_out(meta),
             f'<p class="warning">{html.escape(cut)}: this report is of what it holds.</p>'
             if cut
             else "",

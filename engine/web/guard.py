@@ -39,6 +39,10 @@ PAGE_HEADERS = {
 _WEB_SCHEME = {"ws": "http", "wss": "https"}
 """A WebSocket's page came from the web scheme of its own (its Origin says http)."""
 NEEDS_TOKEN = "a token is needed: open the address vest printed (it ends in ?token=...)"
+WRONG_TOKEN = (
+    "this token is not this server's (an address from an earlier run?): open the address "
+    "vest printed this time"
+)
 FOREIGN = "refused: a page of another site ({origin}) may not ask this server"
 
 
@@ -111,8 +115,8 @@ class TokenGuard:
         headers = Headers(scope=scope)
         refusal = self._refusal(scope, headers)
         if refusal is not None:
-            if scope["type"] == "websocket":  # closed before it opens: the client sees 403
-                await send({"type": "websocket.close", "code": 1008, "reason": refusal})
+            if scope["type"] == "websocket":  # refused before it opens, in words where it can
+                await refuse_websocket(scope, send, 403, refusal)
             else:
                 await PlainTextResponse(refusal + "\n", status_code=403)(scope, receive, send)
             return
@@ -136,10 +140,9 @@ class TokenGuard:
             return FOREIGN.format(origin=origin)
         if origin is None and headers.get("sec-fetch-site") == "cross-site":
             return FOREIGN.format(origin="another site")
-        if not any(
-            hmac.compare_digest(given, self.token) for given in _tokens(scope, headers, self.cookie)
-        ):
-            return NEEDS_TOKEN
+        given = _tokens(scope, headers, self.cookie)
+        if not any(hmac.compare_digest(token, self.token) for token in given):
+            return WRONG_TOKEN if given else NEEDS_TOKEN
         return None
 
     def _cookie_and_on(self, scope: Scope, query: QueryParams) -> RedirectResponse:
@@ -152,6 +155,19 @@ class TokenGuard:
             self.cookie, self.token.decode(), httponly=True, samesite="strict", path="/"
         )
         return answer
+
+
+async def refuse_websocket(scope: Scope, send: Send, status: int, why: str) -> None:
+    """Refuses a WebSocket before it opens: with ``why`` as an HTTP answer where the server
+    can send one (ASGI's denial response), else closed (the client sees 403)."""
+    if "websocket.http.response" in scope.get("extensions", {}):
+        start = {"type": "websocket.http.response.start", "status": status}
+        start["headers"] = [(b"content-type", b"text/plain; charset=utf-8")]
+        await send(start)
+        body = (why + "\n").encode()
+        await send({"type": "websocket.http.response.body", "body": body, "more_body": False})
+        return
+    await send({"type": "websocket.close", "code": 1008, "reason": why[:120]})
 
 
 def _tokens(scope: Scope, headers: Headers, cookie: str) -> list[bytes]:

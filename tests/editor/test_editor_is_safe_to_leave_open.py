@@ -147,3 +147,16 @@ def test_a_link_among_the_dialogs_to_a_file_outside_is_never_read_nor_quoted(
         timeout=60,
     )
     assert tried.status_code == 400 and "brother" not in tried.text and "kid-17" not in tried.text
+
+
+def test_a_save_is_not_blamed_for_problems_another_file_had_before(
+    workspace: Workspace,
+) -> None:
+    """A new user's find: with a broken dialog in the folder, a good tree's save was
+    refused for the dialog's problems."""
+    (workspace.folder / "dialogs" / "broken.yaml").write_text("dialog: broken\nrules: 3\n")
+    text, _ = workspace.read("trees/dialog.yaml")
+    new = text.replace("name: dialog", "name: answers")
+    assert any(not problem["here"] for problem in workspace.check("trees/answers.yaml", new))
+    workspace.save("trees/answers.yaml", new, None)  # a new tree, fine in itself
+    assert (workspace.folder / "trees" / "answers.yaml").read_text() == new

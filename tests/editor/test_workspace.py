@@ -60,7 +60,7 @@ def test_a_file_changed_on_disk_meanwhile_is_never_overwritten(workspace: Worksp
 
 
 def test_a_new_file_is_not_written_over_one_that_exists(workspace: Workspace) -> None:
-    with pytest.raises(EditRefused, match="exists already"):
+    with pytest.raises(EditRefused, match="there is a file of that name already: open it"):
         workspace.save("trees/hug.yaml", "name: hug\n", None)
 
 

@@ -163,3 +163,19 @@ def test_an_origin_option_that_is_no_origin_is_named() -> None:
         text=True,
     )
     assert said.returncode == 2 and "an origin is scheme://host[:port]" in said.stderr
+
+
+def test_a_refusal_says_why(live: FoxgloveLive) -> None:
+    """A lab can tell a missing token from an old one, another site's page and a client
+    that does not speak the protocol."""
+    base = live.url.split("?")[0]
+    evil = {"Origin": "https://evil.example"}
+    for url, headers, protocols, said in [
+        (base, {}, [PROTOCOL], "a token is needed"),
+        (base + "?token=" + "x" * 32, {}, [PROTOCOL], "not this server's"),
+        (live.url, evil, [PROTOCOL], "https://evil.example"),
+        (live.url, {}, ["chat"], "foxglove.websocket.v1"),
+    ]:
+        with pytest.raises(InvalidStatus) as refused:
+            connect(url, subprotocols=protocols, additional_headers=headers, open_timeout=10)
+        assert said in refused.value.response.body.decode(), said

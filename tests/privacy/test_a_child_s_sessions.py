@@ -173,4 +173,6 @@ def test_consent_that_has_ended_keeps_only_sensor_readings(
         "  covers: [sensors, speech_text, cloud_telemetry]\n"
     )
     assert main(["data", "consent", "kid-17"]) == 0
-    assert "kid-17: no consent record: keeps sensor readings" in capsys.readouterr().out
+    said = capsys.readouterr().out
+    assert "kid-17: their consent ended on 2020-12-31 (renew it with vest data consent)" in said
+    assert "keeps sensor readings (and the robot's actions)" in said

@@ -265,3 +265,29 @@ def test_copies_made_from_a_moved_recording_and_the_robot_s_voice_are_erased_too
     assert not (voice / "001-robot.wav").exists() and (voice / "notes.txt").exists()
     assert main(["replay", str(moved)]) == 1  # the copy the erasure could not find
     assert "whose data was erased" in capsys.readouterr().err
+
+
+def test_a_report_says_what_the_person_s_consent_kept_out_of_it(
+    recorded: list[Path], tmp_path: Path
+) -> None:
+    """A new user's find: a report of a session without consent to readings showed no
+    squeeze and empty charts, and said nothing of why."""
+    assert main(["report", str(recorded[2]), "-o", str(tmp_path / "c.html")]) == 0  # kid-4
+    page = (tmp_path / "c.html").read_text()
+    assert "not kept of this person" in page and "what the person said is not in" in page
+    assert "touches, squeezes" not in page  # readings were kept
+    assert main(["report", str(recorded[0]), "-o", str(tmp_path / "a2.html")]) == 0  # kid-17
+    assert "what the person said is not in" not in (tmp_path / "a2.html").read_text()
+
+
+def test_a_consent_given_wrong_is_refused_and_leaves_nothing_behind(
+    site_data: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    given = ["data", "consent", "kid-3", "--covers", "sensors"]
+    assert main([*given, "--given-by", "Maria"]) == 2
+    assert "a role in lower case" in capsys.readouterr().err
+    assert (
+        main([*given, "--given-by", "guardian", "--on", "2026-11-20", "--until", "2026-01-01"]) == 2
+    )
+    assert "before the day consent was given (2026-11-20)" in capsys.readouterr().err
+    assert not list(site_data.glob("*.partial")) and not (site_data / "consent.yaml").exists()
