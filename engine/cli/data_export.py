@@ -145,7 +145,7 @@ def erase(site: Site, args: argparse.Namespace) -> int:
         return 1
     files = f"{len(erased.removed)} file{'' if len(erased.removed) == 1 else 's'}"
     consent = " and consent record" if has_consent else ""
-    kept = "the audit keeps one line"
+    kept = "the audit trail keeps its lines about them, and one for this erasure"
     print(f"erased {person}: {files} removed, their index entries{consent} forgotten ({kept})")
     return 0
 
