@@ -44,6 +44,7 @@ HAND_FINGERS = "/vision/hand/fingers"
 HAND_CONFIDENCE = "/vision/hand/confidence"
 HAND_SHOWN = "/vision/hand/shown"
 HAND_HELD = "/vision/hand/held"
+HAND_BOX = "/vision/hand/box"
 VISION_PREFIX = "/vision/"
 SPEECH_PREFIX = "/speech/"
 
@@ -330,24 +331,32 @@ def default_catalogue() -> KeyCatalogue:
                 HAND_FINGERS,
                 int,
                 "",
-                "vision worker (camera + finger-count CNN)",
-                "fingers the hand in the camera's window shows, 0..5; absent when no hand "
-                "is seen or the network is not sure",
+                "vision worker (camera + hand finder)",
+                "fingers the hand held up in the camera's view shows, 0..5; absent when no "
+                "hand is held up or its count is not sure",
                 alias="hand_fingers",
             ),
             KeySpec(
                 HAND_CONFIDENCE,
                 float,
                 "",
-                "vision worker (camera + finger-count CNN)",
-                "how sure the network is of the newest frame's count, 0..1",
+                "vision worker (camera + hand finder)",
+                "how sure the finder is of the newest frame's hand, 0..1",
                 alias="hand_confidence",
+            ),
+            KeySpec(
+                HAND_BOX,
+                list,
+                "px",
+                "vision worker (camera + hand finder)",
+                "where the hand held up is in the camera's frame: [x, y, width, height] px; "
+                "absent when no hand is held up",
             ),
             KeySpec(
                 HAND_SHOWN,
                 int,
                 "",
-                "vision worker (camera + finger-count CNN)",
+                "vision worker (camera + hand finder)",
                 "a hand showing this many fingers, 0..5: once when the count changes and "
                 "holds for the camera's steady_frames",
                 kind="event",
@@ -356,7 +365,7 @@ def default_catalogue() -> KeyCatalogue:
                 HAND_HELD,
                 int,
                 "",
-                "vision worker (camera + finger-count CNN)",
+                "vision worker (camera + hand finder)",
                 "the count a hand holds up steadily now, 0..5 (the last /vision/hand/shown); "
                 "absent once no hand (or no sure count) has held as long",
                 alias="hand_held",

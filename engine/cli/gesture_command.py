@@ -1,9 +1,11 @@
 """Count the fingers in pictures, and make a lab's own finger-count model.
 
   vest gesture IMAGE... [--model FILE] [--json] [--crop X,Y,W]
-      how many fingers each picture shows (the paper's crop: the centred 128 x 128 px
-      window, or the window W px wide at X,Y, scaled to 128; a smaller picture is scaled
-      up to fill the window, and said so)
+      whether each picture shows a hand held up, where, and how many fingers: the hand is
+      found anywhere in a camera frame (MediaPipe's palm detector and hand landmarks) and
+      counted from its landmarks; a picture smaller than 128 x 128 px is a close-up,
+      counted by the paper's network (--model); --crop X,Y,W gives the paper's network the
+      window W px wide at X,Y instead
   vest gesture record DATA --label N [--frames K] [--camera DEV]   K frames from the camera
   vest gesture record DATA [--camera DEV]      a frame each time you type its label + Enter
   vest gesture record DATA --label N --from FOLDER       pictures you already have
@@ -126,7 +128,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         type=_crop,
         default=None,
         metavar="X,Y,W",
-        help="the window (default: centred 128)",
+        help="the paper's window for its network, instead of finding the hand",
     )
 
     record = actions.add_parser("record", help="add labelled pictures to a data folder")
@@ -210,18 +212,23 @@ def _classify(args: argparse.Namespace) -> int:
     from engine.cli.output import shown, tell
     from engine.media.images import read_image
     from engine.vision.classifier import DEFAULT_MODEL, HandModel
+    from engine.vision.hand_finder import HandFinder
     from engine.vision.preprocess import fills_window, scaled_window
 
     model = HandModel.load(args.model or DEFAULT_MODEL)
+    finder = HandFinder.load(close_ups=model)
     side = model.settings.side_px
     failed = 0
     for path in args.images:
         try:
             image = read_image(path)
-            if args.crop is not None:
+            if args.crop is not None:  # the paper's window, as its network reads it
                 image = scaled_window(image, *args.crop, side_px=side)
-            scaled = not fills_window(image, model.settings)
-            reading = model.read(image)
+                reading = model.read(image)
+            else:
+                finder.forget()  # each picture on its own
+                reading = finder.read(image)
+            close_up = not fills_window(image, model.settings)
         except ValueError as error:
             text = str(error)
             tell(text if str(path) in text else f"{path}: {text}")
@@ -229,20 +236,22 @@ def _classify(args: argparse.Namespace) -> int:
             continue
         size = f"{image.shape[1]}x{image.shape[0]}"
         if args.json:
-            print(json.dumps({"file": str(path), **reading.to_json(), "scaled_up": scaled}))
+            print(json.dumps({"file": str(path), **reading.to_json(), "close_up": close_up}))
+            continue
+        if not reading.present:
+            said = "no hand held up"
+        elif reading.fingers is None:
+            said = "a hand, its count not sure"
         else:
-            said = (
-                "not sure"
-                if reading.fingers is None
-                else f"{reading.fingers} finger" + ("" if reading.fingers == 1 else "s")
-            )
-            note = f" (a {size} px picture, scaled up to the {side} px window)" if scaled else ""
-            if reading.fingers is None and not scaled and args.crop is None:
-                note = (
-                    f" (the centred {side} px window of a {size} px picture; "
-                    "--crop X,Y,W looks where the hand is)"
-                )
-            print(f"{shown(str(path))}: {said} ({reading.confidence:.0%}){note}")
+            said = f"{reading.fingers} finger" + ("" if reading.fingers == 1 else "s")
+        note = ""
+        if close_up:
+            note = f" (a {size} px close-up, counted by the paper's network)"
+        elif reading.box is not None and args.crop is None:
+            x, y, width, height = reading.box
+            note = f" (the hand at {x},{y}, {width}x{height} px, in a {size} px picture)"
+        sure = f" ({reading.confidence:.0%})" if reading.present else ""
+        print(f"{shown(str(path))}: {said}{sure}{note}")
     return 1 if failed else 0
 
 

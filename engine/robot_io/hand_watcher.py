@@ -1,7 +1,8 @@
-"""The vision worker: camera frames through the finger-count network onto the blackboard.
+"""The vision worker: camera frames through the hand finder onto the blackboard.
 
-Every frame it stages ``/vision/hand/fingers`` (0..5, or None when no hand is seen or the
-network is not sure) and ``/vision/hand/confidence``; when a count changes and holds for
+Every frame it stages ``/vision/hand/fingers`` (0..5, or None when no hand is held up or
+its count is not sure), ``/vision/hand/confidence`` and ``/vision/hand/box`` (where the
+hand is, px, or None); when a count changes and holds for
 ``steady_frames`` frames it stages one ``/vision/hand/shown`` event, and
 ``/vision/hand/held`` keeps that count until another (or no hand) holds as long. Trees only read
 the blackboard: the camera, the preprocessing and the network never run in a tick.
@@ -16,7 +17,7 @@ The camera is a device like the chips: ``/devices/<camera>/ok`` is False while i
 no frames, and it is re-opened every ``reopen_s`` until it answers again.
 
 Attention, not a timer (the paper's "attention activation"): while no hand is seen and
-nothing is shown, a frame that looks like the last one the network read (each cell of a
+nothing is shown, a frame that looks like the last one the finder read (each cell of a
 16 x 9 grid of its grey levels within ``STILL_LEVELS``) is not read again: the reading
 stays "no hand". Something coming into view changes the cells and is read at once; the
 network still reads a frame at least once a second (``LOOK_AT_LEAST_EVERY_S``), so a
@@ -32,7 +33,13 @@ import cv2
 import numpy as np
 
 from engine.blackboard.board import Blackboard
-from engine.blackboard.catalogue import HAND_CONFIDENCE, HAND_FINGERS, HAND_HELD, HAND_SHOWN
+from engine.blackboard.catalogue import (
+    HAND_BOX,
+    HAND_CONFIDENCE,
+    HAND_FINGERS,
+    HAND_HELD,
+    HAND_SHOWN,
+)
 from engine.clock import Clock, ClockEvent
 from engine.hardware.device_health import DeviceHealth
 from engine.media.camera import Camera, CameraError
@@ -79,8 +86,8 @@ class SteadyCount:
 
 
 class HandWatcher:
-    """Reads ``camera`` at ``fps`` frames a second, counts fingers with ``model`` (a
-    :class:`~engine.vision.classifier.HandModel`) and
+    """Reads ``camera`` at ``fps`` frames a second, finds and counts a hand with ``model``
+    (a :class:`~engine.vision.hand_finder.HandFinder`) and
     stages the results on ``blackboard``; ``health`` is the camera's device health."""
 
     def __init__(
@@ -122,7 +129,7 @@ class HandWatcher:
         last = self._last
         if (
             last is None
-            or last.fingers is not None
+            or last.present
             or self.steady.shown is not None
             or self._seen is None
             or now_s - self._seen_s >= LOOK_AT_LEAST_EVERY_S
@@ -135,6 +142,7 @@ class HandWatcher:
         self.frames += 1
         self.blackboard.stage(HAND_FINGERS, reading.fingers)
         self.blackboard.stage(HAND_CONFIDENCE, round(reading.confidence, 4))
+        self.blackboard.stage(HAND_BOX, list(reading.box) if reading.box is not None else None)
         held = self.steady.shown
         shown = self.steady.add(reading.fingers)
         if shown is not None:
@@ -175,6 +183,7 @@ class HandWatcher:
             log.info("%s; trying again every %g s", why, self.reopen_s)  # the timeline says so
             self.blackboard.stage(HAND_FINGERS, None)
             self.blackboard.stage(HAND_CONFIDENCE, None)
+            self.blackboard.stage(HAND_BOX, None)
             if self.steady.shown is not None:
                 self.blackboard.stage(HAND_HELD, None)
             self.steady.reset()

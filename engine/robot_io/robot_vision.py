@@ -1,10 +1,11 @@
 """The robot's sight, built from its config's ``camera:`` section.
 
 The camera (a webcam through OpenCV, or the simulated vest's camera looking at the
-simulated world), the hand model named there (the project's by default) and the vision
-worker that joins them. A model that is missing or broken is said once, clearly, at
-start-up, and the robot runs without counting fingers (``/devices/camera/ok`` stays
-False); the rest of the robot is not held up by its eyes.
+simulated world), the hand finder (MediaPipe's palm detector and hand landmarks, with the
+paper's network, named there, for close-ups) and the vision worker that joins them. A
+model that is missing or broken is said once, clearly, at start-up, and the robot runs
+without counting fingers (``/devices/camera/ok`` stays False); the rest of the robot is
+not held up by its eyes.
 """
 
 from __future__ import annotations
@@ -21,6 +22,7 @@ from engine.robot_io.hand_watcher import HandWatcher
 from engine.scenario.world import World
 from engine.sim.camera import SimulatedCamera
 from engine.vision.classifier import DEFAULT_MODEL, HandModel
+from engine.vision.hand_finder import HandFinder
 
 
 @dataclass
@@ -89,16 +91,19 @@ def build_vision(
     """The robot's sight; never raises for a bad model (see the module's doc)."""
     health = DeviceHealth(CAMERA_NAME, blackboard)
     try:
-        model = load_hand_model(config)
+        model = HandFinder.load(threads=config.threads, close_ups=load_hand_model(config))
     except ConfigError as error:
         problem = f"{error}; the robot runs without counting fingers"
         health.driver_status(False, problem)  # the caller says it (vest run: at start-up)
         camera = open_camera(config, world, clock, window=config.crop)
         return RobotVision(camera, health, None, problem)
-    try:  # the simulated camera holds a hand where the model looks
-        window: tuple[int, int] | None = model.settings.window(config.height, config.width)
+    try:  # the simulated camera holds a close-up where the paper's network looks
+        assert model.close_ups is not None
+        window: tuple[int, int] | None = model.close_ups.settings.window(
+            config.height, config.width
+        )
     except ValueError:
-        window = None  # the worker says so when the frames come
+        window = None
     camera = open_camera(config, world, clock, window=window)
     watcher = HandWatcher(
         camera,

@@ -94,7 +94,10 @@ def changes_of(event: ScenarioEvent) -> list[tuple[float, Change]]:
         return [(at, _happen("hear", value))]
     if event.kind == "show_hand":
         seed = round(at * 1000) * 8 + (value["fingers"] if value["fingers"] is not None else 7)
-        hand = ShownHand(value["fingers"], value["image"], value["video"], seed)
+        held_at = (value["at"][0], value["at"][1]) if value["at"] is not None else None
+        hand = ShownHand(
+            value["fingers"], value["image"], value["video"], seed, held_at, value["width_px"]
+        )
         gone = at + value["seconds"]
         return [(at, _set("hand", hand, "hand")), (gone, _take_away(hand))]
     if event.kind == "press":

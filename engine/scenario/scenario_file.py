@@ -36,6 +36,7 @@ from engine.values.params import (
     AnyValue,
     Choice,
     Integer,
+    ListOf,
     Number,
     Param,
     ParamType,
@@ -124,10 +125,28 @@ EVENT_FIELDS: dict[str, tuple[Param[Any], ...] | ParamType[Any]] = {
         Param("seconds", _SECONDS, 1.0, "how long"),
     ),
     "show_hand": (
-        Param("fingers", Integer(0, 5), None, "a drawn hand showing 0..5 fingers"),
+        Param(
+            "fingers",
+            Integer(0, 5),
+            None,
+            "a person holding up 1..5 fingers at arm's length (a real webcam frame); 0: a "
+            "drawn closed hand",
+        ),
         Param("image", Text(), None, "a picture (relative to the scenario file)"),
         Param("video", Text(), None, "a video, played from this moment"),
         Param("seconds", _SECONDS, 2.0, "how long it is held in front of the camera"),
+        Param(
+            "at",
+            ListOf(Integer(0, 10_000), 2, 2),
+            None,
+            "the picture's top-left corner in the camera's frame, [x, y] px (with width_px)",
+        ),
+        Param(
+            "width_px",
+            Integer(8, 10_000),
+            None,
+            "the picture held at a distance: scaled to this width in the frame (px)",
+        ),
     ),
     "press": Text(),
     "cloud": (
@@ -351,7 +370,17 @@ def _check_showing(value: dict[str, Any], body: YValue, folder: Path, problems: 
         )
         return False
     if given[0] == "fingers":
+        if value["at"] is not None or value["width_px"] is not None:
+            problems.add(body.mark, "at and width_px place a picture", "give image: as well")
+            return False
         return True
+    if (value["at"] is None) != (value["width_px"] is None):
+        problems.add(
+            body.mark,
+            "at and width_px go together: where the picture is held, and how big it looks",
+            "e.g. {image: hand.jpg, at: [300, 120], width_px: 110}",
+        )
+        return False
     from engine.media.media_check import check_media  # OpenCV: only for scenarios that need it
 
     path = folder / value[given[0]]

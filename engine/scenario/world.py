@@ -29,13 +29,16 @@ SIDES = ("left", "center", "right")
 
 @dataclass(frozen=True)
 class ShownHand:
-    """What is held in front of the simulated camera: a drawn hand showing ``fingers``
-    (None: an empty view), or a picture, or a video (absolute paths)."""
+    """What is held in front of the simulated camera: a person holding up ``fingers``
+    (None: an empty view), or a picture, or a video (absolute paths); a picture may be held
+    ``at`` a place in the frame ([x, y] px, its top-left) scaled to ``width_px``."""
 
     fingers: int | None = None
     image: str | None = None
     video: str | None = None
     seed: int = 0
+    at: tuple[int, int] | None = None
+    width_px: int | None = None
 
 
 @dataclass

@@ -1,10 +1,12 @@
 """The simulated vest's webcam: frames of the simulated world, at the camera's size.
 
-What the scenario holds in front of it (``show_hand``) becomes frames the same
-preprocessing and network read: a drawn hand (the project's generator, in the crop
-window of a room-like frame), a picture file, or a video file played from when it was
-shown, on the robot's clock. With nothing shown, the camera sees the empty room. A drawn
-hand is a still pose held for the event's seconds, so one frame is drawn per event.
+What the scenario holds in front of it (``show_hand``) becomes frames the same hand
+finder reads: a person holding up 1..5 fingers at arm's length (a real webcam frame of
+``examples/hands-arms-length``, picked by the event), a picture file, or a video file
+played from when it was shown, on the robot's clock. A picture is seen whole (scaled down
+to the frame when it is bigger), or held up at a distance (``at`` and ``width_px``: where
+in the frame, and how big); a picture smaller than the paper's window is a close-up,
+filling the window. With nothing shown, the camera sees the empty room.
 """
 
 from __future__ import annotations
@@ -22,6 +24,16 @@ from engine.scenario.world import ShownHand, World
 from engine.vision.preprocess import SIDE_PX, Preprocessing, filling, fills_window
 from engine.vision_training.shown_hand import render_shown_hand
 from engine.vision_training.synthetic_hands import render_frame
+
+ARMS_LENGTH = Path(__file__).resolve().parents[2] / "examples" / "hands-arms-length"
+"""Real webcam frames of a person holding up 1..5 fingers at arm's length (CC BY-SA 4.0)."""
+
+
+def arms_length_frame(fingers: int, seed: int) -> Path | None:
+    """One of the frames of a person holding up ``fingers`` (1..5), by ``seed``; None when
+    there are none (0 fingers, or the examples are not installed)."""
+    frames = sorted((ARMS_LENGTH / str(fingers)).glob("*.jpg")) if fingers else []
+    return frames[seed % len(frames)] if frames else None
 
 
 class SimulatedCamera:
@@ -103,31 +115,45 @@ class SimulatedCamera:
             self._video_index = -1
             self._video_frame_last: Frame = self._room
         elif hand.image is not None:
-            self._still = self._fit(read_image(Path(hand.image)))
+            self._still = self._fit(read_image(Path(hand.image)), hand.at, hand.width_px)
         elif hand.fingers is not None:  # (no fingers, no picture: the empty room)
-            rng = np.random.default_rng(hand.seed)
+            frame = arms_length_frame(hand.fingers, hand.seed)
+            if frame is not None:
+                self._still = self._fit(read_image(frame))
+                return
+            rng = np.random.default_rng(hand.seed)  # a closed hand, drawn
             self._still = render_shown_hand(
                 hand.fingers, rng, width_px=self.width, height_px=self.height, window=self.window
             )
 
-    def _fit(self, image: Frame) -> Frame:
-        """A picture placed in the camera's frame as it is (no scaling): centred on the
-        room, or its centre cut out when it is larger. A picture smaller than the crop
-        window (a 100 x 100 px photograph of a hand) is held up close: its centred square
-        scaled to fill the window, where the window is (as `vest gesture` reads it)."""
+    def _fit(
+        self, image: Frame, at: tuple[int, int] | None = None, width_px: int | None = None
+    ) -> Frame:
+        """A picture in the camera's frame: held ``at`` a place scaled to ``width_px``;
+        else seen whole, centred on the room (scaled down to fit when it is bigger than
+        the frame). A picture smaller than the crop window (a 100 x 100 px photograph of a
+        hand) is held up close: its centred square scaled to fill the window, where the
+        window is (as `vest gesture` reads it)."""
+        frame = self._room.copy()
+        if at is not None and width_px is not None:
+            height_px = max(1, round(image.shape[0] * width_px / image.shape[1]))
+            scaled = cv2.resize(image, (width_px, height_px), interpolation=cv2.INTER_AREA)
+            x, y = at
+            cut = scaled[: max(0, self.height - y), : max(0, self.width - x)]
+            frame[y : y + cut.shape[0], x : x + cut.shape[1]] = cut
+            return frame
         if not fills_window(image, Preprocessing()):
-            frame = self._room.copy()
             x, y = self.window or ((self.width - SIDE_PX) // 2, (self.height - SIDE_PX) // 2)
             frame[y : y + SIDE_PX, x : x + SIDE_PX] = filling(image, Preprocessing())
             return frame
-        frame = self._room.copy()
         height, width = image.shape[:2]
-        top, left = (height - self.height) // 2, (width - self.width) // 2
-        cut = image[
-            max(0, top) : max(0, top) + self.height, max(0, left) : max(0, left) + self.width
-        ]
-        y, x = max(0, -top), max(0, -left)
-        frame[y : y + cut.shape[0], x : x + cut.shape[1]] = cut
+        shrink = min(1.0, self.width / width, self.height / height)
+        if shrink < 1.0:
+            size = (max(1, round(width * shrink)), max(1, round(height * shrink)))
+            image = np.asarray(cv2.resize(image, size, interpolation=cv2.INTER_AREA), np.uint8)
+            height, width = image.shape[:2]
+        y, x = (self.height - height) // 2, (self.width - width) // 2
+        frame[y : y + height, x : x + width] = image
         return frame
 
     def _video_frame(self) -> Frame:

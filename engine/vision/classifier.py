@@ -2,10 +2,8 @@
 
 A model is ``NAME.onnx`` with ``NAME.json`` beside it: the labels, the preprocessing it was
 trained with (:class:`~engine.vision.preprocess.Preprocessing`) and how it was trained.
-The session's execution providers are chosen from what this onnxruntime build offers
-(TensorRT, then CUDA, then the CPU; GPU builds are the separate ``onnxruntime-gpu``
-package), and the ones in use are logged: asked for a provider it lacks, onnxruntime only
-warns and falls back, so we filter first and say what runs.
+It is opened as every vision model is (:mod:`engine.vision.onnx_session`), and the
+providers in use are logged.
 """
 
 from __future__ import annotations
@@ -22,14 +20,10 @@ import onnxruntime as ort
 
 from engine.errors import ConfigError
 from engine.media.images import Frame
+from engine.vision.onnx_session import onnx_session
 from engine.vision.preprocess import Preprocessing, load_settings, network_input
 
 log = logging.getLogger(__name__)
-PREFERRED_PROVIDERS = (
-    "TensorrtExecutionProvider",
-    "CUDAExecutionProvider",
-    "CPUExecutionProvider",
-)
 DEFAULT_MODEL = Path(__file__).resolve().parent / "models" / "hand_fingers.onnx"
 """The model the project ships (docs/vision-model-card.md says how it was made)."""
 MODEL_FORMAT = "vest-gesture-model/1"
@@ -37,36 +31,32 @@ MODEL_FORMAT = "vest-gesture-model/1"
 
 @dataclass(frozen=True)
 class HandReading:
-    """What the network saw in one frame: ``fingers`` 0..5, or None when it is not sure
-    (its best class below the model's ``min_confidence``); ``confidence`` 0..1; the
-    probability of every label."""
+    """What one frame showed: ``fingers`` 0..5, or None when no hand was held up
+    (``present`` False) or its count is not sure; ``confidence`` 0..1; the probability of
+    every label (the paper's network; empty when the landmarks counted); ``box`` where the
+    hand was (x, y, width, height px; None: no hand)."""
 
     fingers: int | None
     confidence: float
     probabilities: tuple[float, ...]
+    present: bool = True
+    box: tuple[int, int, int, int] | None = None
 
     def to_json(self) -> dict[str, Any]:
-        return {"fingers": self.fingers, "confidence": round(self.confidence, 4)}
+        names = ("x", "y", "width", "height")
+        box = None if self.box is None else dict(zip(names, self.box, strict=True))
+        return {
+            "hand": self.present,
+            "fingers": self.fingers,
+            "confidence": round(self.confidence, 4),
+            "box": box,
+        }
 
 
 class FingerCounter(Protocol):
     """What the vision worker needs of a model: a reading for one frame."""
 
     def read(self, frame: Frame) -> HandReading: ...
-
-
-def choose_providers(wanted: Sequence[str] | None = None) -> list[str]:
-    """The execution providers to use: ``wanted`` (or the preferred order) filtered by what
-    this onnxruntime offers; ConfigError when none of the wanted ones is there."""
-    available = ort.get_available_providers()
-    order = list(wanted) if wanted else list(PREFERRED_PROVIDERS)
-    chosen = [name for name in order if name in available]
-    if not chosen:
-        raise ConfigError(
-            f"none of the providers {', '.join(order)} is in this onnxruntime "
-            f"(it has {', '.join(available)})"
-        )
-    return chosen
 
 
 class HandModel:
@@ -121,16 +111,7 @@ class HandModel:
         ):
             raise ConfigError(f"{sidecar}: 'labels' must be a list of finger counts (0 to 10)")
         settings = Preprocessing.from_json(data.get("preprocessing", {}), str(sidecar))
-        options = ort.SessionOptions()
-        options.intra_op_num_threads = max(1, threads)
-        options.inter_op_num_threads = 1
-        options.log_severity_level = 3  # errors only: we say which providers run
-        chosen = choose_providers(providers)
-        try:
-            session = ort.InferenceSession(str(path), sess_options=options, providers=chosen)
-        except Exception as error:  # onnxruntime raises its own error types for a bad file
-            first = str(error).strip().splitlines()[0] if str(error).strip() else type(error)
-            raise ConfigError(f"{path}: not a model ONNX Runtime can load ({first})") from None
+        session = onnx_session(path, threads=threads, providers=providers)
         model = cls(session, settings, labels, min_confidence=min_confidence, path=path)
         model._check_shape()
         log.info("hand model %s runs on %s", path.name, ", ".join(session.get_providers()))

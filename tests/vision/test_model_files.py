@@ -12,7 +12,8 @@ import onnxruntime as ort
 import pytest
 
 from engine.errors import ConfigError
-from engine.vision.classifier import DEFAULT_MODEL, HandModel, choose_providers
+from engine.vision.classifier import DEFAULT_MODEL, HandModel
+from engine.vision.onnx_session import choose_providers
 
 
 def copy_of_the_shipped_model(folder: Path) -> Path:
