@@ -14,6 +14,7 @@ from engine.cli import main
 from engine.vision_training.synthetic_hands import render_frame
 
 REAL_HANDS = Path(__file__).resolve().parents[2] / "examples" / "hands-real"
+ARMS_LENGTH = Path(__file__).resolve().parents[2] / "examples" / "hands-arms-length"
 
 
 def exit_code(args: list[str]) -> int | str | None:
@@ -30,23 +31,42 @@ def picture(folder: Path, name: str, fingers: int | None, seed: int) -> Path:
     return path
 
 
-def test_pictures_are_counted_one_json_line_each(tmp_path: Path, capsys) -> None:
-    three = picture(tmp_path, "three.png", 3, seed=11)
-    five = picture(tmp_path, "five.png", 5, seed=12)
+def test_pictures_are_counted_one_json_line_each(capsys) -> None:
+    """Webcam frames of a person holding up fingers at arm's length: where the hand is, and
+    its count."""
+    three, five = ARMS_LENGTH / "3" / "three_1.jpg", ARMS_LENGTH / "5" / "five_1.jpg"
     assert main(["gesture", str(three), str(five), "--json"]) == 0
     lines = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
-    assert [(line["file"], line["fingers"]) for line in lines] == [(str(three), 3), (str(five), 5)]
-    assert all(0.6 <= line["confidence"] <= 1.0 for line in lines)
+    assert [(line["file"], line["hand"], line["fingers"]) for line in lines] == [
+        (str(three), True, 3),
+        (str(five), True, 5),
+    ]
+    box = lines[0]["box"]
+    assert set(box) == {"x", "y", "width", "height"} and 40 < box["width"] < 320
+    assert 0 <= box["x"] < 640 and 0 <= box["y"] < 480 and lines[0]["close_up"] is False
 
 
-def test_a_picture_reads_as_words_without_json(tmp_path: Path, capsys) -> None:
-    two = picture(tmp_path, "two.png", 2, seed=13)
+def test_a_frame_with_no_hand_held_up_says_so_never_a_count(capsys) -> None:
+    """An empty room, and a room where a hand rests on a chair: no hand is not "not sure"."""
+    for room in ("office_10.jpg", "office_35.jpg"):
+        assert main(["gesture", str(ARMS_LENGTH / "none" / room), "--json"]) == 0
+        said = json.loads(capsys.readouterr().out)
+        assert (said["hand"], said["fingers"], said["box"]) == (False, None, None), room
+        assert main(["gesture", str(ARMS_LENGTH / "none" / room)]) == 0
+        assert capsys.readouterr().out.endswith(f"{room}: no hand held up\n")
+
+
+def test_a_picture_reads_as_words_without_json(capsys) -> None:
+    two = ARMS_LENGTH / "2" / "two_106.jpg"
     assert main(["gesture", str(two), "--json"]) == 0
     said = json.loads(capsys.readouterr().out)
     assert main(["gesture", str(two)]) == 0
-    count = said["fingers"]
-    words = "not sure" if count is None else f"{count} finger" + ("" if count == 1 else "s")
-    assert capsys.readouterr().out == f"{two}: {words} ({said['confidence']:.0%})\n"
+    box = said["box"]
+    where = f"{box['x']},{box['y']}, {box['width']}x{box['height']} px"
+    assert capsys.readouterr().out == (
+        f"{two}: 2 fingers ({said['confidence']:.0%}) (the hand at {where}, in a 640x480 px "
+        "picture)\n"
+    )
 
 
 def test_a_window_elsewhere_is_given_with_crop(tmp_path: Path, capsys) -> None:
@@ -60,7 +80,7 @@ def test_a_window_elsewhere_is_given_with_crop(tmp_path: Path, capsys) -> None:
 
 
 def test_bad_pictures_are_named_and_the_others_still_counted(tmp_path: Path, capsys) -> None:
-    good = picture(tmp_path, "good.png", 1, seed=15)
+    good = ARMS_LENGTH / "1" / "one_107.jpg"
     (tmp_path / "notes.png").write_text("not a picture")
     args = ["gesture", str(tmp_path / "notes.png"), str(good), str(tmp_path / "gone.png")]
     assert main(args) == 1
@@ -71,28 +91,17 @@ def test_bad_pictures_are_named_and_the_others_still_counted(tmp_path: Path, cap
     assert "Traceback" not in captured.err
 
 
-def test_a_photograph_smaller_than_the_window_is_scaled_up_and_said_so(capsys) -> None:
-    """The real photographs beside the project are 100 x 100 px, the window 128."""
+def test_a_photograph_smaller_than_the_window_is_a_close_up_the_paper_s_network_counts(
+    capsys,
+) -> None:
+    """The close-up photographs beside the project are 100 x 100 px, the window 128."""
     photo = next((REAL_HANDS / "held-out" / "3").glob("*.jpg"))
     assert main(["gesture", str(photo)]) == 0
     said = capsys.readouterr().out
     assert said.startswith(f"{photo}: 3 fingers (")
-    assert said.endswith("(a 100x100 px picture, scaled up to the 128 px window)\n")
+    assert said.endswith("(a 100x100 px close-up, counted by the paper's network)\n")
     assert main(["gesture", str(photo), "--json"]) == 0
-    assert json.loads(capsys.readouterr().out)["scaled_up"] is True
-
-
-def test_a_big_picture_it_is_not_sure_of_hints_at_crop(tmp_path: Path, capsys) -> None:
-    """A 1000 x 1000 px photograph: the centred 128 px window shows a patch of palm."""
-    photo = cv2.imread(str(REAL_HANDS / "held-out" / "3" / "p005-IMG_1161.jpg"))
-    big = tmp_path / "big.png"
-    cv2.imwrite(str(big), cv2.resize(photo, (1000, 1000)))
-    assert main(["gesture", str(big)]) == 0
-    said = capsys.readouterr().out
-    assert said.startswith(f"{big}: not sure (")
-    assert "(the centred 128 px window of a 1000x1000 px picture; --crop X,Y,W" in said
-    assert main(["gesture", str(big), "--crop", "0,0,1000"]) == 0
-    assert capsys.readouterr().out.startswith(f"{big}: 3 fingers (")
+    assert json.loads(capsys.readouterr().out)["close_up"] is True
 
 
 @pytest.mark.parametrize(

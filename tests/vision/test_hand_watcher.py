@@ -50,7 +50,7 @@ class ReadsTheNumber:
     def read(self, frame: Frame) -> HandReading:
         value = int(frame[0, 0])
         if value == 255:
-            return HandReading(None, 0.3, ())
+            return HandReading(None, 0.3, (), False)  # no hand held up
         return HandReading(value, 0.95, ())
 
 
