@@ -346,11 +346,11 @@ def default_catalogue() -> KeyCatalogue:
             ),
             KeySpec(
                 HAND_BOX,
-                list,
+                dict,
                 "px",
                 "vision worker (camera + hand finder)",
-                "where the hand held up is in the camera's frame: [x, y, width, height] px; "
-                "absent when no hand is held up",
+                "where the hand held up is in the camera's frame: {x, y, width, height, "
+                "frame_width, frame_height} px; absent when no hand is held up",
             ),
             KeySpec(
                 HAND_SHOWN,

@@ -58,6 +58,21 @@ STOP_WAIT_S = 5.0
 """How long stopping waits for a frame being read (a webcam gives one within a second)."""
 
 
+def _box(reading: HandReading, frame: Frame) -> dict[str, int] | None:
+    """Where the hand is, and in what size of frame (px), as ``/vision/hand/box`` holds it."""
+    if reading.box is None:
+        return None
+    x, y, width, height = reading.box
+    return {
+        "x": x,
+        "y": y,
+        "width": width,
+        "height": height,
+        "frame_width": int(frame.shape[1]),
+        "frame_height": int(frame.shape[0]),
+    }
+
+
 class SteadyCount:
     """Turns per-frame counts into events: a count is *shown* once it changes and holds
     for ``steady_frames`` frames in a row. "No count" that holds as long ends what was
@@ -142,7 +157,7 @@ class HandWatcher:
         self.frames += 1
         self.blackboard.stage(HAND_FINGERS, reading.fingers)
         self.blackboard.stage(HAND_CONFIDENCE, round(reading.confidence, 4))
-        self.blackboard.stage(HAND_BOX, list(reading.box) if reading.box is not None else None)
+        self.blackboard.stage(HAND_BOX, _box(reading, frame))
         held = self.steady.shown
         shown = self.steady.add(reading.fingers)
         if shown is not None:

@@ -99,6 +99,20 @@ def test_the_replay_slider_shows_the_robot_at_a_moment(page: Page, replay: str) 
     expect(press).to_contain_text("therapist: presses the button 'Well done'")
 
 
+def test_the_page_shows_where_the_camera_sees_a_hand_held_up(page: Page, replay: str) -> None:
+    """The demo's finger game: a hand held up at arm's length at 22 s; its box drawn in the
+    camera's frame, and said in words (the picture itself never reaches the page)."""
+    page.goto(replay)
+    expect(page.locator("body")).to_have_attribute("data-ready", "true", timeout=30_000)
+    expect(page.locator("#camera-said")).to_have_text("no hand held up")
+    page.locator("#slider").evaluate(
+        "(slider) => { slider.value = '22.6'; slider.dispatchEvent(new Event('input')); }"
+    )
+    expect(page.locator("#camera-said")).to_contain_text("a hand held up at")
+    expect(page.locator("#camera-said")).to_contain_text("5 fingers")
+    expect(page.locator("#camera-frame rect.hand")).to_have_count(1)
+
+
 def test_every_request_needs_the_view_s_token_on_loopback_too(page: Page) -> None:
     """Another account on the machine reaches loopback as easily as the therapist: the
     page, its data and its streams all ask for the token the printed address carries; the

@@ -230,7 +230,41 @@ function fill(selector, rows) {
   }));
 }
 
+// where the camera sees a hand held up: the frame's outline and the hand's box (the
+// picture itself is never sent: only where the hand is, and its count)
+function drawCamera() {
+  const svg = $("#camera-frame");
+  const boxed = state.keys.get("/vision/hand/box");
+  const fingers = state.keys.get("/vision/hand/fingers");
+  let box = null;
+  try { box = boxed ? JSON.parse(boxed.value) : null; } catch { box = null; }
+  const ns = "http://www.w3.org/2000/svg";
+  const frame = document.createElementNS(ns, "rect");
+  const width = box ? box.frame_width : 640;
+  const height = box ? box.frame_height : 480;
+  svg.setAttribute("viewBox", `0 0 ${width} ${height}`);
+  for (const [name, value] of Object.entries({ x: 1, y: 1, width: width - 2, height: height - 2, class: "frame" })) {
+    frame.setAttribute(name, value);
+  }
+  const parts = [frame];
+  let said = "no hand held up";
+  if (box) {
+    const hand = document.createElementNS(ns, "rect");
+    for (const [name, value] of Object.entries({ x: box.x, y: box.y, width: box.width, height: box.height, class: "hand" })) {
+      hand.setAttribute(name, value);
+    }
+    parts.push(hand);
+    let count = null;
+    try { count = fingers ? JSON.parse(fingers.value) : null; } catch { count = null; }
+    const shown = count === null ? "its count not sure" : `${count} finger${count === 1 ? "" : "s"}`;
+    said = `a hand held up at ${box.x},${box.y} (${box.width}x${box.height} px of ${width}x${height}): ${shown}`;
+  }
+  svg.replaceChildren(...parts);
+  $("#camera-said").textContent = said;
+}
+
 function drawTables() {
+  drawCamera();
   $("#clock").textContent = `${state.now.toFixed(2)} s`;
   const keys = [...state.keys.values()].sort((a, b) => a.key.localeCompare(b.key));
   fill("#keys", keys.map((change) => [[
