@@ -1,5 +1,6 @@
-"""The simulated vest's camera: what a scenario holds up to it (a drawn hand, a picture,
-a video) becomes frames; it can be unplugged; bad show_hand events are named."""
+"""The simulated vest's camera: what a scenario holds up to it (a person holding up
+fingers, a picture seen whole, held at a distance or up close, a video) becomes frames;
+it can be unplugged; bad show_hand events are named."""
 
 from __future__ import annotations
 
@@ -44,7 +45,7 @@ def at(player: ScenarioPlayer, clock: VirtualClock, seconds: float) -> None:
     player.advance_to(clock.now())
 
 
-def test_a_drawn_hand_is_in_the_window_while_it_is_held_up(tmp_path: Path) -> None:
+def test_a_person_holding_up_fingers_is_in_view_while_it_lasts(tmp_path: Path) -> None:
     camera, player, clock = camera_on(
         tmp_path, "  - {at: 1.0, show_hand: {fingers: 3, seconds: 2}}\n"
     )
@@ -56,6 +57,44 @@ def test_a_drawn_hand_is_in_the_window_while_it_is_held_up(tmp_path: Path) -> No
     assert np.array_equal(camera.read(), held)  # a still hand: the same pose each frame
     at(player, clock, 3.5)
     assert np.array_equal(camera.read(), room)
+
+
+def test_a_person_holding_up_three_fingers_is_counted_three(tmp_path: Path) -> None:
+    """``fingers: 3`` is a real webcam frame of a person holding up three fingers at arm's
+    length (examples/hands-arms-length), which the robot's hand finder counts."""
+    from engine.vision.hand_finder import HandFinder
+
+    camera, player, clock = camera_on(
+        tmp_path, "  - {at: 1.0, show_hand: {fingers: 3, seconds: 2}}\n"
+    )
+    at(player, clock, 1.5)
+    reading = HandFinder.load().read(camera.read())
+    assert reading.present and reading.fingers == 3
+
+
+def test_a_picture_held_at_a_distance_is_placed_and_scaled_in_the_room(tmp_path: Path) -> None:
+    photo = np.zeros((100, 100, 3), np.uint8)
+    photo[:, :, 1] = 180  # green
+    cv2.imwrite(str(tmp_path / "hand.png"), photo)
+    events = "  - {at: 1.0, show_hand: {image: hand.png, at: [300, 50], width_px: 50}}\n"
+    camera, player, clock = camera_on(tmp_path, events)
+    room = camera.read()
+    at(player, clock, 1.0)
+    frame = camera.read()
+    assert (frame[50:100, 300:350, 1] == 180).all() and (frame[50:100, 300:350, 0] == 0).all()
+    assert np.array_equal(frame[100:, :], room[100:, :])  # the room around it is still there
+    assert np.array_equal(frame[:, :300], room[:, :300])
+
+
+def test_a_picture_bigger_than_the_frame_is_seen_whole(tmp_path: Path) -> None:
+    picture = np.zeros((720, 1280, 3), np.uint8)
+    picture[:, :, 2] = 200
+    picture[:10, :10] = 255  # a white corner: still in view, scaled
+    cv2.imwrite(str(tmp_path / "wide.png"), picture)
+    camera, player, clock = camera_on(tmp_path, "  - {at: 1.0, show_hand: {image: wide.png}}\n")
+    at(player, clock, 1.0)
+    frame = camera.read()
+    assert frame.shape == (360, 640, 3) and frame[1, 1].min() > 200 and frame[200, 400, 2] == 200
 
 
 def test_a_picture_is_placed_in_the_frame_unscaled(tmp_path: Path) -> None:
@@ -130,6 +169,14 @@ def problems(tmp_path: Path, events: str) -> list[str]:
     with pytest.raises(LoadError) as caught:
         load_scenario(scenario_file(tmp_path, events), "scene.yaml")
     return [str(problem) for problem in caught.value.problems]
+
+
+def test_a_place_without_a_size_is_named(tmp_path: Path) -> None:
+    (tmp_path / "hand.png").write_bytes(cv2.imencode(".png", np.zeros((9, 9, 3), np.uint8))[1])
+    [problem] = problems(tmp_path, "  - {at: 1.0, show_hand: {image: hand.png, at: [1, 2]}}\n")
+    assert "at and width_px go together" in problem
+    [problem] = problems(tmp_path, "  - {at: 1.0, show_hand: {fingers: 2, width_px: 40}}\n")
+    assert "at and width_px place a picture" in problem
 
 
 def test_show_hand_takes_one_thing_to_show(tmp_path: Path) -> None:
