@@ -164,11 +164,11 @@ def test_frames_smaller_than_the_window_put_the_camera_offline_with_the_reason()
     assert watcher.frames == 0
 
 
-def test_an_empty_view_that_does_not_change_is_read_once_in_five_seconds() -> None:
+def test_an_empty_view_that_does_not_change_is_read_once_in_ten_seconds() -> None:
     watcher, _, board, clock = watching([None])
-    run(watcher, board, clock, 10.0)
-    assert watcher.frames == 100  # every frame taken and staged...
-    assert watcher.looked == 2  # ...but the finder read one every 5 s: nothing going on
+    run(watcher, board, clock, 20.0)
+    assert watcher.frames == 200  # every frame taken and staged...
+    assert watcher.looked == 2  # ...but the finder read one every 10 s: nothing going on
     assert board.get(FINGERS) is None
 
 
