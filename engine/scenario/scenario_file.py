@@ -125,28 +125,12 @@ EVENT_FIELDS: dict[str, tuple[Param[Any], ...] | ParamType[Any]] = {
         Param("seconds", _SECONDS, 1.0, "how long"),
     ),
     "show_hand": (
-        Param(
-            "fingers",
-            Integer(0, 5),
-            None,
-            "a person holding up 1..5 fingers at arm's length (a real webcam frame); 0: a "
-            "drawn closed hand",
-        ),
+        Param("fingers", Integer(0, 5), None, "a person holding up 1..5 fingers (0: a fist)"),
         Param("image", Text(), None, "a picture (relative to the scenario file)"),
         Param("video", Text(), None, "a video, played from this moment"),
         Param("seconds", _SECONDS, 2.0, "how long it is held in front of the camera"),
-        Param(
-            "at",
-            ListOf(Integer(0, 10_000), 2, 2),
-            None,
-            "the picture's top-left corner in the camera's frame, [x, y] px (with width_px)",
-        ),
-        Param(
-            "width_px",
-            Integer(8, 10_000),
-            None,
-            "the picture held at a distance: scaled to this width in the frame (px)",
-        ),
+        Param("at", ListOf(Integer(0, 10_000), 2, 2), None, "a picture held at [x, y] px"),
+        Param("width_px", Integer(8, 10_000), None, "how wide it looks there, px"),
     ),
     "press": Text(),
     "cloud": (
