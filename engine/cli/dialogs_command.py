@@ -28,7 +28,7 @@ from engine.errors import ConfigError
 from engine.speech.hearing import hear, spoken
 from engine.speech.phrase_search import PhraseGrammar
 from engine.speech.recognizers import default_recognizer
-from engine.speech.settings import RECOGNIZER_NAMES
+from engine.speech.settings import HEARING_NAMES, RECOGNIZER_NAMES
 from engine.speech.vad import SileroVad
 from engine.speech.voice_models import load_voice
 from engine.speech.voices import Voice, steady_voice
@@ -76,6 +76,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         default=None,
         help="moonshine (the robot's default) or whisper",
     )
+    check.add_argument(
+        "--hearing",
+        choices=HEARING_NAMES,
+        default="adults",
+        help="hear as for adults (the default) or children: as the profile's hearing:",
+    )
 
 
 def _library(given: Path | None) -> DialogLibrary:
@@ -119,7 +125,8 @@ def main(args: argparse.Namespace) -> int:
     for variant in variants:
         voice = load_voice(variant.voice)
         voices[variant.voice] = steady_voice(voice)
-    recognizer, instead = default_recognizer(args.recognizer)
+    children = args.hearing == "children"
+    recognizer, instead = default_recognizer(args.recognizer, children=children)
     if instead:
         print(f"vest dialogs check: {instead}", file=sys.stderr)
     phrases = library.phrases()
@@ -142,7 +149,9 @@ def main(args: argparse.Namespace) -> int:
                     audio = spoken(
                         voices[variant.voice], phrase.text, variant.speed, variant.snr_db
                     )
-                    hearing = hear(audio, vad, recognizer, dialog, context, whole_turn)
+                    hearing = hear(
+                        audio, vad, recognizer, dialog, context, whole_turn, children=children
+                    )
                     match = hearing.verdict.match if hearing.verdict is not None else None
                     if match is not None and match.rule.id == rule.id:
                         continue

@@ -35,7 +35,7 @@ from engine.media.audio import read_wav
 from engine.speech.hearing import Hearing, conversation, spoken
 from engine.speech.phrase_search import PhraseGrammar
 from engine.speech.recognizers import default_recognizer
-from engine.speech.settings import RECOGNIZER_NAMES
+from engine.speech.settings import HEARING_NAMES, RECOGNIZER_NAMES
 from engine.speech.voice_models import DEFAULT_VOICE, load_voice
 from engine.speech.voices import steady_voice
 
@@ -59,6 +59,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         choices=RECOGNIZER_NAMES,
         default=None,
         help="moonshine (the default) or whisper",
+    )
+    parser.add_argument(
+        "--hearing",
+        choices=HEARING_NAMES,
+        default="adults",
+        help="hear adults (the default) or children (longer pauses, phrases as children "
+        "say them): as a profile's hearing:",
     )
     parser.add_argument(
         "--device", default=None, help="ALSA capture device for --mic (default: the config's)"
@@ -126,7 +133,8 @@ def main(args: argparse.Namespace) -> int:
         audio += [(repr(phrase), spoken(steady, phrase)) for phrase in args.text]
     from engine.speech.vad import SileroVad
 
-    recognizer, instead = default_recognizer(args.recognizer)
+    children = args.hearing == "children"
+    recognizer, instead = default_recognizer(args.recognizer, children=children)
     if instead:
         print(f"vest hear: {instead}", file=sys.stderr)
     phrases = library.phrases()
@@ -138,7 +146,8 @@ def main(args: argparse.Namespace) -> int:
 
         return listen_live(args, recognizer, dialog, RealClock(), whole_turn)
     for name, recording in audio:
-        for hearing in conversation(recording, vad, recognizer, dialog, whole_turn):
+        heard = conversation(recording, vad, recognizer, dialog, whole_turn, children=children)
+        for hearing in heard:
             if args.json:
                 print(json.dumps(hearing.as_json(name), ensure_ascii=False))
             else:

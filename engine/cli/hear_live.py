@@ -12,7 +12,7 @@ from engine.hardware.config_file import load_robot_config
 from engine.media.audio_devices import AlsaMicrophone
 from engine.speech.listener import Heard, Listener
 from engine.speech.recognizer import Recognizer
-from engine.speech.vad import SileroVad, SpeechDetector
+from engine.speech.vad import SileroVad, speech_detector
 
 
 def listen_live(
@@ -48,7 +48,8 @@ def listen_live(
                 flush=True,
             )
 
-    listener = Listener(SpeechDetector(SileroVad()), recognizer, clock, show, whole_turn=whole_turn)
+    detector = speech_detector(SileroVad(), children=args.hearing == "children")
+    listener = Listener(detector, recognizer, clock, show, whole_turn=whole_turn)
     microphone = AlsaMicrophone(device, lambda audio: listener.hear(audio, clock.now()))
     microphone.start()  # AudioDeviceError names the missing card: exit 3
     print(f"listening on {device!r}; Ctrl-C stops", flush=True)

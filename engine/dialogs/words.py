@@ -42,6 +42,31 @@ _CONTRACTIONS = {
     "colours": "colors",
 }
 _SPACES = re.compile(r"\s+")
+_ONES = ["zero", "one", "two", "three", "four", "five", "six", "seven", "eight", "nine"]
+_TEENS = [
+    "ten",
+    "eleven",
+    "twelve",
+    "thirteen",
+    "fourteen",
+    "fifteen",
+    "sixteen",
+    "seventeen",
+    "eighteen",
+    "nineteen",
+]
+_TENS = ["_", "_", "twenty", "thirty", "forty", "fifty", "sixty", "seventy", "eighty", "ninety"]
+_ORDINALS = {
+    "one": "first",
+    "two": "second",
+    "three": "third",
+    "five": "fifth",
+    "eight": "eighth",
+    "nine": "ninth",
+    "twelve": "twelfth",
+}
+NUMBER_WORDS = frozenset([*_ONES, *_TEENS, *_TENS[2:], "hundred"])
+_NUMBER = re.compile(r"^(\d+)(st|nd|rd|th)?$")
 _WORD_CATEGORIES = ("L", "M", "N")
 """Letters, marks and digits of any script (marks: the vowel signs of Devanagari, accents)."""
 
@@ -92,15 +117,63 @@ def _word_character(char: str) -> bool:
 
 
 def normalize(text: str) -> str:
-    """Case folded, no punctuation, contractions spelled out, single spaces; in any script.
+    """Case folded, no punctuation, contractions spelled out, numbers as words, single
+    spaces; in any script.
 
     Accents are kept (``café`` stays ``café``); both sides of a match are normalized the
-    same way (Unicode NFKC), so a composed and a decomposed ``é`` are the same letter.
+    same way (Unicode NFKC), so a composed and a decomposed ``é`` are the same letter. What
+    recognizers write their own way is written as a person writes a phrase: a hyphenated
+    word joined ("Good-bye" is "goodbye"; "twenty-one" and "5-29" stay two numbers), a number
+    in words ("6th" is "sixth", "21" "twenty one", a longer one digit by digit: "2287" is
+    "two two eight seven").
     """
     folded = unicodedata.normalize("NFKC", text).casefold().replace("\u2019", "'")
+    folded = re.sub(r"(?<=\w)-(?=\w)", _joined, folded)
     words = "".join(c if _word_character(c) else " " for c in folded).split()
-    expanded = " ".join(_CONTRACTIONS.get(word, word) for word in words)
+    spelled = " ".join(_spelled(word) for word in words)
+    expanded = " ".join(_CONTRACTIONS.get(word, word) for word in spelled.split())
     return _SPACES.sub(" ", expanded.replace("'", "")).strip()
+
+
+def _joined(hyphen: re.Match[str]) -> str:
+    """A hyphen between letters: nothing (one word), but between numbers a space."""
+    text = hyphen.string
+    before = re.findall(r"\w+$", text[: hyphen.start()])
+    after = re.findall(r"^\w+", text[hyphen.end() :])
+    numbers = before and after and all(_a_number(word[0]) for word in (before, after))
+    return " " if numbers else ""
+
+
+def _a_number(word: str) -> bool:
+    return word in NUMBER_WORDS or word.isdigit()
+
+
+def _spelled(word: str) -> str:
+    """A number written in digits, in words (see :func:`normalize`); other words as they are."""
+    found = _NUMBER.match(word)
+    if found is None:
+        return word
+    digits, ordinal = found.groups()
+    if len(digits) > 2 or (len(digits) == 2 and digits[0] == "0"):
+        said = " ".join(_ONES[int(d)] for d in digits)
+    else:
+        value = int(digits)
+        if value < 10:
+            said = _ONES[value]
+        elif value < 20:
+            said = _TEENS[value - 10]
+        else:
+            said = _TENS[value // 10] + ("" if value % 10 == 0 else " " + _ONES[value % 10])
+    if not ordinal:
+        return said
+    head, _, last = said.rpartition(" ")
+    if last in _ORDINALS:
+        last = _ORDINALS[last]
+    elif last.endswith("y"):
+        last = last[:-1] + "ieth"
+    else:
+        last = last + "th"
+    return f"{head} {last}".strip()
 
 
 def stem(word: str) -> str:
@@ -141,3 +214,11 @@ def same_word(heard: str, expected: str) -> bool:
 def words(text: str) -> tuple[str, ...]:
     """The stemmed words of ``text`` after :func:`normalize`."""
     return tuple(stem(word) for word in normalize(text).split())
+
+
+def alike(one: str, other: str) -> float:
+    """How alike two texts sound as written, 0 (nothing in common) to 1 (the same words):
+    the share of letters in order the two :func:`words` spellings have in common ("can we
+    play a game" and "can you play again" are 0.72, "what is your name" and "I like cats"
+    0.15)."""
+    return difflib.SequenceMatcher(None, " ".join(words(one)), " ".join(words(other))).ratio()

@@ -34,7 +34,7 @@ from engine.speech.recognizers import default_recognizer
 from engine.speech.settings import SPEECH_PROFILE_PARAMS
 from engine.speech.settling import Settling
 from engine.speech.speaker import Playback, SelfHearing, Speaker, Utterance
-from engine.speech.vad import SileroVad, SpeechDetector
+from engine.speech.vad import SileroVad, speech_detector
 from engine.speech.voice_models import default_voice
 from engine.speech.voices import EspeakVoice, Voice, steady_voice
 
@@ -268,10 +268,13 @@ def build_speech(
     volume: float = 1.0,
     voice_name: str | None = None,
     recognizer_name: str | None = None,
+    children: bool = False,
     on_utterance: Callable[[Utterance], None] | None = None,
 ) -> RobotSpeech:
     """The speech of a robot with ``audio`` devices (on the simulated vest's room when
-    ``simulated``), listening for ``phrases``. ``settle``: the clock is virtual."""
+    ``simulated``), listening for ``phrases``; ``children``: it hears children
+    (:func:`~engine.speech.vad.speech_detector`, :mod:`engine.speech.children`).
+    ``settle``: the clock is virtual."""
     problems: dict[str, str] = {}
     settling = Settling()
     self_hearing = SelfHearing()
@@ -308,13 +311,13 @@ def build_speech(
     )
     listener: Listener | None = None
     try:
-        recognizer, instead = default_recognizer(recognizer_name)
+        recognizer, instead = default_recognizer(recognizer_name, children=children)
         if instead:
             problems["recognizer"] = instead
         listened = list(phrases)
         recognizer.listen_for(listened)
         listener = Listener(
-            SpeechDetector(SileroVad()),
+            speech_detector(SileroVad(), children=children),
             recognizer,
             clock,
             on_heard,
@@ -367,7 +370,8 @@ def audio_folder(folder: Path) -> Callable[[Utterance], None]:
 
 
 def speech_settings(profile: Profile | None) -> dict[str, Any]:
-    """The voice, speed and recognizer a profile asks for, as :func:`build_speech` keywords."""
+    """The voice, speed, recognizer and hearing a profile asks for, as :func:`build_speech`
+    keywords."""
     if profile is None:
         return {}
     values = {
@@ -382,4 +386,6 @@ def speech_settings(profile: Profile | None) -> dict[str, Any]:
         settings["speed"] = float(values["speech_rate"])
     if "recognizer" in values:
         settings["recognizer_name"] = str(values["recognizer"])
+    if "hearing" in values:
+        settings["children"] = values["hearing"] == "children"
     return settings

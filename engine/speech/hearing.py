@@ -14,7 +14,13 @@ from engine.clock import stopwatch
 from engine.dialogs.model import Dialog, FollowUp, Verdict
 from engine.media.audio import SPEECH_RATE_HZ, Audio, with_noise
 from engine.speech.recognizer import Recognizer
-from engine.speech.vad import FRAME_SAMPLES, SpeechDetector, SpeechProbability, Utterance
+from engine.speech.vad import (
+    FRAME_SAMPLES,
+    SpeechDetector,
+    SpeechProbability,
+    Utterance,
+    speech_detector,
+)
 from engine.speech.voices import Voice
 from engine.values.templates import CompiledTemplate
 
@@ -77,10 +83,11 @@ class Part:
         return self.ready_s - self.spoken_until_s
 
 
-def utterances(audio: Audio, vad: SpeechProbability) -> list[Utterance]:
-    """The utterances Silero finds in ``audio`` (the full wait for silence after each)."""
+def utterances(audio: Audio, vad: SpeechProbability, *, children: bool = False) -> list[Utterance]:
+    """The utterances Silero finds in ``audio`` (the full wait for silence after each;
+    ``children``: as the robot listens to children, :func:`speech_detector`)."""
     vad.reset()
-    detector = SpeechDetector(vad)
+    detector = speech_detector(vad, children=children)
     found = detector.feed(
         audio.resampled(SPEECH_RATE_HZ).then(Audio.silence(TRAILING_SILENCE_S)).samples
     )
@@ -140,13 +147,16 @@ def heard_live(
     vad: SpeechProbability,
     recognizer: Recognizer,
     whole_turn: Callable[[str], bool] | None = None,
+    *,
+    children: bool = False,
 ) -> list[Part]:
     """Each utterance in ``audio`` as the live :class:`~engine.speech.listener.Listener`
     hears it: drafts recognized during the wait for silence, a whole turn (``whole_turn``)
-    ending it sooner, one recognition at a time, at this machine's speed."""
+    ending it sooner, one recognition at a time, at this machine's speed; ``children``:
+    with the wait for silence of a robot that hears children (:func:`speech_detector`)."""
     vad.reset()
     drafts: list[Utterance] = []
-    detector = SpeechDetector(vad, on_pause=drafts.append)
+    detector = speech_detector(vad, children=children, on_pause=drafts.append)
     live = _LiveTimeline(detector, recognizer, whole_turn)
     samples = audio.resampled(SPEECH_RATE_HZ).then(Audio.silence(TRAILING_SILENCE_S)).samples
     found: list[Part] = []
@@ -168,10 +178,13 @@ def hear(
     dialog: Dialog | None,
     follow_up: FollowUp | None = None,
     whole_turn: Callable[[str], bool] | None = None,
+    *,
+    children: bool = False,
 ) -> Hearing:
-    """What the robot hears in ``audio`` and how ``dialog`` answers it (``whole_turn``: as
-    for :func:`heard_live`)."""
-    texts = [part.text for part in heard_live(audio, vad, recognizer, whole_turn)]
+    """What the robot hears in ``audio`` and how ``dialog`` answers it (``whole_turn``,
+    ``children``: as for :func:`heard_live`)."""
+    parts = heard_live(audio, vad, recognizer, whole_turn, children=children)
+    texts = [part.text for part in parts]
     heard = " ".join(t for t in texts if t) or None
     if heard is None or dialog is None:
         return Hearing(heard, None, None)
@@ -193,13 +206,16 @@ def conversation(
     recognizer: Recognizer,
     dialog: Dialog,
     whole_turn: Callable[[str], bool] | None = None,
+    *,
+    children: bool = False,
 ) -> list[Hearing]:
     """Each utterance in ``audio`` heard and answered in turn, as the robot would: when an
     answer asked a question (``then:``), the next utterance is heard as its reply. A
-    recording without speech is one Hearing of nothing."""
+    recording without speech is one Hearing of nothing. ``whole_turn``, ``children``: as
+    for :func:`heard_live`."""
     hearings: list[Hearing] = []
     follow_up: FollowUp | None = None
-    for part in heard_live(audio, vad, recognizer, whole_turn):
+    for part in heard_live(audio, vad, recognizer, whole_turn, children=children):
         if not part.text:
             continue
         started = stopwatch()

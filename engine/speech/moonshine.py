@@ -33,6 +33,7 @@ import numpy as np
 
 from engine.dialogs.words import words
 from engine.media.audio import SPEECH_RATE_HZ, Audio
+from engine.speech.children import SEARCH_NATS, a_child_said
 from engine.speech.onnx_folding import folded_model
 from engine.speech.phrase_search import (
     CLOSE_ENOUGH_NATS,
@@ -40,6 +41,7 @@ from engine.speech.phrase_search import (
     PhraseGrammar,
     bears_out,
     closest_phrase,
+    closest_phrases,
     sure_of,
 )
 from engine.speech.recognizer import RecognizerError, Transcript, Word, said_in_a_loop
@@ -188,9 +190,12 @@ class _Heard:
 class MoonshineRecognizer:
     """Moonshine Base English on ONNX Runtime, one utterance at a time."""
 
-    def __init__(self, model_dir: Path | None = None, *, threads: int = 1) -> None:
+    def __init__(
+        self, model_dir: Path | None = None, *, threads: int = 1, children: bool = False
+    ) -> None:
         """``threads``: ONNX Runtime's threads for each model (one was faster than two here;
-        recognition runs in the listener's worker, never in a tick)."""
+        recognition runs in the listener's worker, never in a tick). ``children``: closed
+        listening also keeps a phrase as children say it (:mod:`engine.speech.children`)."""
         folder = model_dir or moonshine_model_dir()
         if folder is None:
             raise RecognizerError(
@@ -225,7 +230,8 @@ class MoonshineRecognizer:
         self.grammar = PhraseGrammar(())
         self.closed_listenings = 0
         """Utterances heard again against the phrases (for the benchmarks)."""
-        self.name = f"moonshine base (cpu, {threads} threads)"
+        self.children = children
+        self.name = f"moonshine base (cpu, {threads} threads{', children' if children else ''})"
 
     def listen_for(self, phrases: Iterable[str]) -> None:
         """The phrases closed listening may hear (:mod:`engine.speech.phrase_search`)."""
@@ -246,9 +252,17 @@ class MoonshineRecognizer:
         doubted = looped or mean < DOUBTED_BELOW
         text = "" if doubted else " ".join(w.text for w in once)
         unconfirmed = ""
+        words_heard = [(w.text, w.probability) for w in once]
+        if self.children and self.grammar and not (text and self.grammar.is_a_whole_turn(text)):
+            # a child's words that hold a phrase may still say another ("why had she
+            # turned" for "why had he turned"): the phrases are weighed whenever what was
+            # written is not exactly one of them
+            self.closed_listenings += 1
+            child = self._child_said(heard, words_heard)
+            if child is not None:
+                return Transcript(child.text, once, 1.0 - mean, per_token)
         if self.grammar and not (text and self.grammar.holds_a_phrase(text)):
             self.closed_listenings += 1
-            words_heard = [(w.text, w.probability) for w in once]
             found = self._borne_out(heard, self.grammar, words_heard)
             if found is not None:
                 if sure_of(found, words_heard):
@@ -293,6 +307,22 @@ class MoonshineRecognizer:
         # words as well as a word does.
         written = self._decode(heard.decoder, heard.max_tokens, words_first=True)[2]
         return self._closest(heard.decoder, grammar.sentences, written)
+
+    def _child_said(self, heard: _Heard, words_heard: list[tuple[str, float]]) -> Found | None:
+        """The phrase a child said, as :func:`~engine.speech.children.a_child_said` keeps it;
+        None where it keeps none (the adult rule may still)."""
+        if not heard.tokens:
+            return None
+        found = closest_phrases(
+            heard.decoder,
+            self.grammar,
+            self._texts,
+            end_token=END_TOKEN,
+            max_tokens=self.grammar.longest + 1,
+            at_least=heard.free_log_prob - SEARCH_NATS,
+            keep=2,
+        )
+        return a_child_said(found, heard.free_log_prob, words_heard)
 
     def _closest(self, decoder: _Decoder, grammar: PhraseGrammar, free: float) -> Found | None:
         """The likeliest phrase of ``grammar`` at most :data:`CLOSE_ENOUGH_NATS` less likely

@@ -51,6 +51,7 @@ __all__ = [
     "PhraseGrammar",
     "bears_out",
     "closest_phrase",
+    "closest_phrases",
     "left_out",
     "sure_of",
 ]
@@ -97,7 +98,8 @@ class PhraseGrammar:
     """The phrases the robot listens for, as texts a search may write."""
 
     def __init__(self, phrases: Iterable[str]) -> None:
-        listened = {spelled(phrase).strip() for phrase in phrases} - {""}
+        self._written = {spelled(phrase).strip(): phrase for phrase in phrases}
+        listened = set(self._written) - {""}
         self.spellings = sorted(listened)
         """Each phrase as :func:`spelled`."""
         self.phrases = [words(text) for text in self.spellings]
@@ -126,6 +128,11 @@ class PhraseGrammar:
 
     def complete(self, text: str) -> bool:
         return spelled(text).rstrip() in self.texts
+
+    def written(self, spelling: str) -> str:
+        """A phrase as the dialog writes it, from its spelling ("but its not" is "but it's
+        not": the matcher reads "it's" as "it is"); a plural made here as it is."""
+        return self._written.get(spelling, spelling)
 
     def is_a_whole_turn(self, text: str) -> bool:
         """Whether ``text`` says one of the phrases and nothing more (case, punctuation,
@@ -202,25 +209,46 @@ def closest_phrase(
     ``at_least`` (natural log: a phrase less likely is of no use, so the search drops the
     texts that fall below it). ``pieces[token]`` is the text a token writes ("" for tokens
     that write none)."""
+    found = closest_phrases(
+        decoding, grammar, pieces, end_token=end_token, max_tokens=max_tokens, at_least=at_least
+    )
+    return found[0] if found else None
+
+
+def closest_phrases(
+    decoding: Decoding,
+    grammar: PhraseGrammar,
+    pieces: Sequence[str],
+    *,
+    end_token: int,
+    max_tokens: int,
+    at_least: float = -math.inf,
+    keep: int = 1,
+) -> list[Found]:
+    """The ``keep`` likeliest distinct phrases of ``grammar`` the decoder writes, likeliest
+    first (see :func:`closest_phrase`): with ``keep=2``, how far the best stands above the
+    next, which tells a phrase heard from one of two alike."""
     beams: list[tuple[str, float]] = [("", 0.0)]
     rows = decoding.first()
     top = min(TOP_TOKENS, rows.shape[1])
-    best: Found | None = None
+    finished: dict[str, float] = {}
     for _ in range(max_tokens):
         options: list[tuple[float, int, int, str]] = []
         for row, (text, score) in enumerate(beams):
             log_probs = rows[row]
             if grammar.complete(text):
                 ended = score + float(log_probs[end_token])
-                if ended >= at_least and (best is None or ended > best.log_prob):
-                    best = Found(spelled(text).strip(), ended)
+                phrase = spelled(text).strip()
+                if ended >= at_least and ended > finished.get(phrase, -math.inf):
+                    finished[phrase] = ended
             for token in np.argpartition(-log_probs, top - 1)[:top]:
                 piece = pieces[int(token)]
                 if piece and np.isfinite(log_probs[token]) and grammar.allows(text + piece):
                     options.append((score + float(log_probs[token]), row, int(token), text + piece))
         options.sort(reverse=True)
-        # a text's score only falls as it grows: one below the best phrase never passes it
-        floor = at_least if best is None else max(at_least, best.log_prob)
+        # a text's score only falls as it grows: one below the keep-th phrase never passes it
+        ranked = sorted(finished.values(), reverse=True)
+        floor = at_least if len(ranked) < keep else max(at_least, ranked[keep - 1])
         kept = [o for o in options[:BEAM] if o[0] > floor]
         if not kept:
             break
@@ -228,7 +256,8 @@ def closest_phrase(
             np.array([o[1] for o in kept]), np.array([o[2] for o in kept], dtype=np.int64)
         )
         beams = [(o[3], o[0]) for o in kept]
-    return best
+    best = sorted(finished.items(), key=lambda item: item[1], reverse=True)[:keep]
+    return [Found(grammar.written(text), log_prob) for text, log_prob in best]
 
 
 def bears_out(

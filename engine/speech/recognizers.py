@@ -93,28 +93,33 @@ def says(text: str, phrase: str) -> bool:
     return bool(words(phrase)) and not wanted
 
 
-def load_recognizer(name: str) -> Recognizer:
-    """The recognizer called ``name``; RecognizerError saying why it cannot hear."""
+def load_recognizer(name: str, *, children: bool = False) -> Recognizer:
+    """The recognizer called ``name``; RecognizerError saying why it cannot hear.
+    ``children``: Moonshine's closed listening also keeps phrases as children say them
+    (:mod:`engine.speech.children`; Whisper's hearing is the same for all)."""
     from engine.speech.recognizer import WhisperRecognizer
 
     if name == "moonshine":
         from engine.speech.moonshine import MoonshineRecognizer
 
-        return SecondOpinion(MoonshineRecognizer(), WhisperRecognizer())
+        return SecondOpinion(MoonshineRecognizer(children=children), WhisperRecognizer())
     if name == "whisper":
         return WhisperRecognizer()
     raise RecognizerError(f"no recognizer {name!r}; recognizers: {', '.join(RECOGNIZER_NAMES)}")
 
 
-def default_recognizer(name: str | None = None) -> tuple[Recognizer, str | None]:
-    """The recognizer ``name`` (default moonshine), or the other one with why the wanted
-    one cannot hear; RecognizerError when neither can."""
+def default_recognizer(
+    name: str | None = None, *, children: bool = False
+) -> tuple[Recognizer, str | None]:
+    """The recognizer ``name`` (default moonshine; ``children`` as for
+    :func:`load_recognizer`), or the other one with why the wanted one cannot hear;
+    RecognizerError when neither can."""
     wanted = name or DEFAULT_RECOGNIZER
     try:
-        return load_recognizer(wanted), None
+        return load_recognizer(wanted, children=children), None
     except RecognizerError as error:
         other = next(n for n in RECOGNIZER_NAMES if n != wanted)
         try:
-            return load_recognizer(other), f"{error}; hearing with {other}"
+            return load_recognizer(other, children=children), f"{error}; hearing with {other}"
         except RecognizerError as second:
             raise RecognizerError(f"{error}; and {second}") from None

@@ -1,5 +1,5 @@
-"""The speech settings a profile may give: the voice, how fast it speaks, and the
-recognizer that hears."""
+"""The speech settings a profile may give: the voice, how fast it speaks, the recognizer
+that hears, and whom it hears."""
 
 from __future__ import annotations
 
@@ -7,10 +7,12 @@ from typing import Any
 
 VOICE_NAMES = ("hibari", "joe", "espeak")
 RECOGNIZER_NAMES = ("moonshine", "whisper")
-SPEECH_PROFILE_PARAMS = ("voice", "speech_rate", "recognizer")
+HEARING_NAMES = ("adults", "children")
+SPEECH_PROFILE_PARAMS = ("voice", "speech_rate", "recognizer", "hearing")
 """Profile parameters the speech itself reads (no tree needs to declare them):
-``voice`` (hibari, joe or espeak), ``speech_rate`` (1 natural, 0.5..2) and ``recognizer``
-(moonshine or whisper)."""
+``voice`` (hibari, joe or espeak), ``speech_rate`` (1 natural, 0.5..2), ``recognizer``
+(moonshine or whisper) and ``hearing`` (adults, the default, or children: longer pauses
+within a sentence, and phrases as children say them, :mod:`engine.speech.children`)."""
 
 
 def check_speech_params(params: dict[str, Any]) -> list[tuple[str, str, str]]:
@@ -28,6 +30,11 @@ def check_speech_params(params: dict[str, Any]) -> list[tuple[str, str, str]]:
                 f"no recognizer {recognizer!r}",
                 "recognizers: " + ", ".join(RECOGNIZER_NAMES),
             )
+        )
+    hearing = params.get("hearing")
+    if hearing is not None and hearing not in HEARING_NAMES:
+        problems.append(
+            ("hearing", f"no hearing {hearing!r}", "hearing: " + " or ".join(HEARING_NAMES))
         )
     rate = params.get("speech_rate")
     if rate is not None and (

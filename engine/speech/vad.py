@@ -241,3 +241,30 @@ class SpeechDetector:
             return None  # a click or a cough
         audio = Audio(np.concatenate(speech), SPEECH_RATE_HZ)
         return Utterance(audio, self.position, quiet * FRAME_S, drafted)
+
+
+CHILDREN_END_SILENCE_S = 0.8
+"""The wait for silence when the robot hears children: a child pauses within a sentence
+for longer than an adult ("Mike ... likes the white one"), and 0.3 s cut such a sentence in
+two, each half heard alone. A whole turn still ends after 0.2 s."""
+CHILDREN_PRE_ROLL_S = 0.5
+"""The audio kept from before speech starts when the robot hears children: a child's first
+word is often breathy and quiet ("He was late" heard without its "He" as "I was late")."""
+
+
+def speech_detector(
+    vad: SpeechProbability,
+    *,
+    children: bool = False,
+    on_pause: Callable[[Utterance], None] | None = None,
+) -> SpeechDetector:
+    """The detector the robot listens with: for adults, or for ``children``
+    (:data:`CHILDREN_END_SILENCE_S`, :data:`CHILDREN_PRE_ROLL_S`)."""
+    if children:
+        return SpeechDetector(
+            vad,
+            end_silence_s=CHILDREN_END_SILENCE_S,
+            pre_roll_s=CHILDREN_PRE_ROLL_S,
+            on_pause=on_pause,
+        )
+    return SpeechDetector(vad, on_pause=on_pause)
