@@ -99,7 +99,9 @@ def test_the_report_lists_the_therapist_s_press_and_a_sentence_not_understood_on
     moon = next(m for m in moments if "moon" in m.did)
     assert moon.not_understood == "what is the weather like on the moon"
     assert moon.answer is not None and moon.answer.args["text"] == "Sorry, I did not understand."
-    assert not_understood(recording) == [(pytest.approx(2.0, abs=0.1), moon.not_understood)]
+    [missed] = not_understood(recording)
+    assert (missed.t_s, missed.text) == (pytest.approx(2.0, abs=0.1), moon.not_understood)
+    assert not missed.asked and not missed.reprompt  # the dialog had nothing like it
     page = report_html(recording)
     assert "did not understand \u201cwhat is the weather like on the moon\u201d" in page
     assert "kid-17" in page and "UTC" in page  # whose session, and when

@@ -108,7 +108,9 @@ def describe(name: str, hearing: Hearing) -> str:
         line += f" -> rule {verdict.match.rule.id!r} ({verdict.match.score:.2f})"
     elif verdict is not None:
         line += f" -> no rule ({verdict.reason})"
-    if hearing.answer is not None:
+    if hearing.asks is not None:
+        line += f" -> asks whether it heard rule {hearing.asks.id!r}: {hearing.answer!r}"
+    elif hearing.answer is not None:
         line += f" -> says {hearing.answer!r}"
     return line
 

@@ -28,12 +28,11 @@ A dialog file::
 
 from __future__ import annotations
 
-import itertools
-import math
-from dataclasses import dataclass
 from pathlib import Path
 
 from engine.blackboard.catalogue import KeyCatalogue
+from engine.dialogs.concepts import MAX_DIALOG_EXPANSIONS, Budget, expand, read_concepts
+from engine.dialogs.confirming import with_confirmations
 from engine.dialogs.model import (
     DEFAULT_LISTEN_S,
     DEFAULT_MIN_SCORE,
@@ -43,7 +42,6 @@ from engine.dialogs.model import (
     Phrase,
 )
 from engine.dialogs.rule_checks import check_ids, check_shared_phrases
-from engine.dialogs.words import normalize
 from engine.files.problems import LoadError, Mark, Problems
 from engine.files.yaml_source import (
     YList,
@@ -58,12 +56,8 @@ from engine.services.interfaces import ON_REQUEST_SENSORS
 from engine.values.param_problems import CheckContext, ParamProblem, did_you_mean
 from engine.values.templates import CompiledTemplate, compile_template
 
-MAX_PHRASE_EXPANSIONS = 200
-"""How many phrases one ``hear:`` phrase may expand to through its ``~concepts``."""
-MAX_DIALOG_EXPANSIONS = 2000
-"""How many phrases all of a dialog's ``hear:`` phrases may expand to together."""
-_TOP_KEYS = ("dialog", "description", "concepts", "rules", "fallback", "min_score")
-_RULE_KEYS = ("id", "hear", "say", "read", "then")
+_TOP_KEYS = ("dialog", "description", "concepts", "rules", "fallback", "reprompt", "min_score")
+_RULE_KEYS = ("id", "hear", "say", "read", "then", "confirm")
 _FOLLOW_UP_KEYS = ("rules", "listen_s", "otherwise")
 MAX_FOLLOW_UP_DEPTH = 5
 
@@ -150,20 +144,36 @@ def check_dialog(
     problems.unknown_fields(document.key_marks, _TOP_KEYS, "dialog")
     ctx = CheckContext(catalogue)
     dialog_name = _text(document.get("dialog"), problems, "dialog") or default_name
-    concepts = _concepts(document.get("concepts"), problems)
-    budget = _Budget()
+    concepts = read_concepts(document.get("concepts"), problems)
+    budget = Budget()
     rules = _rules(document.get("rules"), document.mark, concepts, ctx, problems, budget, 0)
     check_ids(rules, problems)
     fallback = None
     raw_fallback = document.get("fallback")
     if raw_fallback is not None:
         fallback = _template(raw_fallback, ctx, problems)
+    reprompts = _reprompts(document.get("reprompt"), ctx, problems)
     min_score = DEFAULT_MIN_SCORE
     raw_score = document.get("min_score")
     if raw_score is not None:
         min_score = _number(raw_score, problems, "min_score", 0.0, 1.0, DEFAULT_MIN_SCORE)
+    no_answer = reprompts[0] if reprompts else fallback
+    rules = with_confirmations(rules, no_answer, concepts, problems)
     problems.raise_if_any()
-    return Dialog(dialog_name, rules, fallback, min_score, file)
+    return Dialog(dialog_name, rules, fallback, min_score, file, reprompts)
+
+
+def _reprompts(
+    value: YValue | None, ctx: CheckContext, problems: Problems
+) -> tuple[CompiledTemplate, ...]:
+    """``reprompt:``: one line or a list of them."""
+    if value is None:
+        return ()
+    items = value.items if isinstance(value, YList) else [value]
+    if not items:
+        problems.add(value.mark, "'reprompt' is empty", "list what the robot says instead")
+    said = (_template(item, ctx, problems) for item in items)
+    return tuple(template for template in said if template is not None)
 
 
 def _text(value: YValue | None, problems: Problems, what: str) -> str | None:
@@ -175,59 +185,13 @@ def _text(value: YValue | None, problems: Problems, what: str) -> str | None:
     return str(value.value)
 
 
-def _concepts(value: YValue | None, problems: Problems) -> dict[str, list[str]]:
-    concepts: dict[str, list[str]] = {}
-    if value is None:
-        return concepts
-    if not isinstance(value, YMap):
-        problems.add(value.mark, "'concepts' must map names to lists of words")
-        return concepts
-    for name, words in value.items():
-        if not isinstance(words, YList) or not all(isinstance(w, YScalar) for w in words):
-            problems.add(words.mark, f"concept {name!r} must be a list of words or phrases")
-            continue
-        concepts[name] = [normalize(str(w.value)) for w in words if isinstance(w, YScalar)]
-    return concepts
-
-
-def _expand(phrase: str, concepts: dict[str, list[str]]) -> list[str] | tuple[str, str | None]:
-    """Every phrase ``~concept`` words expand to, or (message, hint) saying what is wrong."""
-    options: list[list[str]] = []
-    for word in phrase.split():
-        if word.startswith("~"):
-            synonyms = concepts.get(word[1:])
-            if synonyms is None:
-                hint = did_you_mean(word[1:], list(concepts))
-                return f"unknown concept {word!r}" + (f"; {hint}" if hint else ""), None
-            options.append(synonyms)
-        else:
-            options.append([normalize(word)])
-    count = math.prod(len(choices) for choices in options)
-    if count > MAX_PHRASE_EXPANSIONS:  # counted before expanding: 40^5 phrases would hang
-        return (
-            f"phrase expands to {count} phrases, more than {MAX_PHRASE_EXPANSIONS}",
-            "use fewer ~concepts in one phrase, or write several shorter phrases",
-        )
-    expanded = [" ".join(filter(None, combo)) for combo in itertools.product(*options)]
-    if not any(expanded):
-        return f"phrase {phrase!r} has no words", "write it with letters or digits"
-    return expanded
-
-
-@dataclass
-class _Budget:
-    """How many phrases a dialog's concepts may still expand to (-1: gone over)."""
-
-    left: int = MAX_DIALOG_EXPANSIONS
-
-
 def _rules(
     raw_rules: YValue | None,
     where: Mark,
     concepts: dict[str, list[str]],
     ctx: CheckContext,
     problems: Problems,
-    budget: _Budget,
+    budget: Budget,
     depth: int,
     parent: str = "",
 ) -> tuple[DialogRule, ...]:
@@ -274,7 +238,7 @@ def _follow_up(
     concepts: dict[str, list[str]],
     ctx: CheckContext,
     problems: Problems,
-    budget: _Budget,
+    budget: Budget,
     depth: int,
     parent: str,
 ) -> FollowUp | None:
@@ -304,7 +268,7 @@ def _rule(
     concepts: dict[str, list[str]],
     ctx: CheckContext,
     problems: Problems,
-    budget: _Budget,
+    budget: Budget,
     depth: int,
     parent: str,
 ) -> DialogRule | None:
@@ -324,7 +288,7 @@ def _rule(
             if not isinstance(item, YScalar) or not isinstance(item.value, str) or not item.value:
                 problems.add(item.mark, f"a phrase must be text, got {describe(item)}")
                 continue
-            expanded = _expand(item.value, concepts)
+            expanded = expand(item.value, concepts)
             if isinstance(expanded, tuple):
                 problems.add(item.mark, *expanded)
             elif len(expanded) > budget.left:
@@ -360,6 +324,8 @@ def _rule(
     rule_id = _text(raw.get("id"), problems, "id")
     if rule_id is None and unique:  # a follow-up's rule is named under its question's
         rule_id = f"{parent}/{unique[0]}" if parent else unique[0]
+    raw_confirm = raw.get("confirm")
+    confirm = _template(raw_confirm, ctx, problems) if raw_confirm is not None else None
     raw_then = raw.get("then")
     follow_up = None
     if raw_then is not None:
@@ -373,6 +339,7 @@ def _rule(
         read=read,
         follow_up=follow_up,
         mark=raw.mark,
+        confirm=confirm,
     )
 
 

@@ -107,6 +107,12 @@ class DialogRule:
     follow_up: FollowUp | None = None
     mark: Mark | None = None
     """Where the rule is written."""
+    confirm: CompiledTemplate | None = None
+    """The question that asks whether the robot heard this rule right ("Did you ask what
+    my name is?"), asked when what was heard is only like it
+    (:mod:`engine.dialogs.confirming`); None: the robot never asks about it."""
+    confirmed: FollowUp | None = None
+    """What the robot listens for after asking ``confirm``: yes and no."""
 
     @property
     def line(self) -> int:
@@ -178,6 +184,9 @@ class Dialog:
     fallback: CompiledTemplate | None = None
     min_score: float = DEFAULT_MIN_SCORE
     source: str = ""
+    reprompts: tuple[CompiledTemplate, ...] = ()
+    """Said in turn in place of the fallback when the robot again does not understand
+    soon after a sorry (:func:`~engine.dialogs.confirming.reprompt`)."""
 
     def judge(self, utterance: str, follow_up: FollowUp | None = None) -> Verdict:
         """The matching rule, trying ``follow_up``'s rules first when the robot just asked."""
@@ -208,8 +217,11 @@ class Dialog:
 
     @property
     def phrases(self) -> list[str]:
-        """Every phrase the rules listen for, follow-ups included (the recognizer's vocabulary)."""
-        return [phrase.text for rule in self.all_rules() for phrase in rule.phrases]
+        """Every phrase the rules listen for, follow-ups and the answers to confirming
+        questions included (the recognizer's vocabulary)."""
+        rules = self.all_rules()
+        rules += [r for rule in rules if rule.confirmed is not None for r in rule.confirmed.rules]
+        return list(dict.fromkeys(phrase.text for rule in rules for phrase in rule.phrases))
 
     def templates(self) -> list[CompiledTemplate]:
         """Every answer the dialog may say: rules, follow-ups, fallbacks."""
@@ -217,6 +229,7 @@ class Dialog:
         said += [
             r.follow_up.otherwise for r in self.all_rules() if r.follow_up and r.follow_up.otherwise
         ]
+        said += [rule.confirm for rule in self.all_rules() if rule.confirm is not None]
         if self.fallback is not None:
             said.append(self.fallback)
-        return said
+        return [*said, *self.reprompts]

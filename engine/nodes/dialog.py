@@ -7,7 +7,8 @@ from typing import Any, ClassVar
 
 from py_trees.common import Status
 
-from engine.dialogs.model import Dialog, FollowUp
+from engine.dialogs.confirming import REPROMPT_WITHIN_S, maybe_meant, reprompt
+from engine.dialogs.model import Dialog, FollowUp, Verdict
 from engine.errors import ServiceError
 from engine.nodes.base import Leaf
 from engine.services.jobs import ImmediateJob, Job
@@ -27,6 +28,11 @@ class Reply(Leaf):
     RUNNING while reading and speaking; SUCCESS when the answer was said; FAILURE when no
     rule matched and the dialog has no fallback, a field has no value yet, or a sensor or
     the speech service failed.
+
+    When nothing matches but what was heard is like a rule that says how to confirm it,
+    the robot asks (``confirm:``) and a yes is answered as that rule; when it does not
+    understand again soon after a sorry, it says the dialog's next ``reprompt:`` instead
+    (:mod:`engine.dialogs.confirming`).
     """
 
     params: ClassVar = (
@@ -52,6 +58,9 @@ class Reply(Leaf):
         self.phase = "idle"
         self.follow_up: FollowUp | None = None
         self.follow_up_until_s = 0.0
+        self.misses = 0
+        """Utterances not understood in a row, each within REPROMPT_WITHIN_S of the last."""
+        self.missed_at_s = -REPROMPT_WITHIN_S
 
     def dialog(self) -> Dialog:
         dialogs = self.ctx.dialogs
@@ -69,17 +78,9 @@ class Reply(Leaf):
         verdict = dialog.judge(str(heard), asked) if heard else None
         match = verdict.match if verdict is not None else None
         if match is None:
-            why = verdict.reason if verdict is not None else "nothing was heard"
-            self.feedback_message = f"no rule matches {heard!r}: {why}"
-            if heard and self.ctx.session is not None:
-                self.ctx.session.publish(
-                    NotUnderstood(self.ctx.clock.now(), self.ctx.tree, str(heard), why)
-                )
-            said = asked.otherwise if asked is not None else None
-            said = said if said is not None else dialog.fallback
-            if said is not None:
-                self._speak(said)
+            self._not_understood(dialog, str(heard or ""), verdict, asked)
             return
+        self.misses = 0
         self.feedback_message = (
             f"rule {match.rule.id!r} at line {match.rule.line} ({match.score:.2f})"
         )
@@ -91,6 +92,35 @@ class Reply(Leaf):
             self.job = self.ctx.actions.read_sensor(match.rule.read)
         else:
             self._speak(self.answer)
+
+    def _not_understood(
+        self, dialog: Dialog, heard: str, verdict: Verdict | None, asked: FollowUp | None
+    ) -> None:
+        """Ask whether it heard a rule it is like, else say sorry (in other words when it
+        said sorry a moment ago): :mod:`engine.dialogs.confirming`."""
+        why = verdict.reason if verdict is not None else "nothing was heard"
+        self.feedback_message = f"no rule matches {heard!r}: {why}"
+        if not heard:
+            return
+        now = self.ctx.clock.now()
+        maybe = maybe_meant(dialog, heard, asked)
+        again = now - self.missed_at_s <= REPROMPT_WITHIN_S
+        self.misses, self.missed_at_s = (self.misses + 1 if again else 1), now
+        said: CompiledTemplate | None
+        if maybe is not None and maybe.confirm is not None:
+            self.feedback_message += f"; asks whether it heard rule {maybe.id!r}"
+            self.follow_up, said, reprompted = maybe.confirmed, maybe.confirm, 0
+        elif asked is not None and asked.otherwise is not None:
+            said, reprompted = asked.otherwise, 0
+        else:
+            said, reprompted = reprompt(dialog, self.misses)
+        if self.ctx.session is not None:
+            asked_about = maybe.id if maybe is not None else ""
+            self.ctx.session.publish(
+                NotUnderstood(now, self.ctx.tree, heard, why, asked_about, reprompted)
+            )
+        if said is not None:
+            self._speak(said)
 
     def _speak(self, template: CompiledTemplate, read: Callable[[str], Any] | None = None) -> None:
         self.phase = "speaking"

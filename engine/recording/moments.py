@@ -190,20 +190,18 @@ def sensed(recording: Recording) -> list[tuple[float, str, str, str]]:
     return found
 
 
-def not_understood(recording: Recording) -> list[tuple[float, str]]:
-    """(moment, what the robot heard) for each utterance no dialog rule matched, once
-    each (a format 1 recording: read from the dialog node's feedback)."""
+def not_understood(recording: Recording) -> list[NotUnderstood]:
+    """Each utterance no dialog rule matched, once each, with what the robot did instead
+    (asked whether it heard a rule, or said a reprompt); a format 1 recording's are read
+    from the dialog node's feedback (the tree and why left blank)."""
     if recording.format >= 2:
-        return [
-            (event.t_s, event.text)
-            for event in told_events(recording)
-            if isinstance(event, NotUnderstood)
-        ]
-    found: list[tuple[float, str]] = []
+        return [event for event in told_events(recording) if isinstance(event, NotUnderstood)]
+    found: list[NotUnderstood] = []
     last: tuple[float, str] | None = None
     for at, feedback in recording.feedback_containing("no rule matches "):
         if last is not None and last[1] == feedback and at - last[0] <= ANSWER_WITHIN_S:
             continue  # the same node's next status (RUNNING, then done) says it again
         last = (at, feedback)
-        found.append((at, feedback.split("no rule matches ", 1)[1].split(": ", 1)[0]))
+        heard = feedback.split("no rule matches ", 1)[1].split(": ", 1)[0]
+        found.append(NotUnderstood(at, "", heard, ""))
     return found

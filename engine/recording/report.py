@@ -29,9 +29,7 @@ from engine.recording.moments import Moment, not_understood, person_moments
 from engine.recording.replay import RecordedAction, Recording
 from engine.recording.report_plots import numbers, plot
 from engine.recording.told import told_events
-from engine.session.events import (
-    SafetyAction,
-)
+from engine.session.events import NotUnderstood, SafetyAction
 
 
 def outages(recording: Recording) -> list[tuple[str, float, float | None]]:
@@ -102,6 +100,15 @@ def _answer_cell(moment: Moment) -> tuple[str, str]:
         parts.append(f"{moment.answer.tree}: {done}")
     took = f"{moment.response_s:.2f} s" if moment.response_s is not None else "-"
     return html.escape("; ".join(parts)), took
+
+
+def _instead(miss: NotUnderstood) -> str:
+    """What the robot did when it did not understand."""
+    if miss.asked:
+        return f"asked whether it heard \u201c{miss.asked}\u201d"
+    if miss.reprompt:
+        return f"said it in other words (reprompt {miss.reprompt})"
+    return "said its fallback" if miss.tree else ""
 
 
 SAFETY_DID = {
@@ -186,10 +193,14 @@ def report_html(recording: Recording) -> str:
         f"<tr><td>{html.escape(tree)}</td><td class='num'>{count}</td></tr>"
         for tree, count in fired.most_common()
     )
+    misses = not_understood(recording)
     missed = "".join(
-        f"<tr><td class='num'>{at:.1f} s</td><td>{html.escape(text)}</td></tr>"
-        for at, text in not_understood(recording)
+        f"<tr><td class='num'>{miss.t_s:.1f} s</td><td>{html.escape(miss.text)}</td>"
+        f"<td>{html.escape(_instead(miss))}</td></tr>"
+        for miss in misses
     )
+    asked = sum(1 for miss in misses if miss.asked)
+    reprompted = sum(1 for miss in misses if miss.reprompt)
     dropped = "".join(
         f"<tr><td>{html.escape(device)}</td><td class='num'>{since:.1f} s</td>"
         f"<td class='num'>{'-' if back is None else f'{back:.1f} s'}</td>"
@@ -208,6 +219,13 @@ def report_html(recording: Recording) -> str:
             f" {unheard} time{'s' if unheard != 1 else ''} the person spoke while the robot "
             "was speaking, and it could not listen."
             if unheard
+            else ""
+        )
+        + (
+            f" It did not understand {len(misses)} time{'s' if len(misses) != 1 else ''}: it "
+            f"asked whether it heard right {asked} time{'s' if asked != 1 else ''} and said "
+            f"it in other words {reprompted} time{'s' if reprompted != 1 else ''}."
+            if misses
             else ""
         )
     )
@@ -265,7 +283,12 @@ def report_html(recording: Recording) -> str:
             "<p>Actions it could do (not those refused or failed).</p>",
             _table(["behaviour", "actions"], behaviours, "none acted", numeric={1}),
             "<h2>What the robot did not understand</h2>",
-            _table(["when", "heard"], missed, "everything it heard matched a rule", numeric={0}),
+            _table(
+                ["when", "heard", "the robot"],
+                missed,
+                "everything it heard matched a rule",
+                numeric={0},
+            ),
             "<h2>What the safety envelope did</h2>",
             _table(
                 ["when", "did", "joint", "rule", "sensors", "why"],

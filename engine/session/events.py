@@ -210,13 +210,17 @@ class Heard:
 @dataclass(frozen=True, slots=True)
 class NotUnderstood:
     """A dialog had no rule for what was heard; the robot answered with its fallback
-    ("Sorry, I did not understand") when the dialog has one."""
+    ("Sorry, I did not understand") when the dialog has one, asked whether it heard the
+    rule ``asked`` ("" when it did not ask), or said its ``reprompt``-th reprompt (0 when
+    none)."""
 
     kind: ClassVar[str] = "not_understood"
     t_s: float
     tree: str
     text: str
     why: str
+    asked: str = ""
+    reprompt: int = 0
 
 
 @dataclass(frozen=True, slots=True)

@@ -11,7 +11,8 @@ from collections.abc import Callable
 from dataclasses import dataclass, replace
 
 from engine.clock import stopwatch
-from engine.dialogs.model import Dialog, FollowUp, Verdict
+from engine.dialogs.confirming import maybe_meant
+from engine.dialogs.model import Dialog, DialogRule, FollowUp, Verdict
 from engine.media.audio import SPEECH_RATE_HZ, Audio, with_noise
 from engine.speech.recognizer import Recognizer
 from engine.speech.vad import (
@@ -52,6 +53,8 @@ class Hearing:
     after a whole turn), or, when longer, the short pause after which it starts recognizing
     the speech so far plus the recognizer and the matcher (measured here). None when nothing
     was heard."""
+    asks: DialogRule | None = None
+    """The rule the robot asks whether it heard (``answer`` is its ``confirm:`` question)."""
 
     def as_json(self, name: str) -> dict[str, object]:
         match = self.verdict.match if self.verdict is not None else None
@@ -61,6 +64,7 @@ class Hearing:
             "rule": match.rule.id if match is not None else None,
             "score": round(match.score, 3) if match is not None else None,
             "answer": self.answer,
+            "asks": self.asks.id if self.asks is not None else None,
             "latency_s": round(self.latency_s, 3) if self.latency_s is not None else None,
         }
 
@@ -192,9 +196,14 @@ def hear(
 
 
 def _judged(heard: str, dialog: Dialog, follow_up: FollowUp | None) -> Hearing:
+    """What the dialog makes of ``heard``: the answer, the question that confirms a rule it
+    is only like (:mod:`engine.dialogs.confirming`), or the sorry."""
     verdict = dialog.judge(heard, follow_up)
     if verdict.match is not None:
         return Hearing(heard, verdict, shown_answer(verdict.match.rule.answer))
+    maybe = maybe_meant(dialog, heard, follow_up)
+    if maybe is not None and maybe.confirm is not None:
+        return Hearing(heard, verdict, shown_answer(maybe.confirm), asks=maybe)
     otherwise = follow_up.otherwise if follow_up is not None else None
     said = otherwise or dialog.fallback
     return Hearing(heard, verdict, shown_answer(said) if said is not None else None)
@@ -224,6 +233,8 @@ def conversation(
         hearings.append(hearing)
         match = hearing.verdict.match if hearing.verdict is not None else None
         follow_up = match.rule.follow_up if match is not None else None
+        if hearing.asks is not None:
+            follow_up = hearing.asks.confirmed
     return hearings or [Hearing(None, None, None)]
 
 

@@ -131,3 +131,66 @@ def test_a_question_instead_of_an_answer_is_answered(robot: TreeHarness) -> None
     hear(robot, "do you like animals")
     hear(robot, "what is your name")
     assert robot.said[-1] == NAME
+
+
+ASK_NAME = "Did you ask my name?"
+SLOWER = "Sorry, can you say that again, a little slower?"
+HELP = "You can ask me my name, my favorite color, or how warm it is."
+
+
+def test_a_question_heard_only_nearly_is_asked_about_and_a_yes_gets_the_answer(
+    robot: TreeHarness,
+) -> None:
+    hear(robot, "what is your aim")  # like "what is your name", which the matcher refuses
+    hear(robot, "yes")
+    assert robot.said == [ASK_NAME, NAME]
+
+
+def test_a_no_to_the_robot_s_question_gets_the_first_reprompt(robot: TreeHarness) -> None:
+    hear(robot, "what is your aim")
+    hear(robot, "no")
+    assert robot.said == [ASK_NAME, SLOWER]
+
+
+def test_an_answer_that_is_neither_yes_nor_no_is_heard_afresh(robot: TreeHarness) -> None:
+    hear(robot, "what is your aim")
+    hear(robot, "what is your favorite color")
+    assert robot.said == [ASK_NAME, COLOR]
+
+
+def test_a_yes_to_the_temperature_reads_the_sensor_before_it_answers(
+    robot: TreeHarness,
+) -> None:
+    robot.world.temperature_c = 22.2
+    hear(robot, "how worm is it today")
+    hear(robot, "yeah")
+    assert robot.said == ["Did you ask how warm it is?", "The temperature is 72 degrees"]
+    assert [record.action for record in robot.actions] == ["say", "read", "say"]
+
+
+def test_a_yes_long_after_the_question_means_nothing(robot: TreeHarness) -> None:
+    hear(robot, "what is your aim")
+    robot.advance(20.0)  # the robot listens for an answer for 8 s
+    hear(robot, "yes")
+    assert robot.said == [ASK_NAME, SLOWER]  # a miss soon after the question: in other words
+
+
+def test_after_a_sorry_the_robot_says_it_in_other_words_in_turn(robot: TreeHarness) -> None:
+    for _ in range(4):
+        hear(robot, "purple monkey dishwasher")
+    assert robot.said == [FALLBACK, SLOWER, HELP, SLOWER]
+
+
+def test_understood_again_the_robot_starts_over_with_its_plain_sorry(robot: TreeHarness) -> None:
+    hear(robot, "purple monkey dishwasher")
+    hear(robot, "purple monkey dishwasher")
+    hear(robot, "what is your name")
+    hear(robot, "purple monkey dishwasher")
+    assert robot.said == [FALLBACK, SLOWER, NAME, FALLBACK]
+
+
+def test_a_sorry_long_after_the_last_is_the_plain_sorry_again(robot: TreeHarness) -> None:
+    hear(robot, "purple monkey dishwasher")
+    robot.advance(61.0)
+    hear(robot, "purple monkey dishwasher")
+    assert robot.said == [FALLBACK, FALLBACK]

@@ -333,3 +333,76 @@ def test_a_phrase_two_rules_listen_for_is_refused_before_it_silently_answers_not
         "d.yaml:8:5: rules 'name' (line 5) and 'pets' both listen for 'what is your name': "
         "said, it fits both and neither answers (keep the phrase in one rule)"
     ]
+
+
+# -- asking instead of giving up ---------------------------------------------------------
+def test_a_rule_that_confirms_in_a_dialog_with_nothing_to_say_to_a_no_is_refused(
+    tmp_path: Path,
+) -> None:
+    problems = dialog_problems(
+        tmp_path,
+        """\
+        dialog: d
+        rules:
+          - id: name
+            hear: ["what is your name"]
+            say: "I am Ro"
+            confirm: "Did you ask my name?"
+        """,
+    )
+    assert problems == [
+        "d.yaml:3:5: rule 'name' asks to confirm, but the dialog says nothing to a no "
+        "(add 'fallback:' or 'reprompt:' to the dialog)"
+    ]
+
+
+def test_an_empty_reprompt_list_and_a_confirm_that_is_not_text_are_named_where_they_are(
+    tmp_path: Path,
+) -> None:
+    problems = dialog_problems(
+        tmp_path,
+        """\
+        dialog: d
+        rules:
+          - hear: ["what is your name"]
+            say: "I am Ro"
+            confirm: [1, 2]
+        reprompt: []
+        fallback: "Sorry?"
+        """,
+    )
+    assert problems == [
+        "d.yaml:5:14: an answer must be text, got a list",
+        "d.yaml:6:11: 'reprompt' is empty (list what the robot says instead)",
+    ]
+
+
+def test_a_dialog_in_another_language_confirms_with_its_own_yes_and_no(tmp_path: Path) -> None:
+    robot = robot_with(
+        tmp_path,
+        """\
+        dialog: default
+        concepts:
+          yes: ["oui", "ouais"]
+          no: ["non"]
+        rules:
+          - hear: ["comment tu t'appelles"]
+            say: "Je m'appelle Ro"
+            confirm: "Tu demandes mon nom ?"
+        reprompt: "Tu peux répéter plus lentement ?"
+        """,
+    )
+    robot.set("/speech/heard", "comment toi appelles")
+    robot.advance(1.0)
+    robot.set("/speech/heard", "oui")
+    robot.advance(1.0)
+    robot.set("/speech/heard", "comment toi appelles")
+    robot.advance(1.0)
+    robot.set("/speech/heard", "non")
+    robot.advance(1.0)
+    assert robot.said == [
+        "Tu demandes mon nom ?",
+        "Je m'appelle Ro",
+        "Tu demandes mon nom ?",
+        "Tu peux répéter plus lentement ?",
+    ]
