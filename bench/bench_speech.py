@@ -15,6 +15,11 @@ again against the phrases when what it wrote holds none: closed listening, and W
 when closed listening is not sure) and "whisper"
 (Whisper tiny.en alone, prompted with the phrases).
 
+Children's voices (bench/children_speech.py, where ../shared/data/children-speech is):
+children the children's hearing was never tuned on, by age band, with adults' hearing
+and with children's (``hearing: children``); and the real voices below heard with
+children's hearing against the default dialog, which means none of them.
+
 Real voices (tests/speech/real_voices.py, where Debian's packages are installed): 43
 recordings of people; word error rate (jiwer) of Moonshine and of Whisper, each unprompted
 as a general transcriber (no phrases listened for, so no closed listening), after the
@@ -53,6 +58,8 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
+
+from children_speech import adults_out_of_the_dialog, children_figures  # noqa: E402
 
 from engine.blackboard.catalogue import default_catalogue  # noqa: E402
 from engine.dialogs.library import load_dialog  # noqa: E402
@@ -383,6 +390,17 @@ def main() -> int:
 
     if not args.quick:
         word_error_rates({"moonshine": moonshine, "whisper": whisper}, vad)
+    for_children = SecondOpinion(MoonshineRecognizer(children=True), whisper)
+    children_figures(
+        {
+            "adults' hearing": (recognizers["moonshine (default)"], False),
+            "children's hearing": (for_children, True),
+        },
+        vad,
+        quick=args.quick,
+    )
+    if not args.quick:
+        adults_out_of_the_dialog(for_children, vad, dialog)
 
     room = noise(60.0, -50.0, seed=5)
     vad.reset()

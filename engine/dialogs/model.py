@@ -146,7 +146,9 @@ class Verdict:
 
 
 def judge(rules: Sequence[DialogRule], utterance: str, min_score: float) -> Verdict:
-    """The rule ``utterance`` means, or why none: no rule's words, too low, or ambiguous."""
+    """The rule ``utterance`` means, or why none: no rule's words, too low, or ambiguous.
+    A phrase of one rule said word for word, in its order, is that rule's, whatever other
+    rules it also fits ("one nine three four" is not "four nine one three")."""
     heard = words(utterance)
     if not heard:
         return Verdict(None, "nothing was heard")
@@ -159,6 +161,9 @@ def judge(rules: Sequence[DialogRule], utterance: str, min_score: float) -> Verd
     found = tuple(candidates)
     if not candidates:
         return Verdict(None, "no rule's meaning words were all heard", found)
+    said = [m for m in candidates if m.phrase.words == tuple(heard)]
+    if len({m.rule.id for m in said}) == 1:  # a phrase said word for word, in its order
+        return Verdict(said[0], f"phrase {said[0].phrase.text!r}, word for word", found)
     best = candidates[0]
     if best.score < min_score:
         return Verdict(

@@ -102,7 +102,9 @@ def utterances(audio: Audio, vad: SpeechProbability, *, children: bool = False) 
 class _LiveTimeline:
     """The listener's worker on a recording's timeline: one recognition at a time, each
     starting when its audio was told and the worker was free, taking as long as it takes
-    here; a draft that is a whole turn tells the detector when its text is ready."""
+    here; a draft overtaken by newer speech while it waited is never recognized (as the
+    :class:`~engine.speech.listener.Listener` skips it); a draft that is a whole turn tells
+    the detector when its text is ready."""
 
     def __init__(
         self,
@@ -114,29 +116,42 @@ class _LiveTimeline:
         self.recognizer = recognizer
         self.whole_turn = whole_turn
         self.free_s = 0.0
+        self.waiting: Utterance | None = None  # a draft told while the worker was busy
         self.draft: tuple[Utterance, str, float] | None = None  # draft, text, ready
         self.whole_at_s: float | None = None
 
     def at(self, now_s: float) -> None:
-        """Time has reached ``now_s``: a whole turn found by then is told."""
+        """Time has reached ``now_s``: a waiting draft starts once the worker is free, and
+        a whole turn found by then is told."""
+        if self.waiting is not None and self.free_s <= now_s:
+            self._recognize_draft(self.waiting)
+            self.waiting = None
         if self.whole_at_s is not None and self.whole_at_s <= now_s and self.draft:
             self.detector.whole_turn(self.draft[0])
             self.whole_at_s = None
 
     def drafted(self, draft: Utterance) -> None:
-        text, ready_s = self._recognized(draft)
-        self.draft = (draft, text, ready_s)
-        whole = bool(text) and self.whole_turn is not None and self.whole_turn(text)
-        self.whole_at_s = ready_s if whole else None
+        if self.free_s > draft.end_sample / SPEECH_RATE_HZ:
+            self.waiting = draft  # overtakes any draft still waiting
+            self.draft, self.whole_at_s = None, None
+        else:
+            self._recognize_draft(draft)
 
     def ended(self, utterance: Utterance) -> Part:
         ended_s = utterance.end_sample / SPEECH_RATE_HZ
+        self.waiting = None  # overtaken by the end: never recognized
         if utterance.drafted and self.draft is not None:
             text, ready_s = self.draft[1], max(ended_s, self.draft[2])
         else:
             text, ready_s = self._recognized(utterance)
         self.draft, self.whole_at_s = None, None
         return Part(utterance, text, ended_s - utterance.quiet_s, ended_s, ready_s)
+
+    def _recognize_draft(self, draft: Utterance) -> None:
+        text, ready_s = self._recognized(draft)
+        self.draft = (draft, text, ready_s)
+        whole = bool(text) and self.whole_turn is not None and self.whole_turn(text)
+        self.whole_at_s = ready_s if whole else None
 
     def _recognized(self, utterance: Utterance) -> tuple[str, float]:
         begins_s = max(self.free_s, utterance.end_sample / SPEECH_RATE_HZ)

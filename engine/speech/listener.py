@@ -6,7 +6,9 @@ each finished utterance is recognized in the listener's worker, never in a tick,
 ``on_heard`` gets the text. The worker starts on an utterance before the robot's wait
 for silence is over: on the detector's draft (the speech so far, after a short pause);
 when the utterance ends with nothing said after the draft, the draft's text is the
-utterance's and is told at once (a draft that fell short is forgotten). A draft whose text
+utterance's and is told at once (a draft that fell short is forgotten; one that waited
+while the worker was busy and was overtaken by newer speech is never recognized: a child
+who pauses often does not queue up drafts). A draft whose text
 is a whole turn (``whole_turn``: one of the dialogs' phrases, and none goes on from it)
 shortens the wait for silence (:meth:`~engine.speech.vad.SpeechDetector.whole_turn`).
 
@@ -159,6 +161,11 @@ class Listener:
             if item is None:
                 return
             utterance, ended_s = item
+            if ended_s is None and not self._queue.empty():  # overtaken: a newer one waits
+                self._draft_text = None
+                with self._lock:
+                    self._working -= 1
+                continue
             drafted = self._draft_text if utterance.drafted else None
             self._draft_text = None
             text = drafted if drafted is not None else self._recognized(utterance)

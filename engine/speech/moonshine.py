@@ -23,6 +23,7 @@ the robot says it did not understand rather than answer a guess.
 
 from __future__ import annotations
 
+import functools
 import importlib.util
 import math
 from collections.abc import Iterable
@@ -33,7 +34,7 @@ import numpy as np
 
 from engine.dialogs.words import words
 from engine.media.audio import SPEECH_RATE_HZ, Audio
-from engine.speech.children import SEARCH_NATS, a_child_said
+from engine.speech.children import BEAM, NEAR_NATS, a_child_said, search_floor
 from engine.speech.onnx_folding import folded_model
 from engine.speech.phrase_search import (
     CLOSE_ENOUGH_NATS,
@@ -319,8 +320,11 @@ class MoonshineRecognizer:
             self._texts,
             end_token=END_TOKEN,
             max_tokens=self.grammar.longest + 1,
-            at_least=heard.free_log_prob - SEARCH_NATS,
+            at_least=search_floor(heard.free_log_prob, self.grammar.most_words("")),
             keep=2,
+            near=NEAR_NATS,
+            floor_for=functools.partial(search_floor, heard.free_log_prob),
+            beam=BEAM,
         )
         return a_child_said(found, heard.free_log_prob, words_heard)
 

@@ -34,7 +34,7 @@ import functools
 import itertools
 import math
 import re
-from collections.abc import Iterable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 from typing import Protocol
 
@@ -106,7 +106,12 @@ class PhraseGrammar:
         self.texts = {said for text in listened for said in with_plurals(text)}
         self.longest = max((len(text) for text in self.texts), default=0)
         """Characters of the longest text."""
-        self._prefixes = {text[:end] for text in self.texts for end in range(len(text) + 1)}
+        self._prefixes: dict[str, int] = {}  # each text's beginnings: its most words
+        for text in self.texts:
+            count = len(text.split())
+            for end in range(len(text) + 1):
+                begun = text[:end]
+                self._prefixes[begun] = max(count, self._prefixes.get(begun, 0))
         self.keywords = {
             word for phrase in self.phrases for word in phrase if not is_function_word(word)
         }
@@ -128,6 +133,11 @@ class PhraseGrammar:
 
     def complete(self, text: str) -> bool:
         return spelled(text).rstrip() in self.texts
+
+    def most_words(self, text: str) -> int:
+        """The most words of a phrase ``text`` is on the way to (0: none)."""
+        plain = spelled(text)
+        return self._prefixes.get(plain, 0) or len(plain.split()) * self.complete(text)
 
     def written(self, spelling: str) -> str:
         """A phrase as the dialog writes it, from its spelling ("but its not" is "but it's
@@ -224,10 +234,17 @@ def closest_phrases(
     max_tokens: int,
     at_least: float = -math.inf,
     keep: int = 1,
+    near: float = math.inf,
+    floor_for: Callable[[int], float] | None = None,
+    beam: int = BEAM,
 ) -> list[Found]:
     """The ``keep`` likeliest distinct phrases of ``grammar`` the decoder writes, likeliest
     first (see :func:`closest_phrase`): with ``keep=2``, how far the best stands above the
-    next, which tells a phrase heard from one of two alike."""
+    next, which tells a phrase heard from one of two alike. ``near`` (natural log): only
+    phrases at most this much less likely than the best are looked for, which ends the
+    search sooner. ``floor_for``: the least likely (natural log) a phrase of so many words may
+    be, which a text on the way to phrases of at most so many words need not fall below.
+    ``beam``: how many texts are carried on at each step."""
     beams: list[tuple[str, float]] = [("", 0.0)]
     rows = decoding.first()
     top = min(TOP_TOKENS, rows.shape[1])
@@ -249,7 +266,11 @@ def closest_phrases(
         # a text's score only falls as it grows: one below the keep-th phrase never passes it
         ranked = sorted(finished.values(), reverse=True)
         floor = at_least if len(ranked) < keep else max(at_least, ranked[keep - 1])
-        kept = [o for o in options[:BEAM] if o[0] > floor]
+        if ranked:
+            floor = max(floor, ranked[0] - near)
+        kept = [o for o in options[:beam] if o[0] > floor]
+        if floor_for is not None:
+            kept = [o for o in kept if o[0] > floor_for(grammar.most_words(o[3]))]
         if not kept:
             break
         rows = decoding.then(

@@ -7,6 +7,7 @@ test_hearing_the_default_dialog.py and test_real_voices.py."""
 
 from __future__ import annotations
 
+import threading
 from collections.abc import Iterable
 
 import numpy as np
@@ -17,7 +18,7 @@ from engine.media.audio import SPEECH_RATE_HZ, Audio
 from engine.speech.listener import Heard, Listener
 from engine.speech.moonshine import said_once, without_loop
 from engine.speech.phrase_search import PhraseGrammar
-from engine.speech.recognizer import Transcript, Word, said_in_a_loop
+from engine.speech.recognizer import Recognizer, Transcript, Word, said_in_a_loop
 from engine.speech.vad import FRAME_S, SpeechDetector, Utterance
 
 
@@ -53,10 +54,15 @@ def speech(seconds: float) -> Audio:
     return Audio(np.full(round(seconds * SPEECH_RATE_HZ), 0.5, dtype=np.float32), SPEECH_RATE_HZ)
 
 
-def listened(audio: Audio, recognizer: CountingRecognizer) -> list[Heard]:
+def listened(audio: Audio, recognizer: Recognizer) -> list[Heard]:
+    """``audio`` from a microphone in 32 ms pieces, the worker done with each before the
+    next (as when recognition is quick)."""
     told: list[Heard] = []
     listener = Listener(SpeechDetector(LoudnessVad()), recognizer, VirtualClock(), told.append)
-    listener.hear(audio, audio.seconds)
+    for at in range(0, len(audio.samples), 512):
+        piece = Audio(audio.samples[at : at + 512], SPEECH_RATE_HZ)
+        listener.hear(piece, (at + len(piece.samples)) / SPEECH_RATE_HZ)
+        assert listener.settling.wait(listener.settled)
     listener.close()
     return told
 
@@ -80,6 +86,40 @@ def test_speech_that_goes_on_after_a_pause_is_recognized_whole() -> None:
     assert len(recognizer.heard) == 2
     assert recognizer.heard[1] > 1.4
     assert told[0].text == f"{recognizer.heard[1]:.3f} seconds"
+
+
+class SlowRecognizer(CountingRecognizer):
+    """Hears as :class:`CountingRecognizer`, but its first recognition lasts until the
+    story lets it finish (as a slow model on a busy machine)."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.started, self.finish = threading.Event(), threading.Event()
+
+    def transcribe(self, audio: Audio) -> Transcript:
+        if not self.heard:
+            self.started.set()
+            assert self.finish.wait(timeout=30)
+        return super().transcribe(audio)
+
+
+def test_a_draft_overtaken_while_the_worker_was_busy_is_never_recognized() -> None:
+    recognizer = SlowRecognizer()
+    told: list[Heard] = []
+    listener = Listener(SpeechDetector(LoudnessVad()), recognizer, VirtualClock(), told.append)
+    # a child says a few words, pauses, goes on, pauses again and stops
+    first = speech(0.6).then(Audio.silence(0.2))
+    listener.hear(first, first.seconds)
+    assert recognizer.started.wait(timeout=30)  # the first draft is being recognized
+    rest = speech(0.6).then(Audio.silence(0.2)).then(speech(0.4)).then(Audio.silence(1.0))
+    listener.hear(rest, first.seconds + rest.seconds)  # two more drafts, and the end
+    recognizer.finish.set()
+    assert listener.settling.wait(listener.settled)
+    listener.close()
+    # the first draft and the whole utterance: the drafts that waited were overtaken
+    assert len(recognizer.heard) == 2
+    assert recognizer.heard[1] > 2.0
+    assert [heard.text for heard in told] == [f"{recognizer.heard[1]:.3f} seconds"]
 
 
 def test_a_click_is_no_draft_and_no_utterance() -> None:

@@ -22,6 +22,7 @@ from engine.speech.phrase_search import (
     PhraseGrammar,
     bears_out,
     closest_phrase,
+    closest_phrases,
     left_out,
     sure_of,
 )
@@ -123,6 +124,53 @@ def test_a_search_gives_up_on_texts_less_likely_than_a_phrase_can_be_of_use() ->
     assert decoder.steps == 2  # "Do you like" (-6.1) fell below the floor: not decoded on
     unbounded = search(script)  # without a floor: found, and only then judged
     assert unbounded is not None and unbounded.log_prob == pytest.approx(-6.3)
+
+
+def test_a_search_for_the_runner_up_looks_only_near_the_best() -> None:
+    script = {
+        "": {" How": -0.1, " Do": -3.0},
+        " How": {" are": -0.1},
+        " How are": {" you": -0.1},
+        " How are you": {"</s>": -0.1},
+        " Do": {" you": -3.0},
+        " Do you": {" like": -3.0},
+        " Do you like": {" dog": -0.1},
+        " Do you like dog": {"</s>": -0.1},
+    }
+    everything = closest_phrases(
+        ScriptedDecoder(script), GRAMMAR, PIECES, end_token=END, max_tokens=8, keep=2
+    )
+    assert [f.text for f in everything] == ["how are you", "do you like dog"]
+    decoder = ScriptedDecoder(script)
+    near = closest_phrases(decoder, GRAMMAR, PIECES, end_token=END, max_tokens=8, keep=2, near=5)
+    assert [f.text for f in near] == ["how are you"]  # "Do you" (-6) is 5.6 below the best
+    assert decoder.steps == 3
+
+
+def test_a_text_on_the_way_to_short_phrases_only_gives_up_sooner() -> None:
+    # a phrase may be 2 nats a word below -1: "how are you" down to -7, "do you like dog"
+    # down to -9; both texts are at -8 after their second word
+    script = {
+        "": {" How": -0.1, " Do": -0.1},
+        " How": {" are": -7.9},
+        " How are": {" you": -0.1},
+        " How are you": {"</s>": -0.1},
+        " Do": {" you": -7.9},
+        " Do you": {" like": -0.1},
+        " Do you like": {" dog": -0.1},
+        " Do you like dog": {"</s>": -0.1},
+    }
+    found = closest_phrases(
+        ScriptedDecoder(script),
+        GRAMMAR,
+        PIECES,
+        end_token=END,
+        max_tokens=8,
+        at_least=-9.0,
+        keep=2,
+        floor_for=lambda words: -1.0 - 2.0 * words,
+    )
+    assert [f.text for f in found] == ["do you like dog"]
 
 
 def words_heard(text: str, probability: float = 0.9) -> list[tuple[str, float]]:

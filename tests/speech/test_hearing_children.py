@@ -4,8 +4,9 @@ A robot whose profile says ``hearing: children`` waits longer when a child pause
 sentence, keeps a child's breathy first word, and keeps a phrase as children say it (far
 from what a model trained on adults writes, but like it, and standing out from the other
 phrases). The rule's stories are exact (phrases found and their log-probabilities given);
-the last ones hear real children (examples/children-speech, speakers the rule was never
-set on)."""
+the last ones hear four real children with the real models (examples/children-speech:
+children the rule was tuned on; bench/children_speech.py measures it on children held
+back)."""
 
 from __future__ import annotations
 
@@ -13,10 +14,16 @@ from pathlib import Path
 
 import pytest
 
+from engine.blackboard.catalogue import default_catalogue
+from engine.dialogs.library import load_dialog
+from engine.dialogs.model import Dialog
 from engine.dialogs.words import alike, normalize
-from engine.media.audio import Audio
+from engine.media.audio import Audio, read_wav
 from engine.speech.children import ALIKE_ALONE, MARGIN_NATS, NATS_PER_WORD, a_child_said
+from engine.speech.hearing import hear
 from engine.speech.phrase_search import Found
+from engine.speech.recognizer import Recognizer
+from engine.speech.recognizers import load_recognizer
 from engine.speech.vad import SileroVad, speech_detector
 from engine.speech.voices import Voice
 
@@ -113,3 +120,73 @@ def test_a_child_s_pause_within_a_sentence_does_not_cut_it_in_two(
     whole = children.feed(audio.samples)
     assert len(cut) == 2
     assert len(whole) == 1
+
+
+CHILDREN = ROOT / "examples" / "children-speech"
+READ_ALOUD = {
+    "000050003.wav": "mike likes the white one",  # age 6
+    "014470007.wav": "it is a very bossy turkey",  # age 7
+    "030750012.wav": "tell me will you be here long",  # age 9
+    "050150125.wav": "he was late this morning too",  # age 10
+}
+STORY_TIME = """
+dialog: story_time
+rules:
+  - {id: greeting, hear: ["hello", "hi there"], say: "Hello!"}
+  - {id: name, hear: ["what is your name"], say: "I am H B S 2"}
+  - {id: mike, hear: ["mike likes the white one"], say: "The white one is nice."}
+  - {id: mike_red, hear: ["mike likes the red one"], say: "Red is nice too."}
+  - {id: turkey, hear: ["it is a very bossy turkey"], say: "Gobble gobble!"}
+  - {id: long, hear: ["tell me will you be here long"], say: "All afternoon."}
+  - {id: late, hear: ["he was late this morning too"], say: "Oh dear, late again."}
+  - {id: early, hear: ["she was early this morning"], say: "Good for her."}
+fallback: "Sorry, I did not understand."
+"""
+
+
+@pytest.fixture(scope="module")
+def story_time(tmp_path_factory: pytest.TempPathFactory) -> Dialog:
+    path = tmp_path_factory.mktemp("dialogs") / "story_time.yaml"
+    path.write_text(STORY_TIME, encoding="utf-8")
+    return load_dialog(path, default_catalogue())
+
+
+@pytest.fixture(scope="module")
+def childrens_hearing() -> Recognizer:
+    return load_recognizer("moonshine", children=True)
+
+
+def rule_heard(
+    recognizer: Recognizer, dialog: Dialog, file: str, vad: SileroVad, children: bool
+) -> str | None:
+    recognizer.listen_for(dialog.phrases)
+    hearing = hear(read_wav(CHILDREN / file), vad, recognizer, dialog, children=children)
+    match = hearing.verdict.match if hearing.verdict is not None else None
+    return match.rule.id if match is not None else None
+
+
+def test_children_reading_the_dialog_s_sentences_are_understood_with_children_s_hearing(
+    childrens_hearing: Recognizer, story_time: Dialog, vad: SileroVad
+) -> None:
+    expected = {"000050003.wav": "mike", "014470007.wav": "turkey"}
+    expected |= {"030750012.wav": "long", "050150125.wav": "late"}
+    heard = {f: rule_heard(childrens_hearing, story_time, f, vad, True) for f in READ_ALOUD}
+    assert heard == expected
+
+
+def test_adults_hearing_tells_the_same_children_sorry_but_never_a_wrong_answer(
+    story_time: Dialog, vad: SileroVad
+) -> None:
+    adults = load_recognizer("moonshine")
+    expected = {"000050003.wav": "mike", "014470007.wav": "turkey"}
+    expected |= {"030750012.wav": "long", "050150125.wav": "late"}
+    heard = {f: rule_heard(adults, story_time, f, vad, False) for f in READ_ALOUD}
+    assert all(rule in (None, expected[f]) for f, rule in heard.items())
+    assert list(heard.values()).count(None) >= 2
+
+
+def test_a_child_s_sentence_the_dialog_does_not_hold_is_not_answered(
+    childrens_hearing: Recognizer, default_dialog: Dialog, vad: SileroVad
+) -> None:
+    heard = [rule_heard(childrens_hearing, default_dialog, f, vad, True) for f in READ_ALOUD]
+    assert heard == [None, None, None, None]

@@ -125,3 +125,26 @@ def test_follow_up_answers_are_tried_first_while_the_robot_listens(dialog: Dialo
 def test_the_recognizer_vocabulary_holds_the_follow_up_phrases(dialog: Dialog) -> None:
     assert "i have a dog" in dialog.phrases
     assert "nope" in dialog.phrases
+
+
+READING = """
+dialog: reading
+rules:
+  - {id: digits, hear: ["one nine three four"], say: "1934"}
+  - {id: other_digits, hear: ["four nine one three"], say: "4913"}
+  - {id: doing_now, hear: ["that is what i am doing now"], say: "Good."}
+  - {id: doing_it_for, hear: ["what am i doing it for"], say: "For fun."}
+"""
+
+
+def test_a_phrase_said_word_for_word_is_its_rule_s_whatever_else_it_fits(
+    tmp_path: Path,
+) -> None:
+    path = tmp_path / "reading.yaml"
+    path.write_text(READING, encoding="utf-8")
+    reading = load_dialog(path, default_catalogue())
+    assert rule_for(reading, "One, nine, three, four.") == "digits"
+    assert rule_for(reading, "four nine one three") == "other_digits"
+    assert rule_for(reading, "That's what I'm doing now") == "doing_now"
+    # the same words in another order fit both rules alike: neither is answered
+    assert rule_for(reading, "nine one four three") is None
