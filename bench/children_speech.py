@@ -68,7 +68,8 @@ class BandTally:
     right: int = 0
     wrong: int = 0
     sorry: int = 0
-    latencies: list[float] = field(default_factory=list)
+    latencies: list[float] = field(default_factory=list)  # of every clip heard
+    answered: list[float] = field(default_factory=list)  # of those a rule answered
     mistakes: list[str] = field(default_factory=list)
 
     @property
@@ -118,7 +119,8 @@ def hear_children(
 ) -> dict[str, BandTally]:
     """Each clip heard live and judged by ``dialog``: a clip is right when the rule holding
     its sentence answers, wrong when another rule does (any rule, where the dialog does not
-    hold it), sorry when none does. Latency: the last utterance's end of speech to text."""
+    hold it), sorry when none does. Latency: the last utterance's end of speech to its text
+    (for a sorry, the robot's whole wait for silence and any second opinion)."""
     recognizer.listen_for(dialog.phrases)
     whole_turn = PhraseGrammar(dialog.phrases).is_a_whole_turn
     tallies: dict[str, BandTally] = {}
@@ -130,6 +132,8 @@ def hear_children(
         tally = tallies.setdefault(clip.band, BandTally())
         if parts:
             tally.latencies.append(parts[-1].latency_s)
+            if got is not None:
+                tally.answered.append(parts[-1].latency_s)
         if got is None:
             tally.sorry += 1
         elif got == rule_id(clip.text):
@@ -148,12 +152,13 @@ def pct(values: list[float], q: float) -> float:
 def print_tallies(name: str, tallies: dict[str, BandTally]) -> None:
     for band, tally in sorted(tallies.items()):
         n = tally.clips
-        latency = tally.latencies or [0.0]
+        answered, every = tally.answered or [0.0], tally.latencies or [0.0]
         print(
             f"{name:20s} {band:5s} right {tally.right:3d}/{n} ({100 * tally.right / n:5.1f}%)  "
             f"wrong {tally.wrong:2d}  sorry {tally.sorry:3d}   end of speech -> intent "
-            f"p50 {statistics.median(latency) * 1000:4.0f} ms  "
-            f"p90 {pct(latency, 90) * 1000:4.0f} ms"
+            f"p50 {statistics.median(answered) * 1000:4.0f} ms  "
+            f"p90 {pct(answered, 90) * 1000:4.0f} ms (answered); "
+            f"p90 {pct(every, 90) * 1000:4.0f} ms (all)"
         )
         for line in tally.mistakes:
             print(f"  wrong: {line}")

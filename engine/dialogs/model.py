@@ -21,6 +21,7 @@ from engine.dialogs.words import (
     same_word,
     weight,
     words,
+    written_as,
 )
 from engine.files.problems import Mark
 from engine.values.templates import CompiledTemplate
@@ -64,6 +65,7 @@ class Phrase:
         """0..1: 0 when a required word is missing; 1 for the phrase exactly."""
         if not self.words:
             return 0.0
+        heard = written_as(heard, self.words)
         found = [w for w in self.words if any(same_word(h, w) for h in heard)]
         if any(w not in found for w in self.required):
             return 0.0
@@ -161,7 +163,7 @@ def judge(rules: Sequence[DialogRule], utterance: str, min_score: float) -> Verd
     found = tuple(candidates)
     if not candidates:
         return Verdict(None, "no rule's meaning words were all heard", found)
-    said = [m for m in candidates if m.phrase.words == tuple(heard)]
+    said = [m for m in candidates if m.phrase.words == written_as(heard, m.phrase.words)]
     if len({m.rule.id for m in said}) == 1:  # a phrase said word for word, in its order
         return Verdict(said[0], f"phrase {said[0].phrase.text!r}, word for word", found)
     best = candidates[0]

@@ -10,8 +10,10 @@ function-word list and all count as meaning words.
 from __future__ import annotations
 
 import difflib
+import itertools
 import re
 import unicodedata
+from collections.abc import Sequence
 
 _CONTRACTIONS = {
     "what's": "what is",
@@ -214,6 +216,29 @@ def same_word(heard: str, expected: str) -> bool:
 def words(text: str) -> tuple[str, ...]:
     """The stemmed words of ``text`` after :func:`normalize`."""
     return tuple(stem(word) for word in normalize(text).split())
+
+
+def written_as(heard: Sequence[str], phrase: Sequence[str]) -> tuple[str, ...]:
+    """``heard`` (words) with its compounds written as ``phrase`` writes them: a recognizer's
+    "good bye" or "foot ball" is the phrase's "goodbye" or "football", its "icecream" the
+    phrase's "ice cream". Words the phrase has as they are stay as they are."""
+    own = set(phrase)
+    split = {a + b: (a, b) for a, b in itertools.pairwise(phrase)}
+    written: list[str] = []
+    at = 0
+    while at < len(heard):
+        word = heard[at]
+        after = heard[at + 1] if at + 1 < len(heard) else None
+        if word not in own and after is not None and after not in own and word + after in own:
+            written.append(word + after)
+            at += 2
+            continue
+        if word not in own and word in split:
+            written.extend(split[word])
+        else:
+            written.append(word)
+        at += 1
+    return tuple(written)
 
 
 def alike(one: str, other: str) -> float:

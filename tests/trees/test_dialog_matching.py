@@ -148,3 +148,31 @@ def test_a_phrase_said_word_for_word_is_its_rule_s_whatever_else_it_fits(
     assert rule_for(reading, "That's what I'm doing now") == "doing_now"
     # the same words in another order fit both rules alike: neither is answered
     assert rule_for(reading, "nine one four three") is None
+
+
+COMPOUNDS = """
+dialog: compounds
+rules:
+  - {id: bye, hear: ["goodbye"], say: "Bye!"}
+  - {id: sport, hear: ["do you like football"], say: "I like football."}
+  - {id: treat, hear: ["i want ice cream"], say: "Me too."}
+"""
+
+
+@pytest.mark.parametrize(
+    ("written_by_a_recognizer", "rule"),
+    [
+        ("Good-bye.", "bye"),
+        ("Good bye!", "bye"),
+        ("Do you like foot ball?", "sport"),
+        ("I want icecream", "treat"),
+        ("I want ice-cream.", "treat"),
+        ("Do you like foot?", None),  # half a compound is not the word
+    ],
+)
+def test_a_compound_written_the_recognizer_s_way_is_the_phrase_s_word(
+    tmp_path: Path, written_by_a_recognizer: str, rule: str | None
+) -> None:
+    path = tmp_path / "compounds.yaml"
+    path.write_text(COMPOUNDS, encoding="utf-8")
+    assert rule_for(load_dialog(path, default_catalogue()), written_by_a_recognizer) == rule
