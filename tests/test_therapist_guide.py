@@ -63,6 +63,7 @@ def test_the_guide_places_its_examples_where_a_therapist_would() -> None:
         "trees/tickles.yaml",
         "trees/hug.yaml",
         "dialogs/pets.yaml",
+        "dialogs/ask_first.yaml",
         "trees/profiles/calm_child.yaml",
         "examples/scenarios/tickles_test.yaml",
         "trees/buttons/my_session.yaml",

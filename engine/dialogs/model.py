@@ -15,6 +15,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 from engine.dialogs.words import (
+    NUMBER_WORDS,
     PERSON_WORDS,
     QUESTION_WORDS,
     is_function_word,
@@ -62,10 +63,15 @@ class Phrase:
         )
 
     def score(self, heard: Sequence[str]) -> float:
-        """0..1: 0 when a required word is missing; 1 for the phrase exactly."""
+        """0..1: 0 when a required word is missing, or the phrase's numbers were not heard
+        as they are, in their order ("four nine one three" is not "one nine three four";
+        "sixty six" is not "six"); 1 for the phrase exactly."""
         if not self.words:
             return 0.0
         heard = written_as(heard, self.words)
+        numbers = [w for w in self.words if w in NUMBER_WORDS]
+        if numbers and [h for h in heard if h in NUMBER_WORDS] != numbers:
+            return 0.0  # numbers are said in their order, and no other number is theirs
         found = [w for w in self.words if any(same_word(h, w) for h in heard)]
         if any(w not in found for w in self.required):
             return 0.0

@@ -146,8 +146,9 @@ def test_a_phrase_said_word_for_word_is_its_rule_s_whatever_else_it_fits(
     assert rule_for(reading, "One, nine, three, four.") == "digits"
     assert rule_for(reading, "four nine one three") == "other_digits"
     assert rule_for(reading, "That's what I'm doing now") == "doing_now"
-    # the same words in another order fit both rules alike: neither is answered
+    # numbers in another order are neither's
     assert rule_for(reading, "nine one four three") is None
+    assert rule_for(reading, "one nine three") is None
 
 
 COMPOUNDS = """
