@@ -27,12 +27,14 @@ def test_a_new_rule_is_written_as_the_others_and_a_follow_up_is_kept() -> None:
     pets["say"] = "I love animals! Have you got a pet?"
     outline["rules"].append({"rule": "dogs", "hear": ["do you like dogs"], "say": "I do!"})
     written = dialog.written(outline)
-    assert written.endswith(
+    assert (
         '  - id: dogs\n    hear: ["do you like dogs"]\n    say: "I do!"\n'
-        'fallback: "Sorry, I did not understand."\n'
+        'fallback: "Sorry, I did not understand."\nreprompt:' in written
     )
     assert (
-        '    say: "I love animals! Have you got a pet?"\n    then:\n      listen_s: 10\n' in written
+        '    say: "I love animals! Have you got a pet?"\n'
+        '    confirm: "Did you ask whether I like animals?"\n    then:\n      listen_s: 10\n'
+        in written
     )
 
 
