@@ -28,9 +28,10 @@ from engine.files.problems import Mark
 from engine.values.templates import CompiledTemplate
 
 EXTRA_WORD_FACTOR = 0.6
-"""The score is multiplied by this for each meaning word heard that the phrase lacks: one
-is enough to refuse a phrase ("my dog *died*" is not "my dog", "I do *not* like animals" is
-not "I like animals"). List the longer ways of saying it as phrases of their own."""
+"""The score is multiplied by this for each meaning word (or question word) heard that the
+phrase lacks: one is enough to refuse a phrase ("my dog *died*" is not "my dog", "I do *not*
+like animals" is not "I like animals", "*what* pets do you like" is not "do you like pets").
+List the longer ways of saying it as phrases of their own."""
 AMBIGUITY_MARGIN = 0.1
 """Two rules scoring within this of each other cannot be told apart: neither matches.
 Nor can two that both reach ``min_score`` ("what is your name and your favorite color")."""
@@ -79,7 +80,11 @@ class Phrase:
         extra = [
             h
             for h in heard
-            if (not is_function_word(h) or PERSON_WORDS.get(h, "") not in persons | {""})
+            if (
+                not is_function_word(h)
+                or h in QUESTION_WORDS
+                or PERSON_WORDS.get(h, "") not in persons | {""}
+            )
             and not any(same_word(h, w) for w in self.words)
         ]
         if extra and self.only_function_words:

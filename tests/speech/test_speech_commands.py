@@ -48,6 +48,7 @@ def test_hear_says_what_it_heard_the_rule_and_the_answer_per_file(
         "rule": "temperature",
         "score": 1.0,
         "answer": "The temperature is [temperature_f] degrees",
+        "asks": None,
     }
     assert second == {
         "file": str(silence),
@@ -55,6 +56,7 @@ def test_hear_says_what_it_heard_the_rule_and_the_answer_per_file(
         "rule": None,
         "score": None,
         "answer": None,
+        "asks": None,
         "latency_s": None,
     }
 

@@ -177,3 +177,16 @@ def test_a_compound_written_the_recognizer_s_way_is_the_phrase_s_word(
     path = tmp_path / "compounds.yaml"
     path.write_text(COMPOUNDS, encoding="utf-8")
     assert rule_for(load_dialog(path, default_catalogue()), written_by_a_recognizer) == rule
+
+
+def test_a_question_word_the_phrase_does_not_have_means_something_else(
+    dialog: Dialog, tmp_path: Path
+) -> None:
+    assert rule_for(dialog, "what pets do you like") is None  # not "do you like ~pet"
+    assert rule_for(dialog, "which color do you like") == "color"  # the phrase's own
+    path = tmp_path / "reading.yaml"
+    path.write_text(
+        'dialog: reading\nrules:\n  - {id: too, hear: ["do you like it too"], say: "Yes."}\n',
+        encoding="utf-8",
+    )
+    assert rule_for(load_dialog(path, default_catalogue()), "You may do what you like.") is None
