@@ -3,14 +3,17 @@
 For each WAV file: what was heard, which rule of the dialog matched and its score, and
 the answer (or the fallback; [name] is a value the robot fills in from its sensors). A
 recording with several utterances is heard as a conversation: one line each, and an
-answer that asks a question (then:) hears the next utterance as its reply. --json prints
-one object per utterance (per file, for a file of one question):
+answer that asks a question (then:, or a confirm: question) hears the next utterance as
+its reply. --json prints one object per utterance (per file, for a file of one question):
 {"file": ..., "heard": text or null, "rule": rule id or null, "score": ..., "answer": ...,
-"latency_s": ...}: latency_s is the seconds from the end of speech (its last voiced frame)
-to the intent, as the robot would live on this machine: it recognizes the speech so far
-during its wait for silence (0.3 s, or 0.2 s after a whole phrase, counted in 32 ms
-frames), so this is the wait or the recognition, whichever ends later (measured here). A
-file is heard whole: the live robot does not hear speech while it answers.
+"asks": the rule whose confirm: question the answer is, or null, "latency_s": ...}.
+"heard" in lower case, without punctuation, is a phrase of the dialog that the robot found
+in the sound where the recognizer's own words held none. latency_s is the seconds from the
+end of speech (its last voiced frame) to the intent, as the robot would live on this
+machine: it recognizes the speech so far during its wait for silence (0.3 s, or 0.2 s
+after a whole phrase, counted in 32 ms frames; 0.8 s for --hearing children), so this is
+the wait or the recognition, whichever ends later (measured here). A file is heard whole:
+the live robot does not hear speech while it answers.
 --mic listens on the microphone instead (the robot config's, or --device) until Ctrl-C.
 --text "do you like dogs" hears a typed phrase as the robot would hear it spoken: said by
 the robot's voice (hibari, natural speed), then through the same hearing (its "file" is the
@@ -65,7 +68,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         choices=HEARING_NAMES,
         default="adults",
         help="hear adults (the default) or children (longer pauses, phrases as children "
-        "say them): as a profile's hearing:",
+        "say them), as a profile's 'hearing:' does",
     )
     parser.add_argument(
         "--device", default=None, help="ALSA capture device for --mic (default: the config's)"

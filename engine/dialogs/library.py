@@ -172,7 +172,7 @@ def _reprompts(
     items = value.items if isinstance(value, YList) else [value]
     if not items:
         problems.add(value.mark, "'reprompt' is empty", "list what the robot says instead")
-    said = (_template(item, ctx, problems) for item in items)
+    said = (_template(item, ctx, problems, "a 'reprompt' line") for item in items)
     return tuple(template for template in said if template is not None)
 
 
@@ -325,7 +325,9 @@ def _rule(
     if rule_id is None and unique:  # a follow-up's rule is named under its question's
         rule_id = f"{parent}/{unique[0]}" if parent else unique[0]
     raw_confirm = raw.get("confirm")
-    confirm = _template(raw_confirm, ctx, problems) if raw_confirm is not None else None
+    confirm = (
+        _template(raw_confirm, ctx, problems, "'confirm'") if raw_confirm is not None else None
+    )
     raw_then = raw.get("then")
     follow_up = None
     if raw_then is not None:
@@ -343,9 +345,15 @@ def _rule(
     )
 
 
-def _template(value: YValue, ctx: CheckContext, problems: Problems) -> CompiledTemplate | None:
+def _template(
+    value: YValue, ctx: CheckContext, problems: Problems, what: str = "an answer"
+) -> CompiledTemplate | None:
+    """``value`` as what the robot says; ``what`` names it in a problem ("'confirm'")."""
     if not isinstance(value, YScalar) or not isinstance(value.value, str):
-        problems.add(value.mark, f"an answer must be text, got {describe(value)}")
+        problems.add(value.mark, f"{what} must be text, got {describe(value)}", "put it in quotes")
+        return None
+    if what != "an answer" and not value.value.strip():
+        problems.add(value.mark, f"{what} is empty", "write what the robot says")
         return None
     try:
         return compile_template(value.value, ctx)

@@ -367,14 +367,27 @@ def test_an_empty_reprompt_list_and_a_confirm_that_is_not_text_are_named_where_t
           - hear: ["what is your name"]
             say: "I am Ro"
             confirm: [1, 2]
+          - hear: ["how are you"]
+            say: "Fine"
+            confirm: ""
         reprompt: []
         fallback: "Sorry?"
         """,
     )
     assert problems == [
-        "d.yaml:5:14: an answer must be text, got a list",
-        "d.yaml:6:11: 'reprompt' is empty (list what the robot says instead)",
+        "d.yaml:5:14: 'confirm' must be text, got a list (put it in quotes)",
+        "d.yaml:8:14: 'confirm' is empty (write what the robot says)",
+        "d.yaml:9:11: 'reprompt' is empty (list what the robot says instead)",
     ]
+    problems = dialog_problems(
+        tmp_path,
+        """        dialog: d
+        rules:
+          - {hear: ["what is your name"], say: "I am Ro"}
+        reprompt: ["Again?", 42]
+        """,
+    )
+    assert problems == ["d.yaml:4:22: a 'reprompt' line must be text, got 42 (put it in quotes)"]
 
 
 def test_a_dialog_in_another_language_confirms_with_its_own_yes_and_no(tmp_path: Path) -> None:
