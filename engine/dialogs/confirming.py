@@ -82,6 +82,8 @@ def with_confirmations(
     :data:`NO`; ``no_answer`` is said to a no. A rule that confirms in a dialog with nothing
     to say to a no (no ``reprompt:``, no ``fallback:``) is a problem."""
     yes, no = concepts.get("yes", YES), concepts.get("no", NO)
+    yes = [word for word in yes if word.strip()] or list(YES)
+    no = [word for word in no if word.strip()] or list(NO)
     done: list[DialogRule] = []
     for rule in rules:
         follow_up = rule.follow_up
@@ -106,11 +108,13 @@ def with_confirmations(
 def maybe_meant(dialog: Dialog, heard: str, asked: FollowUp | None = None) -> DialogRule | None:
     """The rule with a ``confirm:`` question that ``heard`` (which matched none) is like
     enough to ask about (:data:`MAYBE_ALIKE`, :data:`MAYBE_MARGIN`), the follow-up's
-    rules first when the robot just asked (``asked``); None when none is."""
+    rules first when the robot just asked (``asked``); None when none is, or when the robot
+    has just asked about that very rule (its answer is neither yes nor no: it is not asked
+    again, the robot says sorry)."""
     for rules in ([*asked.rules] if asked is not None else [], [*dialog.rules]):
         likeness = sorted(
             (
-                (max(alike(p.text, heard) for p in rule.phrases), index)
+                (max((alike(p.text, heard) for p in rule.phrases), default=0.0), index)
                 for index, rule in enumerate(rules)
             ),
             reverse=True,
@@ -121,7 +125,8 @@ def maybe_meant(dialog: Dialog, heard: str, asked: FollowUp | None = None) -> Di
         runner_up = likeness[1][0] if len(likeness) > 1 else 0.0
         rule = rules[index]
         if best >= MAYBE_ALIKE and best - runner_up >= MAYBE_MARGIN and rule.confirm is not None:
-            return rule
+            just_asked = asked is not None and asked is rule.confirmed
+            return None if just_asked else rule  # asked once, a sorry follows
     return None
 
 

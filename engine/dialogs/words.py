@@ -110,6 +110,13 @@ PERSON_WORDS = {
 """Whom a sentence is about: "what is *my* name" is not "what is *your* name". A phrase's
 person must be heard, and another person heard counts as a meaning word the phrase lacks."""
 
+NEGATIONS = frozenset({"not", "never", "no", "nobody", "nothing", "nowhere"})
+"""Words that turn a sentence around."""
+NEGATING_PREFIXES = ("un", "in", "im", "il", "ir", "dis", "non")
+"""What turns a word into its opposite: "unfriendly", "incorrect", "impossible"."""
+SLIP_MIN_LETTERS = 8
+"""A word this long or longer may be misspelled by a letter or two and still be the word;
+shorter ones are too often another word ("desert", "dessert"; "weather", "whether")."""
 FUNCTION_WEIGHT = 0.3
 """How much a function word counts towards a phrase's coverage (a meaning word counts 1)."""
 
@@ -147,7 +154,10 @@ def _joined(hyphen: re.Match[str]) -> str:
 
 
 def _a_number(word: str) -> bool:
-    return word in NUMBER_WORDS or word.isdigit()
+    """A number, as digits or words, or its ordinal ("seventieth", "twelfth")."""
+    if word in NUMBER_WORDS or word.isdigit() or word in _ORDINALS.values():
+        return True
+    return word.endswith("th") and word[:-2].rstrip("ie") in {w.rstrip("ye") for w in NUMBER_WORDS}
 
 
 def _spelled(word: str) -> str:
@@ -200,17 +210,39 @@ def weight(word: str) -> float:
 
 
 def same_word(heard: str, expected: str) -> bool:
-    """The same word, or a long word misspelled by a letter or two ("temprature"), or a
-    question word asking the same ("which" for "what")."""
+    """The same word, or a long word misspelled by a letter or two ("temprature"; of
+    :data:`SLIP_MIN_LETTERS` letters or more, the same first letter, neither a number nor
+    the other with a negating prefix), or a question word asking the same ("which" for
+    "what")."""
     if heard == expected:
         return True
     if expected in QUESTION_WORDS:
         return QUESTION_WORDS.get(heard) == QUESTION_WORDS[expected]
     if expected in PERSON_WORDS:
         return PERSON_WORDS.get(heard) == PERSON_WORDS[expected]
-    if min(len(heard), len(expected)) < 6:
-        return False
+    if min(len(heard), len(expected)) < SLIP_MIN_LETTERS or heard[0] != expected[0]:
+        return False  # "desert" is not "dessert", "laughter" not "daughter"
+    if any(
+        one == prefix + other
+        for one, other in ((heard, expected), (expected, heard))
+        for prefix in NEGATING_PREFIXES
+    ):
+        return False  # "incorrect" is not "correct"
+    if _a_number(heard) or _a_number(expected):
+        return False  # "seventeenth" is not "seventieth"
     return difflib.SequenceMatcher(None, heard, expected).ratio() >= 0.85
+
+
+def says_otherwise(written: Sequence[str], phrase: Sequence[str]) -> bool:
+    """Whether ``written`` (words) names a person, asks a question or negates where
+    ``phrase`` does not: "what is *my* name" is not "what is your name", "*why* is it cold"
+    not "is it cold", "it is *not* cold" not "it is cold", however alike they sound."""
+    for word in written:
+        if any(same_word(word, other) for other in phrase):
+            continue
+        if word in PERSON_WORDS or word in QUESTION_WORDS or word in NEGATIONS:
+            return True
+    return False
 
 
 def words(text: str) -> tuple[str, ...]:

@@ -20,6 +20,10 @@ A child's phrase is kept (:func:`a_child_said`) when all of these hold:
   favorite color is blue", however likely the search found it;
 - nothing it wrote clearly (:data:`~engine.speech.phrase_search.CLEARLY_HEARD`) is left out
   of the phrase, as for adults;
+- it wrote no person or question word that the phrase lacks with probability
+  :data:`OTHERWISE_HEARD` or more, and no negation at all
+  (:func:`~engine.dialogs.words.says_otherwise`: "what is *my* name" is not "what is your
+  name", "is it *not* cold" not "is it cold");
 - Moonshine wrote some words: where it wrote none, the adult rule and the second opinion
   decide.
 
@@ -33,7 +37,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
-from engine.dialogs.words import alike, words
+from engine.dialogs.words import NEGATIONS, alike, says_otherwise, words
 from engine.speech.phrase_search import CLEARLY_HEARD, CLOSE_ENOUGH_NATS, Found, left_out
 
 NATS_PER_WORD = 2.0
@@ -47,6 +51,11 @@ ALIKE = 0.45
 """What Moonshine wrote must be this alike the phrase (0..1, :func:`alike`)."""
 ALIKE_ALONE = 0.6
 """As :data:`ALIKE`, where no other phrase was found to weigh the phrase against."""
+OTHERWISE_HEARD = 0.75
+"""A person or question word written at least this likely that the phrase lacks refuses it
+(:func:`~engine.dialogs.words.says_otherwise`; a negation, however unlikely): at 0.5, two
+of the four children of examples/children-speech lost their sentence ("*I* was late" for
+"he was late", "*where* you'll be" for "will you be")."""
 BEAM = 8
 """Texts the children's search carries on at each step: half the adults' (its floor is
 lower, so more texts stay above it; 16 took 0.4 s a search on 2 cores, too slow to answer
@@ -84,4 +93,7 @@ def a_child_said(
     said = [(word, probability) for text, probability in heard for word in words(text)]
     if any(probability >= CLEARLY_HEARD for _, probability in left_out(said, phrase)):
         return None
+    sure = [word for word, p in said if p >= OTHERWISE_HEARD or word in NEGATIONS]
+    if says_otherwise(sure, phrase):
+        return None  # "what is my name" is never "what is your name", however alike
     return best

@@ -190,3 +190,14 @@ def test_a_child_s_sentence_the_dialog_does_not_hold_is_not_answered(
 ) -> None:
     heard = [rule_heard(childrens_hearing, default_dialog, f, vad, True) for f in READ_ALOUD]
     assert heard == [None, None, None, None]
+
+
+def test_a_child_s_phrase_that_names_another_person_or_turns_it_around_is_not_kept() -> None:
+    found = [Found("what is your name", -3.0), Found("what is your game", -9.0)]
+    assert a_child_said(found, -1.0, written("What is your name?", 0.9)) == found[0]
+    assert a_child_said(found, -1.0, written("What is my name?", 0.9)) is None
+    # a negation, however unsure the recognizer was of it
+    found = [Found("is it cold", -3.0), Found("is it hot", -9.0)]
+    assert (
+        a_child_said(found, -1.0, [("Is", 0.9), ("it", 0.9), ("not", 0.2), ("cold", 0.9)]) is None
+    )

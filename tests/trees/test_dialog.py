@@ -158,6 +158,22 @@ def test_an_answer_that_is_neither_yes_nor_no_is_heard_afresh(robot: TreeHarness
     assert robot.said == [ASK_NAME, COLOR]
 
 
+def test_the_robot_does_not_ask_the_same_question_twice_in_a_row(robot: TreeHarness) -> None:
+    hear(robot, "what is your aim")
+    hear(robot, "what is your game")  # like the name again: neither yes nor no
+    assert robot.said == [ASK_NAME, SLOWER]
+
+
+def test_the_answers_the_guide_gives_for_yes_and_no_are_the_default_dialog_s(
+    robot: TreeHarness,
+) -> None:
+    hear(robot, "what is your aim")
+    hear(robot, "yes i did")
+    hear(robot, "what is your aim")
+    hear(robot, "no i did not")
+    assert robot.said == [ASK_NAME, NAME, ASK_NAME, SLOWER]
+
+
 def test_a_yes_to_the_temperature_reads_the_sensor_before_it_answers(
     robot: TreeHarness,
 ) -> None:

@@ -10,6 +10,7 @@ import pytest
 from engine.blackboard.catalogue import default_catalogue
 from engine.dialogs.library import load_dialog
 from engine.dialogs.model import Dialog
+from engine.dialogs.words import same_word
 
 DEFAULT = Path(__file__).resolve().parents[2] / "dialogs" / "default.yaml"
 
@@ -190,3 +191,21 @@ def test_a_question_word_the_phrase_does_not_have_means_something_else(
         encoding="utf-8",
     )
     assert rule_for(load_dialog(path, default_catalogue()), "You may do what you like.") is None
+
+
+@pytest.mark.parametrize(
+    ("one", "other"),
+    [
+        ("incorrect", "correct"),
+        ("unfriendly", "friendly"),
+        ("impossible", "possible"),
+        ("desert", "dessert"),
+        ("feather", "father"),
+        ("laughter", "daughter"),
+        ("weather", "whether"),
+        ("seventeenth", "seventieth"),
+    ],
+)
+def test_a_word_one_letter_or_a_prefix_from_another_is_another_word(one: str, other: str) -> None:
+    assert not same_word(one, other)
+    assert same_word("temprature", "temperature")  # a slip in a long word is forgiven
