@@ -69,7 +69,12 @@ from engine.media.audio import SPEECH_RATE_HZ, Audio, noise, with_noise  # noqa:
 from engine.speech.hearing import heard_live  # noqa: E402
 from engine.speech.moonshine import MoonshineRecognizer  # noqa: E402
 from engine.speech.phrase_search import PhraseGrammar  # noqa: E402
-from engine.speech.recognizer import Recognizer, Transcript, WhisperRecognizer  # noqa: E402
+from engine.speech.recognizer import (  # noqa: E402
+    Abandon,
+    Recognizer,
+    Transcript,
+    WhisperRecognizer,
+)
 from engine.speech.recognizers import SecondOpinion  # noqa: E402
 from engine.speech.vad import SileroVad, SpeechDetector  # noqa: E402
 from engine.speech.voice_models import load_voice  # noqa: E402
@@ -196,9 +201,9 @@ class TimedRecognizer:
     def listen_for(self, phrases: Iterable[str]) -> None:
         self.recognizer.listen_for(phrases)
 
-    def transcribe(self, audio: Audio) -> Transcript:
+    def transcribe(self, audio: Audio, *, abandon: Abandon | None = None) -> Transcript:
         begun, cpu = time.perf_counter(), time.process_time()
-        transcript = self.recognizer.transcribe(audio)
+        transcript = self.recognizer.transcribe(audio, abandon=abandon)
         self.timing["work"].append(time.perf_counter() - begun)
         self.timing["cpu"].append(time.process_time() - cpu)
         self.timing["s"].append(audio.seconds)

@@ -13,7 +13,7 @@ from dataclasses import dataclass, replace
 from engine.clock import stopwatch
 from engine.dialogs.confirming import maybe_meant
 from engine.dialogs.model import Dialog, DialogRule, FollowUp, Verdict
-from engine.media.audio import SPEECH_RATE_HZ, Audio, with_noise
+from engine.media.audio import SPEECH_RATE_HZ, Audio, Samples, with_noise
 from engine.speech.recognizer import Recognizer
 from engine.speech.vad import (
     FRAME_SAMPLES,
@@ -99,22 +99,44 @@ def utterances(audio: Audio, vad: SpeechProbability, *, children: bool = False) 
     return found + ([last] if last is not None else [])
 
 
+def overtaking(samples: Samples, vad: SpeechProbability, *, children: bool) -> dict[int, float]:
+    """Where speech went on after each draft the detector tells in ``samples`` (16 kHz):
+    the draft's end (samples) -> the time speech went on (seconds). A draft never overtaken
+    is not in it. The live robot learns it as it happens; on a recording it is known
+    before, so :func:`heard_live` can stop a draft's recognition when the live one would
+    stop (:class:`~engine.speech.listener.Listener`)."""
+    vad.reset()
+    told: list[Utterance] = []
+    detector = speech_detector(vad, children=children, on_pause=told.append)
+    found: dict[int, float] = {}
+    for at in range(0, len(samples), FRAME_SAMPLES):
+        detector.feed(samples[at : at + FRAME_SAMPLES])
+        for draft in [d for d in told if detector.overtaken(d)]:
+            found[draft.end_sample] = detector.position / SPEECH_RATE_HZ
+            told.remove(draft)
+        del told[:-1]  # a draft not overtaken when the next is told never will be
+    return found
+
+
 class _LiveTimeline:
     """The listener's worker on a recording's timeline: one recognition at a time, each
     starting when its audio was told and the worker was free, taking as long as it takes
-    here; a draft overtaken by newer speech while it waited is never recognized (as the
-    :class:`~engine.speech.listener.Listener` skips it); a draft that is a whole turn tells
-    the detector when its text is ready."""
+    here; a draft overtaken by newer speech while it waited is never recognized, and one
+    overtaken while it is recognized stops then (as the
+    :class:`~engine.speech.listener.Listener` does: ``overtaken``, from :func:`overtaking`);
+    a draft that is a whole turn tells the detector when its text is ready."""
 
     def __init__(
         self,
         detector: SpeechDetector,
         recognizer: Recognizer,
         whole_turn: Callable[[str], bool] | None,
+        overtaken: dict[int, float],
     ) -> None:
         self.detector = detector
         self.recognizer = recognizer
         self.whole_turn = whole_turn
+        self.overtaken = overtaken
         self.free_s = 0.0
         self.waiting: Utterance | None = None  # a draft told while the worker was busy
         self.draft: tuple[Utterance, str, float] | None = None  # draft, text, ready
@@ -148,15 +170,23 @@ class _LiveTimeline:
         return Part(utterance, text, ended_s - utterance.quiet_s, ended_s, ready_s)
 
     def _recognize_draft(self, draft: Utterance) -> None:
-        text, ready_s = self._recognized(draft)
+        text, ready_s = self._recognized(draft, self.overtaken.get(draft.end_sample))
         self.draft = (draft, text, ready_s)
         whole = bool(text) and self.whole_turn is not None and self.whole_turn(text)
         self.whole_at_s = ready_s if whole else None
 
-    def _recognized(self, utterance: Utterance) -> tuple[str, float]:
+    def _recognized(
+        self, utterance: Utterance, overtaken_s: float | None = None
+    ) -> tuple[str, float]:
+        """Its text and when it was ready; a draft overtaken at ``overtaken_s`` is
+        abandoned once the worker's time passes it."""
         begins_s = max(self.free_s, utterance.end_sample / SPEECH_RATE_HZ)
         started = stopwatch()
-        text = self.recognizer.transcribe(utterance.audio).text
+
+        def abandon() -> bool:
+            return overtaken_s is not None and begins_s + stopwatch() - started >= overtaken_s
+
+        text = self.recognizer.transcribe(utterance.audio, abandon=abandon).text
         self.free_s = begins_s + stopwatch() - started
         return text, self.free_s
 
@@ -173,11 +203,12 @@ def heard_live(
     hears it: drafts recognized during the wait for silence, a whole turn (``whole_turn``)
     ending it sooner, one recognition at a time, at this machine's speed; ``children``:
     with the wait for silence of a robot that hears children (:func:`speech_detector`)."""
+    samples = audio.resampled(SPEECH_RATE_HZ).then(Audio.silence(TRAILING_SILENCE_S)).samples
+    overtaken = overtaking(samples, vad, children=children)
     vad.reset()
     drafts: list[Utterance] = []
     detector = speech_detector(vad, children=children, on_pause=drafts.append)
-    live = _LiveTimeline(detector, recognizer, whole_turn)
-    samples = audio.resampled(SPEECH_RATE_HZ).then(Audio.silence(TRAILING_SILENCE_S)).samples
+    live = _LiveTimeline(detector, recognizer, whole_turn, overtaken)
     found: list[Part] = []
     for at in range(0, len(samples), FRAME_SAMPLES):  # a frame at a time, as a microphone
         live.at(at / SPEECH_RATE_HZ)

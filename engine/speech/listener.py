@@ -7,8 +7,9 @@ each finished utterance is recognized in the listener's worker, never in a tick,
 for silence is over: on the detector's draft (the speech so far, after a short pause);
 when the utterance ends with nothing said after the draft, the draft's text is the
 utterance's and is told at once (a draft that fell short is forgotten; one that waited
-while the worker was busy and was overtaken by newer speech is never recognized: a child
-who pauses often does not queue up drafts). A draft whose text
+while the worker was busy and was overtaken by newer speech is never recognized, and one
+being recognized when speech goes on is stopped: a child who pauses often neither queues
+up drafts nor keeps the worker busy with them when the sentence ends). A draft whose text
 is a whole turn (``whole_turn``: one of the dialogs' phrases, and none goes on from it)
 shortens the wait for silence (:meth:`~engine.speech.vad.SpeechDetector.whole_turn`).
 
@@ -168,7 +169,7 @@ class Listener:
                 continue
             drafted = self._draft_text if utterance.drafted else None
             self._draft_text = None
-            text = drafted if drafted is not None else self._recognized(utterance)
+            text = drafted if drafted is not None else self._recognized(utterance, ended_s is None)
             try:
                 if ended_s is None:
                     self._draft_text = text
@@ -183,9 +184,17 @@ class Listener:
                     self._working -= 1
                 self.settling.changed()
 
-    def _recognized(self, utterance: Utterance) -> str:
+    def _recognized(self, utterance: Utterance, draft: bool) -> str:
+        """Its text; a draft's recognition stops as soon as speech goes on after it (its
+        text would never be wanted, and the worker is wanted for what comes next)."""
+
+        def overtaken() -> bool:
+            return self.detector.overtaken(utterance)
+
         try:
-            return self.recognizer.transcribe(utterance.audio).text
+            return self.recognizer.transcribe(
+                utterance.audio, abandon=overtaken if draft else None
+            ).text
         except Exception as error:  # a model that failed on this audio
             log.warning("recognition failed: %s", error)
             return ""

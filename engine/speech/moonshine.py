@@ -45,7 +45,13 @@ from engine.speech.phrase_search import (
     closest_phrases,
     sure_of,
 )
-from engine.speech.recognizer import RecognizerError, Transcript, Word, said_in_a_loop
+from engine.speech.recognizer import (
+    Abandon,
+    RecognizerError,
+    Transcript,
+    Word,
+    said_in_a_loop,
+)
 
 MODEL_PACKAGE = "moonshine_cpp"
 START_TOKEN, END_TOKEN = 1, 2
@@ -133,48 +139,72 @@ def log_softmax(logits: np.ndarray) -> np.ndarray:
     return result
 
 
+class _AbandonedError(Exception):
+    """The utterance was abandoned while it was being decoded (:data:`Abandon`)."""
+
+
 class _Decoder:
     """Moonshine's decoder on one utterance's encoder output, for one text or several at
-    once (rows), with its key/value cache: a :class:`~engine.speech.phrase_search.Decoding`."""
+    once (rows), with its key/value cache: a :class:`~engine.speech.phrase_search.Decoding`.
+    Each step first asks ``abandon`` (None: never) and stops the search when it says so."""
 
-    def __init__(self, recognizer: MoonshineRecognizer, hidden: np.ndarray) -> None:
+    def __init__(
+        self, recognizer: MoonshineRecognizer, hidden: np.ndarray, abandon: Abandon | None
+    ) -> None:
         self._recognizer = recognizer
-        self._hidden = hidden
+        self._abandon = abandon
         self._cache = {name: recognizer._empty for name in recognizer._cache_names}
+        self._rows = 1
         self._started = False
         self._first: tuple[np.ndarray, dict[str, np.ndarray]] | None = None
+        self._encoder: dict[str, np.ndarray] = {}  # its part of the cache: the same each row
+        self._repeated: dict[int, dict[str, np.ndarray]] = {1: {"encoder_hidden_states": hidden}}
+        """The encoder's output and its part of the cache for so many rows."""
 
     def first(self) -> np.ndarray:
         if self._first is None:  # the first step is the same for every text: run once
             rows = self._run(np.array([[START_TOKEN]], dtype=np.int64))
             self._first = (rows, dict(self._cache))
         rows, self._cache = self._first[0], dict(self._first[1])
+        self._rows = 1
         self._started = True
         return rows
 
     def then(self, parents: np.ndarray, tokens: np.ndarray) -> np.ndarray:
         self._cache = {name: value[parents] for name, value in self._cache.items()}
+        self._rows = len(parents)
         return self._run(tokens[:, None])
+
+    def _for_rows(self, rows: int) -> dict[str, np.ndarray]:
+        """What every row shares (the encoder's output and its part of the cache), for
+        ``rows`` rows: repeated once for each count of rows, not copied at each step."""
+        if rows not in self._repeated:
+            one = {**self._repeated[1], **self._encoder}
+            self._repeated[rows] = {name: np.repeat(v, rows, axis=0) for name, v in one.items()}
+        return self._repeated[rows]
 
     def _run(self, ids: np.ndarray) -> np.ndarray:
         """Log-probabilities of the next token after each row of ``ids``."""
-        rows = len(ids)
-        hidden = self._hidden if rows == 1 else np.repeat(self._hidden, rows, axis=0)
+        if self._abandon is not None and self._abandon():
+            raise _AbandonedError
         outputs = self._recognizer.decoder.run(
             None,
             {
                 "input_ids": ids,
-                "encoder_hidden_states": hidden,
                 "use_cache_branch": np.array([self._started]),
                 **self._cache,
+                **self._for_rows(len(ids)),
             },
         )
         for name, value in zip(self._recognizer._outputs[1:], outputs[1:], strict=True):
             past = "past_key_values." + name.removeprefix("present.")
-            if not self._started or ".decoder." in past:  # the encoder's part is computed once
+            if ".decoder." in past:
                 self._cache[past] = value
+            elif not self._started:  # the encoder's part is computed once, at the start
+                self._encoder[past] = self._repeated[1][past] = value
+                del self._cache[past]
         self._started = True
-        return log_softmax(outputs[0][:, -1].astype(np.float64))
+        return log_softmax(outputs[0][:, -1])
 
 
 @dataclass(frozen=True)
@@ -238,8 +268,14 @@ class MoonshineRecognizer:
         """The phrases closed listening may hear (:mod:`engine.speech.phrase_search`)."""
         self.grammar = PhraseGrammar(phrases)
 
-    def transcribe(self, audio: Audio) -> Transcript:
-        heard = self._hear(audio)
+    def transcribe(self, audio: Audio, *, abandon: Abandon | None = None) -> Transcript:
+        try:
+            return self._transcribed(audio, abandon)
+        except _AbandonedError:
+            return Transcript("")
+
+    def _transcribed(self, audio: Audio, abandon: Abandon | None) -> Transcript:
+        heard = self._hear(audio, abandon)
         if heard is None:
             return Transcript("")
         probabilities = [math.exp(p) for p in heard.log_probs]
@@ -281,14 +317,14 @@ class MoonshineRecognizer:
         words_heard = [(w.text, w.probability) for w in said]
         return self._borne_out(heard, PhraseGrammar(phrases), words_heard) is not None
 
-    def _hear(self, audio: Audio) -> _Heard | None:
+    def _hear(self, audio: Audio, abandon: Abandon | None = None) -> _Heard | None:
         """The encoder's output and the free transcript; None for audio too short."""
         samples = audio.resampled(SPEECH_RATE_HZ).samples.astype(np.float32)
         if len(samples) < SPEECH_RATE_HZ // 10:  # shorter than the encoder's window
             return None
         hidden = self.encoder.run(None, {"input_values": samples[None, :]})[0]
         max_tokens = int(len(samples) / SPEECH_RATE_HZ * TOKENS_PER_S) + 4
-        decoder = _Decoder(self, hidden)
+        decoder = _Decoder(self, hidden, abandon)
         tokens, log_probs, free_log_prob = self._decode(decoder, max_tokens)
         return _Heard(decoder, max_tokens, tokens, log_probs, free_log_prob)
 
@@ -297,7 +333,7 @@ class MoonshineRecognizer:
     ) -> Found | None:
         """The phrase of ``grammar`` the audio bears out, or None (see the module's
         docstring and :func:`~engine.speech.phrase_search.bears_out`)."""
-        found = self._closest(heard.decoder, grammar, heard.free_log_prob)
+        found = self._closest(heard, grammar, heard.free_log_prob)
         if found is not None and bears_out(found, heard.free_log_prob, words_heard, grammar):
             return found
         if heard.tokens:
@@ -307,7 +343,7 @@ class MoonshineRecognizer:
         # word is not: a sound ("huh", a laugh) bears out "hello" or "yeah" against such
         # words as well as a word does.
         written = self._decode(heard.decoder, heard.max_tokens, words_first=True)[2]
-        return self._closest(heard.decoder, grammar.sentences, written)
+        return self._closest(heard, grammar.sentences, written)
 
     def _child_said(self, heard: _Heard, words_heard: list[tuple[str, float]]) -> Found | None:
         """The phrase a child said, as :func:`~engine.speech.children.a_child_said` keeps it;
@@ -319,7 +355,7 @@ class MoonshineRecognizer:
             self.grammar,
             self._texts,
             end_token=END_TOKEN,
-            max_tokens=self.grammar.longest + 1,
+            max_tokens=min(self.grammar.longest + 1, heard.max_tokens),
             at_least=search_floor(heard.free_log_prob, self.grammar.most_words("")),
             keep=2,
             near=NEAR_NATS,
@@ -328,15 +364,16 @@ class MoonshineRecognizer:
         )
         return a_child_said(found, heard.free_log_prob, words_heard)
 
-    def _closest(self, decoder: _Decoder, grammar: PhraseGrammar, free: float) -> Found | None:
+    def _closest(self, heard: _Heard, grammar: PhraseGrammar, free: float) -> Found | None:
         """The likeliest phrase of ``grammar`` at most :data:`CLOSE_ENOUGH_NATS` less likely
         than ``free`` (natural log), or None."""
         return closest_phrase(
-            decoder,
+            heard.decoder,
             grammar,
             self._texts,
             end_token=END_TOKEN,
-            max_tokens=grammar.longest + 1,  # a token writes a character or more
+            # a token writes a character or more, and the audio holds at most so many
+            max_tokens=min(grammar.longest + 1, heard.max_tokens),
             at_least=free - CLOSE_ENOUGH_NATS,  # less likely is not borne out
         )
 

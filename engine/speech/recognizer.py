@@ -11,7 +11,7 @@ in the listener's worker, never in a tick; on a GPU when CTranslate2 sees one.
 from __future__ import annotations
 
 import importlib.util
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Protocol
@@ -100,11 +100,17 @@ class Transcript:
         return [w.text for w in self.words if w.probability < UNSURE_BELOW]
 
 
+Abandon = Callable[[], bool]
+"""Asked while an utterance is recognized: True when its text is no longer wanted (a
+draft that speech went on after), and the recognizer may stop and return nothing."""
+
+
 class Recognizer(Protocol):
     name: str
 
-    def transcribe(self, audio: Audio) -> Transcript:
-        """One utterance (any rate; resampled to 16 kHz) to text."""
+    def transcribe(self, audio: Audio, *, abandon: Abandon | None = None) -> Transcript:
+        """One utterance (any rate; resampled to 16 kHz) to text; an empty transcript once
+        ``abandon`` says so (None: never abandoned)."""
         ...
 
     def listen_for(self, phrases: Iterable[str]) -> None:
@@ -193,7 +199,11 @@ class WhisperRecognizer:
     def listen_for(self, phrases: Iterable[str]) -> None:
         self.prompt = prompt_for(phrases)
 
-    def transcribe(self, audio: Audio) -> Transcript:
+    def transcribe(self, audio: Audio, *, abandon: Abandon | None = None) -> Transcript:
+        """As :meth:`Recognizer.transcribe`; CTranslate2 decodes in one call, so ``abandon``
+        is asked only before it starts."""
+        if abandon is not None and abandon():
+            return Transcript("")
         heard = self._heard(audio)
         if said_in_a_loop(heard.text):
             return Transcript("", heard.words, heard.no_speech, heard.log_prob)

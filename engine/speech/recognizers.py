@@ -21,7 +21,7 @@ from typing import Protocol
 
 from engine.dialogs.words import same_word, words
 from engine.media.audio import Audio
-from engine.speech.recognizer import Recognizer, RecognizerError, Transcript
+from engine.speech.recognizer import Abandon, Recognizer, RecognizerError, Transcript
 from engine.speech.settings import RECOGNIZER_NAMES
 
 DEFAULT_RECOGNIZER = "moonshine"
@@ -62,12 +62,12 @@ class SecondOpinion:
         self.fast.listen_for(self.phrases)
         self.careful.listen_for(self.phrases)
 
-    def transcribe(self, audio: Audio) -> Transcript:
-        heard = self.fast.transcribe(audio)
-        if not heard.unconfirmed:
+    def transcribe(self, audio: Audio, *, abandon: Abandon | None = None) -> Transcript:
+        heard = self.fast.transcribe(audio, abandon=abandon)
+        if not heard.unconfirmed or (abandon is not None and abandon()):
             return heard
         self.second_opinions += 1
-        careful = self.careful.transcribe(audio)
+        careful = self.careful.transcribe(audio, abandon=abandon)
         if says(careful.text, heard.unconfirmed):
             return careful
         doubted = " ".join(word.text for word in careful.words)

@@ -140,6 +140,7 @@ class SpeechDetector:
         self._drafted = False
         self._draft: Utterance | None = None  # the draft told last
         self._whole = False  # the draft holds all of the speech so far and is a whole turn
+        self._overtaken: deque[Utterance] = deque(maxlen=4)  # drafts speech went on after
         self._lock = threading.Lock()  # whole_turn comes from the listener's worker
         self._below_floor = 0  # frames in a row the noise floor kept from the VAD
         self.position = 0
@@ -156,7 +157,13 @@ class SpeechDetector:
         self._history.clear()
         self._speech = []
         self._voiced_frames = self._quiet_frames = 0
-        self._forget_draft()
+        self._forget_draft(overtaken=True)
+
+    def overtaken(self, draft: Utterance) -> bool:
+        """Whether speech went on after ``draft`` (told to ``on_pause``), or the stream was
+        reset: its text will never be wanted (any thread)."""
+        with self._lock:
+            return any(told is draft for told in self._overtaken)
 
     def whole_turn(self, draft: Utterance) -> None:
         """``draft`` (told to ``on_pause``) is a whole turn: if no speech came after it,
@@ -165,8 +172,10 @@ class SpeechDetector:
             if draft is self._draft and self._drafted:
                 self._whole = True
 
-    def _forget_draft(self) -> None:
+    def _forget_draft(self, *, overtaken: bool = False) -> None:
         with self._lock:
+            if overtaken and self._draft is not None:
+                self._overtaken.append(self._draft)
             self._drafted, self._whole, self._draft = False, False, None
 
     def feed(self, samples: Samples) -> list[Utterance]:
@@ -199,7 +208,7 @@ class SpeechDetector:
             self._voiced_frames += 1
             self._quiet_frames = 0
             if self._drafted:
-                self._forget_draft()  # speech went on: the draft fell short
+                self._forget_draft(overtaken=True)  # speech went on: the draft fell short
         else:
             self._quiet_frames += 1
             if self._quiet_frames == max(1, round(self.draft_after_s / FRAME_S)):

@@ -15,10 +15,17 @@ import pytest
 
 from engine.clock import VirtualClock
 from engine.media.audio import SPEECH_RATE_HZ, Audio
+from engine.speech.hearing import overtaking
 from engine.speech.listener import Heard, Listener
 from engine.speech.moonshine import said_once, without_loop
 from engine.speech.phrase_search import PhraseGrammar
-from engine.speech.recognizer import Recognizer, Transcript, Word, said_in_a_loop
+from engine.speech.recognizer import (
+    Abandon,
+    Recognizer,
+    Transcript,
+    Word,
+    said_in_a_loop,
+)
 from engine.speech.vad import FRAME_S, SpeechDetector, Utterance
 
 
@@ -45,7 +52,7 @@ class CountingRecognizer:
     def listen_for(self, phrases: Iterable[str]) -> None:
         pass
 
-    def transcribe(self, audio: Audio) -> Transcript:
+    def transcribe(self, audio: Audio, *, abandon: Abandon | None = None) -> Transcript:
         self.heard.append(audio.seconds)
         return Transcript(self.says or f"{audio.seconds:.3f} seconds")
 
@@ -96,11 +103,11 @@ class SlowRecognizer(CountingRecognizer):
         super().__init__()
         self.started, self.finish = threading.Event(), threading.Event()
 
-    def transcribe(self, audio: Audio) -> Transcript:
+    def transcribe(self, audio: Audio, *, abandon: Abandon | None = None) -> Transcript:
         if not self.heard:
             self.started.set()
             assert self.finish.wait(timeout=30)
-        return super().transcribe(audio)
+        return super().transcribe(audio, abandon=abandon)
 
 
 def test_a_draft_overtaken_while_the_worker_was_busy_is_never_recognized() -> None:
@@ -122,6 +129,82 @@ def test_a_draft_overtaken_while_the_worker_was_busy_is_never_recognized() -> No
     assert [heard.text for heard in told] == [f"{recognizer.heard[1]:.3f} seconds"]
 
 
+class AbandonedWhenAsked(CountingRecognizer):
+    """Hears as :class:`CountingRecognizer`; its first recognition lasts until the story
+    lets it finish, and then says whether it was told to give up (as Moonshine asks
+    between its decoder's steps)."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.started, self.finish = threading.Event(), threading.Event()
+        self.abandoned: list[bool | None] = []  # each recognition: abandon() at its end
+
+    def transcribe(self, audio: Audio, *, abandon: Abandon | None = None) -> Transcript:
+        if not self.heard:
+            self.started.set()
+            assert self.finish.wait(timeout=30)
+        self.abandoned.append(abandon() if abandon is not None else None)
+        return super().transcribe(audio, abandon=abandon)
+
+
+def test_a_draft_being_recognized_when_speech_goes_on_is_given_up() -> None:
+    recognizer = AbandonedWhenAsked()
+    told: list[Heard] = []
+    listener = Listener(SpeechDetector(LoudnessVad()), recognizer, VirtualClock(), told.append)
+    # a child says a few words and pauses: the draft is being recognized
+    first = speech(0.6).then(Audio.silence(0.2))
+    listener.hear(first, first.seconds)
+    assert recognizer.started.wait(timeout=30)
+    # ... and goes on: the draft's text will never be wanted, and the worker may stop
+    rest = speech(0.6).then(Audio.silence(1.0))
+    listener.hear(rest, first.seconds + rest.seconds)
+    recognizer.finish.set()
+    assert listener.settling.wait(listener.settled)
+    listener.close()
+    # the draft was told to give up; the whole utterance was not (None: it never is)
+    assert recognizer.abandoned == [True, None]
+    assert [heard.text for heard in told] == [f"{recognizer.heard[1]:.3f} seconds"]
+
+
+def test_a_draft_followed_only_by_silence_is_never_given_up() -> None:
+    recognizer = AbandonedWhenAsked()
+    told: list[Heard] = []
+    listener = Listener(SpeechDetector(LoudnessVad()), recognizer, VirtualClock(), told.append)
+    first = speech(0.6).then(Audio.silence(0.2))
+    listener.hear(first, first.seconds)
+    assert recognizer.started.wait(timeout=30)
+    listener.hear(Audio.silence(1.0), first.seconds + 1.0)  # the utterance ends
+    recognizer.finish.set()
+    assert listener.settling.wait(listener.settled)
+    listener.close()
+    # the draft held all of it: it was recognized to the end, and its text was told
+    assert recognizer.abandoned == [False]
+    assert [heard.text for heard in told] == [f"{recognizer.heard[0]:.3f} seconds"]
+
+
+def test_the_detector_says_which_drafts_speech_went_on_after() -> None:
+    drafts: list[Utterance] = []
+    detector = SpeechDetector(LoudnessVad(), on_pause=drafts.append)
+    detector.feed(speech(0.6).then(Audio.silence(0.2)).samples)
+    detector.feed(speech(0.6).then(Audio.silence(0.2)).samples)
+    first, second = drafts
+    assert detector.overtaken(first) and not detector.overtaken(second)
+    detector.feed(Audio.silence(1.0).samples)  # the utterance ended after the second
+    assert not detector.overtaken(second)
+    detector.feed(speech(0.6).then(Audio.silence(0.2)).samples)
+    detector.reset()  # the robot spoke over the third: it is never wanted either
+    assert detector.overtaken(drafts[2])
+
+
+def test_on_a_recording_the_moment_speech_went_on_after_each_draft_is_known() -> None:
+    # vest hear and the benchmarks stop a draft's recognition where the live robot would
+    audio = speech(0.6).then(Audio.silence(0.2)).then(speech(0.6)).then(Audio.silence(1.0))
+    found = overtaking(audio.samples, LoudnessVad(), children=False)
+    assert len(found) == 1  # the second draft held the rest: never overtaken
+    (draft_end, went_on_s), *_ = found.items()
+    assert draft_end / SPEECH_RATE_HZ < went_on_s == pytest.approx(0.8, abs=FRAME_S)
+
+
 def test_a_click_is_no_draft_and_no_utterance() -> None:
     recognizer = CountingRecognizer()
     assert listened(speech(0.1).then(Audio.silence(1.0)), recognizer) == []
@@ -140,7 +223,7 @@ class SaysInTurn:
     def listen_for(self, phrases: Iterable[str]) -> None:
         pass
 
-    def transcribe(self, audio: Audio) -> Transcript:
+    def transcribe(self, audio: Audio, *, abandon: Abandon | None = None) -> Transcript:
         self.heard.append(audio.seconds)
         return Transcript(self.texts.pop(0) if len(self.texts) > 1 else self.texts[0])
 

@@ -16,6 +16,7 @@ import pytest
 from engine.dialogs.model import Dialog, FollowUp
 from engine.media.audio import Audio
 from engine.speech.hearing import hear
+from engine.speech.moonshine import MoonshineRecognizer
 from engine.speech.phrase_search import (
     CLOSE_ENOUGH_NATS,
     Found,
@@ -26,7 +27,7 @@ from engine.speech.phrase_search import (
     left_out,
     sure_of,
 )
-from engine.speech.recognizer import Recognizer, Transcript, Word
+from engine.speech.recognizer import Abandon, Recognizer, Transcript, Word
 from engine.speech.recognizers import SecondOpinion
 from engine.speech.vad import SileroVad
 from engine.speech.voices import Voice
@@ -237,7 +238,7 @@ class SaysRecognizer:
     def listen_for(self, phrases: Iterable[str]) -> None:
         pass
 
-    def transcribe(self, audio: Audio) -> Transcript:
+    def transcribe(self, audio: Audio, *, abandon: Abandon | None = None) -> Transcript:
         self.heard += 1
         return self.transcript
 
@@ -346,6 +347,23 @@ def test_a_phrase_moonshine_writes_wrong_is_heard_right_through_the_phrases(
     hearing = hear(spoken(said, voice, speed, snr_db), vad, recognizer, default_dialog, context)
     assert hearing.verdict is not None and hearing.verdict.match is not None, hearing
     assert hearing.verdict.match.rule.id == rule
+
+
+def test_moonshine_gives_up_a_recognition_at_the_step_it_is_told_to(
+    spoken: Callable[..., Audio], default_dialog: Dialog
+) -> None:
+    moonshine = MoonshineRecognizer()
+    moonshine.listen_for(default_dialog.phrases)
+    audio = spoken("what is your name")
+    asked: list[bool] = []
+
+    def after_three_steps() -> bool:
+        asked.append(len(asked) >= 3)
+        return asked[-1]
+
+    assert moonshine.transcribe(audio, abandon=after_three_steps).text == ""
+    assert asked == [False, False, False, True]  # no step decoded after it was told
+    assert moonshine.transcribe(audio).text == "What is your name?"  # the next is whole
 
 
 @pytest.mark.parametrize("sentence", ["how old are you", "are you a robot", "how tall are you"])
