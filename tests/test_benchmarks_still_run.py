@@ -12,6 +12,8 @@ from pathlib import Path
 
 import pytest
 
+pytestmark = pytest.mark.bench
+
 ROOT = Path(__file__).resolve().parents[1]
 BENCHMARKS = sorted(path.name for path in (ROOT / "bench").glob("bench_*.py"))
 

@@ -17,6 +17,8 @@ from engine.cli.output import finite_json, shown
 from engine.cli.timeline import Timeline
 from engine.session.events import ActionStarted
 
+pytestmark = pytest.mark.realtime
+
 ROOT = Path(__file__).resolve().parents[1]
 VEST = [sys.executable, "-c", "from engine.cli import main; raise SystemExit(main())"]
 

@@ -13,6 +13,8 @@ import pytest
 
 from engine.cli import main
 
+pytestmark = pytest.mark.realtime
+
 ROOT = Path(__file__).resolve().parents[1]
 VEST = [sys.executable, "-c", "from engine.cli import main; raise SystemExit(main())"]
 

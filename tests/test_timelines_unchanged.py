@@ -22,6 +22,8 @@ import pytest
 
 from engine.cli import main
 
+pytestmark = pytest.mark.models
+
 ROOT = Path(__file__).resolve().parents[1]
 GOLDEN = Path(__file__).parent / "golden_timelines"
 CASES = sorted(

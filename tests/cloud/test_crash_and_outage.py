@@ -25,6 +25,8 @@ import requests
 from engine.cli import main
 from engine.services.cloud_link import DoneCommands
 
+pytestmark = pytest.mark.realtime
+
 ROOT = Path(__file__).resolve().parents[2]
 VEST = [sys.executable, "-c", "from engine.cli import main; raise SystemExit(main())"]
 

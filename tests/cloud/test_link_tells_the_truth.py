@@ -25,6 +25,8 @@ from engine.services.done_commands import DoneCommands
 from engine.session.events import Heard, KeyChanged
 from engine.session.stream import SessionStream
 
+pytestmark = pytest.mark.realtime
+
 ROOT = Path(__file__).resolve().parents[2]
 A_LONG_SENTENCE = " ".join(["one two three four five"] * 8)  # 40 words: 12 s at 0.3 s each
 

@@ -22,6 +22,8 @@ from engine.cli import main
 from engine.clock import EpochClock
 from tests.cloud.conftest import ROOT, VEST, self_signed
 
+pytestmark = pytest.mark.realtime
+
 
 @pytest.fixture(scope="module")
 def certificate(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:

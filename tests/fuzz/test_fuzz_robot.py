@@ -19,6 +19,8 @@ from engine.testing import TreeHarness
 
 from .hostile_values import ABSURD_NUMBERS, SCALARS, VALUES
 
+pytestmark = pytest.mark.fuzz
+
 ROOT = Path(__file__).resolve().parents[2]
 IOT_TREE = ROOT / "trees" / "iot_command.yaml"
 

@@ -23,6 +23,8 @@ from engine.errors import ConfigError
 from engine.interop.foxglove_live import FoxgloveLive
 from engine.session.events import ActionStarted
 
+pytestmark = pytest.mark.realtime
+
 ROOT = Path(__file__).resolve().parents[2]
 CLIENT = Path(__file__).resolve().parent / "foxglove_client"
 VEST = [sys.executable, "-c", "import sys; from engine.cli import main; sys.exit(main())"]

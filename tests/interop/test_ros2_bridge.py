@@ -21,6 +21,8 @@ from typing import Any
 
 import pytest
 
+pytestmark = pytest.mark.realtime
+
 zenoh = pytest.importorskip("zenoh")  # the ros2 extra
 
 from engine.blackboard.board import Blackboard  # noqa: E402

@@ -35,6 +35,8 @@ from engine.recording.replay import Recording
 from engine.recording.session_file import TABLES
 from tests.cloud.conftest import Running, start_service  # noqa: F401 - the fixture
 
+pytestmark = pytest.mark.realtime
+
 zenoh = pytest.importorskip("zenoh")  # the ros2 extra
 
 ROOT = Path(__file__).resolve().parents[2]

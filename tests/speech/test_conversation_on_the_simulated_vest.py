@@ -11,6 +11,8 @@ import pytest
 from engine.cli import main
 from engine.media.audio import read_wav, write_wav
 
+pytestmark = pytest.mark.models
+
 ROOT = Path(__file__).resolve().parents[2]
 
 

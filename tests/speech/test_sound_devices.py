@@ -12,6 +12,8 @@ from engine.hardware.config import AudioConfig
 from engine.media.audio_devices import probe
 from engine.robot_io.robot_speech import build_speech
 
+pytestmark = pytest.mark.models
+
 
 def test_a_missing_card_is_named_by_the_probe() -> None:
     status = probe("microphone", "hw:9,9")

@@ -11,6 +11,8 @@ from engine.cli import main
 from engine.media.audio import Audio, read_wav, write_wav
 from engine.speech.voices import Voice
 
+pytestmark = pytest.mark.models
+
 ROOT = Path(__file__).resolve().parents[2]
 
 

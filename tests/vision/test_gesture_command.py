@@ -13,6 +13,8 @@ import pytest
 from engine.cli import main
 from engine.vision_training.synthetic_hands import render_frame
 
+pytestmark = pytest.mark.models
+
 REAL_HANDS = Path(__file__).resolve().parents[2] / "examples" / "hands-real"
 ARMS_LENGTH = Path(__file__).resolve().parents[2] / "examples" / "hands-arms-length"
 

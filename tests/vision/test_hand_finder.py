@@ -19,6 +19,8 @@ from engine.vision.classifier import HandModel
 from engine.vision.hand_finder import HandFinder
 from engine.vision.palm_detection import anchors
 
+pytestmark = pytest.mark.models
+
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 ARMS_LENGTH = EXAMPLES / "hands-arms-length"
 

@@ -16,6 +16,8 @@ from engine.vision_training.dataset import centred_inputs
 from engine.vision_training.evaluation import Evaluation
 from engine.vision_training.synthetic_hands import render_frame
 
+pytestmark = pytest.mark.models
+
 ROOT = Path(__file__).resolve().parents[2]
 
 
