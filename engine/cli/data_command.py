@@ -28,10 +28,11 @@ from engine.cli.data_export import erase, export
 from engine.cli.output import tell
 from engine.cli.site_access import open_site, pseudonym
 from engine.errors import ConfigError, UsageError
+from engine.files.whole_file import write_whole
 from engine.privacy.consent import CAPTURES, CONSENT_FILE, PSEUDONYM, ROLE, ConsentBook
 from engine.privacy.sealed_sqlite import is_plain_sqlite, seal_copy
 from engine.privacy.site import Site
-from engine.privacy.site_data import check_apart
+from engine.privacy.site_data import OWNER_ONLY_FILE, check_apart
 from engine.recording.replay import Recording
 
 
@@ -184,15 +185,9 @@ def _add_consent(site: Site, args: argparse.Namespace) -> int:
         lines.append(f"  until: {args.until.isoformat()}")
     before = path.read_text(encoding="utf-8") if path.exists() else ""
     separator = "" if not before or before.endswith("\n") else "\n"
-    partial = path.with_name(path.name + ".partial")
-    partial.write_text(before + separator + "\n".join(lines) + "\n", encoding="utf-8")
-    partial.chmod(0o600)
-    try:
-        ConsentBook.load_file(partial)  # never saved unless it reads back whole
-    except BaseException:
-        partial.unlink(missing_ok=True)
-        raise
-    os.replace(partial, path)
+    text = before + separator + "\n".join(lines) + "\n"
+    # never saved unless it reads back whole
+    write_whole(path, text.encode("utf-8"), mode=OWNER_ONLY_FILE, check=ConsentBook.load_file)
     site.audit("consent", args.person, f"given by {args.given_by}: {', '.join(args.covers)}")
     print(f"{path}: added {args.person}")
     return 0

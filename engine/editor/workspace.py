@@ -21,7 +21,6 @@ from __future__ import annotations
 import contextlib
 import hashlib
 import os
-import tempfile
 import threading
 from dataclasses import dataclass
 from pathlib import Path
@@ -29,6 +28,7 @@ from typing import Any, Protocol
 
 from engine.dialogs.library import OUTSIDE
 from engine.files.problems import LoadError, Problem
+from engine.files.whole_file import write_whole
 from engine.files.yaml_source import read_bytes, resolved
 from engine.loader.tree_definition import TreeDefinition
 from engine.nodes.registry import NodeRegistry
@@ -197,23 +197,8 @@ class Workspace:
                 )
         data = text.encode("utf-8")
         path.parent.mkdir(parents=True, exist_ok=True)
-        _write_whole(path, data, self.new_mode)
+        write_whole(path, data, mode=None if path.exists() else self.new_mode)
         return Saved(version_of(data), problems)
-
-
-def _write_whole(path: Path, data: bytes, new_mode: int) -> None:
-    """``data`` into ``path`` at once: a temporary file beside it, then renamed over it."""
-    handle, temporary = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(handle, "wb") as file:
-            file.write(data)
-            file.flush()
-            os.fsync(file.fileno())
-        os.chmod(temporary, path.stat().st_mode & 0o777 if path.exists() else new_mode)
-        os.replace(temporary, path)
-    except BaseException:
-        Path(temporary).unlink(missing_ok=True)
-        raise
 
 
 def _described(problem: Problem, path: Path, folder: Path) -> dict[str, Any]:

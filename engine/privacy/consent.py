@@ -20,15 +20,16 @@ robot does.
 from __future__ import annotations
 
 import datetime
-import os
 import re
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
 from engine.files.problems import Mark, Problems
+from engine.files.whole_file import write_whole
 from engine.files.yaml_source import load_yaml
 from engine.files.yaml_values import YList, YMap, YScalar, YValue
+from engine.privacy.site_data import OWNER_ONLY_FILE
 from engine.values.param_problems import did_you_mean
 
 PSEUDONYM = re.compile(r"[A-Za-z0-9][A-Za-z0-9._-]{0,39}")
@@ -139,10 +140,7 @@ class ConsentBook:
         after = [line for line in starts if line > first]
         end = after[0] - 1 if after else len(lines)
         kept = lines[: first - 1] + lines[end:]
-        partial = path.with_name(path.name + ".partial")
-        partial.write_text("".join(kept), encoding="utf-8")
-        partial.chmod(0o600)
-        os.replace(partial, path)
+        write_whole(path, "".join(kept).encode("utf-8"), mode=OWNER_ONLY_FILE)
 
     @classmethod
     def load(cls, folder: Path) -> ConsentBook:

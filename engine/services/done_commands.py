@@ -9,6 +9,7 @@ from pathlib import Path
 from typing import Any
 
 from engine.files.problems import LoadError
+from engine.files.whole_file import write_whole
 from engine.files.yaml_source import read_bytes
 
 log = logging.getLogger("engine.services.cloud_link")
@@ -89,8 +90,6 @@ class DoneCommands:
                 self._done.pop(next(iter(self._done)))
             text = json.dumps(self._done)
         try:
-            temporary = self.path.with_suffix(".tmp")
-            temporary.write_text(text, encoding="utf-8")
-            temporary.replace(self.path)
+            write_whole(self.path, text.encode("utf-8"))
         except OSError as error:
             log.warning("cannot keep finished commands in %s: %s", self.path, error)
