@@ -75,7 +75,7 @@ def check_joints(definition: TreeDefinition, config: RobotConfig) -> list[Proble
     joints = {joint.name: joint for device in config for joint in device.joints}
     problems: list[Problem] = []
     for node in definition.root.walk():
-        if node.type.name not in ("MoveServo", "LookToward") or not joints:
+        if not node.type.moves_its_joint or not joints:
             continue
         name = str(node.args.get("joint"))
         joint = joints.get(name)

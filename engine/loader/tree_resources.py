@@ -7,29 +7,15 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from engine.loader.tree_definition import TreeDefinition
-from engine.services.turns import FACE_LEDS, SPEAKER, joint_resource
-
-ANY_JOINT = joint_resource("any")
-_SPEAKS = ("Say", "Reply")
-_LIGHTS = ("SetLed",)
-_MOVES = ("MoveServo", "LookToward")
-_REMOTE = ("CarryOut",)  # a remote command may speak, light or move
+from engine.nodes.spec import ANY_JOINT
 
 
 def tree_resources(definition: TreeDefinition) -> set[str]:
-    """The resources the built-in action nodes of ``definition`` use (plugins' own nodes
-    are not known here)."""
+    """The resources the nodes of ``definition`` use, as each node type declares them
+    (:attr:`~engine.nodes.spec.NodeType.uses`; a plugin's nodes included)."""
     used: set[str] = set()
     for node in definition.root.walk():
-        kind = node.type.name
-        if kind in _SPEAKS or kind in _REMOTE:
-            used.add(SPEAKER)
-        if kind in _LIGHTS or kind in _REMOTE:
-            used.add(FACE_LEDS)
-        if kind in _MOVES:
-            used.add(joint_resource(str(node.args.get("joint", "neck"))))
-        if kind in _REMOTE:
-            used.add(ANY_JOINT)
+        used |= node.type.resources(node.args)
     return used
 
 

@@ -15,9 +15,11 @@ from engine.blackboard.catalogue import RANGE_CENTER_MM, RANGE_LEFT_MM, RANGE_RI
 from engine.errors import ServiceError
 from engine.nodes.base import Leaf, ServiceAction
 from engine.nodes.event_reader import EQUALS, ONE_OF, EventReader, check_choice, wanted
+from engine.nodes.spec import ITS_JOINT
 from engine.remote_commands import LED_ARGS, MOVE_ARGS, SAY_ARGS
 from engine.services.interfaces import ON_REQUEST_SENSORS
 from engine.services.jobs import ImmediateJob, Job
+from engine.services.turns import FACE_LEDS, SPEAKER
 from engine.values.param_problems import CheckContext, ParamIssue
 from engine.values.params import (
     DISTANCE_MM,
@@ -41,6 +43,7 @@ class Say(ServiceAction):
     """
 
     text, volume = SAY_ARGS  # an operator's say command takes the same (remote_commands)
+    uses = (SPEAKER,)
 
     def start(self) -> Job:
         try:
@@ -58,6 +61,7 @@ class SetLed(ServiceAction):
     """
 
     color, seconds = LED_ARGS
+    uses = (FACE_LEDS,)
 
     def start(self) -> Job:
         return self.ctx.actions.set_led(self.color, seconds=self.seconds)
@@ -71,6 +75,7 @@ class MoveServo(ServiceAction):
     """
 
     joint, angle_deg, speed_dps = MOVE_ARGS
+    uses = (ITS_JOINT,)
 
     def start(self) -> Job:
         return self.ctx.actions.move_servo(self.joint, self.angle_deg, speed_dps=self.speed_dps)
@@ -87,6 +92,7 @@ class LookToward(Leaf):
     """
 
     joint = Param("joint", Text(), "neck", "the joint to turn")
+    uses = (ITS_JOINT,)
     turn_deg = Param(
         "turn_deg", Number(0.0, 90.0, "deg"), 30.0, "how far to turn; left is positive"
     )

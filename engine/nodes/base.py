@@ -69,6 +69,10 @@ class Leaf(py_trees.behaviour.Behaviour):
     params: ClassVar[tuple[Param[Any], ...]] = ()
     reads: ClassVar[tuple[str, ...]] = ()
     writes: ClassVar[tuple[str, ...]] = ()
+    uses: ClassVar[tuple[str, ...]] = ()
+    """What the node uses of the robot (:data:`~engine.nodes.spec.RESOURCES`: the speaker,
+    the face LEDs, the joint its ``joint`` parameter names, any joint): trees of one
+    priority that use the same are named at load time, and the robot checks read it."""
     _guarding: bool = False
     """True while a guarded lifecycle method runs (a subclass calling super() is not
     guarded twice)."""
@@ -321,6 +325,7 @@ def leaf_type(cls: type[Leaf], *, source: str = "vest", **bound: Any) -> NodeTyp
         fixed_reads=tuple(cls.reads),
         fixed_writes=tuple(cls.writes),
         source=source,
+        uses=tuple(cls.uses),
     )
 
 

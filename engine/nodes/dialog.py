@@ -12,6 +12,7 @@ from engine.dialogs.model import Dialog, FollowUp, Verdict
 from engine.errors import ServiceError
 from engine.nodes.base import Leaf
 from engine.services.jobs import ImmediateJob, Job
+from engine.services.turns import SPEAKER
 from engine.session.events import NotUnderstood
 from engine.values.param_problems import CheckContext, ParamIssue, did_you_mean
 from engine.values.params import Key, Param, Text
@@ -34,6 +35,8 @@ class Reply(Leaf):
     understand again soon after a sorry, it says the dialog's next ``reprompt:`` instead
     (:mod:`engine.dialogs.confirming`).
     """
+
+    uses = (SPEAKER,)
 
     params: ClassVar = (
         Param("heard", Key(), doc="the /vars/ key holding the utterance"),

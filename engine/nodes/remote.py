@@ -15,6 +15,7 @@ from engine.blackboard.catalogue import IOT_CANCELED, NOTHING, READINGS, Carries
 from engine.blackboard.events import EventLog
 from engine.nodes.base import ServiceAction
 from engine.nodes.event_reader import EventReader
+from engine.nodes.spec import ANY_JOINT
 from engine.remote_commands import (
     COMMAND_TYPES,
     POLLED_READINGS,
@@ -23,6 +24,7 @@ from engine.remote_commands import (
     checked_args,
 )
 from engine.services.jobs import ImmediateJob, Job
+from engine.services.turns import FACE_LEDS, SPEAKER
 from engine.values.param_problems import CheckContext
 from engine.values.params import SECONDS, Key, Param
 from engine.values.templates import CompiledTemplate
@@ -38,6 +40,8 @@ class CarryOut(ServiceAction):
     Arguments are checked as Say, SetLed and MoveServo check their parameters. The result
     saved always belongs to this command (it is cleared when the command starts).
     """
+
+    uses = (SPEAKER, FACE_LEDS, ANY_JOINT)  # a remote command may speak, light or move
 
     command = Param("command", Key(), doc="the /vars/ key holding the command")
     save_result_as = Param(

@@ -16,6 +16,7 @@ from typing import Any, Literal
 import py_trees
 
 from engine.nodes.context import TreeContext
+from engine.services.turns import FACE_LEDS, SPEAKER, joint_resource
 from engine.values.param_problems import CheckContext, ParamIssue
 from engine.values.params import Key, ListOf, Param
 from engine.values.templates import CompiledTemplate
@@ -29,6 +30,15 @@ Builder = Callable[
 ]
 ExtraCheck = Callable[[Mapping[str, Any], CheckContext], list[ParamIssue]]
 """Cross-parameter checks: returns (parameter or None, message, hint) per problem."""
+
+ITS_JOINT = "its joint"
+"""A node that uses this moves the joint its ``joint`` parameter names (neck by default)."""
+ANY_JOINT = joint_resource("any")
+"""A node that uses this may move any joint (a remote command)."""
+RESOURCES = (SPEAKER, FACE_LEDS, ITS_JOINT, ANY_JOINT)
+"""What a node type may declare it uses of the robot (:attr:`NodeType.uses`): the
+priority check and the robot checks read it, so a plugin's node takes part as a built-in
+one does."""
 
 
 @dataclass(frozen=True)
@@ -44,6 +54,28 @@ class NodeType:
     fixed_reads: tuple[str, ...] = ()
     fixed_writes: tuple[str, ...] = ()
     source: str = "vest"
+    uses: tuple[str, ...] = ()
+    """What its nodes use of the robot, of :data:`RESOURCES`."""
+
+    def __post_init__(self) -> None:
+        unknown = [use for use in self.uses if use not in RESOURCES]
+        if unknown:
+            raise TypeError(
+                f"{self.name} uses {unknown}: a node uses the "
+                + ", the ".join(repr(r) for r in RESOURCES)
+            )
+
+    @property
+    def moves_its_joint(self) -> bool:
+        return ITS_JOINT in self.uses
+
+    def resources(self, args: Mapping[str, Any]) -> set[str]:
+        """What a node of this type with these arguments can want of the robot: the
+        speaker, the face LEDs, a joint by name (``neck joint``), any joint."""
+        used = {use for use in self.uses if use != ITS_JOINT}
+        if self.moves_its_joint:
+            used.add(joint_resource(str(args.get("joint", "neck"))))
+        return used
 
     @property
     def children(self) -> Literal["none", "one", "many"]:
