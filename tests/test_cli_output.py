@@ -13,9 +13,10 @@ from typing import Any
 import pytest
 
 from engine.cli import main
-from engine.cli.output import finite_json, shown
+from engine.cli.output import shown
 from engine.cli.timeline import Timeline
 from engine.session.events import ActionStarted
+from engine.session.json_values import json_value
 
 pytestmark = pytest.mark.realtime
 
@@ -137,7 +138,7 @@ def test_json_lines_are_strict_json_with_null_for_numbers_that_are_not_finite() 
 
     shown_line = json.loads(out.lines[0], parse_constant=refuse)
     assert shown_line["args"]["result"] == {"c": None, "cm": [None, 1.5]}
-    assert finite_json({"ok": 1.0, "t": (-float("inf"),)}) == {"ok": 1.0, "t": [None]}
+    assert json_value({"ok": 1.0, "t": (-float("inf"),)}) == {"ok": 1.0, "t": [None]}
 
 
 def test_a_tree_name_and_phrase_with_control_characters_are_escaped_in_a_run(

@@ -13,18 +13,23 @@ from pathlib import Path
 
 import pytest
 
+from engine.blackboard.catalogue import default_catalogue
 from engine.cli import main
 from engine.clock import VirtualClock
 from engine.privacy.site_data import SiteKey
 from engine.recording.replay import Recording
 from engine.recording.report import not_understood, person_moments, report_html
 from engine.recording.told import told_events
+from engine.services.telemetry import TelemetrySnapshot
+from engine.session.blackboard_news import ChangedKeys
 from engine.session.events import (
     ActionEnded,
     ButtonPressed,
+    KeyChanged,
     SafetyAction,
     TurnTaken,
 )
+from engine.session.json_values import json_text
 from engine.session.sentences import event_line
 from engine.session.stream import SessionStream
 from engine.view.hub import ViewHub
@@ -136,3 +141,15 @@ def test_a_recording_of_the_first_format_still_replays_and_reports(
     assert ("touch_thanks", 'says "Thank you"') in told
     assert ("vest", "touch is offline") in told
     assert "Session report" in report_html(recording)
+
+
+def test_a_reading_that_cannot_be_trusted_is_null_on_every_path() -> None:
+    # a force pad that fails reads NaN (the worst case); JSON has no NaN
+    key = "/sensors/force/left_n"
+    text, _ = ChangedKeys(default_catalogue()).news(key, float("nan")) or ("", False)
+    assert text == "null"  # the live view's and the recording's text
+    changed = KeyChanged(1.0, key, float("nan"), text, False, "force_pads")
+    telemetry = TelemetrySnapshot()
+    telemetry.on_event(changed)
+    assert telemetry.take() == {key: None}  # what the cloud is sent
+    assert json.loads(json_text({"value": changed.value})) == {"value": None}  # --json, MCAP

@@ -11,7 +11,6 @@ drive the terminal.
 from __future__ import annotations
 
 import errno
-import math
 import os
 import stat
 import sys
@@ -36,19 +35,6 @@ def shown(text: str) -> str:
         repr(char)[1:-1] if unicodedata.category(char) in _UNSAFE_CATEGORIES else char
         for char in text
     )
-
-
-def finite_json(value: Any) -> Any:
-    """``value`` with every NaN or infinite float replaced by None (JSON's null), the way a
-    browser's ``JSON.stringify`` does, so ``json.dumps(..., allow_nan=False)`` never fails
-    and never writes ``NaN`` or ``Infinity``, which are not JSON."""
-    if isinstance(value, float):
-        return value if math.isfinite(value) else None
-    if isinstance(value, dict):
-        return {key: finite_json(item) for key, item in value.items()}
-    if isinstance(value, list | tuple):
-        return [finite_json(item) for item in value]
-    return value
 
 
 def tell(text: str, stream: TextIO | None = None) -> bool:

@@ -12,13 +12,13 @@ number is written as null.
 
 from __future__ import annotations
 
-import json
 from collections.abc import Callable
 from typing import Any, TextIO
 
-from engine.cli.output import discard, finite_json, reason, shown, tell
+from engine.cli.output import discard, reason, shown, tell
 from engine.runtime.scheduler import RunningTree
 from engine.session.events import ActionEnded, DeviceChanged, SessionEvent, told_fields
+from engine.session.json_values import json_text
 from engine.session.sentences import TOLD_KINDS, event_line
 
 
@@ -99,7 +99,7 @@ class Timeline:
             shown_event = event_json(event, self.start_s)
             if shown_event is not None:
                 # a value JSON has no form for (an object in a result) is shown as its text
-                text = json.dumps(finite_json(shown_event), allow_nan=False, default=str)
+                text = json_text(shown_event)
                 self._write(text + "\n")
             return
         line = event_line(event)

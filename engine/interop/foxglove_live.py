@@ -35,9 +35,9 @@ from engine.clock import Clock
 from engine.errors import ConfigError
 from engine.interop.session_formats import SCHEMAS
 from engine.interop.session_topics import NodePaths, live_message
-from engine.services.telemetry import json_safe
 from engine.session.events import SessionEvent, TreeStarted
 from engine.session.handoff import Handoff
+from engine.session.json_values import json_value
 from engine.web.broadcast import Broadcast
 from engine.web.guard import TokenGuard, is_loopback, new_token, refuse_websocket
 from engine.web.serving import ServerThread, listening_socket
@@ -158,7 +158,7 @@ class FoxgloveLive:
                     self._channels[topic] = channel
                 self._items.publish(Item(channel))
             at_ns = max(0, round((event.t_s + self.epoch_offset_s) * 1e9))
-            data = json.dumps(json_safe(message)).encode()  # NaN as null, as everywhere
+            data = json.dumps(json_value(message)).encode()  # NaN as null, as everywhere
             self._items.publish(Item(channel, at_ns, data))
         return True
 

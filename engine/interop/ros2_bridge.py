@@ -63,7 +63,6 @@ from engine.interop.ros2_wire import (
 from engine.interop.session_topics import NodePaths, live_message
 from engine.periodic import Periodic
 from engine.privacy.consent_gate import ConsentGate
-from engine.services.telemetry import json_safe
 from engine.session.events import (
     ActionStarted,
     KeyChanged,
@@ -72,6 +71,7 @@ from engine.session.events import (
     TreeStarted,
 )
 from engine.session.handoff import Handoff
+from engine.session.json_values import json_value
 
 log = logging.getLogger(__name__)
 CAPACITY = 50_000
@@ -222,7 +222,7 @@ class Ros2Bridge:
         elif declared is int and isinstance(value, int) and not isinstance(value, bool):
             self._publish(topic, INTEGER, {"data": max(-(2**63), min(value, 2**63 - 1))}, event.t_s)
         elif declared not in (bool, float, int):
-            text = value if isinstance(value, str) else json.dumps(json_safe(value))
+            text = value if isinstance(value, str) else json.dumps(json_value(value))
             self._publish(topic, STRING, {"data": text}, event.t_s)
 
     def _publish(self, topic: str, typename: str, fields: dict[str, Any], at_s: float) -> None:

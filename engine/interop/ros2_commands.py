@@ -28,8 +28,8 @@ from engine.blackboard.catalogue import IOT_INBOX
 from engine.clock import Clock
 from engine.privacy.consent_gate import RESULT_WITHHELD, ConsentGate
 from engine.remote_commands import COMMAND_TYPES, command_problem
-from engine.services.telemetry import json_safe
 from engine.session.events import ActionStarted
+from engine.session.json_values import json_value
 
 log = logging.getLogger(__name__)
 AT_MOST_WAITING = 8
@@ -158,7 +158,7 @@ class GraphCommands:
         status = str(event.args.get("status", "")).upper()
         if not self.gate.lets_result_out(result, event.carries):
             status, result = "FAILED", {"error": RESULT_WITHHELD}
-        self._tell(command_id.removeprefix(PREFIX), status, json_safe(result))
+        self._tell(command_id.removeprefix(PREFIX), status, json_value(result))
 
     def sweep(self) -> None:
         """Commands waiting too long are told LOST (every second, beside the robot)."""

@@ -26,7 +26,7 @@ from mcap.writer import Writer
 
 from engine.interop.btcpp_export import BTCPP_BUILTINS, xml_safe
 from engine.recording.replay import RecordedNode, RecordedTree, Recording
-from engine.services.telemetry import json_safe
+from engine.session.json_values import json_value
 
 MAGIC = b"BTCPP4-FileLogger2"
 PROTOCOL = 1
@@ -238,7 +238,7 @@ def write_mcap(recording: Recording, out: BinaryIO) -> dict[str, int]:
         if topic not in channels:
             channels[topic] = writer.register_channel(topic, "json", schema_ids[schema])
         at_ns = start_ns + round(float(at_s) * 1e9)
-        data = json.dumps(json_safe(message), allow_nan=False).encode()  # NaN: null
+        data = json.dumps(json_value(message), allow_nan=False).encode()  # NaN: null
         writer.add_message(channels[topic], at_ns, data, at_ns, counts.get(topic, 0))
         counts[topic] = counts.get(topic, 0) + 1
     writer.finish()  # type: ignore[no-untyped-call]

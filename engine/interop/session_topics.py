@@ -7,7 +7,6 @@ from __future__ import annotations
 from typing import Any
 
 from engine.recording.recorder import KEPT_AS_EVENTS
-from engine.services.telemetry import json_safe
 from engine.session.events import (
     ActionEnded,
     ActionStarted,
@@ -17,6 +16,7 @@ from engine.session.events import (
     WorldEvent,
     told_fields,
 )
+from engine.session.json_values import json_value
 
 NodePaths = dict[tuple[str, int, int], tuple[str, str]]
 """(tree, version, node index) -> (the node's path, its type), from each TreeStarted."""
@@ -39,20 +39,20 @@ def live_message(event: SessionEvent, paths: NodePaths) -> tuple[str, str, dict[
         }
         return f"/vest/trees/{event.tree}/status", "vest.NodeStatus", message
     if isinstance(event, KeyChanged):
-        message = {"key": event.key, "value": json_safe(event.value), "event": event.event}
+        message = {"key": event.key, "value": json_value(event.value), "event": event.event}
         return "/vest/blackboard", "vest.KeyChange", message
     if isinstance(event, ActionStarted):
-        message = {"tree": event.tree, "action": event.action, "args": json_safe(event.args)}
+        message = {"tree": event.tree, "action": event.action, "args": json_value(event.args)}
         return "/vest/actions", "vest.Action", message | {"outcome": None, "why": None}
     if isinstance(event, ActionEnded):
-        message = {"tree": event.tree, "action": event.action, "args": json_safe(event.args)}
+        message = {"tree": event.tree, "action": event.action, "args": json_value(event.args)}
         ended = {"outcome": event.outcome, "why": event.why or None}
         return "/vest/actions/outcome", "vest.Action", message | ended
     if isinstance(event, WorldEvent):
         message = {"kind": event.scenario_event, "description": event.description}
         return "/vest/world", "vest.WorldEvent", message
     if event.kind in KEPT_AS_EVENTS:
-        data = {k: json_safe(v) for k, v in vars_of(event).items() if k not in ("t_s", "tree")}
+        data = {k: json_value(v) for k, v in vars_of(event).items() if k not in ("t_s", "tree")}
         message = {"kind": event.kind, "tree": str(getattr(event, "tree", "")), "data": data}
         return "/vest/events", "vest.SessionEvent", message
     return None

@@ -14,6 +14,7 @@ A recording keeps only what the person consented to: one that kept no speech as 
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
@@ -24,6 +25,7 @@ from engine.blackboard.catalogue import (
     TEMPERATURE_F,
     ULTRASOUND_CM,
     VARIABLES_PREFIX,
+    KeyCatalogue,
 )
 from engine.buttons.button_file import BUTTONS_TREE
 from engine.clock import VirtualClock
@@ -71,7 +73,7 @@ def rerun(recording: Recording, behaviors: Behaviors) -> list[RecordedAction]:
     board.reset()
     services = simulated_services(clock, realistic=True, readers=_readers(recording, clock))
     robot = Robot(behaviors, clock=clock, services=services, blackboard=board)
-    robot.scheduler.add_hook(_Inputs(_sensed(recording), board))
+    robot.scheduler.add_hook(_Inputs(_sensed(recording, behaviors.loader.catalogue), board))
     robot.scheduler.run(until_s=recording.duration_s, start_s=0.0)
     return [
         RecordedAction(record.t, record.tree, record.action, record.args, record.error)
@@ -103,13 +105,21 @@ def _readers(recording: Recording, clock: VirtualClock) -> dict[str, Callable[[]
     }
 
 
-def _sensed(recording: Recording) -> list[tuple[float, str, object, bool]]:
+def _sensed(recording: Recording, catalogue: KeyCatalogue) -> list[tuple[float, str, object, bool]]:
+    """Every reading recorded, in time order: (moment, key, value, whether an event). A
+    number recorded as null (JSON has no NaN: engine.session.json_values) was a reading that
+    could not be trusted, and is NaN again, as the trees saw it."""
     rows = []
     for key in recording.keys_like("%"):
         if key.startswith(VARIABLES_PREFIX):
             continue
         event = recording.is_event(key)
-        rows += [(at, key, value, event) for at, value in recording.key_history(key)]
+        spec = catalogue.lookup(key)
+        number = spec is not None and spec.value_type is float
+        rows += [
+            (at, key, math.nan if number and value is None else value, event)
+            for at, value in recording.key_history(key)
+        ]
     return sorted(rows, key=lambda row: row[0])
 
 

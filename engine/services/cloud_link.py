@@ -44,8 +44,9 @@ from engine.privacy.consent import without_record
 from engine.privacy.consent_gate import RESULT_WITHHELD, ConsentGate, Exit
 from engine.services.done_commands import DoneCommands
 from engine.services.jobs import ImmediateJob, Job
-from engine.services.telemetry import TelemetrySnapshot, json_safe
+from engine.services.telemetry import TelemetrySnapshot
 from engine.session.events import KeyChanged
+from engine.session.json_values import json_value
 from engine.session.stream import SessionStream
 
 log = logging.getLogger(__name__)
@@ -151,7 +152,7 @@ class CloudLink:
         """Queue the report (it is sent, and retried, by the reporter); done at once. A
         command that did not come from the cloud (a scenario's, say) is not reported there;
         a result made from ``carries`` of a person goes only with their consent."""
-        report = {"status": status.upper(), "result": json_safe(result)}
+        report = {"status": status.upper(), "result": json_value(result)}
         if not self.gate.lets_result_out(result, carries):
             report = {"status": "FAILED", "result": {"error": RESULT_WITHHELD}}
         with self._carrying_out:

@@ -9,31 +9,14 @@ committed, never the live blackboard.
 
 from __future__ import annotations
 
-import math
 import threading
 from typing import Any
 
 from engine.blackboard.catalogue import DEVICES_PREFIX, SENSORS_PREFIX
-from engine.blackboard.events import EventLog
 from engine.session.events import KeyChanged, SessionEvent
+from engine.session.json_values import json_value
 
 TELEMETRY_PREFIXES = (SENSORS_PREFIX, DEVICES_PREFIX)
-
-
-def json_safe(value: Any) -> Any:
-    """Numbers that JSON cannot carry (NaN, infinity) as None; containers walked; an
-    event key as its latest event's value (None before the first)."""
-    if isinstance(value, EventLog):
-        return json_safe(value.latest.value) if value.latest is not None else None
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    if isinstance(value, dict):
-        return {str(k): json_safe(v) for k, v in value.items()}
-    if isinstance(value, list | tuple):
-        return [json_safe(v) for v in value]
-    if value is None or isinstance(value, bool | int | float | str):
-        return value
-    return str(value)
 
 
 class TelemetrySnapshot:
@@ -46,7 +29,7 @@ class TelemetrySnapshot:
 
     def on_event(self, event: SessionEvent) -> None:
         if isinstance(event, KeyChanged) and event.key.startswith(TELEMETRY_PREFIXES):
-            value = json_safe(event.value)
+            value = json_value(event.value)
             with self._lock:
                 self._values[event.key] = value
 

@@ -9,7 +9,6 @@ someone it could not listen to, a device going offline or coming back.
 
 from __future__ import annotations
 
-import json
 from collections.abc import Callable, Iterable
 from typing import Any
 
@@ -25,15 +24,8 @@ from engine.blackboard.catalogue import (
 )
 from engine.clock import Clock
 from engine.session.events import DeviceChanged, HandShown, Heard, KeyChanged, NotListened
+from engine.session.json_values import json_text
 from engine.session.stream import SessionStream
-
-
-def as_json(value: Any) -> str:
-    """A blackboard value as JSON; what JSON cannot hold is kept as its text."""
-    try:
-        return json.dumps(value, allow_nan=False, default=str)
-    except ValueError:  # NaN or infinity
-        return json.dumps(str(value))
 
 
 class ChangedKeys:
@@ -48,7 +40,7 @@ class ChangedKeys:
         """(the value as JSON, whether ``key`` is an event key), or None: nothing new."""
         spec = self.catalogue.lookup(key)
         event = spec is not None and spec.kind == "event"
-        text = as_json(value)
+        text = json_text(value)
         if not event and self._values.get(key) == text:
             return None
         self._values[key] = text
