@@ -28,8 +28,16 @@ from engine.cli.data_export import erase, export
 from engine.cli.output import tell
 from engine.cli.site_access import open_site, pseudonym
 from engine.errors import ConfigError, UsageError
+from engine.files.problems import LoadError
 from engine.files.whole_file import write_whole
-from engine.privacy.consent import CAPTURES, CONSENT_FILE, PSEUDONYM, ROLE, ConsentBook
+from engine.privacy.consent import (
+    CAPTURES,
+    CONSENT_FILE,
+    PSEUDONYM,
+    ROLE,
+    ConsentBook,
+    editing_consent,
+)
 from engine.privacy.sealed_sqlite import is_plain_sqlite, seal_copy
 from engine.privacy.site import Site
 from engine.privacy.site_data import OWNER_ONLY_FILE, check_apart
@@ -173,8 +181,6 @@ def _add_consent(site: Site, args: argparse.Namespace) -> int:
             f"({given_on.isoformat()})"
         )
     path = site.folder / CONSENT_FILE
-    if args.person in site.consents.records:
-        raise ConfigError(f"{path}: {args.person} has a record already; change it in that file")
     lines = [
         f"{args.person}:",
         f"  given_by: {args.given_by}",
@@ -183,11 +189,23 @@ def _add_consent(site: Site, args: argparse.Namespace) -> int:
     ]
     if args.until is not None:
         lines.append(f"  until: {args.until.isoformat()}")
-    before = path.read_text(encoding="utf-8") if path.exists() else ""
-    separator = "" if not before or before.endswith("\n") else "\n"
-    text = before + separator + "\n".join(lines) + "\n"
-    # never saved unless it reads back whole
-    write_whole(path, text.encode("utf-8"), mode=OWNER_ONLY_FILE, check=ConsentBook.load_file)
+
+    def reads_back(written: Path) -> None:
+        """Never saved unless the whole file reads back (its mistakes named in the file's
+        own name, not the temporary one's)."""
+        try:
+            ConsentBook.load_file(written)
+        except LoadError as error:
+            shown = str(error).replace(str(written), str(path))
+            raise ConfigError(f"{path}: not changed: with {args.person} added,\n{shown}") from None
+
+    with editing_consent(site.folder):  # another vest adding meanwhile takes its turn
+        if args.person in ConsentBook.load(site.folder).records:  # as it is now
+            raise ConfigError(f"{path}: {args.person} has a record already; change it in that file")
+        before = path.read_text(encoding="utf-8") if path.exists() else ""
+        separator = "" if not before or before.endswith("\n") else "\n"
+        text = before + separator + "\n".join(lines) + "\n"
+        write_whole(path, text.encode("utf-8"), mode=OWNER_ONLY_FILE, check=reads_back)
     site.audit("consent", args.person, f"given by {args.given_by}: {', '.join(args.covers)}")
     print(f"{path}: added {args.person}")
     return 0

@@ -19,16 +19,21 @@ robot does.
 
 from __future__ import annotations
 
+import contextlib
 import datetime
+import fcntl
+import os
 import re
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass
 from pathlib import Path
+
+import yaml
 
 from engine.files.problems import Mark, Problems
 from engine.files.whole_file import write_whole
 from engine.files.yaml_source import load_yaml
-from engine.files.yaml_values import YList, YMap, YScalar, YValue
+from engine.files.yaml_values import YList, YMap, YScalar, YValue, plain
 from engine.privacy.site_data import OWNER_ONLY_FILE
 from engine.values.param_problems import did_you_mean
 
@@ -38,6 +43,8 @@ PSEUDONYM = re.compile(r"[A-Za-z0-9][A-Za-z0-9._-]{0,39}")
 ROLE = re.compile(r"[A-Za-z][A-Za-z-]{0,39}")
 """Who gave consent, as a role: guardian, parent, self, legal-guardian."""
 CONSENT_FILE = "consent.yaml"
+CONSENT_LOCK = "consent.lock"
+"""Held while the consent file is read and written again (:func:`editing_consent`)."""
 CAPTURES: dict[str, str] = {
     "sensors": "sensor readings",
     "speech_text": "speech as text",
@@ -125,22 +132,26 @@ class ConsentBook:
         return record
 
     def forget(self, folder: Path, person: str) -> None:
-        """Removes ``person``'s record from ``folder/consent.yaml`` (the lines of its
-        entry; the rest of the file as it was, comments included)."""
+        """Removes ``person``'s record from ``folder/consent.yaml``: the lines of its entry,
+        the rest of the file as it was, comments included; a file written in flow style
+        (``{kid-1: {...}, kid-2: {...}}``) is written again in block style without it,
+        every other record kept (its comments are not)."""
         self.records.pop(person, None)
         path = folder / CONSENT_FILE
-        if not path.exists():
-            return
-        document = load_yaml(path)
-        if not isinstance(document, YMap) or person not in document:
-            return
-        lines = path.read_text(encoding="utf-8").splitlines(keepends=True)
-        starts = sorted(mark.line for mark in document.key_marks.values())
-        first = document.key_marks[person].line
-        after = [line for line in starts if line > first]
-        end = after[0] - 1 if after else len(lines)
-        kept = lines[: first - 1] + lines[end:]
-        write_whole(path, "".join(kept).encode("utf-8"), mode=OWNER_ONLY_FILE)
+        with editing_consent(folder):
+            if not path.exists():
+                return
+            document = load_yaml(path)
+            if not isinstance(document, YMap) or person not in document:
+                return
+            others = [key for key in document.key_marks if key != person]
+            kept = _without_lines_of(path, document, person)
+            if _persons_in(kept) != others:  # entries share lines: flow style
+                rest = {key: plain(value) for key, value in document.items() if key != person}
+                kept = (
+                    yaml.safe_dump(rest, sort_keys=False, default_flow_style=False) if rest else ""
+                )
+            write_whole(path, kept.encode("utf-8"), mode=OWNER_ONLY_FILE)
 
     @classmethod
     def load(cls, folder: Path) -> ConsentBook:
@@ -237,3 +248,33 @@ def _covers(value: YValue | None, problems: Problems) -> frozenset[str] | None:
             continue
         names.add(name)
     return frozenset(names)
+
+
+@contextlib.contextmanager
+def editing_consent(folder: Path) -> Iterator[None]:
+    """Held while ``consent.yaml`` is read and written again (``consent.lock``): two vests
+    adding or forgetting records at once take turns, each reading what the other wrote."""
+    with open(folder / CONSENT_LOCK, "a+b") as lock:
+        os.chmod(lock.name, OWNER_ONLY_FILE)
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        yield
+
+
+def _without_lines_of(path: Path, document: YMap, person: str) -> str:
+    """The text of ``path`` without the lines of ``person``'s entry."""
+    lines = path.read_text(encoding="utf-8").splitlines(keepends=True)
+    starts = sorted(mark.line for mark in document.key_marks.values())
+    first = document.key_marks[person].line
+    after = [line for line in starts if line > first]
+    end = after[0] - 1 if after else len(lines)
+    return "".join(lines[: first - 1] + lines[end:])
+
+
+def _persons_in(text: str) -> list[str]:
+    """The persons a consent file's text holds records of, in order (none when it does not
+    read as a mapping)."""
+    try:
+        document = yaml.safe_load(text)
+    except yaml.YAMLError:
+        return []
+    return [str(key) for key in document] if isinstance(document, dict) else []

@@ -5,6 +5,8 @@ is in an append-only audit trail."""
 from __future__ import annotations
 
 import json
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -291,3 +293,57 @@ def test_a_consent_given_wrong_is_refused_and_leaves_nothing_behind(
     )
     assert "before the day consent was given (2026-11-20)" in capsys.readouterr().err
     assert not list(site_data.glob("*.partial")) and not (site_data / "consent.yaml").exists()
+
+
+def test_erasing_one_person_of_a_file_in_flow_style_keeps_everyone_else(
+    site_data: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # a breaker's file: written by hand on one line
+    site_data.mkdir(mode=0o700, parents=True, exist_ok=True)
+    (site_data / "consent.yaml").write_text(
+        "{kid-1: {given_by: guardian, given_on: 2026-01-05, covers: [sensors]},"
+        " kid-2: {given_by: parent, given_on: 2026-02-01, covers: [sensors, speech_text]}}\n"
+    )
+    assert main(["data", "erase", "--person", "kid-1", "--yes"]) == 0
+    capsys.readouterr()
+    assert main(["data", "consent", "kid-2"]) == 0
+    assert "keeps sensor readings, speech as text" in capsys.readouterr().out  # as it was
+    assert "kid-1" not in (site_data / "consent.yaml").read_text()
+    assert (site_data / "consent.yaml").stat().st_mode & 0o777 == 0o600
+
+
+def test_a_record_that_would_leave_the_file_unreadable_names_the_file_not_a_temporary(
+    site_data: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    site_data.mkdir(mode=0o700, parents=True, exist_ok=True)
+    flow = "{kid-1: {given_by: guardian, given_on: 2026-01-05, covers: [sensors]}}"  # no newline
+    (site_data / "consent.yaml").write_text(flow)
+    given = ["data", "consent", "kid-2", "--given-by", "guardian", "--covers", "sensors"]
+    assert main(given) == 1
+    told = capsys.readouterr().err
+    assert f"{site_data / 'consent.yaml'}: not changed: with kid-2 added" in told
+    assert ".tmp" not in told
+    assert (site_data / "consent.yaml").read_text() == flow
+    assert sorted(p.name for p in site_data.iterdir() if "consent" in p.name) == [
+        "consent.lock",
+        "consent.yaml",
+    ]
+
+
+@pytest.mark.realtime
+def test_guardians_consenting_at_the_same_moment_are_all_kept(site_data: Path) -> None:
+    # four `vest data consent` at once, as two staff members at two terminals might
+    vest = [sys.executable, "-c", "import sys; from engine.cli import main; sys.exit(main())"]
+    adding = [
+        subprocess.Popen(
+            [*vest, "data", "consent", f"kid-{n}", "--given-by", "guardian", "--covers", "sensors"],
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+        )
+        for n in range(1, 5)
+    ]
+    for process in adding:
+        _, err = process.communicate(timeout=120)
+        assert process.returncode == 0, err
+    text = (site_data / "consent.yaml").read_text()
+    assert all(f"kid-{n}:" in text for n in range(1, 5)), text
