@@ -19,8 +19,8 @@ A test is in a slow tier for what it needs, not for how long it took once:
 - ``bench``: the benchmark scripts, run short.
 
 Everything else is the fast tier: trees on a virtual clock, loaders, nodes, drivers on
-simulated buses, fakes. ``pytest`` with paths or node ids, ``-m`` or ``--tiers all`` runs
-what it names whatever its tier.
+simulated buses, fakes. ``pytest`` with paths or node ids, ``-m``, ``-k`` or ``--tiers
+all`` runs what it names whatever its tier.
 """
 
 from __future__ import annotations
@@ -29,7 +29,7 @@ import shutil
 import socket
 from collections.abc import Callable, Iterator
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 from urllib.parse import parse_qs, urlsplit
 
 import pytest
@@ -47,6 +47,8 @@ SLOW_TIERS = {
     "fuzz": "plays generated scenarios by the hundred on the whole robot",
     "bench": "runs a benchmark script",
 }
+LEFT_OUT = pytest.StashKey[int]()
+"""How many tests this run left out for their tier."""
 BROWSER_FIXTURES = {"page", "browser"}
 MODEL_FIXTURES = {"recognizer", "whisper", "vad", "voices", "spoken"}
 """tests/speech's fixtures that load a real model."""
@@ -58,7 +60,7 @@ def pytest_addoption(parser: pytest.Parser) -> None:
         choices=["fast", "all"],
         default=None,
         help="fast: leave out the slow tiers (" + ", ".join(SLOW_TIERS) + "); all: run "
-        "every tier. Default: fast for a plain `pytest`, all when paths, node ids or -m "
+        "every tier. Default: fast for a plain `pytest`, all when paths, node ids, -m or -k "
         "are given.",
     )
 
@@ -73,8 +75,8 @@ def fast_only(config: pytest.Config) -> bool:
     chosen = config.getoption("--tiers")
     if chosen is not None:
         return bool(chosen == "fast")
-    plain = config.args_source == pytest.Config.ArgsSource.TESTPATHS
-    return plain and not config.getoption("-m")
+    named = config.args_source == pytest.Config.ArgsSource.ARGS  # paths or node ids
+    return not (named or config.getoption("-m") or config.getoption("-k"))
 
 
 def tiers_of(item: pytest.Item) -> set[str]:
@@ -104,6 +106,16 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
     if left_out:
         config.hook.pytest_deselected(items=left_out)
         items[:] = kept
+    config.stash[LEFT_OUT] = len(left_out)
+
+
+def pytest_terminal_summary(terminalreporter: Any, config: pytest.Config) -> None:
+    left_out = config.stash.get(LEFT_OUT, 0)
+    if left_out:
+        terminalreporter.write_line(
+            f"tiers: the fast tier ran; {left_out} tests of the slow tiers were left out "
+            "(`pytest --tiers all` or scripts/test runs them)"
+        )
 
 
 def pytest_report_header(config: pytest.Config) -> str:

@@ -60,3 +60,13 @@ def test_a_file_made_new_is_its_owner_s_alone_unless_told(tmp_path: Path) -> Non
     write_whole(tmp_path / "tree.yaml", b"{}", mode=0o644)
     assert (tmp_path / "done.json").stat().st_mode & 0o777 == 0o600
     assert (tmp_path / "tree.yaml").stat().st_mode & 0o777 == 0o644
+
+
+def test_a_file_reached_through_a_link_is_written_and_the_link_kept(tmp_path: Path) -> None:
+    kept = tmp_path / "elsewhere" / "consent.yaml"
+    kept.parent.mkdir()
+    kept.write_text("old\n", encoding="utf-8")
+    link = tmp_path / "consent.yaml"
+    link.symlink_to(kept)
+    write_whole(link, b"new\n")
+    assert link.is_symlink() and kept.read_text(encoding="utf-8") == "new\n"

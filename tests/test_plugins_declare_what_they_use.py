@@ -83,3 +83,19 @@ def test_a_node_type_cannot_declare_something_the_robot_has_not() -> None:
     registry = builtin_registry()
     with pytest.raises(TypeError, match="Sing uses \\['the choir'\\]: a node uses the 'speaker'"):
         registry.add(Sing)
+
+
+def test_a_single_resource_not_in_a_tuple_is_refused_in_words() -> None:
+    class Hum(Leaf):
+        uses = SPEAKER  # type: ignore[assignment]  # the slip this guards against
+
+    with pytest.raises(TypeError, match=r"Hum uses 'speaker': a tuple of what it uses"):
+        builtin_registry().add(Hum)
+
+
+def test_a_node_that_moves_its_joint_must_have_a_joint_parameter() -> None:
+    class Shrug(Leaf):
+        uses = (ITS_JOINT,)
+
+    with pytest.raises(TypeError, match="Shrug uses its joint but has no 'joint' parameter"):
+        builtin_registry().add(Shrug)

@@ -7,6 +7,10 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
+pytestmark = pytest.mark.realtime  # each story starts a pytest of its own
+
 ROOT = Path(__file__).resolve().parents[1]
 
 
@@ -39,3 +43,8 @@ def test_a_path_named_runs_every_test_in_it_whatever_its_tier() -> None:
     ids, said = collected("tests/cloud/test_ledger.py")
     assert any("[postgresql]" in i for i in ids) and any("[sqlite]" in i for i in ids)
     assert "deselected" not in said
+
+
+def test_tests_chosen_by_name_run_whatever_their_tier() -> None:
+    ids, _ = collected("-k", "test_ledger and postgresql")
+    assert ids and all("[postgresql]" in i for i in ids)

@@ -9,6 +9,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 from engine.cli import main, validate_command
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -69,6 +71,7 @@ def test_validate_warns_of_a_button_shown_only_while_a_missing_tree_runs_as_run_
     assert err.count("shows only while 'finger_game' runs, and no such tree runs") == 1
 
 
+@pytest.mark.realtime
 def test_with_only_buttons_asked_for_the_robot_runs_until_ctrl_c(tmp_path: Path) -> None:
     process = subprocess.Popen(
         [

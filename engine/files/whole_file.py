@@ -34,7 +34,9 @@ def write_whole(
     permission bits (None: the old file's, or :data:`NEW_FILE_MODE` for a new one);
     ``check(temporary)`` reads the new file before it replaces the old and raises to keep
     the old one. OSError (and whatever ``check`` raises) leaves ``path`` untouched and no
-    temporary file behind."""
+    temporary file behind. A link is followed: the file it names is written, the link kept."""
+    if path.is_symlink():
+        path = path.resolve()
     if mode is None:
         mode = path.stat().st_mode & 0o777 if path.exists() else NEW_FILE_MODE
     handle, name = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")

@@ -325,7 +325,7 @@ def leaf_type(cls: type[Leaf], *, source: str = "vest", **bound: Any) -> NodeTyp
         fixed_reads=tuple(cls.reads),
         fixed_writes=tuple(cls.writes),
         source=source,
-        uses=tuple(cls.uses),
+        uses=cls.uses if isinstance(cls.uses, str) else tuple(cls.uses),
     )
 
 

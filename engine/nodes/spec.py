@@ -58,6 +58,15 @@ class NodeType:
     """What its nodes use of the robot, of :data:`RESOURCES`."""
 
     def __post_init__(self) -> None:
+        if isinstance(self.uses, str) or not isinstance(self.uses, tuple):
+            raise TypeError(
+                f"{self.name} uses {self.uses!r}: a tuple of what it uses, e.g. uses = (SPEAKER,)"
+            )
+        if ITS_JOINT in self.uses and self.param("joint") is None:
+            raise TypeError(
+                f"{self.name} uses its joint but has no 'joint' parameter naming it; add "
+                'joint = Param("joint", Text(), "neck", ...) or declare ANY_JOINT'
+            )
         unknown = [use for use in self.uses if use not in RESOURCES]
         if unknown:
             raise TypeError(

@@ -19,6 +19,8 @@ import requests
 from cloud.settings import Settings
 from tests.cloud.conftest import ROOT, self_signed
 
+pytestmark = pytest.mark.realtime
+
 NGINX = shutil.which("nginx") or "/usr/sbin/nginx"
 DOCS_BLOCK = re.compile(r"```nginx\n(.*?)```", re.S)
 

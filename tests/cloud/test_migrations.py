@@ -107,6 +107,7 @@ def test_a_database_recorded_at_two_revisions_at_once_is_named_in_one_line(
     assert "Traceback" not in err
 
 
+@pytest.mark.realtime
 def test_commands_opening_a_new_sqlite_database_at_once_all_succeed(tmp_path: Path) -> None:
     opener = "from cloud.store.database import Database; import sys; Database(sys.argv[1]).close()"
     for round_ in range(4):

@@ -25,6 +25,7 @@ def cloud(tmp_path: Path, start_service: Callable[..., Any]) -> tuple[str, Cloud
     return running.url, running.store
 
 
+@pytest.mark.realtime
 def test_vest_run_carries_out_a_say_from_the_cloud_and_reports_it(
     cloud: tuple[str, CloudStore], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:

@@ -17,6 +17,8 @@ import pytest
 
 from engine.cli import main
 
+pytestmark = pytest.mark.realtime
+
 ROOT = Path(__file__).resolve().parents[2]
 VEST = "import sys; from engine.cli import main; sys.exit(main())"
 

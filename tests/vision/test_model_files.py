@@ -23,6 +23,7 @@ def copy_of_the_shipped_model(folder: Path) -> Path:
     return path
 
 
+@pytest.mark.models
 def test_the_shipped_model_reads_one_128_square_edge_image_and_runs_on_the_cpu() -> None:
     model = HandModel.load()
     assert model.session.get_inputs()[0].shape[1:] == [1, 128, 128]

@@ -8,11 +8,14 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from engine.vision.classifier import DEFAULT_MODEL, HandModel
 from engine.vision.preprocess import LABELS
 from engine.vision_training.dataset import find_pictures
 from engine.vision_training.training import evaluate_pictures
+
+pytestmark = pytest.mark.models
 
 HELD_OUT = Path(__file__).resolve().parents[2] / "examples" / "hands-real" / "held-out"
 

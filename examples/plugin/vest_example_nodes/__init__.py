@@ -16,6 +16,7 @@ from typing import ClassVar
 from engine.nodes import Color, Condition, Integer, Leaf, NodeRegistry, Number, Param, Status
 from engine.nodes.context import TreeContext
 from engine.services import Job
+from engine.services.turns import FACE_LEDS
 
 TEMPERATURE_C = "/sensors/temperature/c"
 
@@ -53,6 +54,7 @@ class Blink(Leaf):
     times = Param("times", Integer(1, 20), 3, "how many flashes")
     on_s = Param("on_s", Number(0.05, 5.0, "s"), 0.3, "how long each flash stays lit")
     off_s = Param("off_s", Number(0.05, 5.0, "s"), 0.3, "the dark pause between flashes")
+    uses = (FACE_LEDS,)  # vest validate names a tree of its priority that lights them too
 
     def __init__(self, name: str, args: SimpleNamespace, ctx: TreeContext) -> None:
         super().__init__(name, args, ctx)
