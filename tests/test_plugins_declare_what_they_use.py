@@ -81,7 +81,7 @@ def test_a_node_type_cannot_declare_something_the_robot_has_not() -> None:
         uses = ("the choir",)
 
     registry = builtin_registry()
-    with pytest.raises(TypeError, match="Sing uses \\['the choir'\\]: a node uses the 'speaker'"):
+    with pytest.raises(TypeError, match="Sing uses \\['the choir'\\]: a node uses some of SPEAKER"):
         registry.add(Sing)
 
 
@@ -92,6 +92,12 @@ def test_a_single_resource_not_in_a_tuple_is_refused_in_words() -> None:
     with pytest.raises(TypeError, match=r"Hum uses 'speaker': a tuple of what it uses"):
         builtin_registry().add(Hum)
 
+    class Mute(Leaf):
+        uses = None  # type: ignore[assignment]
+
+    with pytest.raises(TypeError, match=r"Mute uses None: a tuple of what it uses"):
+        builtin_registry().add(Mute)
+
 
 def test_a_node_that_moves_its_joint_must_have_a_joint_parameter() -> None:
     class Shrug(Leaf):
@@ -99,3 +105,16 @@ def test_a_node_that_moves_its_joint_must_have_a_joint_parameter() -> None:
 
     with pytest.raises(TypeError, match="Shrug uses its joint but has no 'joint' parameter"):
         builtin_registry().add(Shrug)
+
+
+def test_a_robot_without_joints_names_every_move_it_cannot_make(tmp_path: Path) -> None:
+    text = (ROOT / "examples" / "robots" / "sim.yaml").read_text(encoding="utf-8")
+    start = text.index("  servos:")
+    end = text.index("# The safety envelope")
+    armless = tmp_path / "armless.yaml"
+    no_arms = (text[:start] + text[end:]).replace("arms: [left_arm, right_arm]", "arms: []")
+    armless.write_text(no_arms, encoding="utf-8")
+    robot = load_robot_config(armless)
+    assert not [joint for device in robot for joint in device.joints]
+    (problem,) = check_joints(loaded(tmp_path, "wave", "Wave: {}"), robot)
+    assert "the robot has no joint 'right_arm' (this robot has no joints)" in str(problem)

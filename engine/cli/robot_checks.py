@@ -75,12 +75,13 @@ def check_joints(definition: TreeDefinition, config: RobotConfig) -> list[Proble
     joints = {joint.name: joint for device in config for joint in device.joints}
     problems: list[Problem] = []
     for node in definition.root.walk():
-        if not node.type.moves_its_joint or not joints:
+        if not node.type.moves_its_joint:
             continue
         name = str(node.args.get("joint"))
         joint = joints.get(name)
         if joint is None:
-            hint = did_you_mean(name, list(joints)) or "joints: " + ", ".join(joints)
+            listed = "joints: " + ", ".join(joints) if joints else "this robot has no joints"
+            hint = did_you_mean(name, list(joints)) or listed
             problems.append(Problem(node.mark, f"the robot has no joint {name!r}", hint))
             continue
         angle = node.args.get("angle_deg")

@@ -325,7 +325,7 @@ def leaf_type(cls: type[Leaf], *, source: str = "vest", **bound: Any) -> NodeTyp
         fixed_reads=tuple(cls.reads),
         fixed_writes=tuple(cls.writes),
         source=source,
-        uses=cls.uses if isinstance(cls.uses, str) else tuple(cls.uses),
+        uses=tuple(cls.uses) if isinstance(cls.uses, list) else cls.uses,
     )
 
 

@@ -70,8 +70,9 @@ class NodeType:
         unknown = [use for use in self.uses if use not in RESOURCES]
         if unknown:
             raise TypeError(
-                f"{self.name} uses {unknown}: a node uses the "
-                + ", the ".join(repr(r) for r in RESOURCES)
+                f"{self.name} uses {unknown}: a node uses some of SPEAKER, FACE_LEDS "
+                "(engine.services.turns), ITS_JOINT (the joint its 'joint' parameter names) "
+                "and ANY_JOINT (engine.nodes.spec)"
             )
 
     @property
