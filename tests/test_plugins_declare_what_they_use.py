@@ -118,3 +118,15 @@ def test_a_robot_without_joints_names_every_move_it_cannot_make(tmp_path: Path) 
     assert not [joint for device in robot for joint in device.joints]
     (problem,) = check_joints(loaded(tmp_path, "wave", "Wave: {}"), robot)
     assert "the robot has no joint 'right_arm' (this robot has no joints)" in str(problem)
+
+
+def test_two_remote_command_trees_are_said_to_share_any_joint_in_words(tmp_path: Path) -> None:
+    first = loaded(
+        tmp_path, "cloud_a", "CarryOut: {command: /vars/cmd, save_result_as: /vars/result}"
+    )
+    second = loaded(
+        tmp_path, "cloud_b", "CarryOut: {command: /vars/cmd, save_result_as: /vars/result}"
+    )
+    (found,) = collisions([first, second])
+    told = found.describe()
+    assert "both use any of the joints and the face LEDs and the speaker at priority 5" in told

@@ -59,7 +59,7 @@ def _covers(text: str) -> list[str]:
             f"{wrong[0] if wrong else text!r}: not something vest keeps; one or more of "
             + ", ".join(CAPTURES)
         )
-    return names
+    return list(dict.fromkeys(names))  # "sensors,sensors" is one
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

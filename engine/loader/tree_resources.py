@@ -28,9 +28,12 @@ class Collision:
     resources: tuple[str, ...]
 
     def describe(self) -> str:
-        shared = " and the ".join(self.resources)
+        shared = " and ".join(
+            "any of the joints" if resource == ANY_JOINT else f"the {resource}"
+            for resource in self.resources
+        )
         return (
-            f"trees {self.first.name!r} and {self.second.name!r} both use the {shared} at "
+            f"trees {self.first.name!r} and {self.second.name!r} both use {shared} at "
             f"priority {self.first.priority}: when both want it, the first to ask has it "
             f"(give one of them a higher 'priority:')"
         )

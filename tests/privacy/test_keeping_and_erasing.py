@@ -347,3 +347,9 @@ def test_guardians_consenting_at_the_same_moment_are_all_kept(site_data: Path) -
         assert process.returncode == 0, err
     text = (site_data / "consent.yaml").read_text()
     assert all(f"kid-{n}:" in text for n in range(1, 5)), text
+
+
+def test_a_capture_named_twice_is_kept_once(site_data: Path) -> None:
+    given = ["data", "consent", "kid-4", "--given-by", "guardian", "--covers", "sensors,sensors"]
+    assert main(given) == 0
+    assert "covers: [sensors]\n" in (site_data / "consent.yaml").read_text()
