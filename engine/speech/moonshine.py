@@ -35,6 +35,7 @@ import numpy as np
 from engine.dialogs.words import words
 from engine.media.audio import SPEECH_RATE_HZ, Audio
 from engine.speech.children import BEAM, NEAR_NATS, a_child_said, search_floor
+from engine.speech.moonshine_decoder import AbandonedError, Decoder, DecoderModel
 from engine.speech.onnx_folding import folded_model
 from engine.speech.phrase_search import (
     CLOSE_ENOUGH_NATS,
@@ -131,87 +132,11 @@ def without_loop(tokens: list[int]) -> list[int]:
     return tokens
 
 
-def log_softmax(logits: np.ndarray) -> np.ndarray:
-    """Natural-log probabilities of each row of ``logits``."""
-    top = logits.max(axis=-1, keepdims=True)
-    shifted: np.ndarray = logits - top
-    result: np.ndarray = shifted - np.log(np.exp(shifted).sum(axis=-1, keepdims=True))
-    return result
-
-
-class _AbandonedError(Exception):
-    """The utterance was abandoned while it was being decoded (:data:`Abandon`)."""
-
-
-class _Decoder:
-    """Moonshine's decoder on one utterance's encoder output, for one text or several at
-    once (rows), with its key/value cache: a :class:`~engine.speech.phrase_search.Decoding`.
-    Each step first asks ``abandon`` (None: never) and stops the search when it says so."""
-
-    def __init__(
-        self, recognizer: MoonshineRecognizer, hidden: np.ndarray, abandon: Abandon | None
-    ) -> None:
-        self._recognizer = recognizer
-        self._abandon = abandon
-        self._cache = {name: recognizer._empty for name in recognizer._cache_names}
-        self._rows = 1
-        self._started = False
-        self._first: tuple[np.ndarray, dict[str, np.ndarray]] | None = None
-        self._encoder: dict[str, np.ndarray] = {}  # its part of the cache: the same each row
-        self._repeated: dict[int, dict[str, np.ndarray]] = {1: {"encoder_hidden_states": hidden}}
-        """The encoder's output and its part of the cache for so many rows."""
-
-    def first(self) -> np.ndarray:
-        if self._first is None:  # the first step is the same for every text: run once
-            rows = self._run(np.array([[START_TOKEN]], dtype=np.int64))
-            self._first = (rows, dict(self._cache))
-        rows, self._cache = self._first[0], dict(self._first[1])
-        self._rows = 1
-        self._started = True
-        return rows
-
-    def then(self, parents: np.ndarray, tokens: np.ndarray) -> np.ndarray:
-        self._cache = {name: value[parents] for name, value in self._cache.items()}
-        self._rows = len(parents)
-        return self._run(tokens[:, None])
-
-    def _for_rows(self, rows: int) -> dict[str, np.ndarray]:
-        """What every row shares (the encoder's output and its part of the cache), for
-        ``rows`` rows: repeated once for each count of rows, not copied at each step."""
-        if rows not in self._repeated:
-            one = {**self._repeated[1], **self._encoder}
-            self._repeated[rows] = {name: np.repeat(v, rows, axis=0) for name, v in one.items()}
-        return self._repeated[rows]
-
-    def _run(self, ids: np.ndarray) -> np.ndarray:
-        """Log-probabilities of the next token after each row of ``ids``."""
-        if self._abandon is not None and self._abandon():
-            raise _AbandonedError
-        outputs = self._recognizer.decoder.run(
-            None,
-            {
-                "input_ids": ids,
-                "use_cache_branch": np.array([self._started]),
-                **self._cache,
-                **self._for_rows(len(ids)),
-            },
-        )
-        for name, value in zip(self._recognizer._outputs[1:], outputs[1:], strict=True):
-            past = "past_key_values." + name.removeprefix("present.")
-            if ".decoder." in past:
-                self._cache[past] = value
-            elif not self._started:  # the encoder's part is computed once, at the start
-                self._encoder[past] = self._repeated[1][past] = value
-                del self._cache[past]
-        self._started = True
-        return log_softmax(outputs[0][:, -1])
-
-
 @dataclass(frozen=True)
 class _Heard:
     """One utterance's encoder output (in its decoder) and free transcript."""
 
-    decoder: _Decoder
+    decoder: Decoder
     max_tokens: int
     tokens: list[int]
     log_probs: list[float]  # natural log, of each token
@@ -249,11 +174,7 @@ class MoonshineRecognizer:
             self.pieces = read_tokens(folder / "tokenizer.bin")
         except Exception as error:  # onnxruntime raises its own untyped errors
             raise RecognizerError(f"{folder}: cannot load the Moonshine model ({error})") from None
-        inputs = {i.name: i for i in self.decoder.get_inputs()}
-        self._cache_names = [name for name in inputs if name.startswith("past_key_values.")]
-        heads, size = inputs[self._cache_names[0]].shape[1], inputs[self._cache_names[0]].shape[3]
-        self._empty = np.zeros((1, int(heads), 0, int(size)), dtype=np.float32)
-        self._outputs = [o.name for o in self.decoder.get_outputs()]
+        self._decoding = DecoderModel.of(self.decoder, START_TOKEN)
         self._texts = [
             "" if token <= END_TOKEN else piece.decode("utf-8", "replace").replace(WORD_START, " ")
             for token, piece in enumerate(self.pieces)
@@ -271,7 +192,7 @@ class MoonshineRecognizer:
     def transcribe(self, audio: Audio, *, abandon: Abandon | None = None) -> Transcript:
         try:
             return self._transcribed(audio, abandon)
-        except _AbandonedError:
+        except AbandonedError:
             return Transcript("")
 
     def _transcribed(self, audio: Audio, abandon: Abandon | None) -> Transcript:
@@ -324,7 +245,7 @@ class MoonshineRecognizer:
             return None
         hidden = self.encoder.run(None, {"input_values": samples[None, :]})[0]
         max_tokens = int(len(samples) / SPEECH_RATE_HZ * TOKENS_PER_S) + 4
-        decoder = _Decoder(self, hidden, abandon)
+        decoder = Decoder(self._decoding, hidden, abandon)
         tokens, log_probs, free_log_prob = self._decode(decoder, max_tokens)
         return _Heard(decoder, max_tokens, tokens, log_probs, free_log_prob)
 
@@ -378,7 +299,7 @@ class MoonshineRecognizer:
         )
 
     def _decode(
-        self, decoder: _Decoder, max_tokens: int, *, words_first: bool = False
+        self, decoder: Decoder, max_tokens: int, *, words_first: bool = False
     ) -> tuple[list[int], list[float], float]:
         """Greedy decoding: the tokens (without start and end), each one's log-probability,
         and the whole text's (its end included), natural log. ``words_first``: the first

@@ -97,42 +97,8 @@ def test_speech_that_goes_on_after_a_pause_is_recognized_whole() -> None:
 
 class SlowRecognizer(CountingRecognizer):
     """Hears as :class:`CountingRecognizer`, but its first recognition lasts until the
-    story lets it finish (as a slow model on a busy machine)."""
-
-    def __init__(self) -> None:
-        super().__init__()
-        self.started, self.finish = threading.Event(), threading.Event()
-
-    def transcribe(self, audio: Audio, *, abandon: Abandon | None = None) -> Transcript:
-        if not self.heard:
-            self.started.set()
-            assert self.finish.wait(timeout=30)
-        return super().transcribe(audio, abandon=abandon)
-
-
-def test_a_draft_overtaken_while_the_worker_was_busy_is_never_recognized() -> None:
-    recognizer = SlowRecognizer()
-    told: list[Heard] = []
-    listener = Listener(SpeechDetector(LoudnessVad()), recognizer, VirtualClock(), told.append)
-    # a child says a few words, pauses, goes on, pauses again and stops
-    first = speech(0.6).then(Audio.silence(0.2))
-    listener.hear(first, first.seconds)
-    assert recognizer.started.wait(timeout=30)  # the first draft is being recognized
-    rest = speech(0.6).then(Audio.silence(0.2)).then(speech(0.4)).then(Audio.silence(1.0))
-    listener.hear(rest, first.seconds + rest.seconds)  # two more drafts, and the end
-    recognizer.finish.set()
-    assert listener.settling.wait(listener.settled)
-    listener.close()
-    # the first draft and the whole utterance: the drafts that waited were overtaken
-    assert len(recognizer.heard) == 2
-    assert recognizer.heard[1] > 2.0
-    assert [heard.text for heard in told] == [f"{recognizer.heard[1]:.3f} seconds"]
-
-
-class AbandonedWhenAsked(CountingRecognizer):
-    """Hears as :class:`CountingRecognizer`; its first recognition lasts until the story
-    lets it finish, and then says whether it was told to give up (as Moonshine asks
-    between its decoder's steps)."""
+    story lets it finish (as a slow model on a busy machine), and then says whether it was
+    told to give up (as Moonshine asks between its decoder's steps)."""
 
     def __init__(self) -> None:
         super().__init__()
@@ -147,36 +113,46 @@ class AbandonedWhenAsked(CountingRecognizer):
         return super().transcribe(audio, abandon=abandon)
 
 
-def test_a_draft_being_recognized_when_speech_goes_on_is_given_up() -> None:
-    recognizer = AbandonedWhenAsked()
+def heard_while_busy(recognizer: SlowRecognizer, first: Audio, rest: Audio) -> list[Heard]:
+    """``first`` from the microphone; while its draft is being recognized, ``rest``; then
+    the recognizer may finish. What the listener told."""
     told: list[Heard] = []
     listener = Listener(SpeechDetector(LoudnessVad()), recognizer, VirtualClock(), told.append)
-    # a child says a few words and pauses: the draft is being recognized
-    first = speech(0.6).then(Audio.silence(0.2))
     listener.hear(first, first.seconds)
-    assert recognizer.started.wait(timeout=30)
-    # ... and goes on: the draft's text will never be wanted, and the worker may stop
-    rest = speech(0.6).then(Audio.silence(1.0))
+    assert recognizer.started.wait(timeout=30)  # the first draft is being recognized
     listener.hear(rest, first.seconds + rest.seconds)
     recognizer.finish.set()
     assert listener.settling.wait(listener.settled)
     listener.close()
+    return told
+
+
+def test_a_draft_overtaken_while_the_worker_was_busy_is_never_recognized() -> None:
+    recognizer = SlowRecognizer()
+    # a child says a few words, pauses, goes on, pauses again and stops
+    first = speech(0.6).then(Audio.silence(0.2))
+    rest = speech(0.6).then(Audio.silence(0.2)).then(speech(0.4)).then(Audio.silence(1.0))
+    told = heard_while_busy(recognizer, first, rest)  # two more drafts, and the end
+    # the first draft and the whole utterance: the drafts that waited were overtaken
+    assert len(recognizer.heard) == 2
+    assert recognizer.heard[1] > 2.0
+    assert [heard.text for heard in told] == [f"{recognizer.heard[1]:.3f} seconds"]
+
+
+def test_a_draft_being_recognized_when_speech_goes_on_is_given_up() -> None:
+    recognizer = SlowRecognizer()
+    # a child says a few words and pauses: the draft is being recognized; and goes on: the
+    # draft's text will never be wanted, and the worker may stop
+    first = speech(0.6).then(Audio.silence(0.2))
+    told = heard_while_busy(recognizer, first, speech(0.6).then(Audio.silence(1.0)))
     # the draft was told to give up; the whole utterance was not (None: it never is)
     assert recognizer.abandoned == [True, None]
     assert [heard.text for heard in told] == [f"{recognizer.heard[1]:.3f} seconds"]
 
 
 def test_a_draft_followed_only_by_silence_is_never_given_up() -> None:
-    recognizer = AbandonedWhenAsked()
-    told: list[Heard] = []
-    listener = Listener(SpeechDetector(LoudnessVad()), recognizer, VirtualClock(), told.append)
-    first = speech(0.6).then(Audio.silence(0.2))
-    listener.hear(first, first.seconds)
-    assert recognizer.started.wait(timeout=30)
-    listener.hear(Audio.silence(1.0), first.seconds + 1.0)  # the utterance ends
-    recognizer.finish.set()
-    assert listener.settling.wait(listener.settled)
-    listener.close()
+    recognizer = SlowRecognizer()
+    told = heard_while_busy(recognizer, speech(0.6).then(Audio.silence(0.2)), Audio.silence(1.0))
     # the draft held all of it: it was recognized to the end, and its text was told
     assert recognizer.abandoned == [False]
     assert [heard.text for heard in told] == [f"{recognizer.heard[0]:.3f} seconds"]
