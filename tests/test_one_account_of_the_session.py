@@ -80,7 +80,9 @@ def test_an_utterance_cut_short_is_told_as_cut_in_the_timeline_the_json_and_the_
     sorry = "Sorry, I did not understand."
     assert f'dialog         cut short: says "{sorry}" (iot_command interrupted it)' in timeline
     [cut] = [
-        e for e in told_events(Recording.open(path, the_site_key)) if isinstance(e, ActionEnded)
+        e
+        for e in told_events(Recording.open(path, the_site_key))
+        if isinstance(e, ActionEnded) and e.outcome != "done"
     ]
     assert (cut.tree, cut.outcome, cut.why) == ("dialog", "cut", "iot_command interrupted it")
     story = str(tmp_path / "story.yaml")
@@ -141,6 +143,28 @@ def test_a_recording_of_the_first_format_still_replays_and_reports(
     assert ("touch_thanks", 'says "Thank you"') in told
     assert ("vest", "touch is offline") in told
     assert "Session report" in report_html(recording)
+
+
+def test_a_recording_of_the_second_format_tells_what_a_new_one_tells(
+    tmp_path, capsys, monkeypatch, the_site_key: SiteKey
+) -> None:
+    # the demo recorded by vest when recordings kept actions, the scenario and the rest
+    # in tables of their own (format 2), and the same demo recorded now (the events)
+    kept = Path(__file__).parent / "recordings" / "demo.format2.db"
+    monkeypatch.chdir(ROOT)
+    now = tmp_path / "demo.db"
+    assert main(["run", "--fast", "--speech", "text", "--record", str(now)]) == 0
+    capsys.readouterr()
+    earlier, later = Recording.open(kept, the_site_key), Recording.open(now, the_site_key)
+    assert (earlier.format, later.format) == (2, 3)
+    told = [[event_line(e) for e in told_events(r)] for r in (earlier, later)]
+    assert [line for line in told[0] if line] == [line for line in told[1] if line]
+    assert [
+        [(a.at_s, a.tree, a.action, a.args, a.outcome) for a in r.actions()]
+        for r in (earlier, later)
+    ] == [[(a.at_s, a.tree, a.action, a.args, a.outcome) for a in later.actions()]] * 2
+    assert earlier.world() == later.world() and earlier.moments() == later.moments()
+    assert "Session report" in report_html(earlier)
 
 
 def test_a_reading_that_cannot_be_trusted_is_null_on_every_path() -> None:

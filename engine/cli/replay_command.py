@@ -9,6 +9,7 @@ jumps to the next action or the next change of a chosen node (until Ctrl-C).
 from __future__ import annotations
 
 import argparse
+import json
 import math
 import os
 from pathlib import Path
@@ -20,7 +21,7 @@ from engine.cli.stop_signals import serve_until_stopped
 from engine.cli.view_options import add_view_arguments, start_view
 from engine.errors import ConfigError, UsageError
 from engine.privacy.site import Site
-from engine.recording.replay import Recording, moment
+from engine.recording.replay import STATUS_MARKS, Recording
 from engine.view.replay_source import ReplaySource
 
 
@@ -147,3 +148,30 @@ def _whole(recording: Recording) -> int:
         return 0
     tell(f"vest replay: {cut}")
     return 1
+
+
+def moment(recording: Recording, at_s: float) -> str:
+    """The trees' statuses and the blackboard at ``at_s``, as ``vest replay --at`` prints."""
+    statuses = recording.statuses_at(at_s)
+    lines = [f"at {at_s:.2f} s of {recording.duration_s:.2f} s ({recording.path.name})"]
+    for tree in recording.trees_at(at_s):
+        reloaded = f", version {tree.version}" if tree.version > 1 else ""
+        lines.append(f"\n{tree.name} ({tree.rate_hz:g} Hz{reloaded})")
+        for node in tree.nodes:
+            state = statuses.get((tree.name, tree.version, node.index))
+            mark = STATUS_MARKS.get(state.status, "?") if state else "  "
+            detail = f"  -- {state.feedback}" if state and state.feedback else ""
+            lines.append(f"  [{mark}] {'  ' * node.depth}{node.label}{detail}")
+    lines.append("\nblackboard")
+    for key, written in sorted(recording.blackboard_at(at_s).items()):
+        lines.append(f"  {key} = {json.dumps(written.value)}  (since {written.since_s:.2f} s)")
+    done = recording.actions(at_s)
+    if done:
+        last = done[-1]
+        lines.append(f"\nlast action: {last.at_s:.2f} s {last.tree} {last.action} {last.args}")
+    around = [(at, what) for at, _, what in recording.world() if at <= at_s]
+    if around:
+        at, what = around[-1]
+        lines.append(f"last around the robot: {at:.2f} s {what}")
+    lines.append("\n[ok] success  [no] failure  [..] running  [  ] not ticked")
+    return "\n".join(lines)

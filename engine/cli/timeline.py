@@ -17,34 +17,25 @@ from typing import Any, TextIO
 
 from engine.cli.output import discard, reason, shown, tell
 from engine.runtime.scheduler import RunningTree
-from engine.session.events import ActionEnded, DeviceChanged, SessionEvent, told_fields
+from engine.session.codec import encode
+from engine.session.events import ActionEnded, DeviceChanged, SessionEvent
 from engine.session.json_values import json_text
 from engine.session.sentences import TOLD_KINDS, event_line
 
 
 def event_json(event: SessionEvent, start_s: float) -> dict[str, Any] | None:
-    """``event`` as one ``--json`` object (times in seconds since ``start_s``); None for
-    the events the timeline does not show."""
+    """``event`` as one ``--json`` object: its message (:mod:`engine.session.codec`, times
+    in seconds since ``start_s``) with its kind named ``event``; None for the events the
+    timeline does not show."""
     if event.kind not in TOLD_KINDS:
-        return None
+        return None  # a status, a key: shown otherwise
     if isinstance(event, ActionEnded) and event.outcome == "done":
         return None  # an action's line says it began; only one that did not end well is told
     if isinstance(event, DeviceChanged) and event.first:
         return None  # the first report at start-up
-    fields: dict[str, Any] = {"t": round(event.t_s - start_s, 3), "event": event.kind}
-    for name in told_fields(event):
-        value = getattr(event, name)
-        if name in ("t_s", "action_id"):
-            continue
-        if name == "started_s":
-            fields["started"] = round(value - start_s, 3)
-        elif name in ("from_s", "until_s"):
-            fields[name.removesuffix("_s")] = round(value - start_s, 3)
-        elif name == "value":
-            fields[name] = value
-        else:
-            fields[name] = list(value) if isinstance(value, tuple) else value
-    return fields
+    message = encode(event, start_s)
+    message.pop("action_id", None)  # --json's lines have told without it since the first
+    return {"t": message.pop("t"), "event": message.pop("kind"), **message}
 
 
 class Timeline:

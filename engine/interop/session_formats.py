@@ -25,7 +25,9 @@ from typing import Any, BinaryIO
 from mcap.writer import Writer
 
 from engine.interop.btcpp_export import BTCPP_BUILTINS, xml_safe
+from engine.interop.session_topics import live_message
 from engine.recording.replay import RecordedNode, RecordedTree, Recording
+from engine.recording.told import every_event
 from engine.session.json_values import json_value
 
 MAGIC = b"BTCPP4-FileLogger2"
@@ -184,39 +186,17 @@ SCHEMAS: dict[str, dict[str, Any]] = {
 
 
 def _messages(recording: Recording) -> Iterator[tuple[str, str, float, dict[str, Any]]]:
-    """(topic, schema, at_s, message) for everything the session kept."""
+    """(topic, schema, at_s, message) for everything the session kept, as the live
+    Foxglove server and the ROS 2 bridge send it (:func:`live_message`)."""
     paths = {
         (tree.name, tree.version, node.index): (node.path, node.type)
         for tree in recording.trees
         for node in tree.nodes
     }
-    for row in recording.table("statuses"):
-        path, kind = paths.get((row["tree"], row["version"], row["node"]), ("", ""))
-        message = {k: row[k] for k in ("tree", "version", "tick", "node", "status", "feedback")}
-        message |= {"path": path, "type": kind}
-        yield f"/vest/trees/{row['tree']}/status", "vest.NodeStatus", row["at_s"], message
-    for row in recording.table("blackboard"):
-        value = recording.json(row["value"])
-        message = {"key": row["key"], "value": value, "event": bool(row["event"])}
-        yield "/vest/blackboard", "vest.KeyChange", row["at_s"], message
-    for action in recording.actions():
-        message = {
-            "tree": action.tree,
-            "action": action.action,
-            "args": action.args,
-            "outcome": None,
-            "why": None,
-        }
-        yield "/vest/actions", "vest.Action", action.at_s, message
-        if action.ended_s is not None:
-            ended = message | {"outcome": action.outcome, "why": action.why or None}
-            yield "/vest/actions/outcome", "vest.Action", action.ended_s, ended
-    for at_s, kind, description in recording.world():
-        message = {"kind": kind, "description": description}
-        yield "/vest/world", "vest.WorldEvent", at_s, message
-    for row in recording.table("events"):
-        message = {"kind": row["kind"], "tree": row["tree"], "data": recording.json(row["data"])}
-        yield "/vest/events", "vest.SessionEvent", row["at_s"], message
+    for event in every_event(recording):
+        found = live_message(event, paths)
+        if found is not None:
+            yield found[0], found[1], event.t_s, found[2]
 
 
 def write_mcap(recording: Recording, out: BinaryIO) -> dict[str, int]:

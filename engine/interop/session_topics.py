@@ -6,15 +6,15 @@ from __future__ import annotations
 
 from typing import Any
 
-from engine.recording.recorder import KEPT_AS_EVENTS
+from engine.session.codec import encode
 from engine.session.events import (
     ActionEnded,
     ActionStarted,
     KeyChanged,
     NodeStatus,
     SessionEvent,
+    TreeStarted,
     WorldEvent,
-    told_fields,
 )
 from engine.session.json_values import json_value
 
@@ -23,8 +23,9 @@ NodePaths = dict[tuple[str, int, int], tuple[str, str]]
 
 
 def live_message(event: SessionEvent, paths: NodePaths) -> tuple[str, str, dict[str, Any]] | None:
-    """(topic, schema, message) of a session event, as the MCAP export writes it; None for
-    what it does not carry."""
+    """(topic, schema, message) of a session event, as the MCAP export writes it (the
+    events of no topic of their own on ``/vest/events``, their fields as
+    :mod:`engine.session.codec` writes them); None for a tree's start."""
     if isinstance(event, NodeStatus):
         path, kind = paths.get((event.tree, event.version, event.node), ("", ""))
         message = {
@@ -51,12 +52,9 @@ def live_message(event: SessionEvent, paths: NodePaths) -> tuple[str, str, dict[
     if isinstance(event, WorldEvent):
         message = {"kind": event.scenario_event, "description": event.description}
         return "/vest/world", "vest.WorldEvent", message
-    if event.kind in KEPT_AS_EVENTS:
-        data = {k: json_value(v) for k, v in vars_of(event).items() if k not in ("t_s", "tree")}
-        message = {"kind": event.kind, "tree": str(getattr(event, "tree", "")), "data": data}
-        return "/vest/events", "vest.SessionEvent", message
-    return None
-
-
-def vars_of(event: SessionEvent) -> dict[str, Any]:
-    return {name: getattr(event, name) for name in told_fields(event)}
+    if isinstance(event, TreeStarted):
+        return None  # its nodes name the statuses' paths
+    data = encode(event)
+    kind, tree = data.pop("kind"), str(data.pop("tree", ""))
+    del data["t"]
+    return "/vest/events", "vest.SessionEvent", {"kind": kind, "tree": tree, "data": data}

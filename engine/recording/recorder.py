@@ -1,8 +1,8 @@
 """Recording a session as it runs (``vest run --record FILE``), without costing the tick.
 
 A reader of the session stream (:mod:`engine.session.events`): the scheduler's thread
-only turns each event into a row (a tree version, a node's status, a blackboard change, an
-action and how it ended, a scenario event, a turn, a safety decision, a press...) and puts
+only turns each event into a row (a tree version, a node's status, a blackboard change,
+and every other event as itself, its message of :mod:`engine.session.codec`) and puts
 it on a bounded queue; a writer thread beside it stores the rows in the SQLite file
 (:mod:`engine.recording.session_file`, encrypted with the site's key) in batches. It
 reads the consent gate's kept exit (:mod:`engine.privacy.consent_gate`), so only what the
@@ -15,7 +15,6 @@ never waited for: the robot's ticks come first, and the file says how many were 
 from __future__ import annotations
 
 import hashlib
-import json
 import logging
 from pathlib import Path
 from typing import Any
@@ -24,27 +23,15 @@ from engine.clock import Clock
 from engine.privacy.sealed_sqlite import Error
 from engine.privacy.site_data import SiteKey
 from engine.recording.session_file import create
-from engine.session.events import (
-    ActionEnded,
-    ActionStarted,
-    KeyChanged,
-    NodeStatus,
-    SessionEvent,
-    TreeStarted,
-    WorldEvent,
-    told_fields,
-)
+from engine.session.codec import encode
+from engine.session.events import KeyChanged, NodeStatus, SessionEvent, TreeStarted
 from engine.session.handoff import Handoff
+from engine.session.json_values import json_text
 
 log = logging.getLogger(__name__)
 CAPACITY = 200_000
 """Notes the queue holds before it drops (minutes of a busy session's changes)."""
 Row = tuple[str, tuple[Any, ...]]
-KEPT_AS_EVENTS = frozenset(
-    {"turn", "safety", "press", "pause", "not_understood", "not_listened", "reload"}
-)
-"""The kinds of session events kept in the ``events`` table (the others have tables of
-their own, or are kept as the blackboard keys they came from)."""
 
 
 class SessionRecorder:
@@ -109,59 +96,16 @@ class SessionRecorder:
                 "INSERT INTO blackboard VALUES (?, ?, ?, ?, ?)",
                 (self._at(event.t_s), event.key, event.text, event.event, self._next()),
             )
-        elif isinstance(event, ActionStarted):
-            self._note(
-                "INSERT INTO actions VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
-                (
-                    self._at(event.t_s),
-                    event.tree,
-                    event.action,
-                    json.dumps(event.args, default=str),
-                    None,
-                    event.action_id,
-                    None,
-                    None,
-                    None,
-                    self._next(),
-                    None,
-                ),
-            )
-        elif isinstance(event, ActionEnded):
-            self._note(
-                "UPDATE actions SET outcome = ?, ended_s = ?, error = ?, why = ?, ended_seq = ? "
-                "WHERE action_id = ?",
-                (
-                    event.outcome,
-                    self._at(event.t_s),
-                    event.why if event.outcome == "failed" else None,
-                    event.why,
-                    self._next(),
-                    event.action_id,
-                ),
-            )
-        elif isinstance(event, WorldEvent):
-            self._note(
-                "INSERT INTO world VALUES (?, ?, ?, ?)",
-                (self._at(event.t_s), event.scenario_event, event.description, self._next()),
-            )
         elif isinstance(event, TreeStarted):
             self._record_tree(event)
-        elif event.kind in KEPT_AS_EVENTS:
-            data = {
-                name: getattr(event, name)
-                for name in told_fields(event)
-                if name not in ("t_s", "tree")
-            }
-            for name in ("from_s", "until_s"):
-                if name in data:
-                    data[name] = self._at(data[name])
+        else:  # the session's account: the event itself (engine/session/codec.py)
             self._note(
                 "INSERT INTO events VALUES (?, ?, ?, ?, ?)",
                 (
                     self._at(event.t_s),
                     event.kind,
                     str(getattr(event, "tree", "")),
-                    json.dumps(data, default=str),
+                    json_text(encode(event, self.start_s)),
                     self._next(),
                 ),
             )

@@ -18,6 +18,8 @@ from engine.errors import ConfigError
 from engine.privacy.sealed_sqlite import Connection, Error
 from engine.privacy.site_data import SiteKey
 from engine.recording.session_file import TABLES, open_for_reading, whole_number
+from engine.session.codec import EventError, decode
+from engine.session.events import ActionEnded, ActionStarted, SessionEvent, WorldEvent
 
 STATUS_MARKS = {"SUCCESS": "ok", "FAILURE": "no", "RUNNING": "..", "INVALID": "  "}
 """How a status reads in the terminal: success, failure, running, not ticked."""
@@ -209,9 +211,14 @@ class Recording:
     def moments(self) -> list[float]:
         """Every moment something changed (a status, a key, an action), in order: the
         steps of a replay."""
+        actions = (
+            "SELECT at_s FROM events WHERE kind = 'action'"
+            if self.format >= 3
+            else "SELECT at_s FROM actions"
+        )
         rows = self._rows(
-            "SELECT at_s FROM statuses UNION SELECT at_s FROM blackboard "
-            "UNION SELECT at_s FROM actions ORDER BY 1"
+            f"SELECT at_s FROM statuses UNION SELECT at_s FROM blackboard UNION {actions} "
+            "ORDER BY 1"
         )
         return [at for (at,) in rows]
 
@@ -227,6 +234,12 @@ class Recording:
     def world(self) -> list[tuple[float, str, str]]:
         """(moment, kind, description) of what happened around a simulated robot (its
         scenario's events); none for a robot in a real room."""
+        if self.format >= 3:
+            return [
+                (e.t_s, e.scenario_event, e.description)
+                for e in self.session_events()
+                if isinstance(e, WorldEvent)
+            ]
         rows = self._rows("SELECT at_s, kind, description FROM world ORDER BY rowid")
         return [(at, kind, description) for at, kind, description in rows]
 
@@ -290,6 +303,8 @@ class Recording:
     def actions(self, until_s: float | None = None) -> list[RecordedAction]:
         """The service calls, in order (up to ``until_s`` when given)."""
         until = float("inf") if until_s is None else until_s
+        if self.format >= 3:
+            return _paired(self._ordered_events(), until)
         if self.format < 2:
             rows = self._rows(
                 "SELECT at_s, tree, action, args, error, NULL, NULL, NULL, NULL, NULL FROM actions "
@@ -313,12 +328,28 @@ class Recording:
             )
         return actions
 
+    def session_events(self, until_s: float | None = None) -> list[SessionEvent]:
+        """The session's events as they were told (format 3 on), up to ``until_s``, in
+        order; a row that is not an event this vest reads is left out, not guessed."""
+        return [event for _, event in self._ordered_events(until_s)]
+
+    def _ordered_events(self, until_s: float | None = None) -> list[tuple[int, SessionEvent]]:
+        """(order, event) of each event the ``events`` table keeps as itself (format 3)."""
+        found = []
+        for _, seq, _, _, message in self.events(until_s):
+            try:
+                found.append((seq, decode(message)))
+            except EventError:
+                continue  # a damaged row, or a kind a later vest tells
+        return found
+
     def events(
         self, until_s: float | None = None
     ) -> list[tuple[float, int, str, str, dict[str, Any]]]:
-        """(moment, order, kind, tree, fields) of each event kept in the ``events`` table
-        (turns, safety, presses, pauses, not understood, not listened to, reloads); none
-        in format 1, which did not keep them."""
+        """(moment, order, kind, tree, fields) of each row of the ``events`` table: every
+        event of the session as its message (format 3), or the fields of its turns,
+        safety, presses, pauses, not understood, not listened to and reloads (format 2);
+        none in format 1, which did not keep them."""
         if self.format < 2:
             return []
         rows = self._rows(
@@ -337,6 +368,26 @@ class Recording:
 def _numbers(*values: Any) -> bool:
     """Whether every value is a real number (a time, an order), as recordings keep them."""
     return all(isinstance(v, int | float) and not isinstance(v, bool) for v in values)
+
+
+def _paired(events: list[tuple[int, SessionEvent]], until_s: float) -> list[RecordedAction]:
+    """The actions begun by ``until_s``, each with how it ended (whenever that was)."""
+    ended = {e.action_id: (seq, e) for seq, e in events if isinstance(e, ActionEnded)}
+    actions = []
+    for seq, e in events:
+        if not isinstance(e, ActionStarted) or e.t_s > until_s:
+            continue
+        end_seq, end = ended.get(e.action_id, (0, None))
+        if end is None:
+            actions.append(RecordedAction(e.t_s, e.tree, e.action, e.args, None, seq=seq))
+            continue
+        error = end.why if end.outcome == "failed" else None
+        actions.append(
+            RecordedAction(
+                e.t_s, e.tree, e.action, e.args, error, end.outcome, end.t_s, end.why, seq, end_seq
+            )
+        )
+    return actions
 
 
 def _action(
@@ -365,30 +416,3 @@ def _action(
         seq or 0,
         ended_seq or seq or 0,
     )
-
-
-def moment(recording: Recording, at_s: float) -> str:
-    """The trees' statuses and the blackboard at ``at_s``, as ``vest replay --at`` prints."""
-    statuses = recording.statuses_at(at_s)
-    lines = [f"at {at_s:.2f} s of {recording.duration_s:.2f} s ({recording.path.name})"]
-    for tree in recording.trees_at(at_s):
-        reloaded = f", version {tree.version}" if tree.version > 1 else ""
-        lines.append(f"\n{tree.name} ({tree.rate_hz:g} Hz{reloaded})")
-        for node in tree.nodes:
-            state = statuses.get((tree.name, tree.version, node.index))
-            mark = STATUS_MARKS.get(state.status, "?") if state else "  "
-            detail = f"  -- {state.feedback}" if state and state.feedback else ""
-            lines.append(f"  [{mark}] {'  ' * node.depth}{node.label}{detail}")
-    lines.append("\nblackboard")
-    for key, written in sorted(recording.blackboard_at(at_s).items()):
-        lines.append(f"  {key} = {json.dumps(written.value)}  (since {written.since_s:.2f} s)")
-    done = recording.actions(at_s)
-    if done:
-        last = done[-1]
-        lines.append(f"\nlast action: {last.at_s:.2f} s {last.tree} {last.action} {last.args}")
-    around = [(at, what) for at, _, what in recording.world() if at <= at_s]
-    if around:
-        at, what = around[-1]
-        lines.append(f"last around the robot: {at:.2f} s {what}")
-    lines.append("\n[ok] success  [no] failure  [..] running  [  ] not ticked")
-    return "\n".join(lines)

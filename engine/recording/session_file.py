@@ -11,17 +11,18 @@ Times are seconds since the session started (its first tick's clock time). Table
   ``vest render`` numbers them (``n0`` is the root), with its path and type;
 - ``statuses``: a node's status (and feedback message) each time it changes after a tick;
 
-(format 2: ``seq`` in ``blackboard``, ``actions``, ``world`` and ``events`` numbers the
+(format 2 on: ``seq`` in ``blackboard``, ``actions``, ``world`` and ``events`` numbers the
 session's events in the order they happened, across tables)
 - ``blackboard``: each write that changed a key's value, and every event, as JSON;
-- ``actions``: each service call (say, led, move, ...) with how it ended (``outcome``:
-  done, failed or cut short; ``ended_s``) and its error when it failed;
-- ``world``: what happened around the robot (a scenario's events);
-- ``events`` (format 2): the rest of the session's account, one row per event with its
-  fields as JSON: turns (interrupts, waits, yields), safety refusals, slow-downs and stops,
-  the therapist's presses, pauses, sentences not understood or not listened to, reloads.
+- ``events`` (format 3): every other event of the session as itself, its message of
+  :mod:`engine.session.codec` in ``data``: actions and how they ended, what happened
+  around the robot, what was heard and seen, devices, turns, safety, presses, pauses,
+  sentences not understood or not listened to, reloads, the end.
 
 A later version of vest reads every earlier format; it refuses a newer one by name.
+Format 2 kept actions (``actions``, with ``outcome``, ``ended_s``, ``why``), the
+scenario's events (``world``) in tables of their own and the rest of the account in
+``events`` as fields; what was heard and seen and the devices came from the blackboard.
 Format 1 (before the session's events were kept) has no ``events`` table and no outcome
 of an action but its error. Recordings made before they were sealed are plain SQLite: they
 are still read (:attr:`Opened.plain` says so), and ``vest data seal`` encrypts them.
@@ -44,9 +45,10 @@ from engine.privacy.sealed_sqlite import (
 )
 from engine.privacy.site_data import SiteKey, check_apart
 
-FORMAT_VERSION = 2
+FORMAT_VERSION = 3
 TABLES = ("meta", "trees", "nodes", "statuses", "blackboard", "actions", "world")
-"""The tables every format has (format 2 adds ``events``)."""
+"""The tables every format has (format 2 adds ``events``; from format 3 on, ``actions`` and
+``world`` stay empty: their events are in ``events``)."""
 SCHEMA = """
 CREATE TABLE meta (key TEXT PRIMARY KEY, value TEXT NOT NULL);
 CREATE TABLE trees (

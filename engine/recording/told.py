@@ -1,13 +1,14 @@
 """A recording's account of the session, as the session events it was made from.
 
-The recorder keeps each kind of event where it fits (actions in ``actions``, scenario
-events in ``world``, what was heard or seen and the devices' health as blackboard keys,
-the rest in ``events``); :func:`told_events` puts them back together, in the order they
-happened, as the same typed events the live run published. The replay page and ``vest
-report`` read a recording through it, so a replay says what the live view said. Times
-are seconds since the session started. A format 1 recording (before ``events`` and
-outcomes were kept) gives what it has: actions (failed or not), scenario events (a press
-among them), what was heard and seen, devices.
+From format 3 on a recording keeps the events themselves (decoded by
+:mod:`engine.session.codec`). Earlier formats kept each kind where it fitted (actions in
+``actions``, scenario events in ``world``, what was heard or seen and the devices' health
+as blackboard keys, the rest in ``events``); :func:`told_events` puts them back together,
+in the order they happened, as the same typed events the live run published. The replay
+page, ``vest report`` and the exports read a recording through it, so a replay says what
+the live view said. Times are seconds since the session started. A format 1 recording
+(before ``events`` and outcomes were kept) gives what it has: actions (failed or not),
+scenario events (a press among them), what was heard and seen, devices.
 """
 
 from __future__ import annotations
@@ -26,6 +27,8 @@ from engine.session.events import (
     DeviceChanged,
     HandShown,
     Heard,
+    KeyChanged,
+    NodeStatus,
     NotListened,
     NotUnderstood,
     Outcome,
@@ -73,8 +76,35 @@ def _typed(kind: str, at_s: float, tree: str, fields: dict[str, Any]) -> Session
         return None
 
 
+def every_event(recording: Recording) -> list[SessionEvent]:
+    """Every event the recording keeps, nodes' statuses and blackboard changes among them,
+    in time order (a key's writer is not kept: ``""``)."""
+    events: list[SessionEvent] = [
+        NodeStatus(
+            row["at_s"],
+            row["tree"],
+            row["version"],
+            row["tick"],
+            row["node"],
+            row["status"],
+            row["feedback"],
+        )
+        for row in recording.table("statuses")
+    ]
+    for row in recording.table("blackboard"):
+        value = recording.json(row["value"])
+        events.append(
+            KeyChanged(row["at_s"], row["key"], value, row["value"], bool(row["event"]), "")
+        )
+    events += told_events(recording)
+    return sorted(events, key=lambda event: event.t_s)
+
+
 def told_events(recording: Recording, until_s: float | None = None) -> list[SessionEvent]:
-    """Every event the session told in words, up to ``until_s``, in the order it happened."""
+    """Every event the session told, up to ``until_s``, in the order it happened (but the
+    nodes' statuses and blackboard changes, which the recording keeps as state)."""
+    if recording.format >= 3:
+        return recording.session_events(until_s)
     until = float("inf") if until_s is None else until_s
     found: list[Ordered] = []
     for index, action in enumerate(recording.actions(until_s)):

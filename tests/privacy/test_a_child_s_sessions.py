@@ -47,7 +47,13 @@ def test_without_consent_the_words_are_not_kept_but_the_robot_still_answers(
     assert 'dialog         says "My name is' in out  # it answered what it heard
     db = connect_sealed(record, the_site_key, read_only=True)
     keys = {key for (key,) in db.execute("SELECT key FROM blackboard")}
-    world = [d for (d,) in db.execute("SELECT description FROM world WHERE kind = 'hear'")]
+    world = [
+        d
+        for (d,) in db.execute(
+            "SELECT json_extract(data, '$.description') FROM events "
+            "WHERE json_extract(data, '$.scenario_event') = 'hear'"
+        )
+    ]
     left_out = db.execute("SELECT value FROM meta WHERE key = 'left_out'").fetchone()[0]
     everything = " ".join(  # every value of every row of every table
         str(value)
