@@ -26,8 +26,9 @@ from mcap.writer import Writer
 
 from engine.interop.btcpp_export import BTCPP_BUILTINS, xml_safe
 from engine.interop.session_topics import live_message
-from engine.recording.replay import RecordedNode, RecordedTree, Recording
+from engine.recording.replay import RecordedTree, Recording
 from engine.recording.told import every_event
+from engine.session.events import NodeInfo
 from engine.session.json_values import json_value
 
 MAGIC = b"BTCPP4-FileLogger2"
@@ -91,7 +92,7 @@ def _model(tree: RecordedTree, kinds: Mapping[str, str]) -> str:
     )
 
 
-def _tag(node: RecordedNode) -> str:
+def _tag(node: NodeInfo) -> str:
     """The element a recorded node is written as, as ``vest export`` writes it: its
     settings read from its label (``Selector memory=True`` is a ``Fallback``)."""
     settings = dict(part.split("=", 1) for part in node.label.split() if "=" in part)

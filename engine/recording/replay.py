@@ -19,19 +19,10 @@ from engine.privacy.sealed_sqlite import Connection, Error
 from engine.privacy.site_data import SiteKey
 from engine.recording.session_file import TABLES, open_for_reading, whole_number
 from engine.session.codec import EventError, decode
-from engine.session.events import ActionEnded, ActionStarted, SessionEvent, WorldEvent
+from engine.session.events import ActionEnded, ActionStarted, NodeInfo, SessionEvent, WorldEvent
 
 STATUS_MARKS = {"SUCCESS": "ok", "FAILURE": "no", "RUNNING": "..", "INVALID": "  "}
 """How a status reads in the terminal: success, failure, running, not ticked."""
-
-
-@dataclass(frozen=True)
-class RecordedNode:
-    index: int
-    path: str
-    type: str
-    label: str
-    depth: int
 
 
 @dataclass(frozen=True)
@@ -43,7 +34,8 @@ class RecordedTree:
     at_s: float
     rate_hz: float
     digest: str
-    nodes: tuple[RecordedNode, ...]
+    nodes: tuple[NodeInfo, ...]
+    file: Path
 
 
 @dataclass(frozen=True)
@@ -159,20 +151,25 @@ class Recording:
         return end_s
 
     def _read_trees(self) -> list[RecordedTree]:
-        nodes: dict[tuple[str, int], list[RecordedNode]] = {}
+        nodes: dict[tuple[str, int], list[NodeInfo]] = {}
         for tree, version, index, path, kind, label, depth in self._rows(
             "SELECT tree, version, node, path, type, label, depth FROM nodes "
             "ORDER BY tree, version, node"
         ):
-            nodes.setdefault((tree, version), []).append(
-                RecordedNode(index, path, kind, label, depth)
-            )
+            nodes.setdefault((tree, version), []).append(NodeInfo(index, path, kind, label, depth))
         return [
             RecordedTree(
-                name, version, at_s, rate_hz, digest, tuple(nodes.get((name, version), []))
+                name,
+                version,
+                at_s,
+                rate_hz,
+                digest,
+                tuple(nodes.get((name, version), [])),
+                Path(file),
             )
-            for name, version, at_s, rate_hz, digest in self._rows(
-                "SELECT tree, version, at_s, rate_hz, digest FROM trees ORDER BY tree, version"
+            for name, version, at_s, rate_hz, digest, file in self._rows(
+                "SELECT tree, version, at_s, rate_hz, digest, file FROM trees "
+                "ORDER BY tree, version"
             )
         ]
 

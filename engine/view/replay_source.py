@@ -6,9 +6,11 @@ import json
 from typing import Any
 
 from engine.blackboard.catalogue import VARIABLES_PREFIX, default_catalogue
+from engine.clock import VirtualClock
 from engine.recording.replay import Recording
 from engine.recording.told import told_events
-from engine.view.hub import RECENT_HAPPENINGS, Change, happened
+from engine.session.events import KeyChanged, NodeStatus, TreeStarted
+from engine.view.hub import Change, ViewHub
 
 STEP_S = 0.01
 """Moments closer than this are one step of the replay (one tick's changes)."""
@@ -42,58 +44,49 @@ class ReplaySource:
         }
 
     def snapshot(self, at_s: float) -> Change:
-        """The state at ``at_s``, shaped as :meth:`ViewHub.snapshot` shapes it."""
+        """The state at ``at_s``: the recording's state then, told to a :class:`ViewHub`
+        as the live run told it, so a replay's page is shaped as the live one."""
         recording = self.recording
+        hub = ViewHub(VirtualClock(at_s))
+        hub.begin(0.0, [])
         statuses = recording.statuses_at(at_s)
-        trees = []
         for tree in recording.trees_at(at_s):
-            trees.append(
-                {
-                    "kind": "tree",
-                    "at": tree.at_s,
-                    "tree": tree.name,
-                    "version": tree.version,
-                    "rate_hz": tree.rate_hz,
-                    "nodes": [vars(node) for node in tree.nodes],
-                    "statuses": [
-                        {
-                            "kind": "status",
-                            "at": state.since_s,
-                            "tree": tree.name,
-                            "version": tree.version,
-                            "node": node.index,
-                            "status": state.status,
-                            "feedback": state.feedback,
-                        }
-                        for node in tree.nodes
-                        if (state := statuses.get((tree.name, tree.version, node.index)))
-                    ],
-                }
+            hub.on_event(
+                TreeStarted(
+                    tree.at_s,
+                    tree.name,
+                    tree.version,
+                    tree.file,
+                    (),
+                    tree.rate_hz,
+                    0,
+                    tree.nodes,
+                    "",
+                )
             )
-        keys = []
+            for node in tree.nodes:
+                state = statuses.get((tree.name, tree.version, node.index))
+                if state is not None:
+                    hub.on_event(
+                        NodeStatus(
+                            state.since_s,
+                            tree.name,
+                            tree.version,
+                            0,
+                            node.index,
+                            state.status,
+                            state.feedback,
+                        )
+                    )
         for key, written in sorted(recording.blackboard_at(at_s).items()):
             spec = self._catalogue.lookup(key)
-            keys.append(
-                {
-                    "kind": "key",
-                    "at": written.since_s,
-                    "key": key,
-                    "value": json.dumps(written.value),
-                    "event": spec is not None and spec.kind == "event",
-                    "writer": "trees"
-                    if key.startswith(VARIABLES_PREFIX)
-                    else (spec.writer if spec else ""),
-                }
-            )
-        told = [happened(event, 0.0) for event in told_events(recording, at_s)]
-        lines = [line for line in told if line is not None]
-        return {
-            "now": at_s,
-            "trees": trees,
-            "keys": keys,
-            "happened": lines[-RECENT_HAPPENINGS:],
-            "stats": {"kind": "stats", "at": at_s, "trees": {}, "devices": {}},
-        }
+            event = spec is not None and spec.kind == "event"
+            writer = "trees" if key.startswith(VARIABLES_PREFIX) else (spec.writer if spec else "")
+            text = json.dumps(written.value)
+            hub.on_event(KeyChanged(written.since_s, key, written.value, text, event, writer))
+        for told in told_events(recording, at_s):
+            hub.on_event(told)
+        return hub.snapshot()
 
     def dot(self, tree: str, version: int) -> str | None:
         return self.recording.dot(tree, version)
