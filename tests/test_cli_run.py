@@ -68,6 +68,7 @@ def test_json_lines_carry_time_event_tree_action_and_args(capsys, monkeypatch):
     assert first == {
         "t": 1.0,
         "event": "action",
+        "action_id": 1,  # its outcome's line, when it does not end well, names it too
         "tree": "touch_thanks",
         "action": "say",
         "args": {"text": "Thank you", "volume": 0.8},

@@ -6,6 +6,7 @@ said and heard as the robot hears them."""
 
 from __future__ import annotations
 
+import json
 import shutil
 import subprocess
 import sys
@@ -17,6 +18,8 @@ from typing import IO
 import yaml
 
 from engine.files.yaml_source import resolved
+from engine.session.codec import decode
+from engine.session.sentences import event_line
 
 TRY_AT_S = 1.0
 TRY_FOR_S = 8.0
@@ -84,7 +87,7 @@ class TryOnSimulatedVest:
             command = self._command(Path(scratch), name, text, event, TRY_FOR_S)
             try:
                 done = subprocess.run(
-                    [*command, "--fast"],
+                    [*command, "--fast", "--json"],
                     capture_output=True,
                     text=True,
                     timeout=TRY_TIMEOUT_S,
@@ -95,8 +98,8 @@ class TryOnSimulatedVest:
         if done.returncode != 0:
             said = done.stderr.strip().splitlines()
             raise TryError(said[-1] if said else f"vest run ended with {done.returncode}")
-        timeline = done.stdout.split("\n\n", 1)[0].splitlines()[1:]  # after its heading
-        return [_sentence(line) for line in timeline if line.strip()]
+        told = (_sentence(line) for line in done.stdout.splitlines() if line.strip())
+        return [sentence for sentence in told if sentence is not None]
 
     def watch(self, name: str, text: str, asked: object, host: str) -> str:
         """Run ``text`` in real time with the event ``asked`` at :data:`WATCH_AT_S` under
@@ -179,10 +182,14 @@ def _drain(stream: IO[str]) -> None:
     threading.Thread(target=lambda: [None for _ in stream], name="watch-drain", daemon=True).start()
 
 
-def _sentence(line: str) -> str:
-    """``"    1.00  tickles   says ..."`` as ``"1.00 s tickles: says ..."``."""
-    at, who, what = [*line.split(None, 2), "", ""][:3]
-    return f"{at} s {who}: {what}"
+def _sentence(line: str) -> str | None:
+    """A ``--json`` line of the run as ``"1.00 s tickles: says ..."``: the event read back
+    (:mod:`engine.session.codec`) and told as the timeline tells it (None: the timeline
+    has no line for it, as a refusal the action's outcome tells)."""
+    message = json.loads(line)
+    event = decode({**message, "kind": message.pop("event")})
+    told = event_line(event)
+    return None if told is None else f"{event.t_s:.2f} s {told[0]}: {told[1]}"
 
 
 HEAR_TIMEOUT_S = 300.0

@@ -34,7 +34,6 @@ def event_json(event: SessionEvent, start_s: float) -> dict[str, Any] | None:
     if isinstance(event, DeviceChanged) and event.first:
         return None  # the first report at start-up
     message = encode(event, start_s)
-    message.pop("action_id", None)  # --json's lines have told without it since the first
     return {"t": message.pop("t"), "event": message.pop("kind"), **message}
 
 
