@@ -42,8 +42,14 @@ from engine.cli.site_access import open_site, pseudonym
 from engine.cli.timeline import Timeline
 from engine.cli.validate_command import turn_warnings
 from engine.cli.view_options import add_view_arguments, tell_view, view_plan
-from engine.clock import Clock, EpochClock, RealClock, VirtualClock
-from engine.composition.session_root import RecordPlan, SessionPlan, build_session
+from engine.clock import EpochClock
+from engine.composition.session_root import (
+    CloudPlan,
+    RecordPlan,
+    SessionPlan,
+    SpeechPlan,
+    build_session,
+)
 from engine.errors import ConfigError, UsageError
 from engine.files.problems import LoadError
 from engine.files.yaml_source import read_text
@@ -51,12 +57,8 @@ from engine.loader.tree_checks import spoken_quote_warnings
 from engine.privacy.consent import of_a_simulation
 from engine.privacy.site import Site
 from engine.recording.session_file import check_new
-from engine.robot_io.robot_speech import RobotSpeech, audio_folder, build_speech, speech_settings
 from engine.runtime.robot import Behaviors
 from engine.scenario.scenario_file import Scenario
-from engine.services.cloud_link import CloudLink
-from engine.services.interfaces import Speech
-from engine.services.simulated import simulated_services
 from engine.session.sentences import TOLD_KINDS
 from engine.view.server import ViewServer
 
@@ -186,9 +188,9 @@ def _is_service_url(text: str) -> bool:
     return parts.scheme in ("http", "https") and bool(parts.hostname) and port != 0
 
 
-def _cloud_link(args: argparse.Namespace) -> CloudLink | None:
-    """The link to the cloud for --cloud URL --token-file FILE; ConfigError or UsageError
-    for what is wrong with them."""
+def _cloud_plan(args: argparse.Namespace) -> CloudPlan | None:
+    """The cloud for --cloud URL --token-file FILE; ConfigError or UsageError for what is
+    wrong with them."""
     if args.cloud is None and args.token_file is None:
         return None
     if args.cloud is None or args.token_file is None:
@@ -212,7 +214,7 @@ def _cloud_link(args: argparse.Namespace) -> CloudLink | None:
     if not token or any(c.isspace() for c in token):
         raise ConfigError(f"--token-file {args.token_file}: holds no token (one line, no spaces)")
     done_file = args.token_file.with_name(args.token_file.name + ".done.json")
-    return CloudLink(args.cloud, token, RealClock(), done_file=done_file)
+    return CloudPlan(args.cloud, token, done_file)
 
 
 def main(args: argparse.Namespace) -> int:
@@ -278,25 +280,7 @@ def _run_for_site(
     leaving = args.record is not None or args.cloud is not None or ros2 is not None
     if leaving or consent.left_out:  # what the timeline and the pages leave out, and why
         tell(f"privacy: {consent.describe()}")
-    link = _cloud_link(args)
-    clock: Clock = VirtualClock() if args.fast else RealClock()
-    if link is not None:
-        link.clock = clock
-    simulated = simulated_services(clock, realistic=True)
-    speech: Speech | RobotSpeech = simulated.speech
-    if args.speech == "models":
-        speech = build_speech(
-            config.audio,
-            clock,
-            simulated=config.simulated,
-            phrases=behaviors.dialogs.phrases(),
-            settle=args.fast,
-            on_utterance=audio_folder(args.audio_out) if args.audio_out else None,
-            **speech_settings(behaviors.loader.profile),
-        )
-        for event in scenario.events:
-            if event.kind == "hear" and event.value["wav"] is None:
-                speech.prepare(event.value["text"])
+    cloud = _cloud_plan(args)
     paged = args.view or (args.buttons is not None and not args.fast)  # a page when asked
     duration = args.duration if args.duration is not None else scenario.duration_s
 
@@ -314,11 +298,9 @@ def _run_for_site(
             behaviors,
             config,
             scenario,
-            clock,
-            speech,
-            iot=simulated.iot,
-            fallback=simulated,
-            link=link,
+            fast=args.fast,
+            speech=SpeechPlan(args.audio_out) if args.speech == "models" else None,
+            cloud=cloud,
             buttons=inputs.buttons,
             view=view_plan(args) if paged else None,
             on_view_up=view_is_up,
@@ -330,7 +312,6 @@ def _run_for_site(
                 "scenario": str(scenario.path),
                 "started": f"{EpochClock().now():.3f}",
             },
-            reload=not args.fast,
             foxglove_port=args.foxglove,
             foxglove_origins=tuple(args.foxglove_origin),
             on_foxglove_up=tell_foxglove,

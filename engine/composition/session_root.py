@@ -1,9 +1,10 @@
 """The one place a running robot is built, every part included.
 
 :func:`build_session` takes a :class:`SessionPlan` (what ``vest run``'s options, checked,
-say: the behaviors, the robot config, the scenario, the clock, speech, the cloud link, the
-buttons, the live view, the recording, hot reload) and builds the robot with
-:func:`~engine.runtime.robot_factory.build_robot`, then every part around it in the order
+say, as data: the behaviors, the robot config, the scenario, the clock's kind, speech, the
+cloud, the buttons, the live view, the recording) and builds the clock, the speech, the
+cloud link and the robot with :func:`~engine.runtime.robot_factory.build_robot`, then
+every part around it in the order
 it must run: the scenario player first among the scheduler's hooks (the world moves, then
 the pollers read it, then the trees tick), the buttons' tree and hook, the live view's hub
 and server, the recorder, the reloader, the cloud link. Each part that runs beside the
@@ -15,7 +16,7 @@ them in reverse.
 from __future__ import annotations
 
 import logging
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, TypeVar
@@ -23,7 +24,7 @@ from typing import TYPE_CHECKING, TypeVar
 from engine.blackboard.catalogue import IOT_INBOX
 from engine.buttons.button_file import ButtonBoard
 from engine.buttons.wizard import Wizard
-from engine.clock import Clock
+from engine.clock import Clock, RealClock, VirtualClock
 from engine.errors import ConfigError
 from engine.hardware.config import RobotConfig
 from engine.interop.ros2_plan import Ros2Plan
@@ -32,14 +33,14 @@ from engine.privacy.consent_gate import ConsentGates
 from engine.privacy.sealed_sqlite import Error as SealedError
 from engine.privacy.site import Site
 from engine.recording.recorder import SessionRecorder
-from engine.robot_io.robot_speech import RobotSpeech
+from engine.robot_io.robot_speech import RobotSpeech, audio_folder, build_speech, speech_settings
 from engine.runtime.reload import TreeReloader
 from engine.runtime.robot import Behaviors
 from engine.runtime.robot_factory import AssembledRobot, build_robot
 from engine.scenario.player import ScenarioPlayer
 from engine.scenario.scenario_file import Scenario, ScenarioEvent
 from engine.services.cloud_link import CloudLink
-from engine.services.interfaces import IotResults, Services, Speech
+from engine.services.simulated import simulated_services
 from engine.session.events import WorldEvent
 from engine.session.stream import SessionStream
 from engine.view.hub import ViewHub
@@ -70,30 +71,46 @@ class RecordPlan:
     site: Site
 
 
-@dataclass
+@dataclass(frozen=True)
+class SpeechPlan:
+    """Hear and speak through the speech models (the plan's ``speech`` None: hand the
+    trees what is said as text, speak nothing); ``audio_out``: a WAV file per utterance
+    there."""
+
+    audio_out: Path | None = None
+
+
+@dataclass(frozen=True)
+class CloudPlan:
+    """Take commands from the cloud service at ``url`` with the robot's ``token``; the
+    finished commands are kept in ``done_file``."""
+
+    url: str
+    token: str
+    done_file: Path
+
+
+@dataclass(frozen=True)
 class SessionPlan:
-    """Everything a run is built from. ``iot``: the cloud's service (the ``link`` when
-    there is one); ``fallback`` serves what the config has no device for; ``record``: the
-    new recording's path and ``facts`` (robot config, profile, scenario, person...)."""
+    """Everything a run is built from, as data. ``fast``: a virtual clock (as fast as the
+    machine allows, no hot reload), else real time with hot reload; ``record``: the new
+    recording's path, and ``facts`` (robot config, profile, scenario, person...)."""
 
     behaviors: Behaviors
     config: RobotConfig
     scenario: Scenario
-    clock: Clock
-    speech: Speech | RobotSpeech
-    iot: IotResults
-    fallback: Services | None = None
-    link: CloudLink | None = None
+    fast: bool = False
+    speech: SpeechPlan | None = None
+    cloud: CloudPlan | None = None
     buttons: ButtonBoard | None = None
     view: ViewPlan | None = None
     on_view_up: Callable[[ViewServer], None] | None = None
     """Told once the view serves (to say its address: a page opened then misses nothing)."""
     record: RecordPlan | None = None
-    facts: dict[str, str] = field(default_factory=dict)
+    facts: Mapping[str, str] = field(default_factory=dict)
     consent: Consent = field(default_factory=lambda: without_record(""))
     """What the person (``consent.person``; '' for none) agreed may be kept and sent: what
     is recorded, and whether sensor readings go to the cloud as telemetry."""
-    reload: bool = False
     foxglove_port: int | None = None
     """Serve the session to Foxglove and Lichtblick on this loopback port (0: any free one)."""
     foxglove_origins: tuple[str, ...] = ()
@@ -142,24 +159,57 @@ def build_session(plan: SessionPlan) -> RunningSession:
 
     A part that cannot be made (the view's port taken, say) closes what was built and
     raises: nothing is left open."""
+    clock: Clock = VirtualClock() if plan.fast else RealClock()
+    simulated = simulated_services(clock, realistic=True)
+    robot_speech = _robot_speech(plan, clock)
+    link = _cloud_link(plan.cloud, clock)
     assembled = build_robot(
         plan.behaviors,
         plan.config,
-        clock=plan.clock,
-        speech=plan.speech,
-        iot=plan.link if plan.link is not None else plan.iot,
-        fallback=plan.fallback,
+        clock=clock,
+        speech=robot_speech.speaker if robot_speech is not None else simulated.speech,
+        robot_speech=robot_speech,
+        iot=link if link is not None else simulated.iot,
+        fallback=simulated,  # what the config has no device for
     )
     try:
-        return _around(assembled, plan)
+        return _around(assembled, plan, link)
     except BaseException:
         assembled.lifecycle.stop()
         raise
 
 
-def _around(assembled: AssembledRobot, plan: SessionPlan) -> RunningSession:
+def _robot_speech(plan: SessionPlan, clock: Clock) -> RobotSpeech | None:
+    """The speech models' voice and ears (None: speech as text), with the scenario's
+    lines synthesized before the run."""
+    if plan.speech is None:
+        return None
+    audio_out = plan.speech.audio_out
+    speech = build_speech(
+        plan.config.audio,
+        clock,
+        simulated=plan.config.simulated,
+        phrases=plan.behaviors.dialogs.phrases(),
+        settle=plan.fast,
+        on_utterance=audio_folder(audio_out) if audio_out is not None else None,
+        **speech_settings(plan.behaviors.loader.profile),
+    )
+    for event in plan.scenario.events:
+        if event.kind == "hear" and event.value["wav"] is None:
+            speech.prepare(event.value["text"])
+    return speech
+
+
+def _cloud_link(cloud: CloudPlan | None, clock: Clock) -> CloudLink | None:
+    if cloud is None:
+        return None
+    return CloudLink(cloud.url, cloud.token, clock, done_file=cloud.done_file)
+
+
+def _around(assembled: AssembledRobot, plan: SessionPlan, link: CloudLink | None) -> RunningSession:
     robot, session, lifecycle = assembled.robot, assembled.robot.session, assembled.lifecycle
-    start_s = plan.clock.now()  # after start-up, which takes simulated time too
+    clock = assembled.clock
+    start_s = clock.now()  # after start-up, which takes simulated time too
     gates = ConsentGates(session, plan.consent)  # the one gate; every reader is behind it
     running = RunningSession(assembled, start_s, gates)
     if plan.buttons is not None:  # priority 100: ticks before the behaviors
@@ -167,7 +217,7 @@ def _around(assembled: AssembledRobot, plan: SessionPlan) -> RunningSession:
         robot.scheduler.add_hook(running.wizard)
         assembled.world.add_listener(running.wizard)
     if plan.view is not None:
-        hub = ViewHub(plan.clock, device_stats=assembled.hardware.stats)
+        hub = ViewHub(clock, device_stats=assembled.hardware.stats)
         hub.begin(start_s, robot.trees)
         gates.kept.subscribe(hub)
         robot.scheduler.add_hook(hub.stats_hook)
@@ -182,7 +232,7 @@ def _around(assembled: AssembledRobot, plan: SessionPlan) -> RunningSession:
         lifecycle.add("view", start=_telling(view.start, view, plan.on_view_up), stop=view.stop)
     if plan.record is not None:
         record, consent = plan.record, plan.consent
-        recorder = SessionRecorder(record.path, plan.clock, record.site.key)
+        recorder = SessionRecorder(record.path, clock, record.site.key)
         running.recorder = recorder
 
         def close_recording() -> None:
@@ -213,7 +263,7 @@ def _around(assembled: AssembledRobot, plan: SessionPlan) -> RunningSession:
         live = FoxgloveLive(
             "127.0.0.1",
             plan.foxglove_port,
-            plan.clock,
+            clock,
             started - start_s,
             origins=plan.foxglove_origins,
         )
@@ -232,7 +282,7 @@ def _around(assembled: AssembledRobot, plan: SessionPlan) -> RunningSession:
 
         started = float(plan.facts.get("started", "0") or 0)
         bridge = Ros2Bridge(
-            plan.ros2, plan.clock, started - start_s, gates.sending, assembled.blackboard.catalogue
+            plan.ros2, clock, started - start_s, gates.sending, assembled.blackboard.catalogue
         )
         running.ros2 = bridge
 
@@ -247,21 +297,20 @@ def _around(assembled: AssembledRobot, plan: SessionPlan) -> RunningSession:
         plan.scenario, assembled.world, start_s=start_s, on_event=_world_events(session)
     )
     robot.scheduler.add_hook(player, first=True)
-    if plan.reload:  # reload work runs beside the scheduler, swaps between ticks
+    if not plan.fast:  # reload work runs beside the scheduler, swaps between ticks
         wizard_tree = running.wizard.tree if running.wizard is not None else None
         behaving = [tree for tree in robot.trees if tree is not wizard_tree]
-        reloader = TreeReloader(plan.behaviors.loader, behaving, plan.clock, session=session)
+        reloader = TreeReloader(plan.behaviors.loader, behaving, clock, session=session)
         robot.scheduler.add_hook(reloader)
         lifecycle.add("reloader", start=reloader.start, stop=reloader.stop)
 
     def begin() -> None:  # every reader hears of every tree; the first tick is due now
-        assembled.first_tick_s = plan.clock.now()
+        assembled.first_tick_s = clock.now()
         robot.begin_session(start_s)
 
     lifecycle.add("session", start=begin, stop=_nothing)
     assembled.add_runners()  # the pollers and the camera, phased on the first tick
-    if plan.link is not None:
-        link = plan.link
+    if link is not None:
 
         def start_link() -> None:
             link.bind(assembled.blackboard, gates.sent, gates.sending)

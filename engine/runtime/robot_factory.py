@@ -6,9 +6,10 @@ answers to, the bus managers, drivers, pollers and hardware services, and the tr
 scheduler whose hooks poll the devices, and the camera's vision worker when the config
 has a camera. Every speech, LED and servo call passes through the config's safety envelope,
 whose watcher stops the arms between ticks when a person is too close or presses too hard.
-The caller hands in the speech (the assembled
-:class:`~engine.robot_io.robot_speech.RobotSpeech`, or any Speech service, e.g. a recording
-fake, with heard text then staged as text) and the cloud's service. What it opens is on
+The caller hands in the Speech service the trees call
+and, when the robot hears and speaks through the models, the assembled
+:class:`~engine.robot_io.robot_speech.RobotSpeech` whose speaker that service is (without
+it, e.g. a recording fake, heard text is staged as text), and the cloud's service. What it opens is on
 the robot's :class:`~engine.runtime.lifecycle.Lifecycle`; the composition root
 (:mod:`engine.composition.session_root`) adds every other part of a run around it.
 """
@@ -86,12 +87,14 @@ def build_robot(
     config: RobotConfig,
     *,
     clock: Clock,
-    speech: Speech | RobotSpeech,
+    speech: Speech,
     iot: IotResults,
+    robot_speech: RobotSpeech | None = None,
     fallback: Services | None = None,
     session: SessionStream | None = None,
 ) -> AssembledRobot:
-    """The robot of ``config`` running ``behaviors`` on ``clock``.
+    """The robot of ``config`` running ``behaviors`` on ``clock``, saying through
+    ``speech`` (``robot_speech``'s speaker when it is given: it also hears).
 
     ``config.simulated`` builds the register-level simulated vest behind the same buses;
     ``fallback`` serves what the config has no device for (e.g. simulated LEDs). What
@@ -105,7 +108,6 @@ def build_robot(
     vest = build_sim_vest(config, world, clock) if config.simulated else None
     if vest is not None:
         lifecycle.add("simulated vest", stop=vest.close)
-    robot_speech = speech if isinstance(speech, RobotSpeech) else None
     if robot_speech is not None:
         lifecycle.add("speech", stop=robot_speech.close)
         robot_speech.hears_into(blackboard)
@@ -119,8 +121,7 @@ def build_robot(
         raise
     lifecycle.add("hardware", stop=hardware.close)
     try:
-        service = robot_speech.speaker if robot_speech is not None else speech
-        services = hardware.services(speech=service, iot=iot, fallback=fallback)  # type: ignore[arg-type]
+        services = hardware.services(speech=speech, iot=iot, fallback=fallback)
         envelope = SafetyEnvelope.of(config, blackboard, session)
         services = with_envelope(services, envelope)  # no tree reaches around it
         robot = Robot(
