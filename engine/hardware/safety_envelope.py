@@ -102,16 +102,6 @@ class SafetyEnvelope:
         now = self.blackboard.clock.now()
         return [read_guard(guard, self.blackboard, now) for guard in guards]
 
-    def nearest_mm(self) -> float | None:
-        """The closest thing the chest's trusted range sensors see, mm (None: nothing)."""
-        seen = [r.value for r in self._read(self.ranges) if r.doubt is None and r.value is not None]
-        return min(seen) if seen else None
-
-    def side_force_n(self) -> float | None:
-        """The larger of the side pads' trusted forces, N."""
-        felt = [r.value for r in self._read(self.forces) if r.doubt is None and r.value is not None]
-        return max(felt) if felt else None
-
     def _doubts(self, rule: str, readings: list[GuardReading]) -> Verdict | None:
         doubtful = [r for r in readings if r.doubt is not None]
         if not doubtful:

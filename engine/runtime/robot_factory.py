@@ -6,12 +6,12 @@ answers to, the bus managers, drivers, pollers and hardware services, and the tr
 scheduler whose hooks poll the devices, and the camera's vision worker when the config
 has a camera. Every speech, LED and servo call passes through the config's safety envelope,
 whose watcher stops the arms between ticks when a person is too close or presses too hard.
-The caller hands in the Speech service the trees call
-and, when the robot hears and speaks through the models, the assembled
+The caller hands in the Speech service the trees call and,
+when the robot hears and speaks through the models, the assembled
 :class:`~engine.robot_io.robot_speech.RobotSpeech` whose speaker that service is (without
-it, e.g. a recording fake, heard text is staged as text), and the cloud's service. What it opens is on
-the robot's :class:`~engine.runtime.lifecycle.Lifecycle`; the composition root
-(:mod:`engine.composition.session_root`) adds every other part of a run around it.
+it, e.g. a recording fake, heard text is staged as text), and the cloud's service. What
+it opens is on the robot's :class:`~engine.runtime.lifecycle.Lifecycle`; the composition
+root (:mod:`engine.composition.session_root`) adds every other part of a run around it.
 """
 
 from __future__ import annotations

@@ -126,10 +126,6 @@ class SessionStream:
         """How many events ``observer`` failed on."""
         return sum(s.failures for s in self._subscriptions if s.observer is observer)
 
-    def since_start(self, t_s: float) -> float:
-        """Clock seconds ``t_s`` as seconds since the session started."""
-        return t_s - self.start_s
-
 
 class EventCollector:
     """A reader that keeps every event it is told (tests, reruns, benchmarks)."""

@@ -99,12 +99,6 @@ class SimMPR121(SimI2CDevice):
             self._touching[pad] = touching
             self._scan()
 
-    def release_all(self) -> None:
-        """Take every finger off the pads."""
-        with self._lock:
-            self._touching = [False] * PADS
-            self._scan()
-
     @property
     def running(self) -> bool:
         """True in run mode (ECR enables at least one electrode)."""

@@ -26,7 +26,6 @@ from pathlib import Path
 
 import cv2
 import numpy as np
-import numpy.typing as npt
 
 from engine.errors import ConfigError
 from engine.media.images import Frame
@@ -383,14 +382,3 @@ def write_dataset(
         if not cv2.imwrite(str(path), image):
             raise ConfigError(f"{path}: cannot be written")
     return count
-
-
-def labelled_windows(
-    count: int, seed: int, *, style: str = "studio"
-) -> tuple[npt.NDArray[np.uint8], npt.NDArray[np.int64]]:
-    """``count`` window-sized pictures with a hand (labels cycle 0..5), in memory: for
-    tests and benchmarks that need a held-out set without files."""
-    rng = np.random.default_rng(seed)
-    labels = np.arange(count, dtype=np.int64) % 6
-    images = np.stack([render_window(int(label), rng, style=style) for label in labels])
-    return images, labels
