@@ -1,4 +1,4 @@
-"""TreeHarness: load one YAML tree and drive it tick by tick on a virtual clock."""
+"""TreeHarness: load one YAML tree and drive it on the robot's scheduler, on a virtual clock."""
 
 from __future__ import annotations
 
@@ -17,6 +17,7 @@ from engine.loader.tree_definition import TreeDefinition
 from engine.loader.tree_file import TreeLoader
 from engine.nodes.context import TreeContext
 from engine.nodes.registry import NodeRegistry, default_registry
+from engine.runtime.scheduler import RunningTree, Scheduler
 from engine.scenario.world import BlackboardSenses, World
 from engine.services.actions import ActionLog, ActionRecord, TreeActions
 from engine.services.interfaces import Services
@@ -69,16 +70,18 @@ class TreeHarness:
             on_node_error=self._node_error,
             on_node_warning=lambda tree, path, message: self.node_warnings.append((path, message)),
         )
-        self.tree = definition.build(self.context)
-        self.origin_s = self.clock.now()
+        self.scheduler = Scheduler(self.clock, self.blackboard)
+        self.running = self.scheduler.add(
+            RunningTree(definition, self.context, definition.build(self.context))
+        )
+        self.tree = self.running.tree
         self.ticks = 0
 
     def _node_error(self, tree: str, path: str, error: BaseException) -> None:
-        """A node raised: the test fails with that exception, unless it asked to keep node
-        errors as data (``keep_node_errors=True``: ``node_errors``, the node FAILURE)."""
+        """A node raised: the test fails with that exception after the step (:meth:`tick`),
+        unless it asked to keep node errors as data (``keep_node_errors=True``:
+        ``node_errors``, the node FAILURE)."""
         self.node_errors.append((path, error))
-        if not self.keep_node_errors:
-            raise error
 
     @classmethod
     def from_file(
@@ -138,13 +141,18 @@ class TreeHarness:
         return self.clock.now()
 
     def tick(self, n: int = 1) -> Status:
-        """Tick ``n`` times, one tree period apart (as the scheduler would); the last status."""
+        """Let ``n`` of the tree's periods pass under the robot's own scheduler (each a
+        step at the tree's deadline: it commits what was staged and ticks the tree, unless
+        the tree rests until a key it wakes on changes); the last status. A node that
+        raised fails the test (unless ``keep_node_errors``)."""
         for _ in range(n):
-            self.blackboard.commit()
-            self.tree.tick()
-            self.ticks += 1
-            # deadlines as the scheduler computes them: no float drift from repeated sums
-            self.clock.sleep_until(self.origin_s + self.ticks * self.period_s)
+            errors = len(self.node_errors)
+            self.clock.sleep_until(self.running.next_deadline_s)
+            if self.running in self.scheduler.step():
+                self.ticks += 1
+            if len(self.node_errors) > errors and not self.keep_node_errors:
+                raise self.node_errors[-1][1]
+            self.clock.sleep_until(self.running.next_deadline_s)  # a period has passed
         return self.status
 
     def advance(self, seconds: float) -> Status:
