@@ -84,7 +84,7 @@ def test_a_drawing_speaks_plainly_frames_subtrees_and_has_a_legend(capsys, monke
     dot = capsys.readouterr().out
     assert 'label="in order"' in dot  # a Sequence
     assert 'label="at the same time"' in dot  # the subtree's Parallel
-    assert 'label="rest 2 s after acting"' in dot  # the Cooldown
+    assert 'label="not again for 2 s after acting"' in dot  # the Cooldown
     assert 'label="parts/greet.yaml"' in dot  # the subtree, framed
     assert "cluster_legend" in dot and "a question (yes / no)" in dot
     assert "(10 times a second, priority 30)" in dot

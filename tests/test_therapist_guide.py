@@ -67,6 +67,8 @@ def test_the_guide_places_its_examples_where_a_therapist_would() -> None:
         "trees/profiles/calm_child.yaml",
         "examples/scenarios/tickles_test.yaml",
         "trees/buttons/my_session.yaml",
+        "trees/two_pats.yaml",
+        "examples/scenarios/two_pats_test.yaml",
     }
 
 
@@ -91,6 +93,27 @@ def test_the_tickles_diary_is_what_the_robot_does(project: Path, capsys) -> None
     command = "vest run --fast --speech text --scenario examples/scenarios/tickles_test.yaml"
     printed = run_out(capsys, *command.split()[1:])
     assert printed == shown_after(command)
+
+
+def test_the_two_pats_diary_is_what_the_robot_does(project: Path, capsys) -> None:
+    command = "vest run --fast --speech text --scenario examples/scenarios/two_pats_test.yaml"
+    printed = run_out(capsys, *command.split()[1:])
+    assert printed == shown_after(command)
+
+
+def test_the_profile_of_the_guide_gives_a_slow_child_longer_for_two_pats(
+    project: Path, capsys
+) -> None:
+    scenario = project / "slow_pats.yaml"
+    scenario.write_text(
+        "duration_s: 9\nevents:\n"
+        "  - {at: 1.0, touch: {pad: middle_back, seconds: 0.3}}\n"
+        "  - {at: 6.0, touch: {pad: middle_back, seconds: 0.3}}\n"
+    )
+    run = ["run", "--fast", "--speech", "text", "--scenario", str(scenario)]
+    assert not any("two_pats" in line for line in run_out(capsys, *run))  # 5 s apart
+    printed = run_out(capsys, *run, "--profile", "calm_child")
+    assert '    6.00  two_pats       says "Two pats! Are we playing?"' in printed
 
 
 def test_the_demo_diary_shown_is_part_of_the_demo(capsys, monkeypatch) -> None:

@@ -65,6 +65,10 @@ PLAIN_WORDS = {  # what a composite or decorator does, in the words a drawing us
     "Inverter": "not",
     "ForceSuccess": "either way",
     "OneShot": "only once",
+    "Cooldown": "not again for a while",
+    "Timeout": "at most so long",
+    "TimesWithin": "N times within T seconds",
+    "HeldFor": "held for T seconds",
 }
 WRAP = 26
 """Characters a drawn label's line holds."""
@@ -79,15 +83,19 @@ LEGEND = (
 def plain_label(node: NodeDefinition) -> str:
     """What a node does, in a few words a line (for drawings people read)."""
     args, kind = node.args, node.type.name
-    if kind in PLAIN_WORDS:
+    if kind == "Cooldown":
+        start = " (from the start)" if args.get("counting_from") == "start" else ""
+        head = f"not again for {_shown(args['seconds'])} s after acting{start}"
+    elif kind == "Timeout":
+        head = f"at most {_shown(args['seconds'])} s"
+    elif kind == "TimesWithin":
+        head = f"{_shown(args['times'])} times within {_shown(args['within_s'])} s"
+    elif kind == "HeldFor":
+        head = f"held for {_shown(args['seconds'])} s"
+    elif kind in PLAIN_WORDS:
         head = PLAIN_WORDS[kind]
         if kind == "OneShot" and args.get("after") == "completion":
             head = "only once, even failed"
-    elif kind == "Cooldown":
-        start = " (from the start)" if args.get("counting_from") == "start" else ""
-        head = f"rest {args['seconds']:g} s after acting{start}"
-    elif kind == "Timeout":
-        head = f"at most {args['seconds']:g} s"
     elif kind in ("Repeat", "Retry"):
         head = f"{'repeat' if kind == 'Repeat' else 'retry'} {args['times']} times"
     else:

@@ -69,6 +69,8 @@ COUNTERPARTS: tuple[Counterpart, ...] = (
         "the same; with after: success (the default), difference 4",
     ),
     Counterpart("Cooldown", "`Cooldown`", "", "none: BehaviorTree.CPP has no such node"),
+    Counterpart("TimesWithin", "`TimesWithin`", "", "none: BehaviorTree.CPP has no such node"),
+    Counterpart("HeldFor", "`HeldFor`", "", "none: BehaviorTree.CPP has no such node"),
 )
 
 DIFFERENCES: tuple[str, ...] = (
@@ -99,7 +101,8 @@ NOTES: tuple[str, ...] = (
     "to be woken up, which our scheduler never does: a tree ticks at its `rate_hz`.",
     "Only in BehaviorTree.CPP: SKIPPED, ForceFailure, KeepRunningUntilFailure, Delay, "
     "Precondition, Switch, IfThenElse, WhileDoElse, and Parallel thresholds other than the "
-    "two above. Only here: Cooldown, OneShot's after: success, Parallel's synchronise: false.",
+    "two above. Only here: Cooldown, TimesWithin, HeldFor, OneShot's after: success, "
+    "Parallel's synchronise: false.",
 )
 
 

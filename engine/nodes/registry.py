@@ -168,12 +168,13 @@ def builtin_registry() -> NodeRegistry:
     from engine.nodes.actions import ACTIONS
     from engine.nodes.composites import COMPOSITES
     from engine.nodes.conditions import CONDITIONS
+    from engine.nodes.counting import COUNTING
     from engine.nodes.decorators import DECORATORS
     from engine.nodes.dialog import DIALOG_NODES
     from engine.nodes.remote import REMOTE_NODES
 
     registry = NodeRegistry()
-    for node_type in (*COMPOSITES, *DECORATORS):
+    for node_type in (*COMPOSITES, *DECORATORS, *COUNTING):
         registry.add(node_type)
     for leaf in (*CONDITIONS, *ACTIONS, *DIALOG_NODES, *REMOTE_NODES):
         registry.add(leaf)
