@@ -9,6 +9,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import pytest
+
 from engine.cli import main
 from engine.privacy.site_data import SiteKey
 from engine.recording.replay import Recording
@@ -212,3 +214,15 @@ def test_validate_checks_a_scenario_s_presses_against_the_buttons_given(tmp_path
     scenario.write_text("duration_s: 2\nevents:\n  - {at: 1.0, press: Hello Tom}\n")
     assert main(["validate", "--buttons", str(buttons), str(scenario)]) == 1
     assert "no button labelled 'Hello Tom'" in capsys.readouterr().err
+
+
+@pytest.mark.realtime
+def test_buttons_alone_in_real_time_say_that_no_scenario_plays(capsys, monkeypatch):
+    # --help says the demo is the default scenario; with the buttons in real time the
+    # therapist leads instead, and the run says so rather than dropping the demo silently
+    monkeypatch.chdir(ROOT)
+    args = ["run", "--speech", "text", "--buttons", "trees/buttons/session.yaml"]
+    assert main([*args, "--view-port", "0", "--duration", "0.3"]) == 0
+    out, err = capsys.readouterr()
+    assert "no scenario plays: the therapist's buttons lead the session" in err
+    assert "world" not in out  # nothing of the demo happened

@@ -85,7 +85,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         type=Path,
         default=None,
         help="scenario file (default: examples/scenarios/demo.yaml on the simulated vest; "
-        "none on a real robot, which then runs until Ctrl-C)",
+        "none on a real robot, or with --buttons in real time, which then run until Ctrl-C)",
     )
     parser.add_argument(
         "--duration",
@@ -168,6 +168,10 @@ def _profile_name(behaviors: Behaviors) -> str:
     return "" if profile is None else str(profile.path or profile.name)
 
 
+def _tell_progress(what: str) -> None:
+    tell(f"vest run: {what}...")
+
+
 def _positive_seconds(text: str) -> float:
     try:
         value = float(text)
@@ -240,6 +244,10 @@ def main(args: argparse.Namespace) -> int:
     if args.buttons is not None and args.scenario is None and not args.fast:
         # only buttons asked for: a session the therapist leads, until Ctrl-C
         scenario = Scenario(duration_s=math.inf, events=(), path=Path("(the buttons alone)"))
+        tell(
+            "vest run: no scenario plays: the therapist's buttons lead the session "
+            "(--scenario FILE plays one, e.g. examples/scenarios/demo.yaml)"
+        )
     site = open_site()  # the key is made on first use
     try:
         return _run_for_site(args, site, inputs, scenario)
@@ -317,6 +325,7 @@ def _run_for_site(
             on_foxglove_up=tell_foxglove,
             ros2=ros2,
             on_ros2_up=tell_ros2,
+            on_progress=_tell_progress,
         )
     )
     assembled = running.assembled

@@ -121,6 +121,9 @@ class SessionPlan:
     """Join this ROS 2 graph (publish the session; take commands when it says so)."""
     on_ros2_up: Callable[[Ros2Bridge], None] | None = None
     """Told once the robot is on the graph."""
+    on_progress: Callable[[str], None] | None = None
+    """Told what is being built before a slow part (the speech models load for seconds,
+    up to a minute the first time), so a person is never left waiting in silence."""
 
 
 @dataclass
@@ -184,6 +187,7 @@ def _robot_speech(plan: SessionPlan, clock: Clock) -> RobotSpeech | None:
     lines synthesized before the run."""
     if plan.speech is None:
         return None
+    _progress(plan, "loading the speech models (the voice, the recognizer): up to a minute")
     audio_out = plan.speech.audio_out
     speech = build_speech(
         plan.config.audio,
@@ -198,6 +202,11 @@ def _robot_speech(plan: SessionPlan, clock: Clock) -> RobotSpeech | None:
         if event.kind == "hear" and event.value["wav"] is None:
             speech.prepare(event.value["text"])
     return speech
+
+
+def _progress(plan: SessionPlan, what: str) -> None:
+    if plan.on_progress is not None:
+        plan.on_progress(what)
 
 
 def _cloud_link(cloud: CloudPlan | None, clock: Clock) -> CloudLink | None:
