@@ -47,7 +47,7 @@ def test_a_button_pressed_mid_hug_speaks_at_once_and_the_hug_gives_way(
         "{at: 1.2, press: Well done}",
     )
     assert lines_after(out, "presses the button")[:9] == [
-        "therapist presses the button 'Well done'",
+        "scenario presses the button 'Well done'",  # a scripted press: the scenario's
         "buttons interrupts hug to use the face LEDs",  # the button's green replaces pink
         "hug cut short: lights the face pink for 2 s (buttons interrupted it)",
         'hug cut short: says "I love hugs!" (buttons interrupted it)',
@@ -155,7 +155,7 @@ def test_a_button_not_shown_now_does_nothing_and_says_so(tmp_path, capsys, monke
     monkeypatch.chdir(ROOT)
     out, _ = run(tmp_path, capsys, "{at: 1.0, press: Show me your hand}")  # no game runs
     assert (
-        "therapist      presses the button 'Show me your hand', which is not shown now: "
+        "scenario       presses the button 'Show me your hand', which is not shown now: "
         "nothing done" in out
     )
     assert "Can you show me your hand?" not in out

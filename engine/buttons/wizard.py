@@ -107,7 +107,8 @@ class Wizard:
     def _carry_out(self, button: Button, now_s: float, by: str) -> None:
         self.presses += 1
         shown = self._shown(button)
-        self.robot.session.publish(ButtonPressed(now_s, button.label, by, done=shown))
+        control = button.control or ""
+        self.robot.session.publish(ButtonPressed(now_s, button.label, by, shown, control))
         if not shown:
             return
         if button.control == "pause":

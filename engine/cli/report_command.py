@@ -34,6 +34,20 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="instead of one FILE: the person's progress across their sessions",
     )
     parser.add_argument(
+        "--with-simulated",
+        action="store_true",
+        help="with --person: count their simulated sessions too (scenarios played on the "
+        "simulated vest; left out by default), marked as such",
+    )
+    parser.add_argument(
+        "--note",
+        type=_note,
+        default="",
+        metavar="TEXT",
+        help="the therapist's note, put at the top of the report (a blank line between "
+        'paragraphs; from a file: --note "$(cat note.txt)")',
+    )
+    parser.add_argument(
         "-o",
         "--output",
         type=Path,
@@ -44,16 +58,32 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
 
 
+MAX_NOTE = 20_000
+"""Characters a note may have (pages of text; a longer one is a file given by mistake)."""
+
+
+def _note(text: str) -> str:
+    if len(text) > MAX_NOTE:
+        raise argparse.ArgumentTypeError(
+            f"is {len(text):,} characters; a note has at most {MAX_NOTE:,}"
+        )
+    if any(ord(c) < 32 and c not in "\n\t\r" for c in text):
+        raise argparse.ArgumentTypeError("holds control characters: give it as plain text")
+    return text
+
+
 def main(args: argparse.Namespace) -> int:
     if (args.recording is None) == (args.person is None):
         raise UsageError("name a recording FILE, or --person PSEUDONYM for their progress")
     if args.person is not None:
-        return _progress(args.person, args.output)
+        if args.note:
+            raise UsageError("--note goes with one session's FILE, not --person")
+        return _progress(args.person, args.output, with_simulated=args.with_simulated)
     recording, site = open_recording(args.recording, "report")
     try:
         output = args.output or args.recording.with_suffix(".html")
         check_replaceable(output, site)
-        page = report_html(recording)
+        page = report_html(recording, args.note)
         cut = recording.cut_short
         write_file(output, page.encode("utf-8"), f"{output}", "the report", private=True)
         if site is not None:  # a report names the person in the clear: erased with them
@@ -90,7 +120,7 @@ def check_replaceable(output: Path, site: Site | None) -> None:
     )
 
 
-def _progress(person: str, given: Path | None) -> int:
+def _progress(person: str, given: Path | None, *, with_simulated: bool) -> int:
     site = open_site(create=False)
     try:
         output = given or site.reports_folder() / f"{person}-progress.html"
@@ -111,13 +141,14 @@ def _progress(person: str, given: Path | None) -> int:
             finally:
                 recording.close()
             site.audit("report", person, str(entry.path))
-        page = progress_html(person, summaries, gone)
+        counted = [s for s in summaries if with_simulated or not s.simulated]
+        page = progress_html(person, counted, gone, left_out=len(summaries) - len(counted))
         write_file(output, page.encode("utf-8"), f"{output}", "the report", private=True)
         held = [entry.path for entry in entries if entry.path not in gone]
         site.output_written(output, person, "progress report", held)
     finally:
         site.close()
-    sessions = f"{len(summaries)} session{'' if len(summaries) == 1 else 's'}"
+    sessions = f"{len(counted)} session{'' if len(counted) == 1 else 's'}"
     print(f"progress of {person} over {sessions}: {output}")
     for path in gone:
         tell(f"warning: {path}: not there any more; left out of the progress")

@@ -319,6 +319,7 @@ def _run_for_site(
                 "profile": _profile_name(behaviors),
                 "scenario": str(scenario.path),
                 "started": f"{EpochClock().now():.3f}",
+                "clock": "virtual" if args.fast else "real",
             },
             foxglove_port=args.foxglove,
             foxglove_origins=tuple(args.foxglove_origin),

@@ -23,7 +23,13 @@ from engine.blackboard.catalogue import (
 from engine.buttons.button_file import BUTTONS_TREE
 from engine.recording.replay import RecordedAction, Recording
 from engine.recording.told import told_events
-from engine.session.events import ButtonPressed, NotListened, NotUnderstood, TurnTaken
+from engine.session.events import (
+    BehaviorsPaused,
+    ButtonPressed,
+    NotListened,
+    NotUnderstood,
+    TurnTaken,
+)
 
 ANSWER_WITHIN_S = 10.0
 """An action this soon after what the person did counts as the robot's answer."""
@@ -46,6 +52,10 @@ class Moment:
     not_listened: bool = False
     gave_way: str | None = None
     """Why nothing answered: a behaviour gave way to another (one voice at a time)."""
+    control: str | None = None
+    """What a control button did (paused the behaviours...): no answer is awaited."""
+    kind: str = ""
+    """The kind of thing done, as a scenario names it (touch, squeeze, hear, press...)."""
 
     @property
     def answer(self) -> RecordedAction | None:
@@ -78,11 +88,15 @@ def person_moments(recording: Recording) -> list[Moment]:
     ]
     if not done:
         done = sensed(recording)
-    done += [
-        (event.t_s, "the therapist", f"pressed the button \u201c{event.label}\u201d", "press")
-        for event in told
-        if isinstance(event, ButtonPressed)
-    ]
+    paused = {event.t_s: event.paused for event in told if isinstance(event, BehaviorsPaused)}
+    controls: dict[float, str] = {}
+    for event in told:
+        if isinstance(event, ButtonPressed):
+            who = "the scenario" if event.by == "scenario" else "the therapist"
+            done.append((event.t_s, who, f"pressed the button \u201c{event.label}\u201d", "press"))
+            control = _control_done(event, paused.get(event.t_s))
+            if control:
+                controls[event.t_s] = control
     done += [
         (event.from_s, "the person", "spoke while the robot was speaking", "not_listened")
         for event in told
@@ -96,7 +110,10 @@ def person_moments(recording: Recording) -> list[Moment]:
     moments = []
     for index, (at, who, did, kind) in enumerate(ordered):
         if kind == "not_listened":  # a line of its own: nothing to answer
-            moments.append(Moment(at, did, (), who, not_listened=True))
+            moments.append(Moment(at, did, (), who, not_listened=True, kind=kind))
+            continue
+        if kind == "press" and at in controls:  # what it did is its answer
+            moments.append(Moment(at, did, (), who, control=controls[at], kind=kind))
             continue
         later = [  # the next thing the same one did ends the wait for an answer
             t for t, w, _, k in ordered[index + 1 :] if t > at and w == who and k != "not_listened"
@@ -105,23 +122,44 @@ def person_moments(recording: Recording) -> list[Moment]:
         window = [  # a command's report is bookkeeping for the cloud, not an answer
             a
             for a in actions
-            if at <= a.at_s < until and a.action != "report" and _answers(who, a.tree, reporting)
+            if at <= a.at_s < until and a.action != "report" and _answers(kind, a.tree, reporting)
         ]
         tree = window[0].tree if window else None
         answers = tuple(a for a in window if a.tree == tree)[:3]
         heard = next(
             (e.text for e in misunderstood if at <= e.t_s < until and kind == "hear"), None
         )
-        gave_way = next(
+        paused_then = [p for t, p in sorted(paused.items()) if t <= at]
+        gave_way = "the behaviours were paused" if paused_then and paused_then[-1] else None
+        gave_way = gave_way or next(
             (
                 f"{e.tree} gave way to {e.other}, who had the {e.resource}"
                 for e in yielded
-                if at <= e.t_s < until and _answers(who, e.tree, reporting)
+                if at <= e.t_s < until and _answers(kind, e.tree, reporting)
             ),
             None,
         )
-        moments.append(Moment(at, did, answers, who, heard, gave_way=gave_way))
+        moments.append(Moment(at, did, answers, who, heard, gave_way=gave_way, kind=kind))
     return moments
+
+
+CONTROLS_DID = {
+    "pause": "paused the behaviours",
+    "resume": "resumed the behaviours",
+    "stop": "stopped everything and paused the behaviours",
+}
+
+
+def _control_done(press: ButtonPressed, paused: bool | None) -> str | None:
+    """What a control button's press did (a recording before presses kept their control:
+    the pause or resume that came with it), or None for a button that acts."""
+    if not press.done:
+        return "nothing: the button was not shown then"
+    if press.control:
+        return CONTROLS_DID.get(press.control)
+    if paused is not None:
+        return CONTROLS_DID["pause" if paused else "resume"]
+    return None
 
 
 def _did(kind: str, description: str) -> str:
@@ -138,13 +176,13 @@ def _did(kind: str, description: str) -> str:
     return description.removeprefix("someone ")
 
 
-def _answers(who: str, tree: str, reporting: set[str]) -> bool:
-    """Whether ``tree`` can answer something ``who`` did: a press is answered by the
-    buttons, an operator's command by the trees that report commands (``reporting``), the
-    person by the other trees."""
-    if who == "the therapist":
+def _answers(kind: str, tree: str, reporting: set[str]) -> bool:
+    """Whether ``tree`` can answer something done (``kind``, as a scenario names it): a
+    press is answered by the buttons, an operator's command by the trees that report
+    commands (``reporting``), the person by the other trees."""
+    if kind == "press":
         return tree == BUTTONS_TREE
-    if who == "the operator":
+    if kind == "cloud":
         return tree in reporting
     return tree != BUTTONS_TREE and tree not in reporting
 

@@ -18,7 +18,7 @@ from pathlib import Path
 
 from engine.recording.moments import not_understood, person_moments
 from engine.recording.replay import Recording
-from engine.recording.report import REPORT_HEAD, STYLE
+from engine.recording.report import REPORT_HEAD, STYLE, simulated
 from engine.recording.report_plots import per_session_plot
 
 THE_PERSON = "the person"
@@ -38,10 +38,17 @@ class SessionSummary:
     not_understood: int
     not_listened: int
     by_behaviour: dict[str, tuple[float, ...]] = field(default_factory=dict)
+    simulated: bool = False
+    """A scripted session on the simulated vest (a scenario, or ``--fast``): no person."""
 
     @property
     def answered(self) -> int:
         return len(self.answer_s)
+
+    @property
+    def did_per_minute(self) -> float | None:
+        """What the person did per minute of the session (sessions of any length compare)."""
+        return self.did / (self.length_s / 60) if self.length_s > 0 else None
 
     @property
     def median_answer_s(self) -> float | None:
@@ -76,12 +83,16 @@ def summarize(recording: Recording, started: float) -> SessionSummary:
         len(not_understood(recording)),
         len(moments) - len(acts),
         {tree: tuple(found) for tree, found in behaviours.items()},
+        simulated(recording.meta),
     )
 
 
-def progress_html(person: str, sessions: list[SessionSummary], gone: list[Path]) -> str:
+def progress_html(
+    person: str, sessions: list[SessionSummary], gone: list[Path], *, left_out: int = 0
+) -> str:
     """The progress page of ``person`` over ``sessions`` (oldest first); ``gone``: indexed
-    sessions whose files are no longer there."""
+    sessions whose files are no longer there; ``left_out``: simulated sessions not
+    counted (those counted are marked)."""
     name = html.escape(person)
     labels = [f"{n}: {s.day}" for n, s in enumerate(sessions, 1)]
     parts = [
@@ -97,6 +108,12 @@ def progress_html(person: str, sessions: list[SessionSummary], gone: list[Path])
         "the therapist's presses or an operator's commands, which the session reports list "
         "too.</p>",
     ]
+    if left_out:
+        parts.append(
+            f"<p class='meta'>{left_out} simulated session{'s' if left_out != 1 else ''} "
+            "(a scenario played on the simulated vest) left out: vest report --person "
+            f"{name} --with-simulated counts {'them' if left_out != 1 else 'it'}, marked.</p>"
+        )
     if gone:
         listed = ", ".join(html.escape(str(path)) for path in gone)
         parts.append(f'<p class="warning">Not there any more, so not counted: {listed}.</p>')
@@ -107,6 +124,7 @@ def progress_html(person: str, sessions: list[SessionSummary], gone: list[Path])
             "What the person did and what the robot answered",
             "times",
             [
+                ("did per minute", "#ef6c00", [s.did_per_minute for s in sessions]),
                 ("did", "#2e7d32", [float(s.did) for s in sessions]),
                 ("answered", "#1565c0", [float(s.answered) for s in sessions]),
                 ("not understood", "#c62828", [float(s.not_understood) for s in sessions]),
@@ -134,6 +152,9 @@ def _in_words(sessions: list[SessionSummary]) -> str:
         f"In the first session the person did {first.did} things and the robot answered "
         f"{first.answered}; in the latest, {last.did} and {last.answered}."
     )
+    rates = [f"{s.did_per_minute:.1f}" for s in sessions if s.did_per_minute is not None]
+    if len(rates) > 1:
+        words += f" Things done per minute, session by session: {', '.join(rates)}."
     if first.median_answer_s is not None and last.median_answer_s is not None:
         words += (
             f" Typical answer time: {first.median_answer_s:.2f} s, then "
@@ -152,11 +173,13 @@ def _seconds(value: float | None) -> str:
 
 
 def _sessions_table(sessions: list[SessionSummary]) -> str:
-    heads = ["#", "day", "length", "did", "answered", "typical answer", "not understood"]
-    heads.append("spoke over the robot")
+    heads = ["#", "day", "length", "did", "per minute", "answered", "typical answer"]
+    heads += ["not understood", "spoke over the robot"]
     rows = "".join(
-        f"<tr><td class='num'>{n}</td><td>{s.day}</td><td class='num'>{s.length_s:.0f} s</td>"
-        f"<td class='num'>{s.did}</td><td class='num'>{s.answered}</td>"
+        f"<tr><td class='num'>{n}</td><td>{s.day}{' (simulated)' if s.simulated else ''}</td>"
+        f"<td class='num'>{s.length_s:.0f} s</td><td class='num'>{s.did}</td>"
+        f"<td class='num'>{'-' if s.did_per_minute is None else f'{s.did_per_minute:.1f}'}</td>"
+        f"<td class='num'>{s.answered}</td>"
         f"<td class='num'>{_seconds(s.median_answer_s)}</td>"
         f"<td class='num'>{s.not_understood}</td><td class='num'>{s.not_listened}</td></tr>"
         for n, s in enumerate(sessions, 1)

@@ -19,6 +19,8 @@ import json
 from collections import Counter
 from pathlib import Path
 
+import yaml
+
 from engine.blackboard.catalogue import (
     FORCE_LEFT_N,
     FORCE_RIGHT_N,
@@ -89,6 +91,8 @@ def _answer_cell(moment: Moment) -> tuple[str, str]:
     """The robot's answer to ``moment`` as the report shows it (HTML), and its delay."""
     if moment.not_listened:
         return '<span class="none">could not listen: it was speaking</span>', "-"
+    if moment.control is not None:
+        return html.escape(moment.control), "-"
     if moment.answer is None and moment.not_understood is None:
         why = f": {moment.gave_way}" if moment.gave_way else ""
         return f'<span class="none">no answer{html.escape(why)}</span>', "-"
@@ -163,14 +167,27 @@ def _left_out(meta: dict[str, str]) -> str:
     )
 
 
+SCENARIO_OF_NONE = ("", "(the buttons alone)")
+"""A session's ``scenario`` fact when no scenario was played (a real session)."""
+
+
+def simulated(meta: dict[str, str]) -> bool:
+    """Whether a recording is of a scripted session: on a virtual clock (``--fast``), or
+    a scenario played on the simulated vest (recordings before the clock was kept)."""
+    if "clock" in meta:
+        return meta["clock"] == "virtual" or meta.get("scenario", "") not in SCENARIO_OF_NONE
+    return meta.get("scenario", "") not in SCENARIO_OF_NONE
+
+
 REPORT_HEAD = '<!doctype html>\n<html lang="en"><head><meta charset="utf-8">'
 """How every report vest writes begins (a file that does may be written over)."""
 STYLE = (Path(__file__).resolve().parent / "report.css").read_text
 """The report's style sheet, read when a report is written (it goes inside the page)."""
 
 
-def report_html(recording: Recording) -> str:
-    """The report as one HTML document (no outside files)."""
+def report_html(recording: Recording, note: str = "") -> str:
+    """The report as one HTML document (no outside files), with the therapist's ``note``
+    (plain text; a blank line between paragraphs) when there is one."""
     end = recording.duration_s
     moments = person_moments(recording)
     answered = [  # an answer the robot could not give (refused, failed) is no answer
@@ -189,9 +206,18 @@ def report_html(recording: Recording) -> str:
     rows_html = "".join(rows)
     fired = Counter({tree.name: 0 for tree in recording.trees})
     fired.update(action.tree for action in recording.actions() if action.outcome != "failed")
+    described = descriptions(recording)
     behaviours = "".join(
-        f"<tr><td>{html.escape(tree)}</td><td class='num'>{count}</td></tr>"
+        f"<tr><td>{html.escape(tree)}</td><td>{html.escape(described.get(tree, ''))}</td>"
+        f"<td class='num'>{count}</td></tr>"
         for tree, count in fired.most_common()
+    )
+    kinds = Counter(KINDS_IN_WORDS.get(m.kind, "other") for m in moments if not m.not_listened)
+    by_kind = "".join(
+        f"<tr><td>{html.escape(kind)}</td><td class='num'>{count}</td>"
+        f"<td class='num'>{count / (end / 60):.1f}</td></tr>"
+        for kind, count in kinds.most_common()
+        if end > 0
     )
     misses = not_understood(recording)
     missed = "".join(
@@ -208,13 +234,20 @@ def report_html(recording: Recording) -> str:
         for device, since, back in outages(recording)
     )
     median = sorted(answered)[len(answered) // 2] if answered else None
-    acts = [m for m in moments if not m.not_listened]
-    unheard = len(moments) - len(acts)
+    acts = [m for m in moments if not m.not_listened and m.control is None]
+    controls = sum(1 for m in moments if m.control is not None)
+    unheard = len(moments) - len(acts) - controls
     summary = (
-        f"{len(acts)} things done (by the person, the therapist or an operator); the robot "
-        f"answered {len(answered)}"
+        f"{len(acts)} things done (by the person, the therapist, the scenario or an "
+        f"operator); the robot answered {len(answered)}"
         + (f", typically within {median:.2f} s" if median is not None else "")
         + "."
+        + (
+            f" The behaviours were paused, resumed or stopped {controls} "
+            f"time{'s' if controls != 1 else ''}."
+            if controls
+            else ""
+        )
         + (
             f" {unheard} time{'s' if unheard != 1 else ''} the person spoke while the robot "
             "was speaking, and it could not listen."
@@ -229,6 +262,11 @@ def report_html(recording: Recording) -> str:
             else ""
         )
     )
+    if simulated(recording.meta):
+        summary += (
+            " A simulated session: a scenario played the person's part on the simulated "
+            "vest (progress reports leave it out unless asked)."
+        )
     cut = recording.cut_short
     plots = [
         plot(
@@ -268,6 +306,7 @@ def report_html(recording: Recording) -> str:
             f'<p class="meta">{when} &middot; {person} &middot; {end:.1f} s &middot; '
             f"{html.escape(profile)} &middot; robot {robot} &middot; {recorded}</p>",
             f"<p>{html.escape(summary)}</p>",
+            _note(note),
             _left_out(meta),
             f'<p class="warning">{html.escape(cut)}: this report is of what it holds.</p>'
             if cut
@@ -279,9 +318,11 @@ def report_html(recording: Recording) -> str:
                 "nothing",
                 numeric={0, 4},
             ),
+            "<h2>What was done, by kind</h2>",
+            _table(["kind", "times", "per minute"], by_kind, "nothing was done", numeric={1, 2}),
             "<h2>How often each behaviour acted</h2>",
             "<p>Actions it could do (not those refused or failed).</p>",
-            _table(["behaviour", "actions"], behaviours, "none acted", numeric={1}),
+            _table(["behaviour", "what it does", "actions"], behaviours, "none acted", numeric={2}),
             "<h2>What the robot did not understand</h2>",
             _table(
                 ["when", "heard", "the robot"],
@@ -303,6 +344,43 @@ def report_html(recording: Recording) -> str:
             "</body></html>\n",
         ]
     )
+
+
+KINDS_IN_WORDS = {
+    "touch": "touches",
+    "squeeze": "squeezes and hugs",
+    "hear": "words",
+    "gesture": "gestures",
+    "show_hand": "hands shown",
+    "obstacle": "coming near",
+    "press": "button presses",
+    "cloud": "operator's commands",
+}
+"""Each kind of thing done (as a scenario names it), as the report counts it."""
+
+
+def descriptions(recording: Recording) -> dict[str, str]:
+    """Each behaviour's description, as its tree file says it (the version first run)."""
+    found: dict[str, str] = {}
+    for row in recording.table("trees"):
+        if row["tree"] in found:
+            continue
+        try:
+            document = yaml.safe_load(row["source"] or "")
+        except yaml.YAMLError:
+            continue
+        described = document.get("description") if isinstance(document, dict) else None
+        found[row["tree"]] = " ".join(str(described).split()) if described else ""
+    return found
+
+
+def _note(note: str) -> str:
+    """The therapist's note as paragraphs ('' when there is none)."""
+    paragraphs = [part.strip() for part in note.split("\n\n") if part.strip()]
+    if not paragraphs:
+        return ""
+    body = "".join(f"<p>{html.escape(part)}</p>" for part in paragraphs)
+    return f'<section class="note"><h2>The therapist\'s note</h2>{body}</section>'
 
 
 def _table(heads: list[str], rows: str, empty: str, *, numeric: set[int]) -> str:

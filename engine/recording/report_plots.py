@@ -17,6 +17,8 @@ def plot(
     values = [v for _, _, points in series for _, v in points if v is not None]
     if not values:
         return ""
+    if not any(values):  # a flat line at 0 is an empty chart: say it
+        return f'<p class="plot-none">{html.escape(title)}: none during the session.</p>'
     top = max(values) if max(values) > 0 else 1.0
 
     def x(t: float) -> float:

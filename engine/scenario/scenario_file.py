@@ -186,12 +186,20 @@ class ScenarioEvent:
                 shown = Path(value["image"] or value["video"]).name
             return f"{shown} in front of the camera for {value['seconds']:g} s"
         if self.kind == "cloud":
-            return f"operator sends {value['type']} {value['args'] or {}}"
+            args = ", ".join(f"{name} {_word(v)}" for name, v in (value["args"] or {}).items())
+            return f"operator sends {value['type']}" + (f": {args}" if args else "")
         if self.kind == "press":
             return f"presses the button {value!r}"
         if self.kind == "button":
             return f"presses the button {value['label']!r}"
         return f"{self.kind} {value}"
+
+
+def _word(value: Any) -> str:
+    """A command's argument as a person reads it: text in quotes, numbers as they are."""
+    if isinstance(value, str):
+        return f'"{value}"'
+    return f"{value:g}" if isinstance(value, float) else str(value)
 
 
 @dataclass(frozen=True)

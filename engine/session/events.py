@@ -167,14 +167,17 @@ class SafetyAction:
 
 @dataclass(frozen=True, slots=True)
 class ButtonPressed:
-    """The therapist pressed a button (on the page, a key, or a scenario's ``press``);
-    ``done`` is False when it was not shown then, so nothing was done."""
+    """The therapist pressed a button (``by``: on the ``page``, a ``key``, or a
+    ``scenario``'s ``press``); ``done`` is False when it was not shown then, so nothing was
+    done; ``control`` is what a control button did (``pause``, ``resume``, ``stop``: stop
+    everything), "" for a button that has the robot do something."""
 
     kind: ClassVar[str] = "press"
     t_s: float
     label: str
     by: str
     done: bool = True
+    control: str = ""
 
 
 @dataclass(frozen=True, slots=True)

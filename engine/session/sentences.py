@@ -75,7 +75,8 @@ def event_line(event: SessionEvent) -> tuple[str, str] | None:
         return "world", event.description
     if isinstance(event, ButtonPressed):
         nothing = "" if event.done else ", which is not shown now: nothing done"
-        return "therapist", f"presses the button {event.label!r}{nothing}"
+        who = "scenario" if event.by == "scenario" else "therapist"
+        return who, f"presses the button {event.label!r}{nothing}"
     if isinstance(event, BehaviorsPaused):
         return "buttons", "pauses the behaviors" if event.paused else "resumes the behaviors"
     if isinstance(event, ActionStarted):
