@@ -104,6 +104,7 @@ class EditorServer:
             shared_files(),
             Route("/api/palette", lambda _: JSONResponse(self.palette)),
             Route("/api/files", lambda _: JSONResponse(self.workspace.files())),
+            Route("/api/profiles", lambda _: JSONResponse(self.workspace.profiles())),
             Route("/api/file", self._read),
             Route("/api/check", self._check, methods=["POST"]),
             Route("/api/save", self._save, methods=["POST"]),

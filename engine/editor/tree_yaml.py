@@ -2,7 +2,8 @@
 still read: the round trip keeps comments, key order and layout of what was not changed.
 
 The outline is plain JSON: the tree's settings (``name``, ``rate_hz``, ``priority``,
-``wake_on``, ``description``) and its ``root``, each node ``{"id", "type", "name",
+``wake_on``, ``description``), its ``params`` (the values a profile may change) and its
+``root``, each node ``{"id", "type", "name",
 "args", "children"}``. ``id`` names where the node stood in the file when it was read
 (``root``, ``root/0``, ``root/0/child``); a node the page added has none. Writing the
 outline back walks the file as read (ruamel.yaml's round-trip document) and changes only
@@ -45,7 +46,10 @@ class TreeText:
     def outline(self) -> dict[str, Any]:
         """The settings and the root, as the page edits them."""
         settings = {key: plain(self.document[key]) for key in SETTINGS if key in self.document}
-        return {"settings": settings, "root": self._node(self.document["root"], "root")}
+        raw_params = self.document.get("params")
+        params = plain(raw_params) if isinstance(raw_params, CommentedMap) else {}
+        root = self._node(self.document["root"], "root")
+        return {"settings": settings, "params": params, "root": root}
 
     def _node(self, raw: Any, ident: str) -> dict[str, Any]:
         if not isinstance(raw, CommentedMap) or len(raw) != 1:
@@ -88,6 +92,7 @@ class TreeText:
             raise OutlineError("settings must be a mapping")
         others = tuple(str(key) for key in document if key not in SETTINGS)
         update(document, {k: v for k, v in settings.items() if k in SETTINGS}, others)
+        _params(document, outline.get("params", {}))
         _settings_first(document)
         document["root"] = self._built(outline.get("root"), originals, "root")
         return dumped(document, self.style, self.newline)
@@ -159,6 +164,23 @@ def _new_body(children: str, args: dict[str, Any]) -> CommentedMap:
     if children == "none" and all(not isinstance(v, dict) for v in args.values()):
         body.fa.set_flow_style()
     return body
+
+
+def _params(document: CommentedMap, params: Any) -> None:
+    """The tree's ``params`` as the page set them: a changed value changed in place (its
+    comment kept), a new one added, one taken out removed (and ``params`` with it when
+    none is left)."""
+    if not isinstance(params, dict) or not all(isinstance(k, str) for k in params):
+        raise OutlineError("params must be a mapping of names to values")
+    held = document.get("params")
+    if not isinstance(held, CommentedMap):
+        if not params:
+            return
+        held = CommentedMap()
+        document.insert(list(document.keys()).index("root"), "params", held)
+    update(held, params, ())
+    if not held:
+        del document["params"]
 
 
 def _settings_first(document: CommentedMap) -> None:

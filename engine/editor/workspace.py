@@ -30,6 +30,8 @@ from engine.dialogs.library import OUTSIDE
 from engine.files.problems import LoadError, Problem
 from engine.files.whole_file import write_whole
 from engine.files.yaml_source import read_bytes, resolved
+from engine.files.yaml_values import plain
+from engine.loader.substitution import load_profile
 from engine.loader.tree_definition import TreeDefinition
 from engine.nodes.registry import NodeRegistry
 
@@ -112,6 +114,23 @@ class Workspace:
                 if not path.resolve().is_relative_to(self.folder):
                     continue  # a link out of the folder is not listed
                 found.append({"file": shown.as_posix(), "kind": self.checks.kind_of(path)})
+        return found
+
+    def profiles(self) -> dict[str, dict[str, Any]]:
+        """What each profile (``trees/profiles/*.yaml``) sets: {profile: {param: value}};
+        a profile that does not load is left out (``vest validate`` names its problems)."""
+        found: dict[str, dict[str, Any]] = {}
+        folder = self.folder / "trees" / "profiles"
+        for path in sorted(folder.glob("*.y*ml")) if folder.is_dir() else ():
+            if not path.resolve().is_relative_to(self.folder):
+                continue  # a link out of the folder is not read
+            try:
+                profile = load_profile(path, path.relative_to(self.folder).as_posix())
+            except LoadError:
+                continue
+            found[profile.name] = {
+                name: plain(given.value) for name, given in profile.params.items()
+            }
         return found
 
     # -- read, check, save ----------------------------------------------------------------

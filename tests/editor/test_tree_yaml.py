@@ -183,3 +183,44 @@ def test_an_outline_nested_past_vest_s_limit_is_refused_in_words() -> None:
         deepest = inner
     with pytest.raises(OutlineError, match="nested more than 100 deep"):
         tree.written(outline)
+
+
+HUG_PARAMS = """\
+name: hug
+rate_hz: 20
+params:
+  hug_threshold_n: 3.0   # a gentle hug is 2 to 4 N
+  hug_phrase: "I love hugs!"
+root:
+  Check: {key: /sensors/force/left_n, above: "${hug_threshold_n}"}
+"""
+
+
+def test_a_tree_s_params_are_in_the_outline_and_change_in_place_with_their_comments() -> None:
+    tree = TreeText(HUG_PARAMS, REGISTRY)
+    outline = tree.outline()
+    assert outline["params"] == {"hug_threshold_n": 3.0, "hug_phrase": "I love hugs!"}
+    outline["params"]["hug_threshold_n"] = 4.5
+    assert tree.written(outline) == HUG_PARAMS.replace("3.0   #", "4.5   #")
+
+
+def test_params_added_to_a_tree_without_go_above_its_root_and_the_last_one_out_takes_them() -> None:
+    tree = TreeText(TICKLES, REGISTRY)
+    outline = tree.outline()
+    assert outline["params"] == {}
+    outline["params"] = {"tickle_rest_s": 5}
+    written = tree.written(outline)
+    assert "priority: 42                   # above touch_thanks (40)\nparams:\n" in written
+    assert "  tickle_rest_s: 5\nroot:\n" in written
+    again = TreeText(written, REGISTRY)
+    emptied = again.outline()
+    emptied["params"] = {}
+    assert again.written(emptied) == TICKLES
+
+
+@pytest.mark.parametrize("params", [["a"], {"": 1} | {1: 2}, "x"], ids=["list", "key", "text"])
+def test_params_that_are_not_names_to_values_are_refused(params: object) -> None:
+    tree = TreeText(TICKLES, REGISTRY)
+    outline = tree.outline() | {"params": params}
+    with pytest.raises(OutlineError, match="params must be a mapping of names to values"):
+        tree.written(outline)

@@ -14,6 +14,7 @@ const make = (tag, props = {}, ...children) => {
 };
 
 let palette = { nodes: [], pads: [], joints: [], colors: [], keys: [], kinds: {} };
+let profiles = {}; // profile name -> {param: value}: what each profile sets
 const types = new Map(); // node type name -> its declaration
 let file = null; // {name, version (null: new), outline}
 let chosen = null; // the chosen node object
@@ -194,7 +195,8 @@ function fieldFor(field, value, set, idPrefix) {
     ? ` ${field.min ?? ""}..${field.max ?? ""}` : "";
   const unit = field.unit ? ` ${field.unit}` : "";
   const label = make("label", { htmlFor: id, textContent: `${field.label ?? field.name.replaceAll("_", " ")}${field.required ? " (needed)" : ""}` });
-  const help = make("p", { className: "help", id: `${id}-help`, textContent: `${field.doc ?? ""}${range || unit ? ` (${(range + unit).trim()})` : ""}` });
+  const from = typeof value === "string" ? /^\$\{(\w+)\}$/.exec(value)?.[1] : undefined;
+  const help = make("p", { className: "help", id: `${id}-help`, textContent: `${field.doc ?? ""}${range || unit ? ` (${(range + unit).trim()})` : ""}${from ? `. ${settingSaid(from)}` : ""}` });
   let input;
   const words = field.words ? palette[field.words] ?? [] : [];
   if (field.kind === "list" && words.length) { // the robot's pads: tick the ones meant
@@ -230,7 +232,21 @@ function fieldFor(field, value, set, idPrefix) {
       wrap.append(make("datalist", { id: listId }, ...suggestions.map((word) => make("option", { value: word }))));
     }
     if (field.default !== undefined) input.placeholder = `default: ${shown(field.default)}`;
-    input.addEventListener("input", () => set(typed(input.value, field), id)); // as you type
+    const setting = typeof value === "string" ? /^\$\{(\w+)\}$/.exec(value)?.[1] : undefined;
+    if (setting !== undefined) { // set by the tree's setting, which profiles change: ask first
+      input.addEventListener("change", () => {
+        const now = typed(input.value, field);
+        const replaces = typeof now !== "string" || !now.includes("${");
+        if (replaces && !confirm(`Replace \${${setting}} with ${now ?? "nothing"}? `
+          + `${settingSaid(setting)}; what you type here is the same for every profile.`)) {
+          input.value = value; // kept: the profile still decides
+          return;
+        }
+        set(now);
+      });
+    } else {
+      input.addEventListener("input", () => set(typed(input.value, field), id)); // as you type
+    }
     input.addEventListener("blur", () => { if (typingIn === id) typingIn = null; });
   }
   input.setAttribute("aria-describedby", help.id);
@@ -247,6 +263,54 @@ function drawSettings() {
     box.append(fieldFor(field, settings[field.name], (value, typing = null) => change(() => {
       if (value === undefined) delete settings[field.name]; else settings[field.name] = value;
     }, false, typing), "setting"));
+  }
+  drawParams();
+}
+
+// -- the tree's settings a profile can change (its params) ----------------------------------
+// Each is shown as a field with the unit and range of where the tree uses it, and what each
+// profile sets it to.
+function usesOf(name) { // the node fields that hold ${name}
+  const found = [];
+  walk(file.outline.root, (node) => {
+    for (const [arg, value] of Object.entries(node.args)) {
+      if (typeof value === "string" && value.includes(`\${${name}}`)) {
+        const field = types.get(node.type)?.params?.find((p) => p.name === arg);
+        found.push({ node: node.type, arg, field });
+      }
+    }
+  });
+  return found;
+}
+
+function settingSaid(name) { // "Set by the tree's setting hug_threshold_n: 3 here; child: 2"
+  const here = file.outline.params?.[name];
+  const set = Object.entries(profiles).filter(([, values]) => name in values)
+    .map(([profile, values]) => `${profile}: ${shown(values[name])}`);
+  const by = set.length ? `; profiles: ${set.join(", ")}` : "; no profile changes it";
+  return `Set by the tree's setting ${name} (${here === undefined ? "not set" : shown(here)} here${by})`;
+}
+
+function drawParams() {
+  const box = $("#params");
+  const params = file.outline.params ?? {};
+  const names = Object.keys(params);
+  box.hidden = names.length === 0;
+  box.replaceChildren(make("legend", { textContent: "Settings a profile can change" }));
+  for (const name of names) {
+    const uses = usesOf(name);
+    const like = uses.find((use) => use.field)?.field ?? { kind: "any" };
+    const where = uses.length ? `used by ${uses.map((use) => `${use.node} ${use.arg}`).join(", ")}` : "not used by any node";
+    const set = Object.entries(profiles).filter(([, values]) => name in values)
+      .map(([profile, values]) => `${profile}: ${shown(values[name])}`);
+    const field = {
+      ...like, name, label: name.replaceAll("_", " "), required: true,
+      doc: `${where}; ${set.length ? `profiles set it: ${set.join(", ")}` : "no profile changes it"}`,
+    };
+    delete field.default;
+    box.append(fieldFor(field, params[name], (value, typing = null) => change(() => {
+      if (value === undefined) delete params[name]; else params[name] = value;
+    }, false, typing), "param"));
   }
 }
 
@@ -545,6 +609,7 @@ function newTree(event) {
 
 async function main() {
   palette = await getJson("/api/palette");
+  profiles = await getJson("/api/profiles");
   for (const node of palette.nodes) types.set(node.name, node);
   $("#where").textContent = "";
   await listFiles();
