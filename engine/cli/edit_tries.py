@@ -37,27 +37,60 @@ class TryError(ValueError):
     """A try the page asked for that cannot be made, in words."""
 
 
-def tried_event(asked: object, pads: list[str], at_s: float = TRY_AT_S) -> dict[str, object]:
-    """The scenario event the page asked for: ``{"kind": "pat", "pad": ...}``,
-    ``{"kind": "squeeze"}``, ``{"kind": "say", "text": ...}`` or ``{"kind": "wave"}``."""
+MAX_TIMES = 5
+LENGTH_S = {"pat": (0.3, 0.1, 10.0), "squeeze": (2.0, 0.1, 10.0)}
+"""How long a pat and a squeeze last by default, and the least and most a try may ask."""
+STRENGTH_N = (6.0, 0.5, 50.0)
+APART_S = (1.5, 0.2, 10.0)
+
+
+def tried_events(asked: object, pads: list[str], at_s: float = TRY_AT_S) -> list[dict[str, object]]:
+    """The scenario events the page asked for, from ``at_s`` on: ``{"kind": "pat", "pad":
+    ...}``, ``{"kind": "squeeze", "strength_n": ...}``, ``{"kind": "say", "text": ...}`` or
+    ``{"kind": "wave"}``, each with ``seconds`` (how long a pat or squeeze lasts),
+    ``times`` (1 to 5) and ``apart_s`` (seconds from one start to the next)."""
     if not isinstance(asked, dict):
         raise TryError("event: a pat, a squeeze, a phrase said or a wave")
     kind = asked.get("kind")
+    times = _number(asked, "times", (1, 1, MAX_TIMES), whole=True)
+    apart_s = _number(asked, "apart_s", APART_S)
     if kind == "pat":
         pad = asked.get("pad")
         if pad not in pads:
             raise TryError(f"no pad {pad!r} on this robot (pads: {', '.join(pads)})")
-        return {"at": at_s, "touch": {"pad": pad, "seconds": 0.3}}
-    if kind == "squeeze":
-        return {"at": at_s, "squeeze": {"left_n": 6.0, "right_n": 6.0, "seconds": 2.0}}
-    if kind == "say":
+        one: dict[str, object] = {
+            "touch": {"pad": pad, "seconds": _number(asked, "seconds", LENGTH_S["pat"])}
+        }
+    elif kind == "squeeze":
+        strength = _number(asked, "strength_n", STRENGTH_N)
+        seconds = _number(asked, "seconds", LENGTH_S["squeeze"])
+        one = {"squeeze": {"left_n": strength, "right_n": strength, "seconds": seconds}}
+    elif kind == "say":
         said = asked.get("text")
         if not isinstance(said, str) or not said.strip() or len(said) > MAX_SAID:
             raise TryError(f"say: the words a person says, 1 to {MAX_SAID} characters")
-        return {"at": at_s, "hear": {"text": said.strip()}}
-    if kind == "wave":
-        return {"at": at_s, "gesture": "wave"}
-    raise TryError("event: a pat, a squeeze, a phrase said or a wave")
+        one = {"hear": {"text": said.strip()}}
+    elif kind == "wave":
+        one = {"gesture": "wave"}
+    else:
+        raise TryError("event: a pat, a squeeze, a phrase said or a wave")
+    return [{"at": round(at_s + n * apart_s, 3), **one} for n in range(int(times))]
+
+
+def _number(
+    asked: dict[str, object], name: str, allowed: tuple[float, float, float], *, whole: bool = False
+) -> float:
+    """``asked[name]`` (its default when not given) if it is a number in range; TryError
+    naming it otherwise."""
+    default, least, most = allowed
+    value = asked.get(name, default)
+    if value is None or value == "":
+        value = default
+    if isinstance(value, bool) or not isinstance(value, int | float) or (whole and value % 1):
+        raise TryError(f"{name}: a {'whole ' if whole else ''}number from {least:g} to {most:g}")
+    if not least <= value <= most:
+        raise TryError(f"{name}: {value:g} is not from {least:g} to {most:g}")
+    return float(value)
 
 
 class TryOnSimulatedVest:
@@ -74,17 +107,18 @@ class TryOnSimulatedVest:
     def __call__(self, name: str, text: str, asked: object) -> list[str]:
         """The timeline of ``text`` (the file ``name``) tried with the event ``asked``;
         TryError (a ValueError) for an event that cannot be or a run that failed."""
-        event = tried_event(asked, self.pads)
+        events = tried_events(asked, self.pads)
         if not self._one_at_a_time.acquire(blocking=False):
             raise TryError("another try is running: wait for its answer")
         try:
-            return self._tried(name, text, event)
+            return self._tried(name, text, events)
         finally:
             self._one_at_a_time.release()
 
-    def _tried(self, name: str, text: str, event: dict[str, object]) -> list[str]:
+    def _tried(self, name: str, text: str, events: list[dict[str, object]]) -> list[str]:
         with tempfile.TemporaryDirectory(prefix="vest-try-") as scratch:
-            command = self._command(Path(scratch), name, text, event, TRY_FOR_S)
+            last_s = max(float(str(event["at"])) for event in events)
+            command = self._command(Path(scratch), name, text, events, last_s + TRY_FOR_S)
             try:
                 done = subprocess.run(
                     [*command, "--fast", "--json"],
@@ -99,17 +133,24 @@ class TryOnSimulatedVest:
             said = done.stderr.strip().splitlines()
             raise TryError(said[-1] if said else f"vest run ended with {done.returncode}")
         told = (_sentence(line) for line in done.stdout.splitlines() if line.strip())
-        return [sentence for sentence in told if sentence is not None]
+        lines = [sentence for sentence in told if sentence is not None]
+        tree = _tree_name(name, text)
+        if not any(f" s {tree}: " in line for line in lines):
+            lines.append(
+                f"{tree} did nothing: what it waits for did not happen (look at its first "
+                "question: the pad, the threshold, the words) or another tree had its turn"
+            )
+        return lines
 
     def watch(self, name: str, text: str, asked: object, host: str) -> str:
         """Run ``text`` in real time with the event ``asked`` at :data:`WATCH_AT_S` under
         the live view (on ``host``, as the editor): the view's address. The run before
         is stopped; TryError when it cannot start."""
-        event = tried_event(asked, self.pads, WATCH_AT_S)
+        events = tried_events(asked, self.pads, WATCH_AT_S)
         with self._one_at_a_time:
             self.stop_watching()
             scratch = Path(tempfile.mkdtemp(prefix="vest-watch-"))
-            command = self._command(scratch, name, text, event, WATCH_FOR_S)
+            command = self._command(scratch, name, text, events, WATCH_FOR_S)
             command += ["--view", "--view-port", "0", "--view-host", host]
             process = subprocess.Popen(
                 command, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True
@@ -140,11 +181,12 @@ class TryOnSimulatedVest:
         shutil.rmtree(scratch, ignore_errors=True)
 
     def _command(
-        self, scratch: Path, name: str, text: str, event: dict[str, object], seconds: float
+        self, scratch: Path, name: str, text: str, events: list[dict[str, object]], seconds: float
     ) -> list[str]:
-        """``vest run`` of ``text`` (the file ``name``) in a copy of the folder's trees and
-        dialogs in ``scratch`` (a link leading out of the folder is not followed), on a
-        scenario of ``seconds`` with ``event`` and the robot config."""
+        """``vest run`` of ``text`` (the file ``name``) among the folder's other trees, in a
+        copy of the folder's trees and dialogs in ``scratch`` (a link leading out of the
+        folder is not followed), on a scenario of ``seconds`` with ``events`` and the robot
+        config."""
         copy = scratch / "folder"
         for part in ("trees", "dialogs"):
             _copy_inside(self.folder / part, copy / part, resolved(self.folder))
@@ -153,10 +195,11 @@ class TryOnSimulatedVest:
         tried.write_text(text, encoding="utf-8")
         scenario = scratch / "try.yaml"
         scenario.write_text(
-            yaml.safe_dump({"duration_s": seconds, "events": [event]}), encoding="utf-8"
+            yaml.safe_dump({"duration_s": seconds, "events": events}), encoding="utf-8"
         )
         command = [sys.executable, "-c", VEST, "run", "--speech", "text"]
-        command += ["--trees", str(tried), "--scenario", str(scenario)]
+        among = copy / "trees" if tried.is_relative_to(copy / "trees") else tried
+        command += ["--trees", str(among), "--scenario", str(scenario)]
         if (copy / "dialogs").is_dir():
             command += ["--dialogs", str(copy / "dialogs")]
         if self.hardware is not None:
@@ -180,6 +223,16 @@ def _copy_inside(source: Path, to: Path, inside: Path) -> None:
 def _drain(stream: IO[str]) -> None:
     """Read what else ``stream`` says, in a thread, so the run never blocks on a full pipe."""
     threading.Thread(target=lambda: [None for _ in stream], name="watch-drain", daemon=True).start()
+
+
+def _tree_name(name: str, text: str) -> str:
+    """The tree's name as its file gives it (the file's stem when it gives none)."""
+    try:
+        document = yaml.safe_load(text)
+    except yaml.YAMLError:
+        document = None
+    given = document.get("name") if isinstance(document, dict) else None
+    return str(given) if given else Path(name).stem
 
 
 def _sentence(line: str) -> str | None:

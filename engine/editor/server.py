@@ -105,6 +105,7 @@ class EditorServer:
             Route("/api/palette", lambda _: JSONResponse(self.palette)),
             Route("/api/files", lambda _: JSONResponse(self.workspace.files())),
             Route("/api/profiles", lambda _: JSONResponse(self.workspace.profiles())),
+            Route("/api/priorities", lambda _: JSONResponse(self.workspace.priorities())),
             Route("/api/file", self._read),
             Route("/api/check", self._check, methods=["POST"]),
             Route("/api/save", self._save, methods=["POST"]),

@@ -26,6 +26,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Protocol
 
+import yaml
+
 from engine.dialogs.library import OUTSIDE
 from engine.files.problems import LoadError, Problem
 from engine.files.whole_file import write_whole
@@ -114,6 +116,22 @@ class Workspace:
                 if not path.resolve().is_relative_to(self.folder):
                     continue  # a link out of the folder is not listed
                 found.append({"file": shown.as_posix(), "kind": self.checks.kind_of(path)})
+        return found
+
+    def priorities(self) -> dict[str, int]:
+        """Each tree's priority by its name (0 when it gives none), for the page to say
+        what a priority interrupts; a file that does not read as a tree is left out."""
+        found: dict[str, int] = {}
+        for listed in self.files():
+            if listed["kind"] != "tree":
+                continue
+            try:
+                document = yaml.safe_load(self.read(listed["file"])[0])
+            except (EditRefused, yaml.YAMLError):
+                continue
+            if isinstance(document, dict) and isinstance(document.get("name"), str):
+                priority = document.get("priority", 0)
+                found[document["name"]] = priority if isinstance(priority, int) else 0
         return found
 
     def profiles(self) -> dict[str, dict[str, Any]]:

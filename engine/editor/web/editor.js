@@ -15,6 +15,7 @@ const make = (tag, props = {}, ...children) => {
 
 let palette = { nodes: [], pads: [], joints: [], colors: [], keys: [], kinds: {} };
 let profiles = {}; // profile name -> {param: value}: what each profile sets
+let priorities = {}; // tree name -> its priority, among the folder's trees
 const types = new Map(); // node type name -> its declaration
 let file = null; // {name, version (null: new), outline}
 let chosen = null; // the chosen node object
@@ -265,6 +266,7 @@ function drawSettings() {
     }, false, typing), "setting"));
   }
   drawParams();
+  drawPriorityHelp();
 }
 
 // -- the tree's settings a profile can change (its params) ----------------------------------
@@ -483,25 +485,42 @@ function tryKindChanged() {
   const kind = $("#try-kind").value;
   $("#try-pad-field").hidden = kind !== "pat";
   $("#try-text-field").hidden = kind !== "say";
+  $("#try-strength-field").hidden = kind !== "squeeze";
+  $("#try-seconds-field").hidden = kind !== "pat" && kind !== "squeeze";
+  $("#try-seconds").placeholder = kind === "squeeze" ? "2" : "0.3";
+}
+
+const number = (id) => ($(id).value.trim() === "" ? undefined : Number($(id).value));
+
+function askedTry() { // what the form asks for, and the same in words
+  const kind = $("#try-kind").value;
+  const asked = {
+    kind, pad: $("#try-pad").value, text: $("#try-text").value, strength_n: number("#try-strength"),
+    seconds: number("#try-seconds"), times: number("#try-times"), apart_s: number("#try-apart"),
+  };
+  const times = asked.times ?? 1;
+  const what = { pat: `a pat on ${asked.pad}`, squeeze: `a squeeze of ${asked.strength_n ?? 6} N`, say: `"${asked.text}" said`, wave: "a wave" }[kind];
+  const said = times > 1 ? `${times} times: ${what}, ${asked.apart_s ?? 1.5} s apart` : what;
+  return { asked, said };
 }
 
 async function tryIt(event) {
   event.preventDefault();
-  const kind = $("#try-kind").value;
-  const asked = { kind, pad: $("#try-pad").value, text: $("#try-text").value };
+  const { asked, said } = askedTry();
+  $("#tried-what").textContent = `Tried on ${file.name}, among the folder's other trees: ${said}`;
   $("#tried").replaceChildren(make("li", { textContent: "trying on the simulated vest..." }));
   const { status, body } = await postJson("/api/try", { file: file.name, outline: file.outline, version: file.version, event: asked });
   if (status !== 200) {
     $("#tried").replaceChildren(make("li", { className: "problem", textContent: body.message ?? `the try failed (${status})` }));
     return;
   }
-  const lines = body.timeline.length ? body.timeline : ["nothing happened in 8 seconds"];
+  const lines = body.timeline.length ? body.timeline : ["nothing happened"];
   $("#tried").replaceChildren(...lines.map((line) => make("li", { textContent: line })));
 }
 
 // the same in real time under the live view: a link to open it (the event comes at 5 s)
 async function watchIt() {
-  const asked = { kind: $("#try-kind").value, pad: $("#try-pad").value, text: $("#try-text").value };
+  const { asked } = askedTry();
   $("#watching").textContent = "starting the simulated vest...";
   const { status, body } = await postJson("/api/watch", { file: file.name, outline: file.outline, version: file.version, event: asked });
   if (status !== 200) { $("#watching").textContent = body.message ?? `cannot watch (${status})`; return; }
@@ -554,8 +573,28 @@ function start(opened) {
   $("#editing").hidden = dialog; $("#dialog-editing").hidden = !dialog;
   $(dialog ? "#dialog-name" : "#file-name").textContent = file.name + (file.version ? "" : " (new)");
   $("#heard").replaceChildren();
-  if (!dialog) drawSettings();
+  $("#tried").replaceChildren(); $("#tried-what").textContent = ""; // a try belongs to its tree
+  $("#watching").replaceChildren();
+  if (!dialog) {
+    drawSettings();
+    getJson("/api/priorities").then((found) => { priorities = found; drawPriorityHelp(); }).catch(unreachable);
+  }
   changed();
+}
+
+// what a priority means among the folder's other trees (the buttons are 100)
+function drawPriorityHelp() {
+  const help = $("#setting-priority-help");
+  if (!help || !file?.outline?.settings) return;
+  const own = file.outline.settings.name;
+  const others = Object.entries(priorities).filter(([name]) => name !== own).sort((a, b) => b[1] - a[1]);
+  if (!others.length) return;
+  const lowest = Math.min(...others.map(([, p]) => p));
+  const highest = Math.max(...others.map(([, p]) => p));
+  help.textContent = `0..99: higher interrupts lower for the speaker, the face lights or a joint. `
+    + `Other trees: ${others.map(([name, p]) => `${name} ${p}`).join(", ")}; the therapist's buttons 100. `
+    + `${lowest > 0 ? `At ${lowest - 1} or lower this tree never interrupts another one that is speaking or moving; ` : ""}`
+    + `above ${highest} it interrupts them all but the buttons.`;
 }
 
 // -- a dialog: questions and their answers -------------------------------------------------------
