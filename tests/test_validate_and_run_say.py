@@ -92,11 +92,14 @@ def test_with_only_buttons_asked_for_the_robot_runs_until_ctrl_c(tmp_path: Path)
     try:
         assert process.stderr is not None
         said = ""
+        told = []
         for line in process.stderr:  # until it says how long the session lasts
-            if "the session" in line or "Traceback" in line:
+            told.append(line)
+            if line.startswith("the session") or "Traceback" in line:
                 said = line
                 break
         assert said == "the session runs until Ctrl-C\n"
+        assert any(line.startswith("vest run: no scenario plays") for line in told)
     finally:
         process.send_signal(signal.SIGINT)
         process.wait(timeout=60)

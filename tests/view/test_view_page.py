@@ -96,7 +96,7 @@ def test_the_replay_slider_shows_the_robot_at_a_moment(page: Page, replay: str) 
         "(slider) => { slider.value = '7.5'; slider.dispatchEvent(new Event('input')); }"
     )
     press = page.locator("#actions li[data-tone=therapist]").first
-    expect(press).to_contain_text("therapist: presses the button 'Well done'")
+    expect(press).to_contain_text("scenario: presses the button 'Well done'")  # scripted
 
 
 def test_the_page_shows_where_the_camera_sees_a_hand_held_up(page: Page, replay: str) -> None:
