@@ -40,6 +40,7 @@ from engine.editor.round_trip import PLAIN_WORD, OutlineError
 from engine.editor.tree_yaml import TreeText
 from engine.editor.workspace import MAX_FILE_BYTES, EditRefused, Workspace
 from engine.errors import ConfigError
+from engine.loader.node_sentences import node_sentence
 from engine.loader.tree_drawing import dot_source, svg_of, without_title_and_legend
 from engine.web.body_limit import BodyLimit
 from engine.web.guard import SecurityHeaders, TokenGuard, new_token
@@ -180,11 +181,33 @@ class EditorServer:
     def _checked(self, body: dict[str, Any]) -> dict[str, Any]:
         name, text = self._text_of(body)
         problems, tree = self.workspace.checked(name, text)
+        words = {} if "rules" in body["outline"] else self._words(body["outline"].get("root"))
         return {
             "text": text,
             "problems": _with_nodes(problems, text, self.workspace),
             "svg": _drawing(tree),
+            "words": words,
         }
+
+    def _words(self, root: Any) -> dict[str, str]:
+        """Each leaf of the outline said in words, by its place (``root/0/child``), as the
+        page's outline names places."""
+        registry, catalogue = self.workspace.registry, self.workspace.registry.catalogue()
+        found: dict[str, str] = {}
+        stack: list[tuple[Any, str]] = [(root, "root")]
+        while stack:
+            node, path = stack.pop()
+            if not isinstance(node, dict) or not isinstance(node.get("type"), str):
+                continue
+            args: dict[str, Any] = node["args"] if isinstance(node.get("args"), dict) else {}
+            sentence = node_sentence(node["type"], args, catalogue)
+            if sentence is not None:
+                found[path] = sentence
+            declared = registry.get(node["type"])
+            one = declared is not None and declared.children == "one"
+            children: list[Any] = node["children"] if isinstance(node.get("children"), list) else []
+            stack += [(c, f"{path}/{'child' if one else i}") for i, c in enumerate(children)]
+        return found
 
     def _saved(self, body: dict[str, Any]) -> dict[str, Any]:
         name, text = self._text_of(body)

@@ -19,6 +19,8 @@ import textwrap
 from collections.abc import Iterator
 from typing import Any
 
+from engine.blackboard.catalogue import KeyCatalogue, default_catalogue
+from engine.loader.node_sentences import node_sentence
 from engine.loader.tree_definition import NodeDefinition, TreeDefinition
 from engine.values.templates import CompiledTemplate
 
@@ -80,8 +82,9 @@ LEGEND = (
 )
 
 
-def plain_label(node: NodeDefinition) -> str:
-    """What a node does, in a few words a line (for drawings people read)."""
+def plain_label(node: NodeDefinition, catalogue: KeyCatalogue | None = None) -> str:
+    """What a node does, in a few words a line (for drawings people read); a leaf is said
+    as :mod:`engine.loader.node_sentences` says it (its keys in ``catalogue``'s words)."""
     args, kind = node.args, node.type.name
     if kind == "Cooldown":
         start = " (from the start)" if args.get("counting_from") == "start" else ""
@@ -98,6 +101,8 @@ def plain_label(node: NodeDefinition) -> str:
             head = "only once, even failed"
     elif kind in ("Repeat", "Retry"):
         head = f"{'repeat' if kind == 'Repeat' else 'retry'} {args['times']} times"
+    elif (sentence := node_sentence(kind, node.args, catalogue or default_catalogue())) is not None:
+        head = "\n".join(textwrap.wrap(sentence, WRAP, break_on_hyphens=False))
     else:
         parts = [kind]
         for param in node.type.params:

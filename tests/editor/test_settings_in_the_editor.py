@@ -72,3 +72,11 @@ def test_a_number_typed_over_a_setting_asks_first_and_keeps_it_unless_agreed(
     after = path.read_text()
     assert 'above: "${hug_threshold_n}"}\n    - Check: {key: /sensors/force/right_n' in before
     assert "- Check: {key: /sensors/force/left_n, above: 5}" in after
+
+
+def test_the_outline_says_each_leaf_in_words(page: Page, editor: str) -> None:
+    open_tree(page, editor, "trees/hug.yaml")
+    expect(node(page, "root/0")).to_contain_text(
+        "force on the left side pad above hug_threshold_n N? (Check)"
+    )
+    expect(node(page, "root/2/child/1")).to_contain_text("say \u201chug_phrase\u201d (Say)")

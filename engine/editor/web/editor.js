@@ -128,7 +128,11 @@ function nodeAt(path) {
   return found;
 }
 
-function summary(node) { // "in order (Sequence)", "Say, text: Hello"
+let leafWords = new Map(); // a leaf's place -> what it does in words (the server says it)
+
+function summary(node, path) { // "in order (Sequence)", "say “Hello” (Say)"
+  const said = leafWords.get(path);
+  if (said) return `${node.name ? `${node.name}: ` : ""}${said} (${node.type})`;
   const words = types.get(node.type)?.words;
   const what = words ? `${words} (${node.type})` : node.type;
   const args = Object.entries(node.args).map(([key, value]) => `${key}: ${shown(value)}`);
@@ -148,7 +152,7 @@ function drawOutline() {
     const kind = types.get(node.type)?.kind ?? "action";
     const button = make("button", { type: "button", className: `node kind-${kind}` });
     button.dataset.path = path;
-    button.append(make("span", { className: "what", textContent: summary(node) }));
+    button.append(make("span", { className: "what", textContent: summary(node, path) }));
     const problems = problemsByNode.get(path) ?? [];
     if (problems.length) {
       button.append(make("span", { className: "badge", textContent: `${problems.length} problem${problems.length > 1 ? "s" : ""}` }));
@@ -374,6 +378,7 @@ async function check() {
     document.body.dataset.problems = String(body.problems.length);
     return;
   }
+  leafWords = new Map(Object.entries(body.words ?? {}));
   problemsByNode = new Map();
   for (const problem of body.problems) {
     const list = problemsByNode.get(problem.node) ?? [];
