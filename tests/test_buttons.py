@@ -92,6 +92,8 @@ def test_stop_everything_ends_a_buttons_action_and_pauses_the_behaviors(
         "{at: 2.0, gesture: wave}",
     )
     assert "buttons        pauses the behaviors" in out
+    stop = "presses the button 'Stop everything': everything stops, and the behaviors stay"
+    assert stop + " paused until resumed" in out
     # the wave at 1.0 is greeted; the one at 2.0, after the stop, is not
     assert [line.split()[0] for line in out.splitlines() if "wave_greeting  says" in line] == [
         "1.00"

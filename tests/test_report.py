@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import shutil
 from pathlib import Path
 
 import pytest
@@ -137,7 +138,7 @@ def test_a_press_of_pause_resume_or_stop_is_what_it_did_never_no_answer(
     assert "\u201cStop everything\u201d</td><td>stopped everything and paused" in page
     # the pat while paused was not answered, and the report says why
     assert "no answer: the behaviours were paused" in page
-    assert "The behaviours were paused, resumed or stopped 3 times." in page
+    assert "the buttons paused, resumed or stopped the behaviours 3 times (a row each)" in page
 
 
 def test_the_report_says_what_was_done_in_words_by_kind_and_per_minute(supervised: Path) -> None:
@@ -179,3 +180,41 @@ def test_a_note_vest_cannot_put_in_a_report_is_refused_in_words(
     except SystemExit as refused:  # refused by the option itself, as argparse does
         assert refused.code == 2
     assert why in capsys.readouterr().err
+
+
+LONG_HUG = """\
+name: long_hug
+rate_hz: 20
+priority: 49
+wait_for_turn_s: 3
+root:
+  Sequence:
+    - HeldFor:
+        seconds: 3
+        child:
+          Check: {key: /sensors/force/left_n, above: 3}
+    - Say: {text: "What a long hug!"}
+"""
+
+
+def test_an_answer_that_comes_after_a_hold_is_on_the_hug_s_row_with_its_delay(
+    tmp_path: Path, capsys, monkeypatch, the_site_key: SiteKey
+) -> None:
+    monkeypatch.chdir(ROOT)
+    trees = tmp_path / "trees"
+    shutil.copytree(ROOT / "trees", trees)
+    (trees / "long_hug.yaml").write_text(LONG_HUG)
+    scenario = tmp_path / "hug.yaml"
+    scenario.write_text(
+        "duration_s: 10\nevents:\n  - {at: 1.0, squeeze: {left_n: 5, right_n: 5, seconds: 4}}\n"
+    )
+    path = tmp_path / "s.vest"
+    args = ["run", "--fast", "--speech", "text", "--trees", str(trees), "--scenario", str(scenario)]
+    assert main([*args, "--record", str(path)]) == 0
+    capsys.readouterr()
+    [hug] = person_moments(Recording.open(path, the_site_key))
+    assert list(hug.by_tree) == ["hug", "long_hug"]  # at once, then after the hold
+    assert main(["report", str(path)]) == 0
+    page = path.with_suffix(".html").read_text()
+    assert "long_hug: said \u201cWhat a long hug!\u201d (3.0" in page
+    assert "<td>long_hug</td><td></td><td class='num'>1</td>" in page  # times it answered

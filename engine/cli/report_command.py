@@ -149,7 +149,14 @@ def _progress(person: str, given: Path | None, *, with_simulated: bool) -> int:
     finally:
         site.close()
     sessions = f"{len(counted)} session{'' if len(counted) == 1 else 's'}"
-    print(f"progress of {person} over {sessions}: {output}")
+    left = len(summaries) - len(counted)
+    simulated = (
+        f" ({left} simulated session{'' if left == 1 else 's'} left out: --with-simulated "
+        "counts them)"
+        if left
+        else ""
+    )
+    print(f"progress of {person} over {sessions}{simulated}: {output}")
     for path in gone:
         tell(f"warning: {path}: not there any more; left out of the progress")
     return 0

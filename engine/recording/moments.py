@@ -40,9 +40,10 @@ PRESSED_N = 1.0
 @dataclass(frozen=True)
 class Moment:
     """Something someone did (``who``: the person, the therapist, the operator), and the
-    robot's answer: the actions of the first tree that acted after it and before the next
-    thing anyone did (none: no answer). ``not_understood`` is what the robot heard and
-    had no rule for; ``not_listened`` says the robot could not listen (it was speaking)."""
+    robot's answer: the first actions of each tree that acted after it (the first to act
+    first) before the same one did something else (none: no answer). ``not_understood``
+    is what the robot heard and had no rule for; ``not_listened`` says the robot could
+    not listen (it was speaking)."""
 
     at_s: float
     did: str
@@ -64,6 +65,19 @@ class Moment:
     @property
     def response_s(self) -> float | None:
         return None if self.answer is None else self.answer.at_s - self.at_s
+
+    @property
+    def by_tree(self) -> dict[str, tuple[RecordedAction, ...]]:
+        """The answers by the tree that gave them, the first to act first."""
+        found: dict[str, tuple[RecordedAction, ...]] = {}
+        for action in self.answers:
+            found[action.tree] = (*found.get(action.tree, ()), action)
+        return found
+
+    @property
+    def is_control(self) -> bool:
+        """A press of pause, resume or stop: what it did is its row's answer."""
+        return self.control in CONTROLS_DID.values()
 
 
 PERSON_EVENTS = ("touch", "squeeze", "gesture", "hear", "show_hand", "obstacle")
@@ -124,8 +138,7 @@ def person_moments(recording: Recording) -> list[Moment]:
             for a in actions
             if at <= a.at_s < until and a.action != "report" and _answers(kind, a.tree, reporting)
         ]
-        tree = window[0].tree if window else None
-        answers = tuple(a for a in window if a.tree == tree)[:3]
+        answers = _each_tree_s_first(window)
         heard = next(
             (e.text for e in misunderstood if at <= e.t_s < until and kind == "hear"), None
         )
@@ -141,6 +154,25 @@ def person_moments(recording: Recording) -> list[Moment]:
         )
         moments.append(Moment(at, did, answers, who, heard, gave_way=gave_way, kind=kind))
     return moments
+
+
+ANSWERING_TREES = 3
+"""Trees whose answers a row shows (one answers at once, another after a hold...)."""
+
+
+def _each_tree_s_first(window: list[RecordedAction]) -> tuple[RecordedAction, ...]:
+    """The first few actions of each tree that acted in ``window``, the first to act first:
+    an answer at once and one that comes later (a hug held for 3 s) both show."""
+    trees: list[str] = []
+    for action in window:
+        if action.tree not in trees:
+            trees.append(action.tree)
+    chosen = trees[:ANSWERING_TREES]
+    return tuple(
+        action
+        for tree in chosen
+        for action in [a for a in window if a.tree == tree][:ANSWERING_TREES]
+    )
 
 
 CONTROLS_DID = {

@@ -73,7 +73,8 @@ def summarize(recording: Recording, started: float) -> SessionSummary:
         if answer is None or took is None or all(a.outcome == "failed" for a in moment.answers):
             continue
         times.append(took)
-        behaviours[answer.tree].append(took)
+        for tree, actions in moment.by_tree.items():  # one at once, one after a hold...
+            behaviours[tree].append(actions[0].at_s - moment.at_s)
     return SessionSummary(
         recording.path,
         started,
@@ -103,7 +104,7 @@ def progress_html(
         f'<p class="meta">{len(sessions)} sessions'
         + (f" from {sessions[0].day} to {sessions[-1].day}" if sessions else "")
         + "</p>",
-        f"<p>{html.escape(_in_words(sessions))}</p>",
+        f"<p>{html.escape(_in_words(sessions, left_out))}</p>",
         "<p class='meta'>Counted: what the person did (touches, hugs, words, gestures), not "
         "the therapist's presses or an operator's commands, which the session reports list "
         "too.</p>",
@@ -144,7 +145,12 @@ def progress_html(
     return "\n".join(parts)
 
 
-def _in_words(sessions: list[SessionSummary]) -> str:
+def _in_words(sessions: list[SessionSummary], left_out: int = 0) -> str:
+    if not sessions and left_out:
+        return (
+            "No real session of this person yet: only simulated ones, where a scenario "
+            "played the person's part (see below)."
+        )
     if not sessions:
         return "No session of this person is held."
     first, last = sessions[0], sessions[-1]

@@ -99,9 +99,11 @@ def _answer_cell(moment: Moment) -> tuple[str, str]:
     parts = []
     if moment.not_understood is not None:
         parts.append(f"did not understand \u201c{moment.not_understood}\u201d")
-    if moment.answer is not None:
-        done = ", ".join(_answer_text(action) for action in moment.answers)
-        parts.append(f"{moment.answer.tree}: {done}")
+    for tree, actions in moment.by_tree.items():
+        done = ", ".join(_answer_text(action) for action in actions)
+        later = actions[0].at_s - moment.at_s
+        after = f" ({later:.2f} s after)" if actions[0] is not moment.answer else ""
+        parts.append(f"{tree}: {done}{after}")
     took = f"{moment.response_s:.2f} s" if moment.response_s is not None else "-"
     return html.escape("; ".join(parts)), took
 
@@ -206,11 +208,12 @@ def report_html(recording: Recording, note: str = "") -> str:
     rows_html = "".join(rows)
     fired = Counter({tree.name: 0 for tree in recording.trees})
     fired.update(action.tree for action in recording.actions() if action.outcome != "failed")
+    answering = Counter(tree for moment in moments for tree in moment.by_tree)
     described = descriptions(recording)
     behaviours = "".join(
         f"<tr><td>{html.escape(tree)}</td><td>{html.escape(described.get(tree, ''))}</td>"
-        f"<td class='num'>{count}</td></tr>"
-        for tree, count in fired.most_common()
+        f"<td class='num'>{answering[tree]}</td><td class='num'>{count}</td></tr>"
+        for tree, count in sorted(fired.items(), key=lambda item: (-answering[item[0]], -item[1]))
     )
     kinds = Counter(KINDS_IN_WORDS.get(m.kind, "other") for m in moments if not m.not_listened)
     by_kind = "".join(
@@ -234,23 +237,23 @@ def report_html(recording: Recording, note: str = "") -> str:
         for device, since, back in outages(recording)
     )
     median = sorted(answered)[len(answered) // 2] if answered else None
-    acts = [m for m in moments if not m.not_listened and m.control is None]
-    controls = sum(1 for m in moments if m.control is not None)
+    acts = [m for m in moments if not m.not_listened and not m.is_control]
+    controls = sum(1 for m in moments if m.is_control)
     unheard = len(moments) - len(acts) - controls
     summary = (
         f"{len(acts)} things done (by the person, the therapist, the scenario or an "
-        f"operator); the robot answered {len(answered)}"
+        f"operator), each a row below; the robot answered {len(answered)}"
         + (f", typically within {median:.2f} s" if median is not None else "")
         + "."
         + (
-            f" The behaviours were paused, resumed or stopped {controls} "
-            f"time{'s' if controls != 1 else ''}."
+            f" Besides, the buttons paused, resumed or stopped the behaviours {controls} "
+            f"time{'s' if controls != 1 else ''} (a row each)."
             if controls
             else ""
         )
         + (
             f" {unheard} time{'s' if unheard != 1 else ''} the person spoke while the robot "
-            "was speaking, and it could not listen."
+            "was speaking, and it could not listen (a row each)."
             if unheard
             else ""
         )
@@ -320,9 +323,15 @@ def report_html(recording: Recording, note: str = "") -> str:
             ),
             "<h2>What was done, by kind</h2>",
             _table(["kind", "times", "per minute"], by_kind, "nothing was done", numeric={1, 2}),
-            "<h2>How often each behaviour acted</h2>",
-            "<p>Actions it could do (not those refused or failed).</p>",
-            _table(["behaviour", "what it does", "actions"], behaviours, "none acted", numeric={2}),
+            "<h2>How often each behaviour answered</h2>",
+            "<p>Times it answered something done (a row above), and its actions: each light, "
+            "word or move it could make (not those refused or failed).</p>",
+            _table(
+                ["behaviour", "what it does", "times it answered", "actions"],
+                behaviours,
+                "none acted",
+                numeric={2, 3},
+            ),
             "<h2>What the robot did not understand</h2>",
             _table(
                 ["when", "heard", "the robot"],

@@ -76,7 +76,12 @@ def event_line(event: SessionEvent) -> tuple[str, str] | None:
     if isinstance(event, ButtonPressed):
         nothing = "" if event.done else ", which is not shown now: nothing done"
         who = "scenario" if event.by == "scenario" else "therapist"
-        return who, f"presses the button {event.label!r}{nothing}"
+        stops = (
+            ": everything stops, and the behaviors stay paused until resumed"
+            if event.control == "stop" and event.done
+            else ""
+        )
+        return who, f"presses the button {event.label!r}{nothing}{stops}"
     if isinstance(event, BehaviorsPaused):
         return "buttons", "pauses the behaviors" if event.paused else "resumes the behaviors"
     if isinstance(event, ActionStarted):
