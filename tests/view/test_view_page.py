@@ -99,6 +99,19 @@ def test_the_replay_slider_shows_the_robot_at_a_moment(page: Page, replay: str) 
     expect(press).to_contain_text("scenario: presses the button 'Well done'")  # scripted
 
 
+def test_the_page_opens_on_what_happened_with_the_engineering_tables_folded(
+    page: Page, replay: str
+) -> None:
+    page.set_viewport_size({"width": 800, "height": 900})  # a tablet: one column
+    page.goto(replay)
+    expect(page.locator("body")).to_have_attribute("data-ready", "true")
+    happened = page.get_by_role("heading", name="what happened")
+    expect(happened).to_be_in_viewport()  # above the trees, not 1,270 px down
+    expect(page.locator("#keys")).to_be_hidden()  # folded: for engineers
+    page.get_by_text("for engineers: the blackboard, the devices, the ticks").click()
+    expect(page.locator("#keys")).to_be_visible()
+
+
 def test_the_page_shows_where_the_camera_sees_a_hand_held_up(page: Page, replay: str) -> None:
     """The demo's finger game: a hand held up at arm's length at 22 s; its box drawn in the
     camera's frame, and said in words (the picture itself never reaches the page)."""
