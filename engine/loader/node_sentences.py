@@ -9,6 +9,7 @@ this module does not know (a plugin's) is said as its type and parameters.
 
 from __future__ import annotations
 
+import re
 from collections.abc import Callable, Mapping
 from typing import Any
 
@@ -33,7 +34,9 @@ class _Keys:
         if str(key).startswith(VARIABLES_PREFIX):
             return f"the variable {str(key).removeprefix(VARIABLES_PREFIX)}"
         spec = self.catalogue.lookup(str(key))
-        return spec.description if spec is not None and spec.description else str(key)
+        if spec is None or not spec.description:
+            return str(key)
+        return spec.description.split(":")[0].split(" (")[0]  # its name, not its details
 
     def unit(self, key: Any) -> str:
         spec = self.catalogue.lookup(str(key))
@@ -67,10 +70,11 @@ def _check(args: Args, keys: _Keys) -> str:
     if "between" in args and isinstance(args["between"], list) and len(args["between"]) == 2:
         low, high = args["between"]
         return f"{what} between {_value(low)} and {_value(high)}{unit}?"
+    state = re.sub(r"^(true|yes) (while|when|if) ", "", what, flags=re.IGNORECASE)
     if args.get("equals") is True:
-        return f"{what}: yes?"
+        return f"{state}?" if state != what else f"{what}: yes?"
     if args.get("equals") is False:
-        return f"{what}: no?"
+        return f"not: {state}?" if state != what else f"{what}: no?"
     if "equals" in args:
         return f"{what} is {_value(args['equals'])}{unit}?"
     if "not_equals" in args:
@@ -84,7 +88,7 @@ def _event(args: Args, keys: _Keys) -> str:
         which = f": {_value(args['equals'])}"
     elif args.get("one_of"):
         which = f": one of {_value(args['one_of'])}"
-    return f"a new {keys.words(args.get('key', '?'))}{which}?"
+    return f"new: {keys.words(args.get('key', '?'))}{which}?"
 
 
 def _pat(args: Args, keys: _Keys) -> str:
