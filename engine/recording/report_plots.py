@@ -111,6 +111,10 @@ def per_session_plot(
         f"{top:.3g}</text>",
         f'<text x="{left - 4}" y="{base + 4}" class="tick" text-anchor="end">0</text>',
     ]
+    parts.append(
+        f'<text x="{width - 8}" y="{height - 4}" class="tick" text-anchor="end">'
+        "session (# in the table)</text>"
+    )
     every = max(1, count // 8)
     for index, label in enumerate(labels):
         if index % every == 0 or index == count - 1:
