@@ -166,10 +166,12 @@ def test_a_scripted_session_s_report_says_it_was_simulated(supervised: Path) -> 
     ("args", "why"),
     [
         (["--note", "a\x07bell"], "--note: holds control characters"),
+        (["--note", "a\x85next line"], "--note: holds control characters"),
+        (["--note", "caf\udce9"], "--note: is not UTF-8 text"),
         (["--note", "x" * 20_001], "a note has at most 20,000"),
         (["--person", "kid-17", "--note", "hi"], "--note goes with one session's FILE"),
     ],
-    ids=["control", "long", "progress"],
+    ids=["control", "c1-control", "not-utf8", "long", "progress"],
 )
 def test_a_note_vest_cannot_put_in_a_report_is_refused_in_words(
     tmp_path: Path, capsys, args: list[str], why: str

@@ -111,6 +111,18 @@ def test_what_only_the_consent_gate_reads_never_leaves_in_a_message() -> None:
             {"kind": "turn", "t": 1, "tree": "a", "turn": "shouts", "resource": "r", "other": "o"},
             "turn.turn: 'shouts' is not one of 'interrupts', 'waits'",
         ),
+        ({"kind": "hand", "t": 10**400, "fingers": 2}, "hand.t: a number too large"),
+        (
+            {
+                "kind": "action",
+                "t": 1,
+                "action_id": 1,
+                "tree": "a",
+                "action": "say",
+                "args": {"z": json.loads("[" * 100 + "]" * 100)},
+            },
+            "action.args: nested more than 64 deep",
+        ),
         (
             {
                 "kind": "safety",

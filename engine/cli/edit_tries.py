@@ -53,7 +53,11 @@ def tried_events(asked: object, pads: list[str], at_s: float = TRY_AT_S) -> list
         raise TryError("event: a pat, a squeeze, a phrase said or a wave")
     kind = asked.get("kind")
     times = _number(asked, "times", (1, 1, MAX_TIMES), whole=True)
-    apart_s = _number(asked, "apart_s", APART_S)
+    lasts_s = LENGTH_S.get(str(kind), (0.0, 0.0, 0.0))[0]
+    if isinstance(asked.get("seconds"), int | float) and not isinstance(asked["seconds"], bool):
+        lasts_s = float(asked["seconds"])
+    default_apart_s = max(APART_S[0], lasts_s + 1.0)  # each one over before the next
+    apart_s = _number(asked, "apart_s", (default_apart_s, *APART_S[1:]))
     if kind == "pat":
         pad = asked.get("pad")
         if pad not in pads:
@@ -88,8 +92,9 @@ def _number(
         value = default
     if isinstance(value, bool) or not isinstance(value, int | float) or (whole and value % 1):
         raise TryError(f"{name}: a {'whole ' if whole else ''}number from {least:g} to {most:g}")
-    if not least <= value <= most:
-        raise TryError(f"{name}: {value:g} is not from {least:g} to {most:g}")
+    if not least <= value <= most:  # exact for a huge whole number too
+        shown = f"{value:g}" if isinstance(value, float) else str(value)[:20]
+        raise TryError(f"{name}: {shown} is not from {least:g} to {most:g}")
     return float(value)
 
 

@@ -11,6 +11,7 @@ how fast, what it did not understand, per behaviour, session by session.
 from __future__ import annotations
 
 import argparse
+import unicodedata
 from pathlib import Path
 
 from engine.cli.output import tell, write_file
@@ -67,7 +68,11 @@ def _note(text: str) -> str:
         raise argparse.ArgumentTypeError(
             f"is {len(text):,} characters; a note has at most {MAX_NOTE:,}"
         )
-    if any(ord(c) < 32 and c not in "\n\t\r" for c in text):
+    try:
+        text.encode("utf-8")
+    except UnicodeEncodeError:
+        raise argparse.ArgumentTypeError("is not UTF-8 text: give it as plain text") from None
+    if any(unicodedata.category(c) == "Cc" and c not in "\n\t\r" for c in text):
         raise argparse.ArgumentTypeError("holds control characters: give it as plain text")
     return text
 

@@ -53,7 +53,7 @@ from engine.composition.session_root import (
 from engine.errors import ConfigError, UsageError
 from engine.files.problems import LoadError
 from engine.files.yaml_source import read_text
-from engine.loader.tree_checks import spoken_quote_warnings
+from engine.loader.tree_checks import counting_warnings, spoken_quote_warnings
 from engine.privacy.consent import of_a_simulation
 from engine.privacy.site import Site
 from engine.recording.session_file import check_new
@@ -334,6 +334,7 @@ def _run_for_site(
     try:
         timeline = Timeline(sys.stdout, start_s=running.start_s, as_json=args.json)
         warnings = turn_warnings(behaviors.trees) + spoken_quote_warnings(behaviors.trees)
+        warnings += counting_warnings(behaviors.trees)
         if inputs.buttons is not None and args.buttons is not None:  # the default: no noise
             warnings += button_warnings(inputs.buttons, [t.name for t in behaviors.trees])
         for warning in warnings:

@@ -35,7 +35,11 @@ from engine.files.problems import LoadError, Mark, Problem, Problems
 from engine.files.yaml_source import YMap, YScalar
 from engine.hardware.config import RobotConfig
 from engine.loader.substitution import Profile, load_profile, undeclared_params
-from engine.loader.tree_checks import spoken_quote_warnings, variable_problems
+from engine.loader.tree_checks import (
+    counting_warnings,
+    spoken_quote_warnings,
+    variable_problems,
+)
 from engine.loader.tree_definition import TreeDefinition
 from engine.loader.tree_file import TreeLoader, shown_path
 from engine.loader.tree_resources import collisions
@@ -345,6 +349,7 @@ def main(args: argparse.Namespace) -> int:
     if not files:
         raise LoadError([Problem(Mark(str(args.paths[0]), 1, 1), "no YAML files found")])
     warnings = turn_warnings(run_together) + spoken_quote_warnings(run_together)
+    warnings += counting_warnings(run_together)
     if run_together:  # as vest run warns: a button shown only while a missing tree runs
         names = [tree.name for tree in run_together]
         for board in validator.boards:

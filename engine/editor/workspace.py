@@ -36,6 +36,7 @@ from engine.files.yaml_values import plain
 from engine.loader.substitution import load_profile
 from engine.loader.tree_definition import TreeDefinition
 from engine.nodes.registry import NodeRegistry
+from engine.session.json_values import json_value
 
 LISTED = ("trees", "dialogs")
 """The folders listed when the folder holds them (a project); else the folder itself."""
@@ -146,9 +147,8 @@ class Workspace:
                 profile = load_profile(path, path.relative_to(self.folder).as_posix())
             except LoadError:
                 continue
-            found[profile.name] = {
-                name: plain(given.value) for name, given in profile.params.items()
-            }
+            values = {name: plain(given.value) for name, given in profile.params.items()}
+            found[profile.name] = json_value(values)  # a NaN or infinity is shown as nothing
         return found
 
     # -- read, check, save ----------------------------------------------------------------

@@ -126,3 +126,29 @@ def spoken_quote_warnings(trees: list[TreeDefinition]) -> list[str]:
                         "by the voice (write ' and \" instead)"
                     )
     return warnings
+
+
+def counting_warnings(trees: list[TreeDefinition]) -> list[str]:
+    """A count or a hold put around what is not a question (an action: it would start
+    again each tick), or a hold of an event (an event is a moment: it is never held)."""
+    warnings: list[str] = []
+    for tree in trees:
+        for node in tree.root.walk():
+            if node.type.name not in ("TimesWithin", "HeldFor"):
+                continue
+            under = [n for child in node.children for n in child.walk()]
+            if any(n.type.kind == "action" for n in under):
+                warnings.append(
+                    f"warning: {node.mark}: {node.type.name} counts the answers of a question "
+                    "(a Check, a pat, an event): put what the robot does after it, in a "
+                    "Sequence, not under it"
+                )
+            elif node.type.name == "HeldFor" and any(
+                n.type.name in ("OnTouch", "OnEvent") for n in under
+            ):
+                warnings.append(
+                    f"warning: {node.mark}: an event (a pat, a word) is a moment and is never "
+                    "held; HeldFor holds a Check (a force, a distance); to count events use "
+                    "TimesWithin"
+                )
+    return warnings

@@ -20,7 +20,10 @@ from py_trees.common import Status
 from engine.clock import Clock
 from engine.nodes.context import TreeContext
 from engine.nodes.spec import NodeType
-from engine.values.params import REQUIRED, SECONDS, Integer, Param
+from engine.values.params import REQUIRED, Integer, Number, Param
+
+A_WHILE_S = Number(0.1, 86_400.0, "s")
+"""A time to count within or hold for: at least a tenth of a second (0 could never be met)."""
 
 
 class TimesWithin(py_trees.decorators.Decorator):
@@ -74,6 +77,12 @@ class HeldFor(py_trees.decorators.Decorator):
         """When the answer became true (clock seconds); None while it is false."""
         self.counted = False
 
+    def terminate(self, new_status: Status) -> None:
+        """Halted while it watched a hold (a higher branch or tree took over): the hold
+        starts again. (A new round's reset, after it answered, keeps what it knows.)"""
+        if new_status == Status.INVALID and self.status == Status.RUNNING:
+            self.since_s, self.counted = None, False
+
     def update(self) -> Status:
         if self.decorated.status != Status.SUCCESS:
             self.since_s, self.counted = None, False
@@ -114,7 +123,7 @@ COUNTING = (
         again); FAILURE until then; RUNNING while the node under it runs.""",
         (
             Param("times", Integer(minimum=2, maximum=100), REQUIRED, "how many times"),
-            Param("within_s", SECONDS, REQUIRED, "within how many seconds"),
+            Param("within_s", A_WHILE_S, REQUIRED, "within how many seconds"),
         ),
         _times_within,
     ),
@@ -127,7 +136,7 @@ COUNTING = (
         SUCCESS once when it has been true that long (it must be false again before it
         counts again); RUNNING while it is true but not yet that long; FAILURE while it
         is false.""",
-        (Param("seconds", SECONDS, REQUIRED, "for how many seconds"),),
+        (Param("seconds", A_WHILE_S, REQUIRED, "for how many seconds"),),
         _held_for,
     ),
 )

@@ -98,13 +98,19 @@ def _hints(declared: type) -> dict[str, Any]:
 def _typed(value: Any, hint: Any, place: str) -> Any:
     """``value`` as the declared type ``hint``; EventError naming ``place`` when it is not."""
     origin = typing.get_origin(hint)
-    if hint is Any:
-        return value
+    if hint is Any or origin is dict:
+        if _deeper_than(value, MAX_DEPTH):
+            raise EventError(f"{place}: nested more than {MAX_DEPTH} deep")
+        if hint is Any:
+            return value
     if hint is float:
         if value is None:
             return math.nan  # NaN and infinities are written as null
         if isinstance(value, int | float) and not isinstance(value, bool):
-            return float(value)
+            try:
+                return float(value)
+            except OverflowError:
+                raise EventError(f"{place}: a number too large") from None
     elif hint is Path:
         if isinstance(value, str):
             return Path(value)
@@ -136,6 +142,25 @@ def _typed(value: Any, hint: Any, place: str) -> Any:
     elif isinstance(hint, type) and isinstance(value, hint) and not _bool_for_int(hint, value):
         return value
     raise EventError(f"{place}: {value!r:.60} is not {_named(hint)}")
+
+
+MAX_DEPTH = 64
+"""How deep a value of an event may nest (an action's arguments are a few levels)."""
+
+
+def _deeper_than(value: Any, depth: int) -> bool:
+    """Whether ``value`` nests deeper than ``depth`` lists or mappings (no recursion)."""
+    level: list[Any] = [value]
+    for _ in range(depth + 1):
+        level = [
+            item
+            for each in level
+            if isinstance(each, dict | list)
+            for item in (each.values() if isinstance(each, dict) else each)
+        ]
+        if not level:
+            return False
+    return True
 
 
 def _bool_for_int(hint: type, value: Any) -> bool:

@@ -25,6 +25,11 @@ def test_a_squeeze_tried_on_the_hug_as_it_is_on_the_page(project: Path) -> None:
     assert "I love hugs!" in (project / "trees" / "hug.yaml").read_text()  # the file unchanged
 
 
+def test_repeated_squeezes_are_apart_by_default_so_each_is_a_squeeze_of_its_own() -> None:
+    first, second = tried_events({"kind": "squeeze", "times": 2}, PADS)
+    assert (first["at"], second["at"]) == (1.0, 4.0)  # 2 s each, a second between
+
+
 def test_two_squeezes_tried_among_the_other_trees_show_who_speaks_and_who_gives_way(
     project: Path,
 ) -> None:
@@ -71,6 +76,7 @@ def test_words_said_reach_a_dialog_tree(project: Path) -> None:
         ({"kind": "wave", "times": 1.5}, "times: a whole number from 1 to 5"),
         ({"kind": "pat", "pad": "middle_back", "apart_s": "soon"}, "apart_s: a number"),
         ({"kind": "squeeze", "seconds": True}, "seconds: a number from 0.1 to 10"),
+        ({"kind": "wave", "times": 10**400}, "times: 10000000000000000000 is not from 1"),
     ],
 )
 def test_an_event_that_cannot_be_is_refused_in_words(asked: object, why: str) -> None:

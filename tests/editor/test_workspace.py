@@ -3,6 +3,7 @@ meanwhile, and never a tree with problems over one without them unless asked."""
 
 from __future__ import annotations
 
+import json
 import os
 from pathlib import Path
 
@@ -119,3 +120,14 @@ def test_a_subtree_s_change_is_checked_in_the_trees_that_use_it(workspace: Works
     with pytest.raises(EditRefused) as refused:  # asked first: wave_greeting is fine today
         workspace.save("trees/parts/greet.yaml", without_phrase, version)
     assert refused.value.status == 409
+
+
+def test_what_each_profile_sets_is_plain_json_even_a_nan(workspace, project) -> None:
+    # a profile setting a number JSON has no form for is shown as nothing, never a 500
+    (project / "trees" / "profiles" / "odd.yaml").write_text(
+        "profile: odd\nparams:\n  hug_threshold_n: .nan\n  volume: 0.5\n"
+    )
+    profiles = workspace.profiles()
+    assert profiles["odd"] == {"hug_threshold_n": None, "volume": 0.5}
+    assert profiles["child"]["hug_threshold_n"] == 2.0
+    json.dumps(profiles, allow_nan=False)

@@ -157,3 +157,78 @@ def test_a_count_of_one_is_refused_in_words(tmp_path: Path) -> None:
     with pytest.raises(LoadError) as refused:
         TreeHarness.from_file(tree)
     assert "once.yaml:4" in str(refused.value) and "times" in str(refused.value)
+
+
+def test_a_hold_cut_short_by_a_higher_branch_starts_again(tmp_path: Path) -> None:
+    tree = write(
+        tmp_path,
+        "held.yaml",
+        """\
+        rate_hz: 10
+        root:
+          Selector:
+            - Check: {key: /sensors/force/right_n, above: 5}
+            - Sequence:
+                - HeldFor: {seconds: 3, child: {Check: {key: /sensors/force/left_n, above: 5}}}
+                - Say: {text: "What a long hug!"}
+        """,
+    )
+    robot = TreeHarness.from_file(tree)
+    robot.set("/sensors/force/left_n", 6.0)
+    robot.advance(1.0)  # held 1 s
+    robot.set("/sensors/force/right_n", 6.0)
+    robot.advance(0.5)  # the first branch wins: the hold is halted
+    robot.set("/sensors/force/left_n", 0.0)
+    robot.advance(3.0)
+    robot.set("/sensors/force/left_n", 6.0)
+    robot.advance(0.1)
+    robot.set("/sensors/force/right_n", 0.0)
+    robot.advance(0.3)  # 0.4 s of a new hold: not 3 s
+    assert robot.said == []
+    robot.advance(3.0)
+    assert robot.said == ["What a long hug!"]
+
+
+def test_a_time_of_zero_to_count_within_is_refused(tmp_path: Path) -> None:
+    tree = write(
+        tmp_path,
+        "never.yaml",
+        """\
+        rate_hz: 10
+        root:
+          TimesWithin: {times: 2, within_s: 0, child: {OnTouch: {}}}
+        """,
+    )
+    with pytest.raises(LoadError) as refused:
+        TreeHarness.from_file(tree)
+    assert "within_s" in str(refused.value) and "0.1" in str(refused.value)
+
+
+@pytest.mark.parametrize(
+    ("under", "warned"),
+    [
+        ('Say: {text: "hello there"}', "put what the robot does after it"),
+        ("OnTouch: {}", "an event (a pat, a word) is a moment and is never held"),
+    ],
+    ids=["action", "event"],
+)
+def test_a_hold_of_what_is_no_held_question_is_warned_of_with_its_place(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], under: str, warned: str
+) -> None:
+    from engine.cli import main
+
+    tree = write(
+        tmp_path,
+        "odd.yaml",
+        f"""\
+        rate_hz: 10
+        root:
+          HeldFor:
+            seconds: 3
+            child:
+              {under}
+        """,
+    )
+    assert main(["validate", str(tree)]) == 0  # a warning: it runs, though not as meant
+    err = capsys.readouterr().err
+    assert "odd.yaml:3" in err and warned in err
