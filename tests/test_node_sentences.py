@@ -62,3 +62,16 @@ def test_a_leaf_is_said_in_words(type_name: str, args: dict[str, object], said: 
 def test_a_node_type_it_does_not_know_is_left_to_its_type_and_parameters() -> None:
     assert node_sentence("Blink", {"times": 3}, CATALOGUE) is None
     assert node_sentence("Sequence", {}, CATALOGUE) is None
+
+
+def test_the_live_view_is_told_each_node_in_words_beside_its_parameters() -> None:
+    from pathlib import Path
+
+    from engine.runtime.tree_watch import TreeWatch
+    from engine.testing import TreeHarness
+
+    hug = TreeHarness.from_file(Path(__file__).resolve().parents[1] / "trees" / "hug.yaml")
+    watched = TreeWatch().watch(hug.running)
+    check = watched.info[1]
+    assert check.label == "Check key=/sensors/force/left_n above=3.0"  # for engineers
+    assert check.words == "force on the left side pad above 3 N?"  # for people

@@ -43,7 +43,7 @@ ONE_OF_EACH: list[SessionEvent] = [
         (Path("trees/hug.yaml"),),
         20.0,
         5,
-        (NodeInfo(0, "/hug", "Sequence", "hug", 0),),
+        (NodeInfo(0, "/hug", "Sequence", "hug", 0, "in order"),),
         "digraph {}",
     ),
     NodeStatus(101.0, "hug", 2, 7, 0, "RUNNING", "waiting for a squeeze"),
@@ -112,6 +112,21 @@ def test_what_only_the_consent_gate_reads_never_leaves_in_a_message() -> None:
             "turn.turn: 'shouts' is not one of 'interrupts', 'waits'",
         ),
         ({"kind": "hand", "t": 10**400, "fingers": 2}, "hand.t: a number too large"),
+        (
+            {
+                "kind": "tree",
+                "t": 0,
+                "tree": "a",
+                "version": 1,
+                "file": "a",
+                "files": [],
+                "rate_hz": 1.0,
+                "priority": 0,
+                "dot": "",
+                "nodes": [{"index": 0, "path": "p", "type": "T", "depth": 0}],
+            },
+            "tree.nodes[]: no 'label'",
+        ),
         (
             {
                 "kind": "action",

@@ -149,6 +149,7 @@ def dot_source(definition: TreeDefinition) -> str:
     """The tree as Graphviz dot, nodes named ``n0..`` depth-first (the live view colors
     them by these names)."""
     name = escape(definition.name)
+    catalogue = default_catalogue()  # the keys' words for the leaves' sentences
     widest = max(_widths(definition.root).values())
     deepest = max(depth for _, depth in preorder(definition.root))
     direction = "LR" if widest > 6 and widest > deepest else "TB"
@@ -177,9 +178,9 @@ def dot_source(definition: TreeDefinition) -> str:
         else:
             inner = indent
         kind = node.type.kind
+        drawn = escape(plain_label(node, catalogue)).replace(chr(92) * 2 + "n", chr(92) + "n")
         lines.append(
-            f'{inner}{ident} [shape={_SHAPES[kind]}, fillcolor="{_COLORS[kind]}", '
-            f'label="{escape(plain_label(node)).replace(chr(92) * 2 + "n", chr(92) + "n")}"];'
+            f'{inner}{ident} [shape={_SHAPES[kind]}, fillcolor="{_COLORS[kind]}", label="{drawn}"];'
         )
         edges = [f"{inner}{ident} -> {walk(child, inner)};" for child in node.children]
         lines.extend(edges)

@@ -16,7 +16,7 @@ import py_trees
 
 from engine.blackboard.catalogue import NOTHING, Carries
 from engine.loader.tree_definition import TreeDefinition
-from engine.loader.tree_drawing import dot_source, label, preorder
+from engine.loader.tree_drawing import dot_source, label, plain_label, preorder
 from engine.nodes.base import node_path
 from engine.runtime.scheduler import RunningTree
 from engine.session.events import NodeInfo, NodeStatus, TreeStarted
@@ -51,8 +51,16 @@ class TreeWatch:
         known = self.trees.get(tree.name)
         nodes = _preorder_nodes(tree.tree.root)
         definitions = list(preorder(tree.definition.root))
+        catalogue = tree.context.blackboard.catalogue
         info = [
-            NodeInfo(index, node_path(node), definition.type.name, label(definition), depth)
+            NodeInfo(
+                index,
+                node_path(node),
+                definition.type.name,
+                label(definition),
+                depth,
+                " ".join(plain_label(definition, catalogue).split()),
+            )
             for index, (node, (definition, depth)) in enumerate(
                 zip(nodes, definitions, strict=True)
             )

@@ -117,10 +117,14 @@ def _typed(value: Any, hint: Any, place: str) -> Any:
     elif hint is NodeInfo:
         if isinstance(value, dict):
             fields = _hints(NodeInfo)
+            missing = [name for name in fields if name not in value and name != "words"]
+            if missing:  # words: not told before they were kept
+                raise EventError(f"{place}: no {missing[0]!r}")
             return NodeInfo(
                 **{
-                    name: _typed(value.get(name), fields[name], f"{place}.{name}")
+                    name: _typed(value[name], fields[name], f"{place}.{name}")
                     for name in fields
+                    if name in value
                 }
             )
     elif origin is typing.Literal:

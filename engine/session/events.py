@@ -28,13 +28,15 @@ from engine.blackboard.catalogue import NOTHING, Carries
 @dataclass(frozen=True, slots=True)
 class NodeInfo:
     """One node of a tree version: its number (depth-first, as ``vest render`` numbers
-    them; ``n0`` is the root), path, type, label (as drawn) and depth."""
+    them; ``n0`` is the root), path, type, label (its type and parameters), depth, and
+    what it does in plain words, as drawn ("" when not known: recordings keep none)."""
 
     index: int
     path: str
     type: str
     label: str
     depth: int
+    words: str = ""
 
 
 @dataclass(frozen=True, slots=True)

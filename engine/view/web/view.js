@@ -150,7 +150,7 @@ async function drawTrees() {
         item.dataset.node = String(node.index);
         item.style.marginLeft = `${node.depth * 1.2}em`;
         item.innerHTML = `<span class="mark" aria-hidden="true"></span> <span class="label"></span>`;
-        item.querySelector(".label").textContent = node.label;
+        item.querySelector(".label").textContent = node.words || node.label;
         chooseBy(item, tree, node.index);
         list.append(item);
       }
@@ -174,7 +174,7 @@ function colorTree(tree) {
     element.dataset.shown = shown[index];
     const markElement = element.querySelector(".mark");
     if (markElement) markElement.textContent = mark;
-    element.setAttribute("aria-label", `${tree.nodes[index]?.label ?? ""}: ${word}`);
+    element.setAttribute("aria-label", `${tree.nodes[index]?.words || tree.nodes[index]?.label || ""}: ${word}`);
     const isChosen = chosen && chosen.tree === tree.tree && chosen.version === tree.version
       && chosen.node === index;
     element.classList.toggle("chosen", Boolean(isChosen));
