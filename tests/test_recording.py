@@ -234,6 +234,19 @@ def test_a_damaged_recording_is_named_in_one_line_by_replay_and_report(
         assert code == 0 or (code == 1 and named), (command, err)
 
 
+def test_a_damaged_event_is_named_once_by_the_export_too(
+    demo: Path, capsys, the_site_key: SiteKey, tmp_path: Path
+) -> None:
+    with connect_sealed(demo, the_site_key) as connection:
+        connection.execute("UPDATE events SET data = '[1]' WHERE rowid = 1")
+        connection.commit()
+    out = tmp_path / "demo.mcap"
+    assert main(["replay", str(demo), "--to", "mcap", "-o", str(out)]) == 1
+    err = capsys.readouterr().err
+    assert err.count("a damaged recording") == 1 and "(an event at 0.0 s)" in err, err
+    assert not out.exists()  # no half-written file
+
+
 def test_a_recording_cut_short_says_where_in_replay_and_report_and_exits_1(
     demo: Path, capsys, the_site_key: SiteKey
 ) -> None:

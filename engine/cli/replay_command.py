@@ -128,6 +128,9 @@ def _converted(recording: Recording, site: Site | None, args: argparse.Namespace
     except OSError as error:
         output.unlink(missing_ok=True)  # ours: made a moment ago
         raise ConfigError(f"-o {output}: cannot write it ({error.strerror or error})") from None
+    except ConfigError:  # a damaged recording, named already
+        output.unlink(missing_ok=True)
+        raise
     except (ValueError, OverflowError) as error:  # NaN, a time no calendar has
         output.unlink(missing_ok=True)
         raise ConfigError(f"{args.recording}: a damaged recording ({error})") from None

@@ -357,7 +357,7 @@ class Recording:
         for at, seq, kind, tree, data in rows:
             fields = self.json(data)
             if not isinstance(fields, dict) or not _numbers(at, seq or 0):
-                raise ConfigError(f"{self.path}: a damaged recording (an event of {at!r})")
+                raise ConfigError(f"{self.path}: a damaged recording (an event at {at!r} s)")
             found.append((at, seq or 0, str(kind), str(tree), fields))
         return found
 
