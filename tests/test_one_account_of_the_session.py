@@ -20,6 +20,7 @@ from engine.privacy.site_data import SiteKey
 from engine.recording.replay import Recording
 from engine.recording.report import not_understood, person_moments, report_html
 from engine.recording.told import told_events
+from engine.recording.session_file import FORMAT_VERSION
 from engine.services.telemetry import TelemetrySnapshot
 from engine.session.blackboard_news import ChangedKeys
 from engine.session.events import (
@@ -156,7 +157,11 @@ def test_a_recording_of_the_second_format_tells_what_a_new_one_tells(
     assert main(["run", "--fast", "--speech", "text", "--record", str(now)]) == 0
     capsys.readouterr()
     earlier, later = Recording.open(kept, the_site_key), Recording.open(now, the_site_key)
-    assert (earlier.format, later.format) == (2, 3)
+    assert (earlier.format, later.format) == (2, FORMAT_VERSION)
+    # a node's plain words are kept now (a replay shows them as the live view did)
+    [hug] = [tree for tree in later.trees if tree.name == "hug"]
+    assert "force on the left side pad above 3 N?" in [node.words for node in hug.nodes]
+    assert {node.words for tree in earlier.trees for node in tree.nodes} == {""}
     told = [[event_line(e) for e in told_events(r)] for r in (earlier, later)]
     # an operator's command is now told in words; a recording keeps the words it was told in
     old_words = ("world", "operator sends say {'text': 'hello from the cloud'}")

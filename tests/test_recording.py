@@ -13,7 +13,7 @@ from engine.cli import main
 from engine.privacy.sealed_sqlite import connect_sealed
 from engine.privacy.site_data import SiteKey
 from engine.recording.replay import Recording
-from engine.recording.session_file import COLUMNS
+from engine.recording.session_file import COLUMNS, FORMAT_VERSION
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -97,7 +97,7 @@ def test_a_recording_from_a_newer_vest_is_refused_by_its_format(
     with connect_sealed(demo, the_site_key) as db:
         db.execute("UPDATE meta SET value = '99' WHERE key = 'format'")
     assert main(["replay", str(demo)]) == 1
-    assert "recorded in format 99, newer than this vest reads (3)" in capsys.readouterr().err
+    assert f"recorded in format 99, newer than this vest reads ({FORMAT_VERSION})" in capsys.readouterr().err
 
 
 def test_recording_into_a_missing_folder_stops_before_the_robot_starts(

@@ -11,7 +11,7 @@ import pytest
 from engine.cli import main
 from engine.privacy.site_data import SiteKey
 from engine.recording.replay import Recording
-from engine.recording.report import outages, person_moments
+from engine.recording.report import outages, person_moments, printable
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -220,3 +220,10 @@ def test_an_answer_that_comes_after_a_hold_is_on_the_hug_s_row_with_its_delay(
     page = path.with_suffix(".html").read_text()
     assert "long_hug: said \u201cWhat a long hug!\u201d (3.0" in page
     assert "<td>long_hug</td><td></td><td class='num'>1</td>" in page  # times it answered
+
+
+def test_a_control_character_in_a_recording_s_text_never_reaches_the_page() -> None:
+    # a hand-made or damaged recording may hold a NUL or a terminal's colour codes in a label
+    assert printable("<td>a\x00b\x1b[31m\x85c\nd\te</td>") == (
+        "<td>a\ufffdb\ufffd[31m\ufffdc\nd\te</td>"
+    )

@@ -30,12 +30,13 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 from engine.files.problems import LoadError, Mark, Problems
 from engine.files.yaml_source import YList, YMap, YScalar, YValue, describe, load_yaml, plain
 from engine.loader.tree_definition import TreeDefinition
 from engine.loader.tree_file import TreeLoader
+from engine.session.events import ButtonControl
 from engine.values.param_problems import did_you_mean
 
 ACTIONS = ("say", "led", "move", "play", "do")
@@ -72,7 +73,7 @@ class Button:
     key: str | None
     mark: Mark
     tree: TreeDefinition | None = None
-    control: str | None = None
+    control: ButtonControl | None = None
     when: When | None = None
 
     def to_json(self) -> dict[str, Any]:
@@ -180,7 +181,7 @@ def _button(
                 did_you_mean(str(control), CONTROLS) if isinstance(control, str) else None,
             )
             return None
-        return Button(number, label, key, raw.mark, control=str(control), when=when)
+        return Button(number, label, key, raw.mark, control=cast(ButtonControl, control), when=when)
     node = _node(action, body, raw, problems)
     if node is None:
         return None

@@ -32,7 +32,7 @@ from engine.buttons.button_file import Button, ButtonBoard, When
 from engine.loader.tree_definition import TreeDefinition
 from engine.runtime.robot import Robot
 from engine.runtime.scheduler import RunningTree
-from engine.session.events import BehaviorsPaused, ButtonPressed
+from engine.session.events import BehaviorsPaused, ButtonPressed, PressedBy
 from engine.web.broadcast import Broadcast
 
 PAGE_QUEUE = 16
@@ -53,21 +53,21 @@ class Wizard:
         self.paused = False
         self.doing: Button | None = None
         self.presses = 0
-        self._pressed: queue.SimpleQueue[tuple[int, str]] = queue.SimpleQueue()
+        self._pressed: queue.SimpleQueue[tuple[int, PressedBy]] = queue.SimpleQueue()
         self._lock = threading.Lock()
         self.states: Broadcast[dict[str, Any]] = Broadcast(robot.clock, PAGE_QUEUE)
         """Each new state, for the pages' streams (the state now: :meth:`state`)."""
         self._state: dict[str, Any] = self._current_state()
 
     # -- from any thread ----------------------------------------------------------------------
-    def press(self, number: int, *, by: str = "page") -> Button | None:
+    def press(self, number: int, *, by: PressedBy = "page") -> Button | None:
         """Queue a press of button ``number`` for the next step; None when there is none."""
         button = self.board.button(number)
         if button is not None:
             self._pressed.put((number, by))
         return button
 
-    def press_label(self, label: str, *, by: str = "scenario") -> Button | None:
+    def press_label(self, label: str, *, by: PressedBy = "scenario") -> Button | None:
         for button in self.board.buttons:
             if button.label == label:
                 return self.press(button.number, by=by)
@@ -104,7 +104,7 @@ class Wizard:
             self.doing = None
         self._publish()
 
-    def _carry_out(self, button: Button, now_s: float, by: str) -> None:
+    def _carry_out(self, button: Button, now_s: float, by: PressedBy) -> None:
         self.presses += 1
         shown = self._shown(button)
         control = button.control or ""

@@ -105,7 +105,7 @@ class EditorServer:
             shared_files(),
             Route("/api/palette", lambda _: JSONResponse(self.palette)),
             Route("/api/files", lambda _: JSONResponse(self.workspace.files())),
-            Route("/api/profiles", lambda _: JSONResponse(self.workspace.profiles())),
+            Route("/api/profiles", self._profiles),
             Route("/api/priorities", lambda _: JSONResponse(self.workspace.priorities())),
             Route("/api/file", self._read),
             Route("/api/check", self._check, methods=["POST"]),
@@ -131,6 +131,10 @@ class EditorServer:
     # -- endpoints (plain functions run in uvicorn's threads) ---------------------------
     def _file(self, request: Request) -> Response:
         return FileResponse(WEB / STATIC[request.url.path])
+
+    def _profiles(self, _: Request) -> Response:
+        profiles, problems = self.workspace.profiles()
+        return JSONResponse({"profiles": profiles, "problems": problems})
 
     def _read(self, request: Request) -> Response:
         name = request.query_params.get("name", "")

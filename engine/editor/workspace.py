@@ -135,21 +135,23 @@ class Workspace:
                 found[document["name"]] = priority if isinstance(priority, int) else 0
         return found
 
-    def profiles(self) -> dict[str, dict[str, Any]]:
-        """What each profile (``trees/profiles/*.yaml``) sets: {profile: {param: value}};
-        a profile that does not load is left out (``vest validate`` names its problems)."""
+    def profiles(self) -> tuple[dict[str, dict[str, Any]], list[str]]:
+        """What each profile (``trees/profiles/*.yaml``) sets: {profile: {param: value}},
+        and for each profile that does not load, its first problem with its place."""
         found: dict[str, dict[str, Any]] = {}
+        problems: list[str] = []
         folder = self.folder / "trees" / "profiles"
         for path in sorted(folder.glob("*.y*ml")) if folder.is_dir() else ():
             if not path.resolve().is_relative_to(self.folder):
                 continue  # a link out of the folder is not read
             try:
                 profile = load_profile(path, path.relative_to(self.folder).as_posix())
-            except LoadError:
+            except LoadError as error:
+                problems.append(f"{error.problems[0]} (the editor leaves this profile out)")
                 continue
             values = {name: plain(given.value) for name, given in profile.params.items()}
             found[profile.name] = json_value(values)  # a NaN or infinity is shown as nothing
-        return found
+        return found, problems
 
     # -- read, check, save ----------------------------------------------------------------
     def read(self, name: str) -> tuple[str, str]:

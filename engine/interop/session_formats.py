@@ -28,6 +28,7 @@ from engine.interop.btcpp_export import BTCPP_BUILTINS, xml_safe
 from engine.interop.session_topics import live_message
 from engine.recording.replay import RecordedTree, Recording
 from engine.recording.told import every_event
+from engine.session.codec import LATEST_S
 from engine.session.events import NodeInfo
 from engine.session.json_values import json_value
 
@@ -214,7 +215,7 @@ def write_mcap(recording: Recording, out: BinaryIO) -> dict[str, int]:
     start_ns = round(_epoch_s(recording) * 1e9)
     messages = sorted(_messages(recording), key=lambda m: m[2])  # time order, stable
     for topic, schema, at_s, message in messages:
-        if not (math.isfinite(float(at_s)) and 0 <= float(at_s) < 1e9):
+        if not (math.isfinite(float(at_s)) and 0 <= float(at_s) < LATEST_S):
             raise ValueError(f"{topic} at {at_s!r} s")
         if topic not in channels:
             channels[topic] = writer.register_channel(topic, "json", schema_ids[schema])

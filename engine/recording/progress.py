@@ -18,7 +18,7 @@ from pathlib import Path
 
 from engine.recording.moments import not_understood, person_moments
 from engine.recording.replay import Recording
-from engine.recording.report import REPORT_HEAD, STYLE, simulated
+from engine.recording.report import REPORT_HEAD, STYLE, printable, simulated
 from engine.recording.report_plots import per_session_plot
 
 THE_PERSON = "the person"
@@ -142,7 +142,7 @@ def progress_html(
         _behaviours_table(sessions),
         "</body></html>\n",
     ]
-    return "\n".join(parts)
+    return printable("\n".join(parts))
 
 
 def _in_words(sessions: list[SessionSummary], left_out: int = 0) -> str:

@@ -130,7 +130,7 @@ class SessionRecorder:
         )
         for node in event.nodes:
             self._note(
-                "INSERT INTO nodes VALUES (?, ?, ?, ?, ?, ?, ?)",
+                "INSERT INTO nodes VALUES (?, ?, ?, ?, ?, ?, ?, ?)",
                 (
                     event.tree,
                     event.version,
@@ -139,6 +139,7 @@ class SessionRecorder:
                     node.type,
                     node.label,
                     node.depth,
+                    node.words,
                 ),
             )
 

@@ -152,11 +152,13 @@ class Recording:
 
     def _read_trees(self) -> list[RecordedTree]:
         nodes: dict[tuple[str, int], list[NodeInfo]] = {}
-        for tree, version, index, path, kind, label, depth in self._rows(
-            "SELECT tree, version, node, path, type, label, depth FROM nodes "
+        words = "words" if self.format >= 4 else "''"  # not kept before format 4
+        for tree, version, index, path, kind, label, depth, said in self._rows(
+            f"SELECT tree, version, node, path, type, label, depth, {words} FROM nodes "
             "ORDER BY tree, version, node"
         ):
-            nodes.setdefault((tree, version), []).append(NodeInfo(index, path, kind, label, depth))
+            node = NodeInfo(index, path, kind, label, depth, said)
+            nodes.setdefault((tree, version), []).append(node)
         return [
             RecordedTree(
                 name,

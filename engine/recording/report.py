@@ -300,58 +300,64 @@ def report_html(recording: Recording, note: str = "") -> str:
     robot = html.escape(meta.get("robot_config", "?"))
     person = html.escape(meta.get("person") or "no person named")
     when = html.escape(_started(meta.get("started")))
-    return "\n".join(
-        [
-            REPORT_HEAD,
-            f"<title>Session report: {recorded}</title>",
-            f"<style>{STYLE(encoding='utf-8')}</style></head><body>",
-            "<h1>Session report</h1>",
-            f'<p class="meta">{when} &middot; {person} &middot; {end:.1f} s &middot; '
-            f"{html.escape(profile)} &middot; robot {robot} &middot; {recorded}</p>",
-            f"<p>{html.escape(summary)}</p>",
-            _note(note),
-            _left_out(meta),
-            f'<p class="warning">{html.escape(cut)}: this report is of what it holds.</p>'
-            if cut
-            else "",
-            "<h2>What the person did, and how the robot answered</h2>",
-            _table(
-                ["when", "who", "did", "the robot", "answer after"],
-                rows_html,
-                "nothing",
-                numeric={0, 4},
-            ),
-            "<h2>What was done, by kind</h2>",
-            _table(["kind", "times", "per minute"], by_kind, "nothing was done", numeric={1, 2}),
-            "<h2>How often each behaviour answered</h2>",
-            "<p>Times it answered something done (a row above), and its actions: each light, "
-            "word or move it could make (not those refused or failed).</p>",
-            _table(
-                ["behaviour", "what it does", "times it answered", "actions"],
-                behaviours,
-                "none acted",
-                numeric={2, 3},
-            ),
-            "<h2>What the robot did not understand</h2>",
-            _table(
-                ["when", "heard", "the robot"],
-                missed,
-                "everything it heard matched a rule",
-                numeric={0},
-            ),
-            "<h2>What the safety envelope did</h2>",
-            _table(
-                ["when", "did", "joint", "rule", "sensors", "why"],
-                _safety_rows(recording),
-                "nothing: no move was refused, slowed or stopped",
-                numeric={0},
-            ),
-            "<h2>Devices that dropped out</h2>",
-            _table(["device", "offline at", "back at", "for"], dropped, "none", numeric={1, 2, 3}),
-            "<h2>The sensors over the session</h2>",
-            *plots,
-            "</body></html>\n",
-        ]
+    return printable(
+        "\n".join(
+            [
+                REPORT_HEAD,
+                f"<title>Session report: {recorded}</title>",
+                f"<style>{STYLE(encoding='utf-8')}</style></head><body>",
+                "<h1>Session report</h1>",
+                f'<p class="meta">{when} &middot; {person} &middot; {end:.1f} s &middot; '
+                f"{html.escape(profile)} &middot; robot {robot} &middot; {recorded}</p>",
+                f"<p>{html.escape(summary)}</p>",
+                _note(note),
+                _left_out(meta),
+                f'<p class="warning">{html.escape(cut)}: this report is of what it holds.</p>'
+                if cut
+                else "",
+                "<h2>What the person did, and how the robot answered</h2>",
+                _table(
+                    ["when", "who", "did", "the robot", "answer after"],
+                    rows_html,
+                    "nothing",
+                    numeric={0, 4},
+                ),
+                "<h2>What was done, by kind</h2>",
+                _table(
+                    ["kind", "times", "per minute"], by_kind, "nothing was done", numeric={1, 2}
+                ),
+                "<h2>How often each behaviour answered</h2>",
+                "<p>Times it answered something done (a row above), and its actions: each light, "
+                "word or move it could make (not those refused or failed).</p>",
+                _table(
+                    ["behaviour", "what it does", "times it answered", "actions"],
+                    behaviours,
+                    "none acted",
+                    numeric={2, 3},
+                ),
+                "<h2>What the robot did not understand</h2>",
+                _table(
+                    ["when", "heard", "the robot"],
+                    missed,
+                    "everything it heard matched a rule",
+                    numeric={0},
+                ),
+                "<h2>What the safety envelope did</h2>",
+                _table(
+                    ["when", "did", "joint", "rule", "sensors", "why"],
+                    _safety_rows(recording),
+                    "nothing: no move was refused, slowed or stopped",
+                    numeric={0},
+                ),
+                "<h2>Devices that dropped out</h2>",
+                _table(
+                    ["device", "offline at", "back at", "for"], dropped, "none", numeric={1, 2, 3}
+                ),
+                "<h2>The sensors over the session</h2>",
+                *plots,
+                "</body></html>\n",
+            ]
+        )
     )
 
 
@@ -381,6 +387,17 @@ def descriptions(recording: Recording) -> dict[str, str]:
         described = document.get("description") if isinstance(document, dict) else None
         found[row["tree"]] = " ".join(str(described).split()) if described else ""
     return found
+
+
+_UNPRINTABLE = dict.fromkeys(
+    [*range(0x09), 0x0B, 0x0C, *range(0x0E, 0x20), *range(0x7F, 0xA0)], "\ufffd"
+)
+
+
+def printable(page: str) -> str:
+    """``page`` with each control character (NUL, ESC, C1...) shown as \ufffd, so a damaged
+    or hand-made recording's text cannot put one in a page a supervisor opens."""
+    return page.translate(_UNPRINTABLE)
 
 
 def _note(note: str) -> str:

@@ -8,7 +8,8 @@ Times are seconds since the session started (its first tick's clock time). Table
 - ``trees``: each tree as it was run, one row per version (a hot reload adds one): its
   file, the SHA-256 of its files, its rate, its YAML source and its Graphviz drawing;
 - ``nodes``: each node of each tree version, numbered in depth-first order as
-  ``vest render`` numbers them (``n0`` is the root), with its path and type;
+  ``vest render`` numbers them (``n0`` is the root), with its path, type and (format 4
+  on) what it does in plain words;
 - ``statuses``: a node's status (and feedback message) each time it changes after a tick;
 
 (format 2 on: ``seq`` in ``blackboard``, ``actions``, ``world`` and ``events`` numbers the
@@ -45,7 +46,7 @@ from engine.privacy.sealed_sqlite import (
 )
 from engine.privacy.site_data import SiteKey, check_apart
 
-FORMAT_VERSION = 3
+FORMAT_VERSION = 4
 TABLES = ("meta", "trees", "nodes", "statuses", "blackboard", "actions", "world")
 """The tables every format has (format 2 adds ``events``; from format 3 on, ``actions`` and
 ``world`` stay empty: their events are in ``events``)."""
@@ -59,6 +60,7 @@ CREATE TABLE trees (
 CREATE TABLE nodes (
     tree TEXT NOT NULL, version INTEGER NOT NULL, node INTEGER NOT NULL,
     path TEXT NOT NULL, type TEXT NOT NULL, label TEXT NOT NULL, depth INTEGER NOT NULL,
+    words TEXT NOT NULL,
     PRIMARY KEY (tree, version, node)
 );
 CREATE TABLE statuses (
@@ -254,6 +256,7 @@ COLUMNS: dict[str, dict[str, tuple[tuple[str, ...], bool]]] = {
         "type": (TEXT, False),
         "label": (TEXT, False),
         "depth": (WHOLE, False),
+        "words": (TEXT, False),
     },
     "statuses": {
         "at_s": (NUMBER, False),

@@ -40,6 +40,11 @@ _BY_KIND: dict[str, type[SessionEvent]] = {
 }
 
 
+LATEST_S = 1e9
+"""The latest time an event may have, in seconds since the session's start (31 years):
+one later or before the start is damage."""
+
+
 class EventError(ValueError):
     """A message that is not a session event this vest reads (the text says which field)."""
 
@@ -82,8 +87,11 @@ def decode(message: Mapping[str, Any], start_s: float = 0.0) -> SessionEvent:
             message[name], _hints(typing.cast(type, event_type))[field.name], f"{kind}.{name}"
         )
         if field.name in TIMES:
-            if not math.isfinite(value):
-                raise EventError(f"{kind}.{name}: a time must be a number of seconds")
+            if not (math.isfinite(value) and 0 <= value < LATEST_S):
+                raise EventError(
+                    f"{kind}.{name}: {value!r:.30} is not a time (seconds since the start, "
+                    f"0 to {LATEST_S:.0e})"
+                )
             value += start_s
         values[field.name] = value
     return event_type(**values)

@@ -29,7 +29,8 @@ from engine.blackboard.catalogue import NOTHING, Carries
 class NodeInfo:
     """One node of a tree version: its number (depth-first, as ``vest render`` numbers
     them; ``n0`` is the root), path, type, label (its type and parameters), depth, and
-    what it does in plain words, as drawn ("" when not known: recordings keep none)."""
+    what it does in plain words, as drawn ("" when not known: recordings before format 4
+    kept none)."""
 
     index: int
     path: str
@@ -142,6 +143,10 @@ class TurnTaken:
         return f"yields the {self.resource} to {self.other}: not {self.what}"
 
 
+PressedBy = Literal["page", "key", "scenario"]
+"""Where a button was pressed: on the buttons page, by its keyboard key, or a scenario's press."""
+ButtonControl = Literal["", "pause", "resume", "stop"]
+"""What a control button did ("": none, the button has the robot do something)."""
 SafetyKind = Literal["refused", "stopped", "slowed", "held"]
 """refused a move, stopped one under way, slowed one, or held an arm where it is until it
 may go back to rest."""
@@ -177,9 +182,9 @@ class ButtonPressed:
     kind: ClassVar[str] = "press"
     t_s: float
     label: str
-    by: str
+    by: PressedBy
     done: bool = True
-    control: str = ""
+    control: ButtonControl = ""
 
 
 @dataclass(frozen=True, slots=True)

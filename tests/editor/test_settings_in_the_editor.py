@@ -80,3 +80,15 @@ def test_the_outline_says_each_leaf_in_words(page: Page, editor: str) -> None:
         "force on the left side pad above hug_threshold_n N? (Check)"
     )
     expect(node(page, "root/2/child/1")).to_contain_text("say \u201chug_phrase\u201d (Say)")
+
+
+def test_a_profile_that_does_not_load_is_named_beside_the_settings(
+    page: Page, editor: str, project: Path
+) -> None:
+    # a broken profile is not silently missing: the settings say which file and where
+    (project / "trees" / "profiles" / "broken.yaml").write_text("profile: broken\nparams: [1, 2\n")
+    open_tree(page, editor, "trees/hug.yaml")
+    problem = page.locator("#params .problem")
+    expect(problem).to_contain_text("trees/profiles/broken.yaml:")
+    expect(problem).to_contain_text("the editor leaves this profile out")
+    expect(page.locator("#param-hug_threshold_n-help")).not_to_contain_text("broken")

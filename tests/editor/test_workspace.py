@@ -127,7 +127,18 @@ def test_what_each_profile_sets_is_plain_json_even_a_nan(workspace, project) -> 
     (project / "trees" / "profiles" / "odd.yaml").write_text(
         "profile: odd\nparams:\n  hug_threshold_n: .nan\n  volume: 0.5\n"
     )
-    profiles = workspace.profiles()
+    profiles, problems = workspace.profiles()
+    assert problems == []
     assert profiles["odd"] == {"hug_threshold_n": None, "volume": 0.5}
     assert profiles["child"]["hug_threshold_n"] == 2.0
     json.dumps(profiles, allow_nan=False)
+
+
+def test_a_profile_that_does_not_load_is_named_with_its_place(workspace, project) -> None:
+    # an unclosed list: the editor leaves the profile out and says where it broke
+    (project / "trees" / "profiles" / "broken.yaml").write_text("profile: broken\nparams: [1, 2\n")
+    profiles, problems = workspace.profiles()
+    assert "broken" not in profiles and "child" in profiles
+    assert len(problems) == 1
+    assert problems[0].startswith("trees/profiles/broken.yaml:")
+    assert problems[0].endswith("(the editor leaves this profile out)")

@@ -36,8 +36,8 @@ def test_a_tree_waiting_for_a_hug_reads_waiting_not_failed(page: Page, replay: s
     expect(node(page, "hug", 1)).to_have_attribute("data-shown", "no")
     expect(node(page, "hug", 0)).to_have_attribute("data-shown", "waiting")
     expect(hug.locator("h2 .status")).to_have_text("waiting")
-    expect(node(page, "hug", 1)).to_have_attribute(
-        "aria-label", "Check key=/sensors/force/left_n above=3.0: no"
+    expect(node(page, "hug", 1)).to_have_attribute(  # in words, as the live view says it
+        "aria-label", "force on the left side pad above 3 N?: no"
     )
     assert page.locator('[data-shown="failed"]').count() == 0
 

@@ -15,6 +15,7 @@ const make = (tag, props = {}, ...children) => {
 
 let palette = { nodes: [], pads: [], joints: [], colors: [], keys: [], kinds: {} };
 let profiles = {}; // profile name -> {param: value}: what each profile sets
+let profileProblems = []; // "trees/profiles/x.yaml:2:3: ... (left out)": profiles that do not load
 let priorities = {}; // tree name -> its priority, among the folder's trees
 const types = new Map(); // node type name -> its declaration
 let file = null; // {name, version (null: new), outline}
@@ -301,7 +302,7 @@ function drawParams() {
   const box = $("#params");
   const params = file.outline.params ?? {};
   const names = Object.keys(params);
-  box.hidden = names.length === 0;
+  box.hidden = names.length === 0 && profileProblems.length === 0;
   box.replaceChildren(make("legend", { textContent: "Settings a profile can change" }));
   for (const name of names) {
     const uses = usesOf(name);
@@ -318,6 +319,7 @@ function drawParams() {
       if (value === undefined) delete params[name]; else params[name] = value;
     }, false, typing), "param"));
   }
+  for (const problem of profileProblems) box.append(make("p", { className: "problem", textContent: problem }));
 }
 
 function drawNodeForm() {
@@ -653,7 +655,7 @@ function newTree(event) {
 
 async function main() {
   palette = await getJson("/api/palette");
-  profiles = await getJson("/api/profiles");
+  ({ profiles, problems: profileProblems } = await getJson("/api/profiles"));
   for (const node of palette.nodes) types.set(node.name, node);
   $("#where").textContent = "";
   await listFiles();
