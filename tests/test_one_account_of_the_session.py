@@ -19,8 +19,8 @@ from engine.clock import VirtualClock
 from engine.privacy.site_data import SiteKey
 from engine.recording.replay import Recording
 from engine.recording.report import not_understood, person_moments, report_html
-from engine.recording.told import told_events
 from engine.recording.session_file import FORMAT_VERSION
+from engine.recording.told import told_events
 from engine.services.telemetry import TelemetrySnapshot
 from engine.session.blackboard_news import ChangedKeys
 from engine.session.events import (

@@ -97,7 +97,10 @@ def test_a_recording_from_a_newer_vest_is_refused_by_its_format(
     with connect_sealed(demo, the_site_key) as db:
         db.execute("UPDATE meta SET value = '99' WHERE key = 'format'")
     assert main(["replay", str(demo)]) == 1
-    assert f"recorded in format 99, newer than this vest reads ({FORMAT_VERSION})" in capsys.readouterr().err
+    assert (
+        f"recorded in format 99, newer than this vest reads ({FORMAT_VERSION})"
+        in capsys.readouterr().err
+    )
 
 
 def test_recording_into_a_missing_folder_stops_before_the_robot_starts(
