@@ -154,7 +154,17 @@ def test_a_recording_of_the_second_format_tells_what_a_new_one_tells(
     kept = Path(__file__).parent / "recordings" / "demo.format2.db"
     monkeypatch.chdir(ROOT)
     now = tmp_path / "demo.db"
-    assert main(["run", "--fast", "--speech", "text", "--record", str(now)]) == 0
+    demo = ROOT / "examples" / "scenarios" / "demo.yaml"
+    then = [line for line in demo.read_text().splitlines() if "at: 27.6" not in line]
+    scenario = tmp_path / "demo_then.yaml"  # the demo as it was: no one spoke over the robot
+    scenario.write_text(
+        "\n".join(then)
+        .replace("wav: voices/", f"wav: {demo.parent}/voices/")
+        .replace("image: ../", f"image: {demo.parent}/../"),
+        encoding="utf-8",
+    )
+    args = ["run", "--fast", "--speech", "text", "--scenario", str(scenario)]
+    assert main([*args, "--record", str(now)]) == 0
     capsys.readouterr()
     earlier, later = Recording.open(kept, the_site_key), Recording.open(now, the_site_key)
     assert (earlier.format, later.format) == (2, FORMAT_VERSION)

@@ -171,6 +171,7 @@ EXTRAS = {
         "hibari",
         "moonshine_cpp",
         "onnx",
+        "livekit",
         "cv2",
         "starlette",
         "ruamel",

@@ -16,7 +16,7 @@ from engine.clock import RealClock
 from engine.errors import ConfigError, ServiceError, UsageError
 from engine.loader.substitution import load_profile
 from engine.media.audio import Audio, write_wav
-from engine.robot_io.robot_speech import speech_settings
+from engine.robot_io.speech_assembly import speech_settings
 from engine.speech.settings import VOICE_NAMES
 from engine.speech.speaker import Speaker
 from engine.speech.voice_models import DEFAULT_VOICE, load_voice

@@ -33,7 +33,8 @@ from engine.privacy.consent_gate import ConsentGates
 from engine.privacy.sealed_sqlite import Error as SealedError
 from engine.privacy.site import Site
 from engine.recording.recorder import SessionRecorder
-from engine.robot_io.robot_speech import RobotSpeech, audio_folder, build_speech, speech_settings
+from engine.robot_io.robot_speech import RobotSpeech
+from engine.robot_io.speech_assembly import audio_folder, build_speech, speech_settings
 from engine.runtime.reload import TreeReloader
 from engine.runtime.robot import Behaviors
 from engine.runtime.robot_factory import AssembledRobot, build_robot

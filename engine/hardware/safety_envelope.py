@@ -231,8 +231,9 @@ class EnvelopedSpeech:
     def __init__(self, inner: Speech, envelope: SafetyEnvelope) -> None:
         self.inner, self.envelope = inner, envelope
 
-    def say(self, text: str, *, volume: float | None = None) -> Job:
-        return self.inner.say(text, volume=self.envelope.volume(volume))
+    def say(self, text: str, *, volume: float | None = None, interruptible: bool = True) -> Job:
+        volume = self.envelope.volume(volume)
+        return self.inner.say(text, volume=volume, interruptible=interruptible)
 
 
 class EnvelopedLeds:

@@ -61,6 +61,8 @@ class TreeDefinition:
     or ``try_again`` (it starts again with them)."""
     wake_on: tuple[str, ...] = ()
     """Keys whose change ticks the tree at once; with them it rests between rounds."""
+    interruptible: bool = True
+    """Whether a person speaking over the robot stops this tree's sentences."""
 
     def build(self, ctx: TreeContext) -> py_trees.trees.BehaviourTree:
         """A fresh py_trees tree whose nodes use ``ctx``."""

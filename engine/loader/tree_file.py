@@ -147,6 +147,7 @@ class TreeLoader:
             wait_for_turn_s=settings.wait_for_turn_s,
             when_interrupted=settings.when_interrupted,
             wake_on=settings.wake_on,
+            interruptible=settings.interruptible,
         )
 
     # -- file level -----------------------------------------------------------------------

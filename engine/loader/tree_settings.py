@@ -8,6 +8,7 @@
     when_interrupted: try_again   # a round a higher tree cut short starts again (default:
                                   # let_go, the events that started it are spent)
     wake_on: [/sensors/touch/pat] # rest between rounds; tick at once when one changes
+    interruptible: false   # a person speaking does not stop its sentences (default: true)
 
 Each may be a ``${parameter}``, so a profile can set it.
 """
@@ -21,7 +22,7 @@ from engine.files.problems import Problems
 from engine.files.yaml_source import YMap, plain
 from engine.loader.substitution import ParamValue, substitute, unresolved
 from engine.values.param_problems import CheckContext, ParamProblem
-from engine.values.params import RATE_HZ, Choice, Integer, Key, ListOf, Number, Param
+from engine.values.params import RATE_HZ, Boolean, Choice, Integer, Key, ListOf, Number, Param
 
 DEFAULT_RATE_HZ = 10.0
 PRIORITY = Integer(0, 99)
@@ -64,6 +65,14 @@ SETTINGS = (
         "times a second) and rests between rounds instead of ticking at its rate, e.g. "
         "wake_on: [/sensors/touch/pat, /sensors/force/squeeze]",
     ),
+    Param(
+        "interruptible",
+        Boolean(),
+        True,
+        "whether a person who speaks over the robot stops this tree's sentences (true) "
+        "or they always finish (false: an exercise that must be heard out), e.g. "
+        "interruptible: false",
+    ),
 )
 
 
@@ -74,6 +83,7 @@ class TreeSettings:
     wait_for_turn_s: float = 0.0
     when_interrupted: str = "let_go"
     wake_on: tuple[str, ...] = ()
+    interruptible: bool = True
 
 
 def read_settings(

@@ -158,7 +158,8 @@ class AlsaSpeaker:
             except (BrokenPipeError, ValueError, OSError):
                 pass  # stopped while writing: the next piece goes to the new process
 
-    def stop(self) -> None:
+    def stop(self, at_s: float | None = None) -> None:
+        """Silence now (``at_s``, when the robot decided to, is past for a sound card)."""
         with self._lock:
             self._close()
 

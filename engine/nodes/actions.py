@@ -26,6 +26,7 @@ from engine.values.params import (
     SECONDS,
     SPEED_DPS,
     AnyValue,
+    Boolean,
     Choice,
     Key,
     Number,
@@ -43,6 +44,13 @@ class Say(ServiceAction):
     """
 
     text, volume = SAY_ARGS  # an operator's say command takes the same (remote_commands)
+    interruptible = Param(
+        "interruptible",
+        Boolean(),
+        None,
+        "whether a person speaking over the robot stops this sentence; empty: as the "
+        "tree's interruptible setting says (true unless set)",
+    )
     uses = (SPEAKER,)
 
     def start(self) -> Job:
@@ -50,7 +58,7 @@ class Say(ServiceAction):
             text = self.text.fill(self.read)
         except (KeyError, ValueError) as error:
             return ImmediateJob(error=ServiceError(str(error).strip("'\"")))
-        return self.ctx.actions.say(text, volume=self.volume)
+        return self.ctx.actions.say(text, volume=self.volume, interruptible=self.interruptible)
 
 
 class SetLed(ServiceAction):

@@ -55,6 +55,7 @@ from engine.session.events import (
     NotUnderstood,
     SafetyAction,
     SessionEvent,
+    SpokenOver,
     TurnTaken,
     WorldEvent,
 )
@@ -164,6 +165,8 @@ class ConsentGate:
             if event.what and not self.allows(event.carries):
                 return dataclasses.replace(event, what=self.withheld(event.carries))
             return event
+        if isinstance(event, SpokenOver) and not self.allows(event.carries):
+            return dataclasses.replace(event, saying=self.withheld(event.carries))
         if isinstance(event, SafetyAction) and not self.allows(event.carries):
             why = f"by the rule {event.rule} {self.withheld(event.carries)}"
             return dataclasses.replace(event, why=why)

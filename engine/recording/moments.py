@@ -9,6 +9,7 @@ the robot was speaking, and so was not listened to, is a row of its own.
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 from engine.blackboard.catalogue import (
@@ -28,9 +29,21 @@ from engine.session.events import (
     ButtonPressed,
     NotListened,
     NotUnderstood,
+    SpokenOver,
     TurnTaken,
 )
 
+KINDS_IN_WORDS = {
+    "touch": "touches",
+    "squeeze": "squeezes and hugs",
+    "hear": "words",
+    "gesture": "gestures",
+    "show_hand": "hands shown",
+    "obstacle": "coming near",
+    "press": "button presses",
+    "cloud": "operator's commands",
+}
+"""Each kind of thing done (as a scenario names it), as the report counts it."""
 ANSWER_WITHIN_S = 10.0
 """An action this soon after what the person did counts as the robot's answer."""
 PRESSED_N = 1.0
@@ -43,7 +56,8 @@ class Moment:
     robot's answer: the first actions of each tree that acted after it (the first to act
     first) before the same one did something else (none: no answer). ``not_understood``
     is what the robot heard and had no rule for; ``not_listened`` says the robot could
-    not listen (it was speaking)."""
+    not listen (it was speaking); ``stopped_saying``: the person spoke over the robot,
+    which stopped saying it (after ``stopped_after_s``)."""
 
     at_s: float
     did: str
@@ -57,6 +71,13 @@ class Moment:
     """What a control button did (paused the behaviours...): no answer is awaited."""
     kind: str = ""
     """The kind of thing done, as a scenario names it (touch, squeeze, hear, press...)."""
+    stopped_saying: str | None = None
+    stopped_after_s: float | None = None
+
+    @property
+    def of_its_own(self) -> bool:
+        """A line that tells how the robot listened, with no answer awaited."""
+        return self.not_listened or self.stopped_saying is not None
 
     @property
     def answer(self) -> RecordedAction | None:
@@ -116,6 +137,8 @@ def person_moments(recording: Recording) -> list[Moment]:
         for event in told
         if isinstance(event, NotListened)
     ]
+    spoken_over = {event.from_s: event for event in told if isinstance(event, SpokenOver)}
+    done += [(at, "the person", "spoke over the robot", "spoken_over") for at in spoken_over]
     misunderstood = [event for event in told if isinstance(event, NotUnderstood)]
     yielded = [e for e in told if isinstance(e, TurnTaken) and e.turn in ("yields", "waits")]
     actions = recording.actions()
@@ -126,11 +149,18 @@ def person_moments(recording: Recording) -> list[Moment]:
         if kind == "not_listened":  # a line of its own: nothing to answer
             moments.append(Moment(at, did, (), who, not_listened=True, kind=kind))
             continue
+        if kind == "spoken_over":  # the robot's answer: it stopped talking
+            event = spoken_over[at]
+            stopped = Moment(at, did, (), who, kind=kind, stopped_saying=event.saying)
+            moments.append(dataclasses.replace(stopped, stopped_after_s=event.t_s - at))
+            continue
         if kind == "press" and at in controls:  # what it did is its answer
             moments.append(Moment(at, did, (), who, control=controls[at], kind=kind))
             continue
         later = [  # the next thing the same one did ends the wait for an answer
-            t for t, w, _, k in ordered[index + 1 :] if t > at and w == who and k != "not_listened"
+            t
+            for t, w, _, k in ordered[index + 1 :]
+            if t > at and w == who and k not in ("not_listened", "spoken_over")
         ]
         until = min([at + ANSWER_WITHIN_S, *later])
         window = [  # a command's report is bookkeeping for the cloud, not an answer

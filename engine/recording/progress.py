@@ -65,7 +65,7 @@ def summarize(recording: Recording, started: float) -> SessionSummary:
     """What ``recording`` (which began at ``started``, seconds since the epoch) says of
     the person."""
     moments = [m for m in person_moments(recording) if m.who == THE_PERSON]
-    acts = [m for m in moments if not m.not_listened]
+    acts = [m for m in moments if not m.of_its_own]
     behaviours: dict[str, list[float]] = defaultdict(list)
     times: list[float] = []
     for moment in acts:

@@ -27,7 +27,7 @@ from engine.blackboard.catalogue import (
     RANGE_CENTER_MM,
     TOUCH_ANY,
 )
-from engine.recording.moments import Moment, not_understood, person_moments
+from engine.recording.moments import KINDS_IN_WORDS, Moment, not_understood, person_moments
 from engine.recording.replay import RecordedAction, Recording
 from engine.recording.report_plots import numbers, plot
 from engine.recording.told import told_events
@@ -91,6 +91,12 @@ def _answer_cell(moment: Moment) -> tuple[str, str]:
     """The robot's answer to ``moment`` as the report shows it (HTML), and its delay."""
     if moment.not_listened:
         return '<span class="none">could not listen: it was speaking</span>', "-"
+    if moment.stopped_saying is not None:
+        said = html.escape(moment.stopped_saying)
+        return (
+            f"stopped talking (it was saying \u201c{said}\u201d)",
+            f"{moment.stopped_after_s:.2f} s",
+        )
     if moment.control is not None:
         return html.escape(moment.control), "-"
     if moment.answer is None and moment.not_understood is None:
@@ -215,7 +221,7 @@ def report_html(recording: Recording, note: str = "") -> str:
         f"<td class='num'>{answering[tree]}</td><td class='num'>{count}</td></tr>"
         for tree, count in sorted(fired.items(), key=lambda item: (-answering[item[0]], -item[1]))
     )
-    kinds = Counter(KINDS_IN_WORDS.get(m.kind, "other") for m in moments if not m.not_listened)
+    kinds = Counter(KINDS_IN_WORDS.get(m.kind, "other") for m in moments if not m.of_its_own)
     by_kind = "".join(
         f"<tr><td>{html.escape(kind)}</td><td class='num'>{count}</td>"
         f"<td class='num'>{count / (end / 60):.1f}</td></tr>"
@@ -237,7 +243,7 @@ def report_html(recording: Recording, note: str = "") -> str:
         for device, since, back in outages(recording)
     )
     median = sorted(answered)[len(answered) // 2] if answered else None
-    acts = [m for m in moments if not m.not_listened and not m.is_control]
+    acts = [m for m in moments if not m.of_its_own and not m.is_control]
     controls = sum(1 for m in moments if m.is_control)
     unheard = len(moments) - len(acts) - controls
     summary = (
@@ -359,19 +365,6 @@ def report_html(recording: Recording, note: str = "") -> str:
             ]
         )
     )
-
-
-KINDS_IN_WORDS = {
-    "touch": "touches",
-    "squeeze": "squeezes and hugs",
-    "hear": "words",
-    "gesture": "gestures",
-    "show_hand": "hands shown",
-    "obstacle": "coming near",
-    "press": "button presses",
-    "cloud": "operator's commands",
-}
-"""Each kind of thing done (as a scenario names it), as the report counts it."""
 
 
 def descriptions(recording: Recording) -> dict[str, str]:

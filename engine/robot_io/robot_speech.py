@@ -1,42 +1,34 @@
-"""The robot's speech, assembled: voice and speaker, microphone and listener.
+"""The robot's speech at work: what it hears staged on the blackboard, a person who speaks
+over it stopping it (barge-in), and on the simulated vest the room it speaks and hears in.
 
-On the simulated vest the microphone and speaker are the simulated room's; on a robot
-they are the ALSA devices its config names. A device or model that is missing is named
-in ``problems`` and the rest runs: without a microphone the robot does not hear, and
-without a speaker its answers fail with the reason.
+:mod:`engine.robot_io.speech_assembly` puts the parts together. A person's voice that
+begins while the robot speaks (the listener's ``on_barge_in``) silences the speaker at
+once, if what it says may be interrupted; the scheduler's hook then tells the robot
+(``on_interrupted``), which halts the tree that was speaking and gives the speaker's turn
+to the person (:class:`PersonsTurn`) until what they said is heard.
 """
 
 from __future__ import annotations
 
 import logging
-import os
 import threading
 from collections import deque
-from collections.abc import Callable, Iterable
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 from engine.blackboard.board import Blackboard
 from engine.blackboard.catalogue import SPEECH_HEARD, SPEECH_NOT_LISTENED
-from engine.clock import Clock
-from engine.errors import ConfigError
-from engine.files.yaml_values import plain
-from engine.hardware.config import AudioConfig
-from engine.loader.substitution import Profile
-from engine.media.audio import Audio, read_wav, with_noise, write_wav
-from engine.media.audio_devices import AlsaMicrophone, AlsaSpeaker, AudioDeviceError
+from engine.media.audio import Audio, read_wav, with_noise
+from engine.media.audio_devices import AlsaMicrophone
+from engine.services.jobs import Job
+from engine.sim.echo_path import EchoPath
 from engine.sim.room import RoomSpeaker, SimulatedRoom
 from engine.speech.listener import Heard, Listener, NotListenedListener
-from engine.speech.phrase_search import PhraseGrammar
-from engine.speech.recognizer import RecognizerError
-from engine.speech.recognizers import default_recognizer
-from engine.speech.settings import SPEECH_PROFILE_PARAMS
 from engine.speech.settling import Settling
-from engine.speech.speaker import Playback, SelfHearing, Speaker, Utterance
-from engine.speech.vad import SileroVad, speech_detector
-from engine.speech.voice_models import default_voice
-from engine.speech.voices import EspeakVoice, Voice, steady_voice
+from engine.speech.speaker import SelfHearing, Speaker
+from engine.speech.voices import Voice, steady_voice
 
 log = logging.getLogger(__name__)
 HEARD_KEPT = 100
@@ -50,34 +42,50 @@ DEAF_STEP_S = 0.05
 NOT_LISTENED_AT_LEAST_S = 0.2
 """A person's speech that overlaps the robot's by less is not told as not listened to
 (the robot's last syllable over the first of an answer)."""
+STOPS_AFTER_S = 0.5
+"""On a virtual clock, the robot stops talking this long after a scripted line spoken over
+it starts (its lead of quiet excluded): the listener finds the voice 0.1 to 0.4 s in, and
+where the sound stops must not depend on a frame more or less on another machine
+(:meth:`RobotSpeech.snapped`; bench/bench_barge_in.py measures the real stop latency)."""
+FLOOR_AT_MOST_S = 10.0
+"""A person who spoke over the robot has the speaker's turn until what they said is heard,
+and at most this long (seconds)."""
+Interrupted = Callable[[float, str, Job], None]
+"""Told ``(onset_s, saying, floor)`` on the scheduler's thread: a person's voice began at
+``onset_s`` (clock seconds) over the robot saying ``saying``, which stopped; ``floor`` is
+done when the person's turn is over (what they said was heard)."""
 
 
-class NoPlayback:
-    """A speaker that is not there: every utterance fails with why."""
+class PersonsTurn:
+    """The turn of a person who spoke over the robot (a job, so that trees wait for it as
+    for each other): over once their utterance ended and was recognized, or after
+    :data:`FLOOR_AT_MOST_S`; on a virtual clock, when a scripted line is heard
+    (:meth:`RobotSpeech.heard_when`), so it ends at the same tick on every machine."""
 
-    def __init__(self, why: str) -> None:
-        self.why = why
+    def __init__(self, speech: RobotSpeech, onset_s: float) -> None:
+        self.speech = speech
+        self.clock = speech.speaker.clock
+        self.until_s = onset_s + FLOOR_AT_MOST_S
+        self.heard_s = speech.heard_after(onset_s) if speech.settle else None
+        self.cancelled = False
 
-    def start(self, audio: Audio, at_s: float) -> None:
-        raise AudioDeviceError(self.why)
+    def done(self) -> bool:
+        now_s = self.clock.now()
+        if self.cancelled or now_s >= self.until_s:
+            return True
+        if self.heard_s is not None:
+            return now_s >= self.heard_s - 1e-9
+        listener = self.speech.listener
+        return listener is None or (not listener.detector.in_speech and listener.settled())
 
-    def stop(self) -> None:
-        """Nothing plays."""
+    def error(self) -> BaseException | None:
+        return None
 
+    def result(self) -> Any:
+        return None
 
-class BothPlaybacks:
-    """The simulated room (which the microphone hears) and a real speaker (for people)."""
-
-    def __init__(self, *parts: Playback) -> None:
-        self.parts = parts
-
-    def start(self, audio: Audio, at_s: float) -> None:
-        for part in self.parts:
-            part.start(audio, at_s)
-
-    def stop(self) -> None:
-        for part in self.parts:
-            part.stop()
+    def cancel(self) -> None:
+        self.cancelled = True
 
 
 @dataclass
@@ -107,6 +115,13 @@ class RobotSpeech:
     _due: list[tuple[float, str]] = field(default_factory=list)
     """On a virtual clock: what was heard, and when it is staged."""
     _due_lock: threading.Lock = field(default_factory=threading.Lock)
+    room_speaker: RoomSpeaker | None = None
+    on_interrupted: Interrupted | None = None
+    """Told each time a person stopped the robot talking (the robot halts the tree)."""
+    _barge_ins: list[tuple[float, float]] = field(default_factory=list)
+    """On a virtual clock: (when the robot stops talking, when the voice began)."""
+    _stopped: list[tuple[float, str]] = field(default_factory=list)
+    """(when the voice began, what the robot was saying), until the scheduler's hook."""
 
     def describe(self) -> str:
         """Which voice speaks and which recognizer hears, in words (told at start-up)."""
@@ -125,10 +140,61 @@ class RobotSpeech:
             self.settling.wait(self.settled)
         if self.room is not None and self.listener is not None:
             self.listener.hear(self.room.capture(now_s), now_s)
-            self._not_listened_in_room(now_s)
+            if self.listener.canceller is None:
+                self._not_listened_in_room(now_s)
         if self.settle:
             self.settling.wait(self.settled)
             self._stage_due(now_s)
+            self._stop_when_due(now_s)
+        with self._due_lock:
+            stopped, self._stopped = self._stopped, []
+        for onset_s, saying in stopped:
+            if self.on_interrupted is not None:
+                self.on_interrupted(onset_s, saying, PersonsTurn(self, onset_s))
+
+    def barged_in(self, onset_s: float) -> None:
+        """A person's voice began at ``onset_s`` over the robot's (the listener's thread):
+        the robot stops talking now (on a virtual clock: as :meth:`snapped` says)."""
+        if not self.settle:
+            self._hush(onset_s)
+            return
+        with self._due_lock:
+            self._barge_ins.append(self.snapped(onset_s))
+
+    def _line_of(self, onset_s: float) -> tuple[float, float] | None:
+        """The scripted line (start, end: clock seconds) a voice found at ``onset_s`` is."""
+        for start_s, end_s in self._lines:
+            if start_s - HEARD_AFTER_LINE_S <= onset_s <= end_s:
+                return start_s, end_s
+        return None
+
+    def heard_after(self, onset_s: float) -> float | None:
+        """On a virtual clock, when the scripted line a voice that began at ``onset_s``
+        belongs to is heard (None: it is no scripted line's)."""
+        line = self._line_of(onset_s)
+        return line[1] + HEARD_AFTER_LINE_S if line is not None else None
+
+    def snapped(self, onset_s: float) -> tuple[float, float]:
+        """On a virtual clock, (when the robot stops, when the voice began) for a voice the
+        VAD found to begin at ``onset_s``: :data:`STOPS_AFTER_S` into the scripted line it
+        belongs to, which began at the line's start (the same on every machine), or at
+        once for a voice that is no scripted line's."""
+        line = self._line_of(onset_s)
+        return (line[0] + STOPS_AFTER_S, line[0]) if line is not None else (onset_s, onset_s)
+
+    def _stop_when_due(self, now_s: float) -> None:
+        with self._due_lock:
+            due = [item for item in self._barge_ins if item[0] <= now_s + 1e-9]
+            self._barge_ins = [item for item in self._barge_ins if item[0] > now_s + 1e-9]
+        for _, onset_s in sorted(due):
+            self._hush(onset_s)
+            self.settling.wait(self.settled)
+
+    def _hush(self, onset_s: float) -> None:
+        saying = self.speaker.hush()
+        if saying is not None:
+            with self._due_lock:
+                self._stopped.append((onset_s, saying))
 
     def heard_when(self, ended_s: float) -> float | None:
         """On a virtual clock, when an utterance whose end the VAD found at ``ended_s``
@@ -233,6 +299,7 @@ class RobotSpeech:
         self.on_not_listened = not_listened  # the simulated room tells what it knows
         if self.listener is not None:
             self.listener.on_heard = stage
+            self.listener.on_barge_in = self.barged_in
             if self.room is None:  # a real microphone: what the listener can tell
                 self.listener.on_not_listened = not_listened
 
@@ -240,7 +307,10 @@ class RobotSpeech:
         """Nothing the room carries changes with the polled senses."""
 
     def world_event(self, kind: str, value: Any) -> None:
-        """A scenario's ``hear:`` is said in the room, now."""
+        """A scenario's ``hear:`` is said in the room, now; its ``echo:`` changes how the
+        microphone hears the robot."""
+        if kind == "echo" and self.room_speaker is not None:
+            self.room_speaker.echo = EchoPath(**value)
         if kind == "hear":
             said: dict[str, Any] = value if isinstance(value, dict) else {"text": str(value)}
             now_s = self.speaker.clock.now()
@@ -254,138 +324,3 @@ class RobotSpeech:
             self.listener.close()
         for close in self.closers:
             close()
-
-
-def build_speech(
-    audio: AudioConfig,
-    clock: Clock,
-    *,
-    on_heard: Callable[[Heard], None] = lambda heard: None,
-    simulated: bool,
-    phrases: Iterable[str],
-    settle: bool,
-    speed: float = 1.0,
-    volume: float = 1.0,
-    voice_name: str | None = None,
-    recognizer_name: str | None = None,
-    children: bool = False,
-    on_utterance: Callable[[Utterance], None] | None = None,
-) -> RobotSpeech:
-    """The speech of a robot with ``audio`` devices (on the simulated vest's room when
-    ``simulated``), listening for ``phrases``; ``children``: it hears children
-    (:func:`~engine.speech.vad.speech_detector`, :mod:`engine.speech.children`).
-    ``settle``: the clock is virtual."""
-    problems: dict[str, str] = {}
-    settling = Settling()
-    self_hearing = SelfHearing()
-    voice, why = default_voice(voice_name)
-    if why:
-        problems["voice"] = why
-    if settle:
-        voice = steady_voice(voice)  # a virtual clock's run is the same every time
-    room = SimulatedRoom(clock) if simulated else None
-    playback: Playback
-    if audio.speaker is not None:
-        card = AlsaSpeaker(audio.speaker)
-        try:
-            card.open(voice.synthesize("a").rate_hz)
-            playback = card if room is None else BothPlaybacks(RoomSpeaker(room), card)
-        except AudioDeviceError as error:  # said at start-up; each answer tries it again
-            problems["speaker"] = str(error)
-            playback = RoomSpeaker(room) if room is not None else card
-    elif room is not None:
-        playback = RoomSpeaker(room)
-    else:
-        playback = NoPlayback("the robot config names no speaker (audio: speaker:)")
-    speaker = Speaker(
-        voice,
-        playback,
-        clock,
-        fallback_voice=EspeakVoice() if voice.name != "espeak" else None,
-        self_hearing=self_hearing,
-        speed=speed,
-        volume=volume,
-        on_utterance=on_utterance,
-        settling=settling,
-        instant_synthesis=settle,
-    )
-    listener: Listener | None = None
-    try:
-        recognizer, instead = default_recognizer(recognizer_name, children=children)
-        if instead:
-            problems["recognizer"] = instead
-        listened = list(phrases)
-        recognizer.listen_for(listened)
-        listener = Listener(
-            speech_detector(SileroVad(), children=children),
-            recognizer,
-            clock,
-            on_heard,
-            self_hearing=self_hearing,
-            settling=settling,
-            whole_turn=PhraseGrammar(listened).is_a_whole_turn,
-        )
-    except (RecognizerError, ImportError) as error:
-        problems["recognizer"] = str(error)
-    speech = RobotSpeech(
-        speaker, listener, room, settling, settle, voice, problems, self_hearing=self_hearing
-    )
-    for part in (playback, *getattr(playback, "parts", ())):
-        if isinstance(part, AlsaSpeaker):
-            speech.closers.append(part.close)
-    if room is None and audio.microphone is not None and listener is not None:
-        heard_by = listener
-        microphone = AlsaMicrophone(audio.microphone, lambda a: heard_by.hear(a, clock.now()))
-        try:
-            microphone.start()
-            speech.microphone = microphone
-        except AudioDeviceError as error:
-            problems["microphone"] = str(error)
-    return speech
-
-
-def audio_folder(folder: Path) -> Callable[[Utterance], None]:
-    """Keeps each utterance as ``NNN-robot.wav`` in ``folder`` (made if missing), its
-    owner's alone (a sentence may quote what a person said: never in a file's name);
-    ConfigError when it cannot be made."""
-    try:
-        folder.mkdir(mode=0o700, parents=True, exist_ok=True)
-    except OSError as error:
-        raise ConfigError(
-            f"--audio-out {folder}: cannot make it ({error.strerror or error})"
-        ) from None
-    count = [0]
-
-    def keep(utterance: Utterance) -> None:
-        count[0] += 1
-        path = folder / f"{count[0]:03d}-robot.wav"
-        try:
-            os.close(os.open(path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600))
-            path.chmod(0o600)  # one of an earlier run, made with another mode
-            write_wav(path, utterance.audio)
-        except OSError as error:
-            log.warning("could not write %s: %s", path, error)
-
-    return keep
-
-
-def speech_settings(profile: Profile | None) -> dict[str, Any]:
-    """The voice, speed, recognizer and hearing a profile asks for, as :func:`build_speech`
-    keywords."""
-    if profile is None:
-        return {}
-    values = {
-        name: plain(profile.params[name].value)
-        for name in SPEECH_PROFILE_PARAMS
-        if name in profile.params
-    }
-    settings: dict[str, Any] = {}
-    if "voice" in values:
-        settings["voice_name"] = str(values["voice"])
-    if "speech_rate" in values:
-        settings["speed"] = float(values["speech_rate"])
-    if "recognizer" in values:
-        settings["recognizer_name"] = str(values["recognizer"])
-    if "hearing" in values:
-        settings["children"] = values["hearing"] == "children"
-    return settings

@@ -6,7 +6,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from engine.blackboard.board import Blackboard
-from engine.blackboard.catalogue import KeyCatalogue
+from engine.blackboard.catalogue import NOTHING, KeyCatalogue
 from engine.clock import Clock
 from engine.dialogs.library import DialogLibrary
 from engine.files.problems import LoadError, Mark, Problem, Problems
@@ -20,10 +20,11 @@ from engine.runtime.scheduler import RunningTree, Scheduler
 from engine.runtime.tree_watch import TreeNews
 from engine.services.actions import ActionLog, TreeActions, TurnTaking
 from engine.services.interfaces import Services
+from engine.services.jobs import Job
 from engine.services.staged_readings import with_staged_readings
-from engine.services.turns import Turns
+from engine.services.turns import SPEAKER, Turns
 from engine.session.blackboard_news import BlackboardNews
-from engine.session.events import TurnTaken
+from engine.session.events import SpokenOver, TurnTaken
 from engine.session.stream import SessionStream
 from engine.values.params import Key
 
@@ -151,6 +152,13 @@ def unwritten_wake_keys(definitions: list[TreeDefinition]) -> list[Problem]:
     ]
 
 
+THE_PERSON = "the person"
+"""Who holds the speaker after speaking over the robot, in the turns' words."""
+PERSONS_PRIORITY = 99
+"""The person's turn outranks every tree (0..99: a tree of 99 waits); only the therapist's
+buttons (100) speak over it."""
+
+
 class Robot:
     """Built trees on one blackboard and clock, ticked by one scheduler; what happens is
     published on one session stream (``session``), which every reader subscribes to."""
@@ -195,7 +203,12 @@ class Robot:
                 self.clock,
                 definition.name,
                 self.action_log,
-                taking=TurnTaking(self.turns, definition.priority, definition.wait_for_turn_s),
+                taking=TurnTaking(
+                    self.turns,
+                    definition.priority,
+                    definition.wait_for_turn_s,
+                    definition.interruptible,
+                ),
             ),
             dialogs=self.behaviors.dialogs,
             on_node_error=self._node_errors,
@@ -214,10 +227,40 @@ class Robot:
         for tree in self.trees:
             self.tree_news.started(tree)
 
+    def spoken_over(self, from_s: float, saying: str, floor: Job) -> None:
+        """A person's voice began at ``from_s`` (clock seconds) over the robot saying
+        ``saying``, which has stopped: the tree that was saying it is halted as an
+        interruption halts it (its other actions stop, its joints go to rest), without
+        trying again: the person's words are what comes next. Until ``floor`` is done the
+        speaker is the person's (priority :data:`PERSONS_PRIORITY`): a tree waits for its
+        turn or lets its sentence go, as it would for another tree."""
+        speaking = [
+            record
+            for record in self.action_log.records
+            if record.action == "say" and record.outcome is None
+        ]
+        said = speaking[-1] if speaking else None
+        tree = said.tree if said is not None else ""
+        self.session.publish(
+            SpokenOver(
+                self.clock.now(),
+                tree,
+                said.action_id if said is not None else 0,
+                saying,
+                from_s,
+                said.carries if said is not None else NOTHING,
+            )
+        )
+        if tree:
+            self.scheduler.tree(tree).halt("a person spoke over it")
+        self.turns.hold((SPEAKER,), THE_PERSON, PERSONS_PRIORITY, floor)
+
     def interrupt(self, name: str, by: str, resource: str) -> None:
         """Halt tree ``name`` cleanly because ``by`` takes ``resource``: its actions stop
         (cut short), its joints go back to rest and its LEDs off. It starts afresh at its
         next tick: with the events of the round cut short when it tries again (once)."""
+        if name == THE_PERSON:
+            return  # the person's turn is over: nothing of theirs to halt
         tree = self.scheduler.tree(name)
         tree.halt(f"{by} interrupted it")
         # once: a round cut short again while trying again lets go (no stutter), and

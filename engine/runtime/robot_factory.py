@@ -136,6 +136,7 @@ def build_robot(
     robot.scheduler.add_hook(EnvelopeWatcher(services.servos, envelope))
     if robot_speech is not None:  # the microphone hears the room the world just changed
         robot.scheduler.add_hook(robot_speech)
+        robot_speech.on_interrupted = robot.spoken_over  # a person spoke over the robot
     vision = None
     if config.camera is not None:  # the camera sees the world just changed, as the chips do
         try:

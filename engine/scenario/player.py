@@ -90,8 +90,8 @@ def changes_of(event: ScenarioEvent) -> list[tuple[float, Change]]:
         return [(at, _happen("gesture", value))]
     if event.kind in ("unplug", "fault"):
         return [(at, _happen(event.kind, dict(value)))]
-    if event.kind == "hear":
-        return [(at, _happen("hear", value))]
+    if event.kind in ("hear", "echo"):
+        return [(at, _happen(event.kind, dict(value)))]
     if event.kind == "show_hand":
         seed = round(at * 1000) * 8 + (value["fingers"] if value["fingers"] is not None else 7)
         held_at = (value["at"][0], value["at"][1]) if value["at"] is not None else None

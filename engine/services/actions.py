@@ -176,12 +176,14 @@ class Acting(Protocol):
 @dataclass(frozen=True)
 class TurnTaking:
     """How one tree takes turns with the others (see :mod:`engine.services.turns`):
-    its ``priority`` (higher interrupts lower) and how long an action of it waits for a
-    busy resource before it is let go (``wait_for_turn_s``; 0: let go at once)."""
+    its ``priority`` (higher interrupts lower), how long an action of it waits for a
+    busy resource before it is let go (``wait_for_turn_s``; 0: let go at once), and
+    whether a person speaking over the robot stops its sentences (``interruptible``)."""
 
     turns: Turns
     priority: int = 0
     wait_for_turn_s: float = 0.0
+    interruptible: bool = True
 
 
 class TreeActions:
@@ -272,15 +274,27 @@ class TreeActions:
         deadline_s = self.clock.now() + taking.wait_for_turn_s
         return WaitingJob(turns, begin, uses, self.tree, priority, deadline_s, what, made_of)
 
-    def say(self, text: str, *, volume: float | None = None, carries: Carries | None = None) -> Job:
-        """Speak ``text`` (made from ``carries`` of a person; None: what the node reads)."""
+    def say(
+        self,
+        text: str,
+        *,
+        volume: float | None = None,
+        carries: Carries | None = None,
+        interruptible: bool | None = None,
+    ) -> Job:
+        """Speak ``text`` (made from ``carries`` of a person; None: what the node reads);
+        ``interruptible``: whether a person's voice stops it (None: as the tree says)."""
         args: dict[str, Any] = {"text": text}
         if volume is not None:
             args["volume"] = volume
+        if interruptible is None:
+            interruptible = self.taking is None or self.taking.interruptible
+        if not interruptible:
+            args["interruptible"] = False
         return self._call(
             "say",
             args,
-            lambda: self.services.speech.say(text, volume=volume),
+            lambda: self.services.speech.say(text, volume=volume, interruptible=interruptible),
             (SPEAKER,),
             f"saying {text!r}",
             carries,

@@ -13,8 +13,9 @@ from engine.services.jobs import Job
 
 
 class Speech(Protocol):
-    def say(self, text: str, *, volume: float | None = None) -> Job:
-        """Speak ``text``; ``volume`` is 0..1 (None: the robot's default)."""
+    def say(self, text: str, *, volume: float | None = None, interruptible: bool = True) -> Job:
+        """Speak ``text``; ``volume`` is 0..1 (None: the robot's default); a person's voice
+        stops it unless not ``interruptible``."""
         ...
 
 

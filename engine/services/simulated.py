@@ -37,7 +37,7 @@ class SimulatedSpeech(_Recording):
         self.clock = clock
         self.seconds_per_word = seconds_per_word
 
-    def say(self, text: str, *, volume: float | None = None) -> Job:
+    def say(self, text: str, *, volume: float | None = None, interruptible: bool = True) -> Job:
         self.calls.append((text, volume))
         return self._refused() or TimedJob(self.clock, self.seconds_per_word * len(text.split()))
 

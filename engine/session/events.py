@@ -246,6 +246,22 @@ class NotListened:
 
 
 @dataclass(frozen=True, slots=True)
+class SpokenOver:
+    """A person's voice began (``from_s``) while the robot was saying ``saying`` (its
+    action ``action_id`` of ``tree``): the robot stopped talking, and the tree's round
+    stopped as an interruption stops it. What the person said is heard as any utterance."""
+
+    kind: ClassVar[str] = "spoken_over"
+    t_s: float
+    tree: str
+    action_id: int
+    saying: str
+    from_s: float
+    carries: Carries = NOTHING
+    """What of a person ``saying`` was made from (a Say that fills in what was heard)."""
+
+
+@dataclass(frozen=True, slots=True)
 class HandShown:
     """The camera saw ``fingers`` held up (a ``/vision/hand/shown`` event)."""
 
@@ -315,6 +331,7 @@ SessionEvent = (
     | Heard
     | NotUnderstood
     | NotListened
+    | SpokenOver
     | HandShown
     | TreeReloaded
     | WorldEvent
@@ -334,6 +351,7 @@ EVENT_TYPES: tuple[type[SessionEvent], ...] = (
     Heard,
     NotUnderstood,
     NotListened,
+    SpokenOver,
     HandShown,
     TreeReloaded,
     WorldEvent,

@@ -20,6 +20,7 @@ from engine.session.events import (
     NotUnderstood,
     SafetyAction,
     SessionEvent,
+    SpokenOver,
     TreeReloaded,
     TurnTaken,
     WorldEvent,
@@ -38,6 +39,7 @@ TOLD_KINDS = (
     HandShown.kind,
     NotUnderstood.kind,
     NotListened.kind,
+    SpokenOver.kind,
     TreeReloaded.kind,
 )
 """The kinds of events told in words (statuses and blackboard keys are shown otherwise)."""
@@ -115,6 +117,8 @@ def event_line(event: SessionEvent) -> tuple[str, str] | None:
         return event.tree, f"does not understand {event.text!r}"
     if isinstance(event, NotListened):
         return "vest", f"did not listen: {event.why}"
+    if isinstance(event, SpokenOver):
+        return event.tree or "vest", f"stops saying {event.saying!r}: a person spoke over it"
     if isinstance(event, TreeReloaded):
         if event.problem:
             return "vest", f"keeps the running {event.tree}: {event.problem}"
@@ -131,7 +135,7 @@ def tone(event: SessionEvent) -> str:
         return "therapist"
     if isinstance(event, ActionEnded):
         return "cut" if event.outcome == "cut" else "failed"
-    if isinstance(event, TurnTaken):
+    if isinstance(event, TurnTaken | SpokenOver):
         return "turn"
     if isinstance(event, SafetyAction):
         return "safety"

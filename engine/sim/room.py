@@ -1,7 +1,8 @@
 """The air around the simulated vest, as its microphone picks it up.
 
 People's speech (a scenario's ``hear:`` events, synthesized or from a WAV), the robot's
-own voice from its speaker (an echo the listener must not answer) and a quiet room hum
+own voice from its speaker (through the room's echo path,
+:mod:`engine.sim.echo_path`: an echo the listener must not answer) and a quiet room hum
 are mixed on one 16 kHz timeline; the microphone captures it piece by piece.
 """
 
@@ -14,11 +15,10 @@ import numpy as np
 
 from engine.clock import Clock
 from engine.media.audio import SPEECH_RATE_HZ, Audio
+from engine.sim.echo_path import EchoPath
 
 HUM_DBFS = -60.0
 """The room's background, RMS below full scale (a quiet therapy room)."""
-ECHO_GAIN = 0.5
-"""How loud the robot's own voice reaches its microphone."""
 
 
 @dataclass
@@ -79,15 +79,16 @@ class SimulatedRoom:
 
 
 class RoomSpeaker:
-    """The simulated vest's speaker: its sound goes into the room (and so into the
-    microphone, at :data:`ECHO_GAIN`). Implements :class:`~engine.speech.speaker.Playback`."""
+    """The simulated vest's speaker: its sound reaches the microphone through the room's
+    ``echo`` path. Implements :class:`~engine.speech.speaker.Playback`."""
 
-    def __init__(self, room: SimulatedRoom, echo_gain: float = ECHO_GAIN) -> None:
+    def __init__(self, room: SimulatedRoom, echo: EchoPath | None = None) -> None:
         self.room = room
-        self.echo_gain = echo_gain
+        self.echo = echo or EchoPath()
 
     def start(self, audio: Audio, at_s: float) -> None:
-        self.room.add(audio.scaled(self.echo_gain), at_s, "robot")
+        heard = self.echo.apply(audio.resampled(SPEECH_RATE_HZ).samples)
+        self.room.add(Audio(heard, SPEECH_RATE_HZ), at_s, "robot")
 
-    def stop(self) -> None:
-        self.room.silence_from(self.room.clock.now(), "robot")
+    def stop(self, at_s: float) -> None:
+        self.room.silence_from(at_s, "robot")

@@ -13,13 +13,19 @@ up drafts nor keeps the worker busy with them when the sentence ends). A draft w
 is a whole turn (``whole_turn``: one of the dialogs' phrases, and none goes on from it)
 shortens the wait for silence (:meth:`~engine.speech.vad.SpeechDetector.whole_turn`).
 
-While the robot speaks, the microphone is ignored
-(:class:`~engine.speech.speaker.SelfHearing`): it never answers its own voice. Someone who
-speaks over the robot is therefore not heard; what can be known of it is told to
+While the robot speaks it keeps listening, and never answers its own voice: an echo
+canceller (:mod:`engine.speech.echo_canceller`) takes what the speaker plays (known from
+:class:`~engine.speech.speaker.SelfHearing`) out of the microphone's audio, and the
+detector is stricter while the robot speaks and just after
+(:attr:`~engine.speech.vad.SpeechDetector.strict`). A person who speaks over the robot is
+heard like anyone else, and told at once to ``on_barge_in(onset_s)`` (when their voice
+began, clock seconds), so the robot can stop talking.
+
+Without a canceller the microphone is ignored while the robot speaks. Someone who speaks
+over it is then not heard; what can be known of it is told to
 ``on_not_listened(from_s, until_s, why)``: here, speech already under way when the robot
-stops (its start was lost). Telling speech *within* the robot's voice apart from its echo
-needs echo cancellation, which a microphone here does not have; the simulated room knows
-who spoke when, and tells it itself (:mod:`engine.robot_io.robot_speech`).
+stops (its start was lost); the simulated room knows who spoke when, and tells it itself
+(:mod:`engine.robot_io.robot_speech`).
 """
 
 from __future__ import annotations
@@ -32,6 +38,7 @@ from dataclasses import dataclass
 
 from engine.clock import Clock
 from engine.media.audio import Audio
+from engine.speech.echo_canceller import EchoCanceller
 from engine.speech.recognizer import Recognizer
 from engine.speech.settling import Settling
 from engine.speech.speaker import SelfHearing
@@ -42,6 +49,8 @@ ALREADY_S = 0.15
 """Speech this soon after the robot fell silent was already under way while it spoke."""
 NotListenedListener = Callable[[float, float, str], None]
 """Told ``(from_s, until_s, why)`` (clock seconds) of speech the robot did not listen to."""
+BargeInListener = Callable[[float], None]
+"""Told when a person's voice began over the robot's (clock seconds)."""
 
 
 @dataclass(frozen=True)
@@ -68,9 +77,12 @@ class Listener:
         settling: Settling | None = None,
         on_not_listened: NotListenedListener | None = None,
         whole_turn: Callable[[str], bool] | None = None,
+        canceller: EchoCanceller | None = None,
+        on_barge_in: BargeInListener | None = None,
     ) -> None:
         """``whole_turn(text)``: whether a draft's text is all a person means to say (None:
-        the robot always waits ``detector.end_silence_s``)."""
+        the robot always waits ``detector.end_silence_s``); ``canceller``: the robot
+        listens while it speaks (None: it is deaf then)."""
         self.detector = detector
         self.recognizer = recognizer
         self.clock = clock
@@ -87,14 +99,34 @@ class Listener:
         """Seconds of microphone audio ignored because the robot was speaking."""
         self.on_not_listened = on_not_listened
         self.whole_turn = whole_turn
+        self.canceller = canceller
+        self.on_barge_in = on_barge_in
         detector.on_pause = self._draft
         self._deaf_since_s: float | None = None
+        self._held_back: list[tuple[Utterance, float | None]] | None = None
         self._listening_since_s: float | None = None
 
     def hear(self, audio: Audio, ends_at_s: float) -> None:
-        """A piece of the microphone stream (16 kHz) that ended at ``ends_at_s``."""
+        """A piece of the microphone stream (16 kHz) that ended at ``ends_at_s``. What it
+        finished (drafts, utterances) goes to the worker once the whole piece is taken, so
+        which draft a later one overtook never depends on how fast the worker was."""
+        self._held_back = []
+        try:
+            self._hear(audio, ends_at_s)
+        finally:
+            held, self._held_back = self._held_back, None
+            for item in held:
+                self._queue.put(item)
+            if held and self._thread is None:
+                self.start()
+
+    def _hear(self, audio: Audio, ends_at_s: float) -> None:
         starts_at_s = ends_at_s - audio.seconds
-        if self.self_hearing.deaf_at(starts_at_s) or self.self_hearing.deaf_at(ends_at_s):
+        speaking = self.self_hearing.deaf_at(starts_at_s) or self.self_hearing.deaf_at(ends_at_s)
+        if self.canceller is not None:
+            self._hear_over_the_robot(audio, starts_at_s, ends_at_s, speaking)
+            return
+        if speaking:
             if self.detector.in_speech:
                 self.detector.reset()  # what was being heard ran into the robot's voice
             self.ignored_s += audio.seconds
@@ -106,6 +138,28 @@ class Listener:
             self._listening_since_s, self._deaf_since_s = starts_at_s, None
         utterances = self.detector.feed(audio.samples)
         self._already_speaking(ends_at_s)
+        for utterance in utterances:
+            late_s = (self.detector.position - utterance.end_sample) / audio.rate_hz
+            self._submit(utterance, ends_at_s - late_s)
+
+    def _hear_over_the_robot(
+        self, audio: Audio, starts_at_s: float, ends_at_s: float, speaking: bool
+    ) -> None:
+        """A piece heard with the robot's own voice taken out; a voice that began over the
+        robot's is told to ``on_barge_in``."""
+        assert self.canceller is not None
+        reference = self.self_hearing.reference(starts_at_s, len(audio.samples))
+        samples = self.canceller.cancel(audio.samples, reference)
+        ends_at_s -= self.canceller.lag_samples / audio.rate_hz  # still in the canceller
+        self.detector.strict = speaking
+        self.detector.held = speaking and not self.canceller.learned
+        utterances = self.detector.feed(samples)
+        onset = self.detector.take_onset()
+        if onset is not None and self.on_barge_in is not None:
+            try:
+                self.on_barge_in(ends_at_s - (self.detector.position - onset) / audio.rate_hz)
+            except Exception:  # whoever listens must not stop the robot hearing
+                log.exception("telling a person spoke over the robot failed")
         for utterance in utterances:
             late_s = (self.detector.position - utterance.end_sample) / audio.rate_hz
             self._submit(utterance, ends_at_s - late_s)
@@ -141,6 +195,9 @@ class Listener:
     def _submit(self, utterance: Utterance, ended_s: float | None) -> None:
         with self._lock:
             self._working += 1
+        if self._held_back is not None:  # within a piece: sent when it is all taken
+            self._held_back.append((utterance, ended_s))
+            return
         self._queue.put((utterance, ended_s))
         if self._thread is None:
             self.start()

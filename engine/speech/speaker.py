@@ -18,9 +18,11 @@ from concurrent.futures import CancelledError
 from dataclasses import dataclass
 from typing import Any, Protocol
 
+import numpy as np
+
 from engine.clock import Clock, ClockEvent
 from engine.errors import ServiceError
-from engine.media.audio import Audio
+from engine.media.audio import SPEECH_RATE_HZ, Audio, Samples
 from engine.services.jobs import Job
 from engine.speech.settling import Settling
 from engine.speech.voices import Voice, VoiceError, sentences
@@ -38,18 +40,21 @@ class Playback(Protocol):
         is playing); return at once. AudioDeviceError (a RuntimeError) when it cannot."""
         ...
 
-    def stop(self) -> None:
-        """Silence now."""
+    def stop(self, at_s: float) -> None:
+        """Silence from ``at_s`` (clock seconds: when the robot decided to stop; a sound
+        card stops now)."""
         ...
 
 
 class SelfHearing:
-    """When the robot speaks (clock seconds), so the microphone can be ignored then and
-    for ``tail_s`` after."""
+    """When the robot speaks and what it plays (clock seconds), so the listener knows when
+    the microphone hears the robot (then and ``tail_s`` after, the room's echo) and can
+    take that voice out of it (:meth:`reference`)."""
 
     def __init__(self, tail_s: float = TAIL_S) -> None:
         self.tail_s = tail_s
         self._spans: list[list[float]] = []
+        self._played: list[tuple[int, Samples]] = []  # (first sample, 16 kHz samples)
         self._lock = threading.Lock()
 
     def speaking(self, from_s: float, until_s: float = float("inf")) -> None:
@@ -60,16 +65,42 @@ class SelfHearing:
             else:
                 self._spans = [*self._spans[-7:], [from_s, until_s]]
 
+    def played(self, audio: Audio, at_s: float) -> None:
+        """The speaker plays ``audio`` from ``at_s``: the voice the microphone will hear."""
+        samples = audio.resampled(SPEECH_RATE_HZ).samples
+        with self._lock:
+            self._played = [*self._played[-15:], (_sample_at(at_s), samples)]
+
     def quiet(self, at_s: float) -> None:
         """The robot stopped speaking at ``at_s`` (cut short, or done)."""
         with self._lock:
             if self._spans:
                 self._spans[-1][1] = min(self._spans[-1][1], at_s)
+            cut = _sample_at(at_s)
+            self._played = [
+                (start, samples[: max(0, cut - start)]) for start, samples in self._played
+            ]
 
     def deaf_at(self, at_s: float) -> bool:
-        """True when sound at ``at_s`` may be the robot's own voice."""
+        """True when sound at ``at_s`` may be the robot's own voice (or its echo)."""
         with self._lock:
             return any(start <= at_s < end + self.tail_s for start, end in self._spans)
+
+    def reference(self, from_s: float, count: int) -> Samples:
+        """What the speaker played over ``count`` samples (16 kHz) from ``from_s``:
+        silence where it played nothing."""
+        first = _sample_at(from_s)
+        mixed = np.zeros(count, dtype=np.float32)
+        with self._lock:
+            for start, samples in self._played:
+                lo, hi = max(first, start), min(first + count, start + len(samples))
+                if lo < hi:
+                    mixed[lo - first : hi - first] += samples[lo - start : hi - start]
+        return mixed
+
+
+def _sample_at(at_s: float) -> int:
+    return round(at_s * SPEECH_RATE_HZ)
 
 
 class SpeechJob:
@@ -80,13 +111,23 @@ class SpeechJob:
     on every machine, however long the worker takes to notice.
     """
 
-    def __init__(self, text: str, volume: float, clock: Clock) -> None:
+    def __init__(
+        self, text: str, volume: float, clock: Clock, *, interruptible: bool = True
+    ) -> None:
         self.text = text
         self.volume = volume
+        self.interruptible = interruptible
+        """Whether a person's voice may stop it (False: a sentence that must finish)."""
+        self.hushed = False
+        """A person spoke over it: its sound stopped, and it waits to be cancelled (by
+        the halt of its tree) rather than end as if it had been said."""
         self.clock = clock
         self.requested_s = clock.now()
         self.stop: ClockEvent = clock.event()
         self.cancelled = False
+        self.cancelled_s = float("inf")
+        """When it was cancelled (clock seconds): its sound stops there, wherever the
+        worker is when it notices."""
         self.ends_s: float | None = None
         self._done = threading.Event()
         self._error: BaseException | None = None
@@ -105,6 +146,8 @@ class SpeechJob:
         return None
 
     def cancel(self) -> None:
+        if not self.cancelled:  # the first cancel says when (its tree was halted then)
+            self.cancelled_s = self.clock.now()
         self.cancelled = True
         self.stop.set()
 
@@ -161,8 +204,9 @@ class Speaker:
         self._thread: threading.Thread | None = None
         self._current: SpeechJob | None = None
 
-    def say(self, text: str, *, volume: float | None = None) -> Job:
-        job = SpeechJob(text, self.volume if volume is None else volume, self.clock)
+    def say(self, text: str, *, volume: float | None = None, interruptible: bool = True) -> Job:
+        volume = self.volume if volume is None else volume
+        job = SpeechJob(text, volume, self.clock, interruptible=interruptible)
         self._queue.put(job)
         if self._thread is None:
             self.start()
@@ -187,10 +231,30 @@ class Speaker:
             if job is not None:
                 job.finish(CancelledError("the speaker was closed"))
 
+    def hush(self) -> str | None:
+        """A person spoke over the robot: silence the utterance playing now, if it may be
+        interrupted, and return what it was saying (None: nothing that may be interrupted
+        plays). Its job stays unfinished until it is cancelled (its tree is halted, the
+        robot's other actions of the round with it), so no tree takes it for said."""
+        current = self._current
+        now_s = self.clock.now()
+        if current is None or not current.interruptible or current.done() or current.hushed:
+            return None
+        if not self.self_hearing.deaf_at(now_s):
+            return None  # still being made: nothing of it was heard yet
+        current.hushed = True
+        self.playback.stop(now_s)
+        self.self_hearing.quiet(now_s)
+        self._free_from_s = min(self._free_from_s, now_s)
+        return current.text
+
     def settled(self) -> bool:
         """Nothing to do now: idle with nothing queued, or waiting on the clock for a sound
         that is still playing (what is queued behind it waits too)."""
         waits = self._waits_until_s
+        current = self._current
+        if current is not None and current.cancelled and waits is not None:
+            return False  # its worker has yet to stop the sound and take the next
         if waits is not None:
             return self.clock.now() < waits
         return self._queue.unfinished_tasks == 0
@@ -239,12 +303,16 @@ class Speaker:
             for index, sentence in enumerate(parts):
                 if job.cancelled:
                     raise CancelledError("cancelled")
+                if job.hushed:  # the rest is not said; it waits for its cancel
+                    ends_s = self._free_from_s = min(self._free_from_s, self.clock.now())
+                    break
                 audio = self._synthesize(sentence).scaled(job.volume)
                 ready_s = job.requested_s if self.instant_synthesis else self.clock.now()
                 if not said:
                     started_s = ends_s = max(ready_s, self._free_from_s)
                 at_s = max(ends_s, ready_s)
                 self.playback.start(audio, at_s)  # the next is synthesized while it plays
+                self.self_hearing.played(audio, at_s)
                 if not said:  # only sound that really plays makes the microphone deaf
                     self.self_hearing.speaking(started_s)
                 said.append(audio)
@@ -255,7 +323,9 @@ class Speaker:
             self._wait_until(ends_s, job)
         finally:
             if said:
-                self.self_hearing.quiet(min(ends_s, self.clock.now()))
+                self.self_hearing.quiet(min(ends_s, self.clock.now(), job.cancelled_s))
+            if job.cancelled:  # what was queued after it may start when it stopped
+                self._free_from_s = min(self._free_from_s, job.cancelled_s)
         if self.on_utterance is not None and said:
             audio = said[0]
             for more in said[1:]:
@@ -269,7 +339,7 @@ class Speaker:
             while self.clock.now() < ends_s and not job.cancelled:
                 self.clock.wait(job.stop, ends_s - self.clock.now())
             if job.cancelled:
-                self.playback.stop()
+                self.playback.stop(job.cancelled_s)
                 raise CancelledError("cancelled")
         finally:
             self._state()

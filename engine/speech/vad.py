@@ -64,6 +64,16 @@ class SileroVad:
         self._detector.reset()
 
 
+BARGE_IN_THRESHOLD = 0.5
+"""While the robot speaks, a frame is a person's voice from this probability up, as at any
+time: the echo canceller leaves too little of the robot's own voice to reach it once it
+has learned the room (until then nobody may start, :attr:`SpeechDetector.held`)."""
+BARGE_IN_S = 0.064
+"""While the robot speaks, speech starts only after this long (two frames) in a row at
+:data:`BARGE_IN_THRESHOLD`: a click of the robot's echo is shorter. Chosen on the tuning
+children of bench/children_speech.py (bench/bench_barge_in.py): longer runs or a higher
+threshold stopped the robot later and never less often for its own voice."""
+
 REOPEN_FRESH_S = 1.0
 """The VAD's network starts afresh when the room rises above its floor after this long
 below it (seconds): its memory of a sound that long ago says nothing of this one."""
@@ -130,6 +140,12 @@ class SpeechDetector:
     noise_floor: NoiseFloor | None = field(default_factory=NoiseFloor)
     """Between utterances, frames no louder than the room's noise are not asked about
     (None: every frame is)."""
+    strict: bool = False
+    """The robot is speaking: speech starts only at :data:`BARGE_IN_THRESHOLD`, held
+    :data:`BARGE_IN_S` (set by the listener for each piece it feeds)."""
+    held: bool = False
+    """No speech may start now (the robot speaks, and its echo cannot yet be told from a
+    person); speech already started goes on."""
 
     def __post_init__(self) -> None:
         self._pending = np.zeros(0, dtype=np.float32)
@@ -143,6 +159,8 @@ class SpeechDetector:
         self._overtaken: deque[Utterance] = deque(maxlen=4)  # drafts speech went on after
         self._lock = threading.Lock()  # whole_turn comes from the listener's worker
         self._below_floor = 0  # frames in a row the noise floor kept from the VAD
+        self._strict_run = 0  # frames in a row at the barge-in threshold
+        self._onset: int | None = None
         self.position = 0
         """Samples taken so far."""
 
@@ -156,8 +174,15 @@ class SpeechDetector:
         self._pending = np.zeros(0, dtype=np.float32)
         self._history.clear()
         self._speech = []
-        self._voiced_frames = self._quiet_frames = 0
+        self._voiced_frames = self._quiet_frames = self._strict_run = 0
         self._forget_draft(overtaken=True)
+
+    def take_onset(self) -> int | None:
+        """Where (samples since the detector started) speech that began while
+        :attr:`strict` began, once: a person speaking over the robot; None: no such start
+        since the last call."""
+        onset, self._onset = self._onset, None
+        return onset
 
     def overtaken(self, draft: Utterance) -> bool:
         """Whether speech went on after ``draft`` (told to ``on_pause``), or the stream was
@@ -197,9 +222,11 @@ class SpeechDetector:
     def _frame(self, frame: Samples) -> Utterance | None:
         probability = self._probability(frame)
         if not self._speech:
-            if probability >= self.start_threshold:
+            if self._starts(probability):
+                if self.strict:  # over the robot's voice: from the run's first frame
+                    self._onset = self.position - self._strict_run * FRAME_SAMPLES
                 self._speech = [*self._history, frame]
-                self._voiced_frames, self._quiet_frames = 1, 0
+                self._voiced_frames, self._quiet_frames, self._strict_run = 1, 0, 0
             else:
                 self._history.append(frame)
             return None
@@ -219,6 +246,18 @@ class SpeechDetector:
         if len(self._speech) * FRAME_S >= self.max_utterance_s:
             return self._end()
         return None
+
+    def _starts(self, probability: float) -> bool:
+        """Whether a frame of this probability starts speech (over the robot's voice, the
+        last of a run of them)."""
+        if self.held:
+            self._strict_run = 0
+            return False
+        if not self.strict:
+            self._strict_run = 0
+            return probability >= self.start_threshold
+        self._strict_run = self._strict_run + 1 if probability >= BARGE_IN_THRESHOLD else 0
+        return self._strict_run >= round(BARGE_IN_S / FRAME_S)
 
     def _probability(self, frame: Samples) -> float:
         """The VAD's probability; 0 for the room's noise between utterances."""

@@ -82,7 +82,9 @@ def test_a_job_failing_later_is_marked_when_its_node_sees_it_fail() -> None:
     future: Future[Any] = Future()
 
     class SlowSpeech:
-        def say(self, text: str, *, volume: float | None = None) -> FutureJob:
+        def say(
+            self, text: str, *, volume: float | None = None, interruptible: bool = True
+        ) -> FutureJob:
             return FutureJob(future)
 
     job = actions_with(log, speech=SlowSpeech()).say("hello")

@@ -10,7 +10,7 @@ from engine.cli import main
 from engine.clock import RealClock
 from engine.hardware.config import AudioConfig
 from engine.media.audio_devices import probe
-from engine.robot_io.robot_speech import build_speech
+from engine.robot_io.speech_assembly import build_speech
 
 pytestmark = pytest.mark.models
 

@@ -33,7 +33,7 @@ class Recorder:
     def start(self, audio: Audio, at_s: float) -> None:
         self.started.append((at_s, audio.seconds))
 
-    def stop(self) -> None:
+    def stop(self, at_s: float) -> None:
         self.stops += 1
 
 
@@ -105,7 +105,7 @@ class Unplugged:
     def start(self, audio: Audio, at_s: float) -> None:
         raise RuntimeError("speaker 'hw:1,0' cannot be opened")
 
-    def stop(self) -> None:
+    def stop(self, at_s: float) -> None:
         """Nothing plays."""
 
 

@@ -1,0 +1,71 @@
+"""How the robot's own voice reaches its microphone on the simulated vest.
+
+A robot's microphone hears its speaker a hand's width away: sooner and far louder than
+any person in the room, colored by the room's reverberation and by the small speaker's
+distortion. The simulated room plays the robot's voice through such a path (a scenario
+may change it, or turn it off: ``echo:`` in docs/hardware-guide.md says how to measure a
+real robot's), so the listener meets what it meets on a robot.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from engine.media.audio import SPEECH_RATE_HZ, Samples
+
+ROOM_SEED = 41
+"""The reverberation's random tail is the same on every run."""
+DIRECT_OVER_REVERB_DB = 10.0
+"""The speaker is close to the microphone: its direct sound is louder than the room's."""
+
+
+@dataclass(frozen=True)
+class EchoPath:
+    """Speaker to microphone: ``delay_s`` (sound's travel and the sound card's buffers),
+    ``gain_db`` (loudness at the microphone against what was played), ``rt60_s`` (the
+    room's reverberation: seconds for it to fall 60 dB), ``distortion`` (0: none; 1: a
+    small speaker driven hard). ``on``: False, the microphone does not hear the robot."""
+
+    delay_s: float = 0.012
+    gain_db: float = -6.0
+    rt60_s: float = 0.35
+    distortion: float = 0.3
+    on: bool = True
+
+    def __post_init__(self) -> None:
+        checks = (
+            (0.0 <= self.delay_s <= 0.5, "delay_s must be 0 to 0.5 s"),
+            (-60.0 <= self.gain_db <= 20.0, "gain_db must be -60 to 20 dB"),
+            (0.0 <= self.rt60_s <= 2.0, "rt60_s must be 0 to 2 s"),
+            (0.0 <= self.distortion <= 1.0, "distortion must be 0 to 1"),
+        )
+        for fine, why in checks:
+            if not fine:
+                raise ValueError(why)
+
+    def response(self) -> Samples:
+        """The room's impulse response (16 kHz): the direct sound, then a tail of
+        reflections falling 60 dB in ``rt60_s``, :data:`DIRECT_OVER_REVERB_DB` below it."""
+        length = max(1, round(self.rt60_s * SPEECH_RATE_HZ))
+        decay = 6.9 / max(self.rt60_s * SPEECH_RATE_HZ, 1.0)  # per sample, in nepers
+        tail = np.random.default_rng(ROOM_SEED).standard_normal(length)
+        tail *= np.exp(-decay * np.arange(length))
+        energy = float(np.sum(np.square(tail[1:]))) or 1.0
+        tail *= np.sqrt(10 ** (-DIRECT_OVER_REVERB_DB / 10) / energy)
+        tail[0] = 1.0
+        return tail.astype(np.float32)
+
+    def apply(self, played: Samples) -> Samples:
+        """What the microphone hears of ``played`` (16 kHz), delay included: longer by the
+        delay and the reverberation's tail; nothing when the path is off."""
+        if not self.on:
+            return np.zeros(0, dtype=np.float32)
+        heard = np.convolve(played, self.response())
+        if self.distortion > 0:
+            drive = 1.0 + 4.0 * self.distortion
+            heard = np.tanh(drive * heard) / drive
+        delay = np.zeros(round(self.delay_s * SPEECH_RATE_HZ), dtype=np.float32)
+        gain = np.float32(10 ** (self.gain_db / 20))
+        return np.concatenate([delay, heard.astype(np.float32) * gain])

@@ -1,0 +1,166 @@
+"""A person who speaks over the robot stops it and is answered; the robot, which hears its
+own voice as a real robot does (the simulated room's echo path), never stops itself."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from engine.cli import main
+from engine.clock import VirtualClock
+from engine.media.audio import SPEECH_RATE_HZ, Audio
+from engine.sim.echo_path import EchoPath
+from engine.sim.room import RoomSpeaker, SimulatedRoom
+from engine.speech.echo_canceller import EchoCanceller
+from engine.speech.listener import Listener
+from engine.speech.speaker import SelfHearing
+from engine.speech.vad import SileroVad, speech_detector
+from engine.speech.voice_models import default_voice
+from engine.speech.voices import steady_voice
+
+pytestmark = pytest.mark.models
+
+ROOT = Path(__file__).resolve().parents[2]
+STORY = "Once upon a time a little robot told a very long story to everyone it met."
+
+
+def run(tmp_path: Path, capsys: pytest.CaptureFixture[str], events: str, *trees: str) -> list[dict]:
+    scenario = tmp_path / "scenario.yaml"
+    scenario.write_text(f"duration_s: 12\nevents:\n{events}", encoding="utf-8")
+    chosen = trees or ("trees/dialog.yaml", "trees/iot_command.yaml")
+    args = ["run", "--fast", "--json", "--trees", *chosen, "--scenario", str(scenario)]
+    assert main(args) == 0
+    return [json.loads(line) for line in capsys.readouterr().out.splitlines() if line]
+
+
+def said(lines: list[dict]) -> list[str]:
+    return [e["args"]["text"] for e in lines if e["event"] == "action" and e["action"] == "say"]
+
+
+@pytest.fixture(autouse=True)
+def in_repo(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.chdir(ROOT)
+
+
+def test_a_child_who_speaks_over_the_robot_stops_it_and_is_answered(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    lines = run(
+        tmp_path,
+        capsys,
+        f"""\
+  - {{at: 1.0, cloud: {{type: say, args: {{text: "{STORY}"}}}}}}
+  - {{at: 3.0, hear: "what is your name"}}
+""",
+    )
+    [stop] = [e for e in lines if e["event"] == "spoken_over"]
+    assert stop["tree"] == "iot_command" and stop["saying"] == STORY
+    voice_began = 3.0 + 0.3  # the scenario's line starts after 0.3 s of quiet
+    assert voice_began <= stop["from"] <= voice_began + 0.3
+    assert stop["t"] - voice_began <= 0.3  # the robot stopped talking within 0.3 s
+    [cut] = [e for e in lines if e["event"] == "outcome" and e["args"].get("text") == STORY]
+    assert cut["outcome"] == "cut" and cut["why"] == "a person spoke over it"
+    assert said(lines) == [STORY, "My name is H B S 2"]  # heard, and answered
+
+
+def test_the_robot_at_full_volume_in_a_loud_echoing_room_never_stops_itself(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # the room makes the robot's voice as loud at the microphone as what it plays, and
+    # rings for 0.8 s; the robot asks questions its own dialog would answer
+    lines = run(
+        tmp_path,
+        capsys,
+        """\
+  - {at: 0.0, echo: {gain_db: 0, rt60_s: 0.8, distortion: 0.6}}
+  - {at: 1.0, cloud: {type: say, args: {text: "What is your name? Do you like animals?"}}}
+  - {at: 5.0, cloud: {type: say, args: {text: "What is the temperature? How are you?"}}}
+""",
+    )
+    assert [e for e in lines if e["event"] in ("spoken_over", "heard")] == []
+    assert said(lines) == [
+        "What is your name? Do you like animals?",
+        "What is the temperature? How are you?",
+    ]
+
+
+def test_a_sentence_that_must_finish_is_heard_out_and_then_the_child_is_answered(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    exercise = tmp_path / "exercise.yaml"
+    exercise.write_text(
+        "name: exercise\npriority: 55\ninterruptible: false\nwake_on: [/sensors/touch/any]\n"
+        "root:\n  Sequence:\n    - Check: {key: /sensors/touch/any, equals: true}\n"
+        f'    - Say: {{text: "{STORY}"}}\n',
+        encoding="utf-8",
+    )
+    lines = run(
+        tmp_path,
+        capsys,
+        """\
+  - {at: 1.0, touch: {pad: 3}}
+  - {at: 3.0, hear: "what is your name"}
+""",
+        "trees/dialog.yaml",
+        str(exercise),
+    )
+    assert [e for e in lines if e["event"] == "spoken_over"] == []
+    [story] = [e for e in lines if e["event"] == "action" and e["args"].get("text") == STORY]
+    assert story["args"]["interruptible"] is False  # told, so a reader sees why
+    [answer] = [e for e in lines if e["event"] == "action" and e["tree"] == "dialog"]
+    assert answer["args"]["text"] == "My name is H B S 2"
+    [waited] = [e for e in lines if e["event"] == "turn"]  # for the story to finish
+    assert (waited["tree"], waited["turn"], waited["other"]) == ("dialog", "waits", "exercise")
+    assert [e for e in lines if e["event"] == "outcome"] == []  # nothing cut short
+    assert answer["t"] > waited["t"]
+
+
+def test_the_listener_tells_when_a_voice_began_over_the_robot() -> None:
+    # two sentences through the room to the robot's microphone, and a person 0.8 s into
+    # the second: the canceller learned the room during the first
+    voice = steady_voice(default_voice(None)[0])
+    first = voice.synthesize("Hello, nice to see you today.").resampled(SPEECH_RATE_HZ)
+    second = voice.synthesize("I love animals. Do you have a pet?").resampled(SPEECH_RATE_HZ)
+    person = voice.synthesize("what is your name").resampled(SPEECH_RATE_HZ).samples * 0.5
+    clock = VirtualClock()
+    room, hearing, onsets = SimulatedRoom(clock), SelfHearing(), []
+    for sentence, at_s in ((first, 0.2), (second, 3.0)):
+        RoomSpeaker(room).start(sentence, at_s)
+        hearing.played(sentence, at_s)
+        hearing.speaking(at_s, at_s + sentence.seconds)
+    room.add(Audio(person, SPEECH_RATE_HZ), 3.8)
+    listener = Listener(
+        speech_detector(SileroVad()),
+        _NoWords(),
+        clock,
+        lambda heard: None,
+        self_hearing=hearing,
+        canceller=EchoCanceller(),
+        on_barge_in=onsets.append,
+    )
+    for _ in range(120):  # 6 s in the microphone's 50 ms pieces
+        clock.advance(0.05)
+        listener.hear(room.capture(clock.now()), clock.now())
+    listener.close()
+    assert len(onsets) == 1 and 3.8 <= onsets[0] <= 4.1  # the person, never the robot
+
+
+def test_a_room_with_its_echo_off_never_hears_the_robot() -> None:
+    clock = VirtualClock()
+    room = SimulatedRoom(clock, hum_dbfs=-120.0)
+    RoomSpeaker(room, EchoPath(on=False)).start(Audio(np.ones(1600, np.float32), 16000), 0.0)
+    clock.advance(0.2)
+    assert float(np.max(np.abs(room.capture(clock.now()).samples))) < 1e-4
+
+
+class _NoWords:
+    name = "none"
+
+    def listen_for(self, phrases: list[str]) -> None:
+        """Nothing to listen for."""
+
+    def transcribe(self, audio: Audio, abandon: object = None) -> object:
+        return type("Text", (), {"text": ""})()
