@@ -40,15 +40,16 @@ def test_every_demo_event_is_answered_by_the_right_behavior_once(capsys, monkeyp
         ("iot_command", "hello from the cloud"),
         ("finger_game", "Let's play a counting game!"),  # a hand held up to the camera
         ("finger_game", "Show me three fingers!"),
-        ("finger_game", "Yes! That's three. Well done!"),
-        ("finger_game", "Show me two fingers!"),
+        ("finger_game", "Yes! That's three. Well done!"),  # a child speaks over it...
+        ("dialog", "My name is H B S 2"),  # ...and is answered
+        ("finger_game", "Let's play a counting game!"),  # the game, stopped, starts again
     ]
     assert [(t, a["color"]) for t, action, a in actions if action == "led"] == [
         ("hug", "pink"),
         ("wave_greeting", "green"),
         ("buttons", "green"),
         ("finger_game", "green"),
-        ("finger_game", "off"),  # the run ends mid-game: halted, its lights go out
+        ("finger_game", "off"),  # spoken over: halted, its lights go out
     ]
     assert [(t, a["joint"], a["angle_deg"]) for t, action, a in actions if action == "servo"] == [
         ("tracking", "neck", 30.0)

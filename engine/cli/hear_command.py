@@ -15,6 +15,8 @@ after a whole phrase, counted in 32 ms frames; 0.8 s for --hearing children), so
 the wait or the recognition, whichever ends later (measured here). A file is heard whole:
 the live robot does not hear speech while it answers.
 --mic listens on the microphone instead (the robot config's, or --device) until Ctrl-C.
+--echo-of PLAYED.wav measures how the robot hears its own voice in FILE.wav (recorded while
+its speaker played PLAYED.wav): the echo path, and whether it would stop for it.
 --text "do you like dogs" hears a typed phrase as the robot would hear it spoken: said by
 the robot's voice (hibari, natural speed), then through the same hearing (its "file" is the
 text, quoted).
@@ -87,6 +89,15 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--dialog", default="default", help="which dialog answers (default: default)"
     )
     parser.add_argument("--json", action="store_true", help="one JSON object per utterance")
+    parser.add_argument(
+        "--echo-of",
+        type=Path,
+        default=None,
+        metavar="PLAYED.wav",
+        help="FILE.wav was recorded on the robot's microphone while its speaker played "
+        "PLAYED.wav: measure the echo path (a scenario's echo: event) and say whether the "
+        "robot would stop for its own voice (exit 1 when it would)",
+    )
 
 
 def load_dialog_named(folder: Path | None, name: str) -> tuple[DialogLibrary, Dialog]:
@@ -119,6 +130,13 @@ def describe(name: str, hearing: Hearing) -> str:
 
 
 def main(args: argparse.Namespace) -> int:
+    if args.echo_of is not None:
+        if len(args.files) != 1 or args.mic or args.text:
+            raise UsageError("--echo-of PLAYED.wav goes with one FILE.wav (the microphone's)")
+        from engine.cli.hear_echo import hear_own_voice
+
+        microphone, speaker = read_wav(args.files[0]), read_wav(args.echo_of)
+        return hear_own_voice(microphone, speaker, str(args.files[0]), as_json=args.json)
     if args.mic and (args.files or args.text):
         raise UsageError("give WAV files or --text, or --mic, not both")
     if not args.mic and not args.files and not args.text:

@@ -10,8 +10,10 @@ real robot's), so the listener meets what it meets on a robot.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 
 from engine.media.audio import SPEECH_RATE_HZ, Samples
 
@@ -57,6 +59,28 @@ class EchoPath:
         tail[0] = 1.0
         return tail.astype(np.float32)
 
+    @classmethod
+    def measured(cls, played: Samples, heard: Samples) -> EchoPath:
+        """The path that made ``heard`` (the microphone, 16 kHz) of ``played`` (what the
+        speaker played, from the same moment): the delay where they match best, the direct
+        sound's gain, and the room's rt60 from the decay of the response (Schroeder's
+        backward integration, fitted from -5 to -25 dB). Distortion is not measured (it
+        stays the default). ValueError when ``heard`` holds nothing of ``played``."""
+        size = 1 << (len(played) + len(heard) - 1).bit_length()
+        spectrum = np.fft.rfft(played, size)
+        power = np.abs(spectrum) ** 2
+        ratio = np.fft.rfft(heard, size) * np.conj(spectrum) / (power + 1e-3 * power.mean())
+        response = np.fft.irfft(ratio, size)[: 4 * SPEECH_RATE_HZ]
+        lag = int(np.argmax(np.abs(response[: SPEECH_RATE_HZ // 2])))
+        direct = float(np.abs(response[lag]))
+        if direct < 1e-4:
+            raise ValueError("the recording holds nothing of what was played")
+        return cls(
+            delay_s=lag / SPEECH_RATE_HZ,
+            gain_db=float(np.clip(20 * np.log10(direct), -60.0, 20.0)),
+            rt60_s=float(np.clip(_rt60_s(response[lag + round(0.003 * SPEECH_RATE_HZ) :]), 0, 2)),
+        )
+
     def apply(self, played: Samples) -> Samples:
         """What the microphone hears of ``played`` (16 kHz), delay included: longer by the
         delay and the reverberation's tail; nothing when the path is off."""
@@ -69,3 +93,24 @@ class EchoPath:
         delay = np.zeros(round(self.delay_s * SPEECH_RATE_HZ), dtype=np.float32)
         gain = np.float32(10 ** (self.gain_db / 20))
         return np.concatenate([delay, heard.astype(np.float32) * gain])
+
+
+def _rt60_s(tail: npt.NDArray[np.floating[Any]]) -> float:
+    """Seconds for the reflections in ``tail`` (a response after its direct sound) to fall
+    60 dB: the energy still to come, from where it falls 5 dB to where it falls 25 dB,
+    extrapolated; the response's noise floor (its level 2 to 3 s on) is taken out first."""
+    energy = np.square(tail[: 3 * SPEECH_RATE_HZ].astype(np.float64))
+    floor = float(np.mean(energy[2 * SPEECH_RATE_HZ :]))
+    envelope = np.convolve(energy, np.ones(160) / 160, mode="same")
+    below = np.nonzero(envelope < 2 * floor)[0]
+    energy = np.clip(energy[: below[0] if len(below) else len(energy)] - floor, 0, None)
+    to_come = np.cumsum(energy[::-1])[::-1]
+    if len(to_come) < 10 or to_come[0] <= 0:
+        return 0.0
+    decay_db = 10 * np.log10(to_come / to_come[0] + 1e-12)
+    fitted = (decay_db <= -5) & (decay_db >= -25)
+    if fitted.sum() < 10:
+        return 0.0
+    times_s = np.arange(len(decay_db)) / SPEECH_RATE_HZ
+    slope = float(np.polyfit(times_s[fitted], decay_db[fitted], 1)[0])
+    return -60.0 / slope if slope < 0 else 0.0
