@@ -42,13 +42,16 @@ LENGTH_S = {"pat": (0.3, 0.1, 10.0), "squeeze": (2.0, 0.1, 10.0)}
 """How long a pat and a squeeze last by default, and the least and most a try may ask."""
 STRENGTH_N = (6.0, 0.5, 50.0)
 APART_S = (1.5, 0.2, 10.0)
+SIDES = ("both", "left", "right")
+"""Which side pads a tried squeeze presses."""
 
 
 def tried_events(asked: object, pads: list[str], at_s: float = TRY_AT_S) -> list[dict[str, object]]:
     """The scenario events the page asked for, from ``at_s`` on: ``{"kind": "pat", "pad":
     ...}``, ``{"kind": "squeeze", "strength_n": ...}``, ``{"kind": "say", "text": ...}`` or
     ``{"kind": "wave"}``, each with ``seconds`` (how long a pat or squeeze lasts),
-    ``times`` (1 to 5) and ``apart_s`` (seconds from one start to the next)."""
+    ``times`` (1 to 5) and ``apart_s`` (seconds from one start to the next); a squeeze's
+    ``side`` is ``both`` (a hug, the default), ``left`` or ``right``."""
     if not isinstance(asked, dict):
         raise TryError("event: a pat, a squeeze, a phrase said or a wave")
     kind = asked.get("kind")
@@ -68,7 +71,11 @@ def tried_events(asked: object, pads: list[str], at_s: float = TRY_AT_S) -> list
     elif kind == "squeeze":
         strength = _number(asked, "strength_n", STRENGTH_N)
         seconds = _number(asked, "seconds", LENGTH_S["squeeze"])
-        one = {"squeeze": {"left_n": strength, "right_n": strength, "seconds": seconds}}
+        side = asked.get("side") or "both"
+        if side not in SIDES:
+            raise TryError(f"side: {str(side)[:20]!r} is not one of {', '.join(SIDES)}")
+        left, right = (strength if side in (s, "both") else 0.0 for s in ("left", "right"))
+        one = {"squeeze": {"left_n": left, "right_n": right, "seconds": seconds}}
     elif kind == "say":
         said = asked.get("text")
         if not isinstance(said, str) or not said.strip() or len(said) > MAX_SAID:
@@ -110,20 +117,38 @@ class TryOnSimulatedVest:
         self._watching: tuple[subprocess.Popen[str], Path] | None = None
 
     def __call__(self, name: str, text: str, asked: object) -> list[str]:
-        """The timeline of ``text`` (the file ``name``) tried with the event ``asked``;
-        TryError (a ValueError) for an event that cannot be or a run that failed."""
+        """The timeline of ``text`` (the file ``name``) tried with the event ``asked`` (as
+        the profile ``asked["profile"]`` sets the trees, when it names one); TryError (a
+        ValueError) for an event that cannot be or a run that failed."""
         events = tried_events(asked, self.pads)
+        profile = self._profile(asked)
         if not self._one_at_a_time.acquire(blocking=False):
             raise TryError("another try is running: wait for its answer")
         try:
-            return self._tried(name, text, events)
+            return self._tried(name, text, events, profile)
         finally:
             self._one_at_a_time.release()
 
-    def _tried(self, name: str, text: str, events: list[dict[str, object]]) -> list[str]:
+    def _profile(self, asked: object) -> str | None:
+        """The profile a try asks for (a file of trees/profiles/ by its name), or None."""
+        wanted = asked.get("profile") if isinstance(asked, dict) else None
+        if wanted in (None, ""):
+            return None
+        folder = self.folder / "trees" / "profiles"
+        names = sorted(p.stem for p in folder.glob("*.yaml")) if folder.is_dir() else []
+        if wanted not in names:
+            known = ", ".join(names) or "none"
+            raise TryError(f"profile: no profile {str(wanted)[:40]!r} (profiles: {known})")
+        return str(wanted)
+
+    def _tried(
+        self, name: str, text: str, events: list[dict[str, object]], profile: str | None
+    ) -> list[str]:
         with tempfile.TemporaryDirectory(prefix="vest-try-") as scratch:
             last_s = max(float(str(event["at"])) for event in events)
             command = self._command(Path(scratch), name, text, events, last_s + TRY_FOR_S)
+            if profile is not None:
+                command += ["--profile", profile]
             try:
                 done = subprocess.run(
                     [*command, "--fast", "--json"],
@@ -152,10 +177,12 @@ class TryOnSimulatedVest:
         the live view (on ``host``, as the editor): the view's address. The run before
         is stopped; TryError when it cannot start."""
         events = tried_events(asked, self.pads, WATCH_AT_S)
+        profile = self._profile(asked)
         with self._one_at_a_time:
             self.stop_watching()
             scratch = Path(tempfile.mkdtemp(prefix="vest-watch-"))
             command = self._command(scratch, name, text, events, WATCH_FOR_S)
+            command += ["--profile", profile] if profile is not None else []
             command += ["--view", "--view-port", "0", "--view-host", host]
             process = subprocess.Popen(
                 command, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True

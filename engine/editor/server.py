@@ -15,7 +15,10 @@ stack (:mod:`engine.web`), in a thread of its own.
   when the event or the run cannot be); ``POST /api/watch`` the same in real time under
   the live view, answering the view's address;
 - ``POST /api/hear`` ``{"file", "outline", "version"}`` a dialog's phrases said and heard
-  as the robot hears them (vest dialogs check --quick).
+  as the robot hears them (vest dialogs check --quick);
+- ``GET /api/profiles`` what each profile sets (and the profiles that do not load);
+  ``POST /api/profile`` ``{"profile", "setting", "value"}`` has a profile set a tree's
+  setting (``value`` null: no longer), written in place in its file.
 
 Bodies are JSON; every request asks for the token in the address ``vest edit`` prints, on
 loopback too, and a page of another site is refused (:mod:`engine.web.guard`).
@@ -110,6 +113,7 @@ class EditorServer:
             Route("/api/file", self._read),
             Route("/api/check", self._check, methods=["POST"]),
             Route("/api/save", self._save, methods=["POST"]),
+            Route("/api/profile", self._profile, methods=["POST"]),
         ]
         if self.try_out is not None:
             routes.append(Route("/api/try", self._try, methods=["POST"]))
@@ -161,6 +165,9 @@ class EditorServer:
     async def _save(self, request: Request) -> Response:
         return await self._answer(request, self._saved)
 
+    async def _profile(self, request: Request) -> Response:
+        return await self._answer(request, self._set_in_profile, of_a_file=False)
+
     async def _try(self, request: Request) -> Response:
         return await self._answer(request, self._tried)
 
@@ -171,12 +178,16 @@ class EditorServer:
         return await self._answer(request, self._watched)
 
     async def _answer(
-        self, request: Request, work: Callable[[dict[str, Any]], dict[str, Any]]
+        self,
+        request: Request,
+        work: Callable[[dict[str, Any]], dict[str, Any]],
+        *,
+        of_a_file: bool = True,
     ) -> Response:
         """The page's JSON body, worked on in a thread of the pool (a long check or try
         never holds up the server's other requests); a refusal in words."""
         try:
-            body = await self._body(request)
+            body = await self._body(request, of_a_file=of_a_file)
             return JSONResponse(await run_in_threadpool(work, body))
         except EditRefused as refused:
             return _refused(refused)
@@ -223,6 +234,14 @@ class EditorServer:
         )
         return {"version": saved.version, "problems": saved.problems}
 
+    def _set_in_profile(self, body: dict[str, Any]) -> dict[str, Any]:
+        profile, setting = body.get("profile"), body.get("setting")
+        if not isinstance(profile, str) or not isinstance(setting, str):
+            raise EditRefused(400, "profile and setting are names")
+        self.workspace.set_in_profile(profile, setting, body.get("value"))
+        profiles, problems = self.workspace.profiles()
+        return {"profiles": profiles, "problems": problems}
+
     def _tried(self, body: dict[str, Any]) -> dict[str, Any]:
         assert self.try_out is not None
         name, text = self._runnable(body)
@@ -247,9 +266,9 @@ class EditorServer:
         except ValueError as why:
             raise EditRefused(400, str(why)) from None
 
-    async def _body(self, request: Request) -> dict[str, Any]:
-        """The page's JSON body naming a file and holding an outline; EditRefused (400,
-        403) for one that is not the page's."""
+    async def _body(self, request: Request, *, of_a_file: bool = True) -> dict[str, Any]:
+        """The page's JSON body (``of_a_file``: naming a file and holding an outline);
+        EditRefused (400, 403) for one that is not the page's."""
         kind = request.headers.get("content-type", "").split(";")[0].strip().lower()
         if kind != "application/json":
             raise EditRefused(400, 'send JSON: {"file": ..., "outline": ...}')
@@ -257,7 +276,11 @@ class EditorServer:
             body = json.loads(await request.body())
         except (ValueError, RecursionError):
             raise EditRefused(400, "the body is not JSON") from None
-        if not isinstance(body, dict) or not isinstance(body.get("file"), str):
+        if not isinstance(body, dict):
+            raise EditRefused(400, "send a JSON object")
+        if not of_a_file:
+            return body
+        if not isinstance(body.get("file"), str):
             raise EditRefused(400, 'send JSON: {"file": ..., "outline": ...}')
         if not isinstance(body.get("outline"), dict):
             raise EditRefused(400, "outline: the tree or dialog as the page holds it")

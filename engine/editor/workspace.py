@@ -20,15 +20,19 @@ from __future__ import annotations
 
 import contextlib
 import hashlib
+import math
 import os
+import re
 import threading
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Protocol
 
 import yaml
+from ruamel.yaml.comments import CommentedMap
 
 from engine.dialogs.library import OUTSIDE
+from engine.editor import round_trip
 from engine.files.problems import LoadError, Problem
 from engine.files.whole_file import write_whole
 from engine.files.yaml_source import read_bytes, resolved
@@ -41,6 +45,10 @@ from engine.session.json_values import json_value
 LISTED = ("trees", "dialogs")
 """The folders listed when the folder holds them (a project); else the folder itself."""
 MAX_FILE_BYTES = 1_000_000
+
+
+SETTING_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]{0,63}")
+"""A tree's setting (a ``${name}``), as a profile names it."""
 
 
 class EditRefused(Exception):  # noqa: N818 - a refusal told to the page, not a failure
@@ -152,6 +160,38 @@ class Workspace:
             values = {name: plain(given.value) for name, given in profile.params.items()}
             found[profile.name] = json_value(values)  # a NaN or infinity is shown as nothing
         return found, problems
+
+    def set_in_profile(self, profile: str, setting: str, value: Any) -> None:
+        """The profile called ``profile`` sets ``setting`` to ``value`` (None: it no longer
+        sets it, the tree's own value holds), written in place in its file (its comments
+        kept); EditRefused when there is no such profile or the value is not one."""
+        if not isinstance(setting, str) or not SETTING_NAME.fullmatch(setting):
+            raise EditRefused(400, "setting: letters, digits and _, e.g. left_squeeze_n")
+        if value is not None and not isinstance(value, str | int | float | bool):
+            raise EditRefused(400, f"{setting}: a number, a word or true/false")
+        if isinstance(value, float) and not math.isfinite(value):
+            raise EditRefused(400, f"{setting}: a number, not {value}")
+        folder = self.folder / "trees" / "profiles"
+        for path in sorted(folder.glob("*.y*ml")) if folder.is_dir() else ():
+            name = path.relative_to(self.folder).as_posix()
+            try:
+                found = load_profile(path, name)
+            except LoadError:
+                continue
+            if found.name == profile:
+                break
+        else:
+            raise EditRefused(404, f"no profile {str(profile)[:40]!r} in trees/profiles/")
+        text, version = self.read(name)
+        document, style = round_trip.read(text)
+        params = document.get("params")
+        if not isinstance(params, CommentedMap):
+            params = document["params"] = CommentedMap()
+        if value is None:
+            params.pop(setting, None)
+        else:
+            params[setting] = round_trip.yaml_value(value)
+        self.save(name, round_trip.dumped(document, style, round_trip.newline_of(text)), version)
 
     # -- read, check, save ----------------------------------------------------------------
     def read(self, name: str) -> tuple[str, str]:

@@ -145,9 +145,8 @@ def _lookup(
     found = params.get(name.strip())
     if found is None:
         hint = did_you_mean(name, list(params)) or (
-            "declare it under params: at the top of the file"
-            if params
-            else "add params: with a default at the top of the file"
+            "give the tree this setting: under params: at the top of the file, or New "
+            "setting in the editor"
         )
         problems.add(mark, f"unknown parameter ${{{name}}}", hint)
         return None

@@ -25,6 +25,27 @@ def test_a_squeeze_tried_on_the_hug_as_it_is_on_the_page(project: Path) -> None:
     assert "I love hugs!" in (project / "trees" / "hug.yaml").read_text()  # the file unchanged
 
 
+def test_a_squeeze_on_one_side_presses_that_side_pad_alone() -> None:
+    [left] = tried_events({"kind": "squeeze", "side": "left", "strength_n": 2.5}, PADS)
+    assert left["squeeze"] == {"left_n": 2.5, "right_n": 0.0, "seconds": 2.0}
+    [right] = tried_events({"kind": "squeeze", "side": "right"}, PADS)
+    assert right["squeeze"] == {"left_n": 0.0, "right_n": 6.0, "seconds": 2.0}
+
+
+def test_a_try_with_a_profile_sets_the_trees_as_that_profile_does(project: Path) -> None:
+    # the hug's threshold is the profile's: 2 N for a child; a 2.5 N squeeze is a hug then
+    try_out = TryOnSimulatedVest(project, ROOT / "examples/robots/sim.yaml", PADS)
+    text = (project / "trees" / "hug.yaml").read_text()
+    asked = {"kind": "squeeze", "strength_n": 2.5}
+    assert any(
+        "hug: says" in line
+        for line in try_out("trees/hug.yaml", text, {**asked, "profile": "child"})
+    )
+    assert not any("hug: says" in line for line in try_out("trees/hug.yaml", text, asked))
+    with pytest.raises(TryError, match="no profile 'grandma' .profiles: adult, child"):
+        try_out("trees/hug.yaml", text, {**asked, "profile": "grandma"})
+
+
 def test_repeated_squeezes_are_apart_by_default_so_each_is_a_squeeze_of_its_own() -> None:
     first, second = tried_events({"kind": "squeeze", "times": 2}, PADS)
     assert (first["at"], second["at"]) == (1.0, 4.0)  # 2 s each, a second between
@@ -77,6 +98,7 @@ def test_words_said_reach_a_dialog_tree(project: Path) -> None:
         ({"kind": "pat", "pad": "middle_back", "apart_s": "soon"}, "apart_s: a number"),
         ({"kind": "squeeze", "seconds": True}, "seconds: a number from 0.1 to 10"),
         ({"kind": "wave", "times": 10**400}, "times: 10000000000000000000 is not from 1"),
+        ({"kind": "squeeze", "side": "middle"}, "side: 'middle' is not one of both, left, right"),
     ],
 )
 def test_an_event_that_cannot_be_is_refused_in_words(asked: object, why: str) -> None:
@@ -116,7 +138,7 @@ def test_the_page_tries_two_squeezes_says_what_it_tried_and_forgets_it_for_anoth
     page.get_by_role("button", name="Try it").click()
     expect(page.locator("#tried-what")).to_have_text(
         "Tried on trees/hug.yaml, among the folder's other trees: "
-        "2 times: a squeeze of 4 N, 3 s apart"
+        "2 times: a squeeze of 4 N on both sides, 3 s apart, with the trees' own settings"
     )
     expect(page.locator("#tried")).to_contain_text(
         "4.00 s world: squeezed left 4 N, right 4 N for 2 s", timeout=60_000

@@ -102,6 +102,8 @@ function changed(redrawForm = true) {
     drawOutline();
     if (redrawForm) drawNodeForm();
   }
+  const asked = $("#new-setting-name");
+  if (asked && !asked.value && document.activeElement !== asked) asked.value = unknownSettings()[0] ?? "";
   checkSoon();
 }
 
@@ -277,6 +279,47 @@ function drawSettings() {
 // -- the tree's settings a profile can change (its params) ----------------------------------
 // Each is shown as a field with the unit and range of where the tree uses it, and what each
 // profile sets it to.
+// a new setting: its name and the tree's own value; a node's field then says ${name}
+function addSettingForm(names) {
+  const wanted = unknownSettings().filter((name) => !names.includes(name));
+  const row = make("div", { className: "add-setting" });
+  const name = make("input", { id: "new-setting-name", type: "text", maxLength: 60, value: wanted[0] ?? "", placeholder: "left_squeeze_n" });
+  const value = make("input", { id: "new-setting-value", type: "text", maxLength: 60, placeholder: "3" });
+  const add = make("button", { type: "button", textContent: "Add the setting" });
+  add.addEventListener("click", () => addSetting(name.value.trim(), value.value.trim()));
+  row.append(
+    make("label", { htmlFor: "new-setting-name", textContent: "New setting" }), " ", name, " ",
+    make("label", { htmlFor: "new-setting-value", textContent: "its value here" }), " ", value, " ", add,
+    make("p", { className: "help", id: "new-setting-help", textContent: "A node's value written ${name} (e.g. above: ${left_squeeze_n}) is this setting: the tree's own value, which each profile may change." }),
+  );
+  return row;
+}
+
+function unknownSettings() { // ${name}s the nodes use that the tree does not declare
+  const declared = file.outline.params ?? {};
+  const found = new Set();
+  walk(file.outline.root, (node) => {
+    for (const value of Object.values(node.args)) {
+      if (typeof value !== "string") continue;
+      for (const [, name] of value.matchAll(/\$\{([A-Za-z_][A-Za-z0-9_]*)\}/g)) if (!(name in declared)) found.add(name);
+    }
+  });
+  return [...found];
+}
+
+function addSetting(name, raw) {
+  if (!/^[A-Za-z_][A-Za-z0-9_]*$/.test(name)) {
+    say("A setting's name is letters, digits and _ (no spaces), e.g. left_squeeze_n", "problem");
+    return;
+  }
+  if (name in (file.outline.params ?? {})) { say(`The tree already has the setting ${name}.`, "problem"); return; }
+  if (raw === "") { say(`Give ${name} its value here (a profile may change it), e.g. 3`, "problem"); return; }
+  const value = raw !== "" && !Number.isNaN(Number(raw)) ? Number(raw) : raw === "true" ? true : raw === "false" ? false : raw;
+  change(() => { file.outline.params = { ...(file.outline.params ?? {}), [name]: value }; });
+  drawParams();
+  $(`#param-${name}`)?.focus?.();
+}
+
 function usesOf(name) { // the node fields that hold ${name}
   const found = [];
   walk(file.outline.root, (node) => {
@@ -302,8 +345,9 @@ function drawParams() {
   const box = $("#params");
   const params = file.outline.params ?? {};
   const names = Object.keys(params);
-  box.hidden = names.length === 0 && profileProblems.length === 0;
+  box.hidden = false;
   box.replaceChildren(make("legend", { textContent: "Settings a profile can change" }));
+  box.append(addSettingForm(names));
   for (const name of names) {
     const uses = usesOf(name);
     const like = uses.find((use) => use.field)?.field ?? { kind: "any" };
@@ -318,8 +362,30 @@ function drawParams() {
     box.append(fieldFor(field, params[name], (value, typing = null) => change(() => {
       if (value === undefined) delete params[name]; else params[name] = value;
     }, false, typing), "param"));
+    box.append(profileValues(name));
   }
   for (const problem of profileProblems) box.append(make("p", { className: "problem", textContent: problem }));
+}
+
+// what each profile sets a setting to, changed here and written to the profile's own file
+function profileValues(name) {
+  const row = make("div", { className: "profile-values" });
+  for (const [profile, values] of Object.entries(profiles)) {
+    const id = `profile-${profile}-${name}`;
+    const input = make("input", { id, type: "text", maxLength: 60, value: values[name] === undefined ? "" : shown(values[name]), placeholder: "the tree's own" });
+    input.addEventListener("change", () => setInProfile(profile, name, input.value.trim()));
+    row.append(make("label", { htmlFor: id, textContent: `${profile} profile` }), " ", input, " ");
+  }
+  return row;
+}
+
+async function setInProfile(profile, setting, raw) {
+  const value = raw === "" ? null : !Number.isNaN(Number(raw)) ? Number(raw) : raw === "true" ? true : raw === "false" ? false : raw;
+  const { status, body } = await postJson("/api/profile", { profile, setting, value });
+  if (status !== 200) { say(body.message ?? `the ${profile} profile was not changed (${status})`, "problem"); return; }
+  ({ profiles, problems: profileProblems } = body);
+  say(value === null ? `The ${profile} profile no longer sets ${setting}: the tree's own value holds.` : `The ${profile} profile now sets ${setting} to ${raw} (saved in its file).`);
+  drawParams();
 }
 
 function drawNodeForm() {
@@ -493,6 +559,7 @@ function tryKindChanged() {
   $("#try-pad-field").hidden = kind !== "pat";
   $("#try-text-field").hidden = kind !== "say";
   $("#try-strength-field").hidden = kind !== "squeeze";
+  $("#try-side-field").hidden = kind !== "squeeze";
   $("#try-seconds-field").hidden = kind !== "pat" && kind !== "squeeze";
   $("#try-seconds").placeholder = kind === "squeeze" ? "2" : "0.3";
 }
@@ -504,11 +571,16 @@ function askedTry() { // what the form asks for, and the same in words
   const asked = {
     kind, pad: $("#try-pad").value, text: $("#try-text").value, strength_n: number("#try-strength"),
     seconds: number("#try-seconds"), times: number("#try-times"), apart_s: number("#try-apart"),
+    side: $("#try-side").value, profile: $("#try-profile").value,
   };
   const times = asked.times ?? 1;
-  const what = { pat: `a pat on ${asked.pad}`, squeeze: `a squeeze of ${asked.strength_n ?? 6} N`, say: `"${asked.text}" said`, wave: "a wave" }[kind];
-  const said = times > 1 ? `${times} times: ${what}, ${asked.apart_s ?? 1.5} s apart` : what;
-  return { asked, said };
+  const side = { both: "both sides", left: "the left side pad", right: "the right side pad" }[asked.side];
+  const what = { pat: `a pat on ${asked.pad}`, squeeze: `a squeeze of ${asked.strength_n ?? 6} N on ${side}`, say: `"${asked.text}" said`, wave: "a wave" }[kind];
+  const lasts = asked.seconds ?? { pat: 0.3, squeeze: 2 }[kind] ?? 0; // as the try does
+  const apart = asked.apart_s ?? Math.max(1.5, lasts + 1); // each one over before the next
+  const said = times > 1 ? `${times} times: ${what}, ${apart} s apart` : what;
+  const as = asked.profile ? `, with the ${asked.profile} profile's settings` : ", with the trees' own settings";
+  return { asked, said: said + as };
 }
 
 async function tryIt(event) {
@@ -552,7 +624,18 @@ async function listFiles() {
 
 const leave = () => document.body.dataset.dirty !== "true" || confirm("Leave this tree? Its changes are not saved.");
 
+async function loadProfiles() { // what each profile sets, read again: a profile may have changed
+  ({ profiles, problems: profileProblems } = await getJson("/api/profiles"));
+  const chosen = $("#try-profile").value;
+  $("#try-profile").replaceChildren(
+    make("option", { value: "", textContent: "the tree's own" }),
+    ...Object.keys(profiles).map((name) => make("option", { value: name, textContent: `the ${name} profile's` })),
+  );
+  $("#try-profile").value = chosen in profiles ? chosen : "";
+}
+
 async function open(name, keepMessage = false) {
+  await loadProfiles();
   const read = await getJson("/api/file", { name });
   if (!keepMessage) say("");
   if (read.kind === "dialog") {
@@ -655,7 +738,7 @@ function newTree(event) {
 
 async function main() {
   palette = await getJson("/api/palette");
-  ({ profiles, problems: profileProblems } = await getJson("/api/profiles"));
+  await loadProfiles();
   for (const node of palette.nodes) types.set(node.name, node);
   $("#where").textContent = "";
   await listFiles();
