@@ -19,6 +19,11 @@ CATALOGUE = default_catalogue()
             {"key": "/sensors/force/left_n", "above": 5.0},
             "force on the left side pad above 5 N?",
         ),
+        (  # the live view is told every parameter, those not given as None
+            "Check",
+            {"key": "/sensors/force/left_n", "above": None, "below": 2.0, "equals": None},
+            "force on the left side pad below 2 N?",
+        ),
         (
             "Check",
             {"key": "/sensors/force/left_n", "above": "${hug_threshold_n}"},

@@ -4,6 +4,7 @@ and plots whose labels stay on the page when printed on A4."""
 
 from __future__ import annotations
 
+import dataclasses
 import re
 from pathlib import Path
 
@@ -49,3 +50,23 @@ def test_the_plots_labels_stay_inside_the_page() -> None:
         left = float(x) - (len(text) * 7 if anchor == "end" else half)
         right = float(x) + (len(text) * 7 if anchor == "start" else half)
         assert left >= 0 and right <= 680, (x, anchor, text)
+
+
+def test_one_session_is_told_as_one_not_as_a_first_and_a_latest() -> None:
+    page = progress_html("kid-17", [session(1, 60.0, 3)], [])
+    assert '<p class="meta">1 session from ' in page
+    assert "In this session the person did 3 things and the robot answered 3." in page
+    assert "In the first session" not in page
+
+
+def test_speaking_over_the_robot_counts_each_time_and_those_it_could_not_hear() -> None:
+    spoke = dataclasses.replace(session(1, 60.0, 3), spoken_over=2, not_listened=1)
+    page = progress_html("kid-17", [spoke], [])
+    assert "<td class='num'>3 (1 not heard)</td></tr>" in page
+    assert "Spoke over the robot: times the person spoke while the robot was talking" in page
+
+
+def test_an_axis_s_top_reads_as_a_person_reads_a_number() -> None:
+    quick = dataclasses.replace(session(1, 60.0, 2), answer_s=(0.0884, 0.0884))
+    page = progress_html("kid-17", [quick], [])
+    assert ">0.09</text>" in page and "0.0884" not in page

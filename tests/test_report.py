@@ -149,7 +149,7 @@ def test_the_report_says_what_was_done_in_words_by_kind_and_per_minute(supervise
     # 12 s: 2 touches are 10 a minute, 3 presses 15
     assert "<td>touches</td><td class='num'>2</td><td class='num'>10.0</td>" in page
     assert "<td>button presses</td><td class='num'>3</td><td class='num'>15.0</td>" in page
-    assert "<td>hug</td><td>Both side pads squeezed at once (a hug)" in page  # described
+    assert "<td>hug</td><td>When both sides are squeezed at once (a hug)" in page  # described
 
 
 def test_the_therapist_s_note_is_in_the_report_as_written(supervised: Path) -> None:
@@ -227,3 +227,42 @@ def test_a_control_character_in_a_recording_s_text_never_reaches_the_page() -> N
     assert printable("<td>a\x00b\x1b[31m\x85c\nd\te</td>") == (
         "<td>a\ufffdb\ufffd[31m\ufffdc\nd\te</td>"
     )
+
+
+TWO_SQUEEZES = """\
+name: two_squeezes
+rate_hz: 20
+root:
+  Sequence:
+    - TimesWithin:
+        times: 2
+        within_s: 4
+        child:
+          Check: {key: /sensors/force/left_n, above: 2}
+    - Say: {text: "Two squeezes!"}
+"""
+
+
+def test_the_first_of_two_squeezes_is_counted_not_left_unanswered(
+    tmp_path: Path, capsys, monkeypatch, the_site_key: SiteKey
+) -> None:
+    # "squeezed twice": the robot is right to say nothing at the first squeeze
+    monkeypatch.chdir(ROOT)
+    tree = tmp_path / "two_squeezes.yaml"
+    tree.write_text(TWO_SQUEEZES)
+    scenario = tmp_path / "twice.yaml"
+    scenario.write_text(
+        "duration_s: 8\nevents:\n"
+        "  - {at: 1.0, squeeze: {left_n: 3, seconds: 0.5}}\n"
+        "  - {at: 3.0, squeeze: {left_n: 3, seconds: 0.5}}\n"
+    )
+    path = tmp_path / "s.vest"
+    args = ["run", "--fast", "--speech", "text", "--trees", str(tree), "--scenario", str(scenario)]
+    assert main([*args, "--record", str(path)]) == 0
+    first, second = person_moments(Recording.open(path, the_site_key))
+    assert first.counted_by == "two_squeezes" and first.answer is None
+    assert second.answer is not None and second.answer.args["text"] == "Two squeezes!"
+    assert main(["report", str(path)]) == 0
+    page = path.with_suffix(".html").read_text()
+    assert "counted by two_squeezes, which answers the next one" in page
+    assert "no answer" not in page

@@ -44,7 +44,7 @@ def palette(
         {
             "name": node.name,
             "kind": node.kind,
-            "summary": _plain_doc(node.doc).split("\n", 1)[0],
+            "summary": " ".join(_plain_doc(node.doc).split("\n\n", 1)[0].split()),
             "doc": _plain_doc(node.doc),
             "children": node.children,
             "source": node.source,

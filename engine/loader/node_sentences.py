@@ -58,6 +58,7 @@ def _value(value: Any) -> str:
 
 
 def _check(args: Args, keys: _Keys) -> str:
+    args = {name: value for name, value in args.items() if value is not None}  # not given
     key = args.get("key", "?")
     what = keys.words(key)
     if args.get("item") is not None:

@@ -115,8 +115,8 @@ COUNTING = (
     NodeType(
         "TimesWithin",
         "decorator",
-        """N times within T seconds: the question under it must come true ``times``
-        times within ``within_s`` seconds ("patted twice within 4 seconds").
+        """N times within T seconds: the question under it must come true that many times
+        (times) within that many seconds (within s), as in "patted twice within 4 seconds".
 
         A reading that stays true (a squeeze) counts once until it is false again; each
         event (a pat, a word) counts. SUCCESS when the count is reached (then it starts
@@ -130,8 +130,8 @@ COUNTING = (
     NodeType(
         "HeldFor",
         "decorator",
-        """Held for T seconds: the question under it must stay true for ``seconds``
-        ("a hug held for 3 seconds").
+        """Held for T seconds: the question under it must stay true that long (seconds), as
+        in "a hug held for 3 seconds".
 
         SUCCESS once when it has been true that long (it must be false again before it
         counts again); RUNNING while it is true but not yet that long; FAILURE while it

@@ -73,6 +73,9 @@ class Moment:
     """The kind of thing done, as a scenario names it (touch, squeeze, hear, press...)."""
     stopped_saying: str | None = None
     stopped_after_s: float | None = None
+    counted_by: str | None = None
+    """A tree that counts (twice within, held for) counted this toward its answer to the
+    next one: no answer was due."""
 
     @property
     def of_its_own(self) -> bool:
@@ -183,7 +186,39 @@ def person_moments(recording: Recording) -> list[Moment]:
             None,
         )
         moments.append(Moment(at, did, answers, who, heard, gave_way=gave_way, kind=kind))
-    return moments
+    return _counted(moments, _counting_trees(recording))
+
+
+COUNTING_NODES = ("TimesWithin", "HeldFor")
+"""Nodes whose tree answers only the second (or a held) thing done: the first is counted."""
+
+
+def _counting_trees(recording: Recording) -> set[str]:
+    return {
+        tree.name
+        for tree in recording.trees
+        if any(node.type in COUNTING_NODES for node in tree.nodes)
+    }
+
+
+def _counted(moments: list[Moment], counting: set[str]) -> list[Moment]:
+    """Each unanswered moment that a counting tree counted toward its answer to the next
+    one of the same kind (the first of "squeezed twice"), marked so: the robot did what it
+    was made to do, it did not fail to answer."""
+    marked = list(moments)
+    for index, moment in enumerate(moments):
+        if moment.answer is not None or moment.of_its_own or moment.is_control:
+            continue
+        later = next(
+            (m for m in moments[index + 1 :] if m.who == moment.who and m.kind == moment.kind),
+            None,
+        )
+        if later is None or later.at_s - moment.at_s > ANSWER_WITHIN_S:
+            continue
+        tree = next((a.tree for a in later.answers if a.tree in counting), None)
+        if tree is not None:
+            marked[index] = dataclasses.replace(moment, counted_by=tree)
+    return marked
 
 
 ANSWERING_TREES = 3

@@ -40,10 +40,17 @@ class SessionSummary:
     by_behaviour: dict[str, tuple[float, ...]] = field(default_factory=dict)
     simulated: bool = False
     """A scripted session on the simulated vest (a scenario, or ``--fast``): no person."""
+    counted: int = 0
+    """Things done that a tree counted toward its answer to the next (the first of two)."""
+    spoken_over: int = 0
+    """Times the person spoke over the robot and it stopped to listen (``not_listened``:
+    times it could not listen then)."""
 
     @property
     def answered(self) -> int:
-        return len(self.answer_s)
+        """Things done the robot answered, or counted toward an answer (the first of two
+        squeezes of "squeezed twice")."""
+        return len(self.answer_s) + self.counted
 
     @property
     def did_per_minute(self) -> float | None:
@@ -82,9 +89,11 @@ def summarize(recording: Recording, started: float) -> SessionSummary:
         len(acts),
         tuple(times),
         len(not_understood(recording)),
-        len(moments) - len(acts),
+        sum(moment.not_listened for moment in moments),
         {tree: tuple(found) for tree, found in behaviours.items()},
         simulated(recording.meta),
+        sum(moment.counted_by is not None for moment in acts),
+        sum(moment.stopped_saying is not None for moment in moments),
     )
 
 
@@ -101,13 +110,14 @@ def progress_html(
         f"<title>Progress: {name}</title>",
         f"<style>{STYLE(encoding='utf-8')}</style></head><body>",
         f"<h1>Progress of {name}</h1>",
-        f'<p class="meta">{len(sessions)} sessions'
+        f'<p class="meta">{len(sessions)} session{"" if len(sessions) == 1 else "s"}'
         + (f" from {sessions[0].day} to {sessions[-1].day}" if sessions else "")
         + "</p>",
         f"<p>{html.escape(_in_words(sessions, left_out))}</p>",
         "<p class='meta'>Counted: what the person did (touches, hugs, words, gestures), not "
         "the therapist's presses or an operator's commands, which the session reports list "
-        "too.</p>",
+        "too. Spoke over the robot: times the person spoke while the robot was talking (it "
+        "stopped to listen; not heard: it could not listen then).</p>",
     ]
     if left_out:
         parts.append(
@@ -154,6 +164,16 @@ def _in_words(sessions: list[SessionSummary], left_out: int = 0) -> str:
     if not sessions:
         return "No session of this person is held."
     first, last = sessions[0], sessions[-1]
+    if len(sessions) == 1:
+        took = (
+            f" Typical answer time: {first.median_answer_s:.2f} s."
+            if first.median_answer_s is not None
+            else ""
+        )
+        return (
+            f"In this session the person did {first.did} things and the robot answered "
+            f"{first.answered}.{took} Not understood: {first.not_understood}."
+        )
     words = (
         f"In the first session the person did {first.did} things and the robot answered "
         f"{first.answered}; in the latest, {last.did} and {last.answered}."
@@ -174,6 +194,12 @@ def _in_words(sessions: list[SessionSummary], left_out: int = 0) -> str:
     return words
 
 
+def _spoke_over(session: SessionSummary) -> str:
+    unheard = session.not_listened
+    total = session.spoken_over + unheard
+    return f"{total} ({unheard} not heard)" if unheard else str(total)
+
+
 def _seconds(value: float | None) -> str:
     return "-" if value is None else f"{value:.2f} s"
 
@@ -187,7 +213,7 @@ def _sessions_table(sessions: list[SessionSummary]) -> str:
         f"<td class='num'>{'-' if s.did_per_minute is None else f'{s.did_per_minute:.1f}'}</td>"
         f"<td class='num'>{s.answered}</td>"
         f"<td class='num'>{_seconds(s.median_answer_s)}</td>"
-        f"<td class='num'>{s.not_understood}</td><td class='num'>{s.not_listened}</td></tr>"
+        f"<td class='num'>{s.not_understood}</td><td class='num'>{_spoke_over(s)}</td></tr>"
         for n, s in enumerate(sessions, 1)
     )
     head = "".join(f"<th>{h}</th>" for h in heads)

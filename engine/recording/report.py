@@ -99,6 +99,8 @@ def _answer_cell(moment: Moment) -> tuple[str, str]:
         )
     if moment.control is not None:
         return html.escape(moment.control), "-"
+    if moment.counted_by is not None:
+        return f"counted by {html.escape(moment.counted_by)}, which answers the next one", "-"
     if moment.answer is None and moment.not_understood is None:
         why = f": {moment.gave_way}" if moment.gave_way else ""
         return f'<span class="none">no answer{html.escape(why)}</span>', "-"

@@ -108,7 +108,7 @@ def per_session_plot(
         f'<text x="{left}" y="12" class="plot-title">{html.escape(title)} ({unit})</text>',
         f'<line x1="{left}" y1="{base}" x2="{width - 8}" y2="{base}" class="axis"/>',
         f'<text x="{left - 4}" y="{y(top) + 4:.1f}" class="tick" text-anchor="end">'
-        f"{top:.3g}</text>",
+        f"{_tick(top)}</text>",
         f'<text x="{left - 4}" y="{base + 4}" class="tick" text-anchor="end">0</text>',
     ]
     parts.append(
@@ -137,6 +137,11 @@ def per_session_plot(
         )
     parts.append("</svg>")
     return "".join(parts)
+
+
+def _tick(value: float) -> str:
+    """An axis's top value as a person reads it: 12, 3.5, 0.09."""
+    return f"{value:.0f}" if value >= 10 else f"{value:.1f}" if value >= 1 else f"{value:.2f}"
 
 
 def _marker(shape: str, px: float, py: float, colour: str) -> str:
