@@ -29,7 +29,7 @@ let checking = null;
 const SETTING_LABELS = {
   rate_hz: "Looks how often (times a second)", priority: "Priority",
   wait_for_turn_s: "Waits for its turn (seconds)", when_interrupted: "When cut short",
-  wake_on: "Wakes on (keys)",
+  wake_on: "Wakes on (keys)", interruptible: "A child's voice stops its sentences",
 };
 const settingFields = () => [
   { name: "name", label: "Name", kind: "text", doc: "the tree's name (unique in its folder)" },
