@@ -54,7 +54,7 @@ from engine.sim.echo_path import EchoPath  # noqa: E402
 from engine.speech.echo_canceller import FRAME, EchoCanceller  # noqa: E402
 from engine.speech.listener import Heard, Listener  # noqa: E402
 from engine.speech.recognizer import Recognizer  # noqa: E402
-from engine.speech.recognizers import default_recognizer  # noqa: E402
+from engine.speech.recognizers import NoWords, default_recognizer  # noqa: E402
 from engine.speech.speaker import SelfHearing  # noqa: E402
 from engine.speech.vad import SileroVad, speech_detector  # noqa: E402
 from engine.speech.voice_models import default_voice, load_voice  # noqa: E402
@@ -172,7 +172,7 @@ def listen(
 
     listener = Listener(
         speech_detector(vad, children=True),
-        recognizer or _Deaf(),
+        recognizer or NoWords(),
         clock,
         lambda h: heard.append(h.text) if isinstance(h, Heard) else None,
         self_hearing=hearing,
@@ -188,16 +188,6 @@ def listen(
             listener.settling.wait(listener.settled)
     listener.close()
     return Run(onsets, heard)
-
-
-class _Deaf:
-    name = "none"
-
-    def listen_for(self, phrases: list[str]) -> None:
-        pass
-
-    def transcribe(self, audio: Audio, abandon: object = None) -> object:
-        return type("Text", (), {"text": ""})()
 
 
 def voice_onset_s(samples: np.ndarray, vad: SileroVad) -> float:
@@ -320,7 +310,7 @@ def idle_cpu(vad: SileroVad) -> None:
         clock = VirtualClock()
         canceller = make() if make is not None else None
         listener = Listener(
-            speech_detector(vad), _Deaf(), clock, lambda h: None, canceller=canceller
+            speech_detector(vad), NoWords(), clock, lambda h: None, canceller=canceller
         )  # type: ignore[arg-type]
         started = time.process_time()
         for end in range(CHUNK, len(room) + 1, CHUNK):

@@ -10,7 +10,6 @@ speaks) over the recording: a robot that would stop for its own voice here is to
 from __future__ import annotations
 
 import json
-from collections.abc import Iterable
 
 import numpy as np
 
@@ -20,24 +19,12 @@ from engine.media.audio import SPEECH_RATE_HZ, Audio
 from engine.sim.echo_path import EchoPath
 from engine.speech.echo_canceller import EchoCanceller
 from engine.speech.listener import Listener
-from engine.speech.recognizer import Abandon, Transcript
+from engine.speech.recognizers import NoWords
 from engine.speech.speaker import SelfHearing
 from engine.speech.vad import SileroVad, speech_detector
 
 PIECE = 1024
 """Samples the robot's microphone hands over at a time (64 ms)."""
-
-
-class _NoWords:
-    """Only where a voice begins matters here: nothing is recognized."""
-
-    name = "none"
-
-    def listen_for(self, phrases: Iterable[str]) -> None:
-        """Nothing is listened for."""
-
-    def transcribe(self, audio: Audio, *, abandon: Abandon | None = None) -> Transcript:
-        return Transcript("")
 
 
 def hear_own_voice(heard: Audio, played: Audio, heard_name: str, *, as_json: bool) -> int:
@@ -88,7 +75,7 @@ def _stops_for_itself(microphone: np.ndarray, speaker: np.ndarray) -> list[float
         hearing.speaking(start_s, start_s + len(speaker) / SPEECH_RATE_HZ)
     listener = Listener(
         speech_detector(SileroVad()),
-        _NoWords(),
+        NoWords(),
         clock,
         lambda heard: None,
         self_hearing=hearing,

@@ -35,6 +35,19 @@ class FindsPhrases(Recognizer, Protocol):
         ...
 
 
+class NoWords:
+    """A recognizer that hears no words: for listening only to where speech begins and
+    ends (how a robot hears its own voice, benchmarks of barge-in)."""
+
+    name = "none"
+
+    def listen_for(self, phrases: Iterable[str]) -> None:
+        """Nothing is listened for."""
+
+    def transcribe(self, audio: Audio, *, abandon: Abandon | None = None) -> Transcript:
+        return Transcript("")
+
+
 class SecondOpinion:
     """A fast recognizer, and a careful one that hears again the utterances whose phrase
     the fast one found but is not sure of (:attr:`Transcript.unconfirmed`). The careful

@@ -16,6 +16,7 @@ from engine.sim.echo_path import EchoPath
 from engine.sim.room import RoomSpeaker, SimulatedRoom
 from engine.speech.echo_canceller import EchoCanceller
 from engine.speech.listener import Listener
+from engine.speech.recognizers import NoWords
 from engine.speech.speaker import SelfHearing
 from engine.speech.vad import SileroVad, speech_detector
 from engine.speech.voice_models import default_voice
@@ -135,7 +136,7 @@ def test_the_listener_tells_when_a_voice_began_over_the_robot() -> None:
     room.add(Audio(person, SPEECH_RATE_HZ), 3.8)
     listener = Listener(
         speech_detector(SileroVad()),
-        _NoWords(),
+        NoWords(),
         clock,
         lambda heard: None,
         self_hearing=hearing,
@@ -155,13 +156,3 @@ def test_a_room_with_its_echo_off_never_hears_the_robot() -> None:
     RoomSpeaker(room, EchoPath(on=False)).start(Audio(np.ones(1600, np.float32), 16000), 0.0)
     clock.advance(0.2)
     assert float(np.max(np.abs(room.capture(clock.now()).samples))) < 1e-4
-
-
-class _NoWords:
-    name = "none"
-
-    def listen_for(self, phrases: list[str]) -> None:
-        """Nothing to listen for."""
-
-    def transcribe(self, audio: Audio, abandon: object = None) -> object:
-        return type("Text", (), {"text": ""})()
