@@ -70,3 +70,10 @@ def test_an_axis_s_top_reads_as_a_person_reads_a_number() -> None:
     quick = dataclasses.replace(session(1, 60.0, 2), answer_s=(0.0884, 0.0884))
     page = progress_html("kid-17", [quick], [])
     assert ">0.09</text>" in page and "0.0884" not in page
+
+
+def test_a_squeeze_counted_toward_the_next_one_s_answer_is_not_called_answered() -> None:
+    twice = dataclasses.replace(session(1, 60.0, 2), answer_s=(0.4,), counted=1)
+    page = progress_html("kid-17", [twice], [])
+    assert "did 2 things and the robot answered 1, and counted 1 toward an answer" in page
+    assert "<td class='num'>1 (+1 counted)</td>" in page

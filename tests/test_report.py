@@ -266,3 +266,4 @@ def test_the_first_of_two_squeezes_is_counted_not_left_unanswered(
     page = path.with_suffix(".html").read_text()
     assert "counted by two_squeezes, which answers the next one" in page
     assert "no answer" not in page
+    assert "nothing was said to it" in page  # not "everything it heard matched a rule"

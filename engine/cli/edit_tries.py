@@ -61,6 +61,12 @@ def tried_events(asked: object, pads: list[str], at_s: float = TRY_AT_S) -> list
         lasts_s = float(asked["seconds"])
     default_apart_s = max(APART_S[0], lasts_s + 1.0)  # each one over before the next
     apart_s = _number(asked, "apart_s", (default_apart_s, *APART_S[1:]))
+    if times > 1 and apart_s <= lasts_s:
+        raise TryError(
+            f"apart_s: {apart_s:g} s apart, each lasting {lasts_s:g} s, they would be one long "
+            f"{'squeeze' if kind == 'squeeze' else 'touch'}: set Apart to more than How long "
+            f"(empty: {default_apart_s:g} s)"
+        )
     if kind == "pat":
         pad = asked.get("pad")
         if pad not in pads:

@@ -48,9 +48,14 @@ class SessionSummary:
 
     @property
     def answered(self) -> int:
-        """Things done the robot answered, or counted toward an answer (the first of two
-        squeezes of "squeezed twice")."""
-        return len(self.answer_s) + self.counted
+        """Things done the robot answered (not those it counted toward an answer)."""
+        return len(self.answer_s)
+
+    @property
+    def answered_words(self) -> str:
+        """How many it answered, and how many more it counted toward an answer: "1 (+1
+        counted)"."""
+        return f"{self.answered} (+{self.counted} counted)" if self.counted else str(self.answered)
 
     @property
     def did_per_minute(self) -> float | None:
@@ -170,9 +175,15 @@ def _in_words(sessions: list[SessionSummary], left_out: int = 0) -> str:
             if first.median_answer_s is not None
             else ""
         )
+        counted = (
+            f", and counted {first.counted} toward an answer to the next (the first of "
+            "\u201ctwice\u201d)"
+            if first.counted
+            else ""
+        )
         return (
             f"In this session the person did {first.did} things and the robot answered "
-            f"{first.answered}.{took} Not understood: {first.not_understood}."
+            f"{first.answered}{counted}.{took} Not understood: {first.not_understood}."
         )
     words = (
         f"In the first session the person did {first.did} things and the robot answered "
@@ -211,7 +222,7 @@ def _sessions_table(sessions: list[SessionSummary]) -> str:
         f"<tr><td class='num'>{n}</td><td>{s.day}{' (simulated)' if s.simulated else ''}</td>"
         f"<td class='num'>{s.length_s:.0f} s</td><td class='num'>{s.did}</td>"
         f"<td class='num'>{'-' if s.did_per_minute is None else f'{s.did_per_minute:.1f}'}</td>"
-        f"<td class='num'>{s.answered}</td>"
+        f"<td class='num'>{s.answered_words}</td>"
         f"<td class='num'>{_seconds(s.median_answer_s)}</td>"
         f"<td class='num'>{s.not_understood}</td><td class='num'>{_spoke_over(s)}</td></tr>"
         for n, s in enumerate(sessions, 1)

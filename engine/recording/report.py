@@ -347,7 +347,9 @@ def report_html(recording: Recording, note: str = "") -> str:
                 _table(
                     ["when", "heard", "the robot"],
                     missed,
-                    "everything it heard matched a rule",
+                    "everything it heard matched a rule"
+                    if any(moment.kind == "hear" for moment in moments)
+                    else "nothing was said to it",
                     numeric={0},
                 ),
                 "<h2>What the safety envelope did</h2>",

@@ -99,6 +99,10 @@ def test_words_said_reach_a_dialog_tree(project: Path) -> None:
         ({"kind": "squeeze", "seconds": True}, "seconds: a number from 0.1 to 10"),
         ({"kind": "wave", "times": 10**400}, "times: 10000000000000000000 is not from 1"),
         ({"kind": "squeeze", "side": "middle"}, "side: 'middle' is not one of both, left, right"),
+        (
+            {"kind": "squeeze", "times": 2, "apart_s": 1.5},
+            "1.5 s apart, each lasting 2 s, they would be one long squeeze",
+        ),
     ],
 )
 def test_an_event_that_cannot_be_is_refused_in_words(asked: object, why: str) -> None:

@@ -102,8 +102,7 @@ function changed(redrawForm = true) {
     drawOutline();
     if (redrawForm) drawNodeForm();
   }
-  const asked = $("#new-setting-name");
-  if (asked && !asked.value && document.activeElement !== asked) asked.value = unknownSettings()[0] ?? "";
+  if (file.kind !== "dialog" && !$("#params").contains(document.activeElement)) drawParams(); // where each setting is used
   checkSoon();
 }
 
@@ -282,9 +281,10 @@ function drawSettings() {
 // a new setting: its name and the tree's own value; a node's field then says ${name}
 function addSettingForm(names) {
   const wanted = unknownSettings().filter((name) => !names.includes(name));
+  const typed = { name: $("#new-setting-name")?.value ?? "", value: $("#new-setting-value")?.value ?? "" };
   const row = make("div", { className: "add-setting" });
-  const name = make("input", { id: "new-setting-name", type: "text", maxLength: 60, value: wanted[0] ?? "", placeholder: "left_squeeze_n" });
-  const value = make("input", { id: "new-setting-value", type: "text", maxLength: 60, placeholder: "3" });
+  const name = make("input", { id: "new-setting-name", type: "text", maxLength: 60, value: typed.name && !names.includes(typed.name) ? typed.name : wanted[0] ?? "", placeholder: "left_squeeze_n" });
+  const value = make("input", { id: "new-setting-value", type: "text", maxLength: 60, value: typed.value, placeholder: "3" });
   const add = make("button", { type: "button", textContent: "Add the setting" });
   add.addEventListener("click", () => addSetting(name.value.trim(), value.value.trim()));
   row.append(
@@ -316,6 +316,7 @@ function addSetting(name, raw) {
   if (raw === "") { say(`Give ${name} its value here (a profile may change it), e.g. 3`, "problem"); return; }
   const value = raw !== "" && !Number.isNaN(Number(raw)) ? Number(raw) : raw === "true" ? true : raw === "false" ? false : raw;
   change(() => { file.outline.params = { ...(file.outline.params ?? {}), [name]: value }; });
+  $("#new-setting-name").value = ""; $("#new-setting-value").value = ""; // added: start afresh
   drawParams();
   $(`#param-${name}`)?.focus?.();
 }
@@ -562,6 +563,13 @@ function tryKindChanged() {
   $("#try-side-field").hidden = kind !== "squeeze";
   $("#try-seconds-field").hidden = kind !== "pat" && kind !== "squeeze";
   $("#try-seconds").placeholder = kind === "squeeze" ? "2" : "0.3";
+  tryApartShown();
+}
+
+function tryApartShown() { // the distance the try makes when Apart is left empty
+  const kind = $("#try-kind").value;
+  const lasts = number("#try-seconds") ?? { pat: 0.3, squeeze: 2 }[kind] ?? 0;
+  $("#try-apart").placeholder = String(Math.max(1.5, lasts + 1));
 }
 
 const number = (id) => ($(id).value.trim() === "" ? undefined : Number($(id).value));
@@ -764,6 +772,7 @@ async function main() {
   });
   $("#try-pad").replaceChildren(...palette.pads.map((pad) => make("option", { value: pad, textContent: pad })));
   $("#try-kind").addEventListener("change", tryKindChanged);
+  $("#try-seconds").addEventListener("input", tryApartShown);
   $("#try").addEventListener("submit", (event) => tryIt(event).catch(unreachable));
   $("#watch").addEventListener("click", () => watchIt().catch(unreachable));
   document.addEventListener("keydown", (event) => {
