@@ -57,6 +57,7 @@ class Wizard:
         self._lock = threading.Lock()
         self.states: Broadcast[dict[str, Any]] = Broadcast(robot.clock, PAGE_QUEUE)
         """Each new state, for the pages' streams (the state now: :meth:`state`)."""
+        self._begun = False  # the button's tree has ticked since it was pressed
         self._state: dict[str, Any] = self._current_state()
 
     # -- from any thread ----------------------------------------------------------------------
@@ -99,8 +100,15 @@ class Wizard:
             except queue.Empty:
                 break
             self._carry_out(self.board.buttons[number], now_s, by)
-        if self.doing is not None and self.tree.status.name in ("SUCCESS", "FAILURE"):
-            self._swap(self.idle)  # done: the buttons' tree idles again
+        status = self.tree.status.name
+        if self.doing is not None and status != "INVALID":
+            self._begun = True
+        # done, or cut short after it began (a person spoke over it): it idles again, and
+        # never says its phrase again from the top over the person
+        if self.doing is not None and (
+            status in ("SUCCESS", "FAILURE") or (status == "INVALID" and self._begun)
+        ):
+            self._swap(self.idle)
             self.doing = None
         self._publish()
 
@@ -122,7 +130,7 @@ class Wizard:
             self.doing = None
         elif button.tree is not None:
             self._swap(button.tree)  # what it needs it takes from whoever holds it
-            self.doing = button
+            self.doing, self._begun = button, False
 
     def _pause(self, paused: bool) -> None:
         if paused == self.paused:

@@ -136,7 +136,8 @@ def main(args: argparse.Namespace) -> int:
         from engine.cli.hear_echo import hear_own_voice
 
         microphone, speaker = read_wav(args.files[0]), read_wav(args.echo_of)
-        return hear_own_voice(microphone, speaker, str(args.files[0]), as_json=args.json)
+        names = str(args.files[0]), str(args.echo_of)
+        return hear_own_voice(microphone, speaker, *names, as_json=args.json)
     if args.mic and (args.files or args.text):
         raise UsageError("give WAV files or --text, or --mic, not both")
     if not args.mic and not args.files and not args.text:

@@ -14,10 +14,10 @@ import json
 import numpy as np
 
 from engine.clock import VirtualClock
-from engine.errors import ConfigError
+from engine.errors import ConfigError, DeviceError
 from engine.media.audio import SPEECH_RATE_HZ, Audio
 from engine.sim.echo_path import EchoPath
-from engine.speech.echo_canceller import EchoCanceller
+from engine.speech.echo_canceller import EchoCanceller, NoEchoCancellerError
 from engine.speech.listener import Listener
 from engine.speech.recognizers import NoWords
 from engine.speech.speaker import SelfHearing
@@ -27,16 +27,24 @@ PIECE = 1024
 """Samples the robot's microphone hands over at a time (64 ms)."""
 
 
-def hear_own_voice(heard: Audio, played: Audio, heard_name: str, *, as_json: bool) -> int:
+def hear_own_voice(
+    heard: Audio, played: Audio, heard_name: str, played_name: str, *, as_json: bool
+) -> int:
     """Print the echo path of ``heard`` (the microphone) of ``played`` (the speaker) and
     how often the robot would have stopped for its own voice; 0 when it never would, 1
     when it would (ConfigError when the recording holds nothing of what was played)."""
     microphone = heard.resampled(SPEECH_RATE_HZ).samples
     speaker = played.resampled(SPEECH_RATE_HZ).samples
+    if not np.any(speaker):
+        raise ConfigError(f"{played_name}: silent: play a sentence of the robot's")
     try:
         path = EchoPath.measured(speaker, microphone)
     except ValueError as error:
         raise ConfigError(f"{heard_name}: {error}") from None
+    try:
+        EchoCanceller()
+    except NoEchoCancellerError as error:
+        raise DeviceError(str(error)) from None
     stopped = _stops_for_itself(microphone, speaker)
     event = {
         "delay_s": round(path.delay_s, 3),

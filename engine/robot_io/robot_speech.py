@@ -140,8 +140,7 @@ class RobotSpeech:
             self.settling.wait(self.settled)
         if self.room is not None and self.listener is not None:
             self.listener.hear(self.room.capture(now_s), now_s)
-            if self.listener.canceller is None:
-                self._not_listened_in_room(now_s)
+            self._not_listened_in_room(now_s)
         if self.settle:
             self.settling.wait(self.settled)
             self._stage_due(now_s)
@@ -228,18 +227,21 @@ class RobotSpeech:
         self._spoken_in_room = [span for span in self._spoken_in_room if span[1] > now_s]
         for from_s, until_s in ended:
             steps = max(1, round((until_s - from_s) / DEAF_STEP_S))
-            deaf = [
-                from_s + index * DEAF_STEP_S
-                for index in range(steps)
-                if self.self_hearing.deaf_at(from_s + index * DEAF_STEP_S)
-            ]
+            times = [from_s + index * DEAF_STEP_S for index in range(steps)]
+            deaf = [at_s for at_s in times if self.listener and self.listener.deaf_at(at_s)]
             if len(deaf) * DEAF_STEP_S >= NOT_LISTENED_AT_LEAST_S and self.on_not_listened:
                 missed = len(deaf) * DEAF_STEP_S
+                why = (
+                    "it does not listen while it speaks"
+                    if self.listener is None or self.listener.canceller is None
+                    else "it could not yet tell a voice from its own (it learns the room "
+                    "in its first seconds of speech)"
+                )
                 self.on_not_listened(
                     deaf[0],
                     deaf[-1] + DEAF_STEP_S,
                     f"someone spoke while the robot was speaking ({missed:.1f} s of "
-                    f"{until_s - from_s:.1f} s); it does not listen while it speaks",
+                    f"{until_s - from_s:.1f} s); {why}",
                 )
 
     def settled(self) -> bool:

@@ -239,8 +239,15 @@ class Robot:
             for record in self.action_log.records
             if record.action == "say" and record.outcome is None
         ]
-        said = speaking[-1] if speaking else None
+        # the sentence stopped is the first still under way that says it (another may be
+        # queued behind it); what it carries of a person goes with it, and when no one
+        # sentence is sure, what any of them carries (the consent gate then withholds it)
+        exact = [record for record in speaking if record.args.get("text") == saying]
+        said = exact[0] if exact else None
         tree = said.tree if said is not None else ""
+        carries = said.carries if said is not None else NOTHING
+        if said is None:
+            carries = carries.union(*(record.carries for record in speaking))
         self.session.publish(
             SpokenOver(
                 self.clock.now(),
@@ -248,7 +255,7 @@ class Robot:
                 said.action_id if said is not None else 0,
                 saying,
                 from_s,
-                said.carries if said is not None else NOTHING,
+                carries,
             )
         )
         if tree:

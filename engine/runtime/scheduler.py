@@ -146,6 +146,7 @@ class RunningTree:
                 actions.taking,
                 priority=definition.priority,
                 wait_for_turn_s=definition.wait_for_turn_s,
+                interruptible=definition.interruptible,
             )
 
     def halt(self, why: str = "its tree was stopped") -> None:

@@ -65,16 +65,26 @@ class EchoPath:
         speaker played, from the same moment): the delay where they match best, the direct
         sound's gain, and the room's rt60 from the decay of the response (Schroeder's
         backward integration, fitted from -5 to -25 dB). Distortion is not measured (it
-        stays the default). ValueError when ``heard`` holds nothing of ``played``."""
+        stays the default). ValueError when ``played`` is silent, or ``heard`` holds
+        nothing of it that stands out of its noise, or later than 0.5 s (a delay the
+        simulation does not model: start the recording and the playing together)."""
+        if not np.any(played):
+            raise ValueError("what was played is silent")
         size = 1 << (len(played) + len(heard) - 1).bit_length()
         spectrum = np.fft.rfft(played, size)
         power = np.abs(spectrum) ** 2
         ratio = np.fft.rfft(heard, size) * np.conj(spectrum) / (power + 1e-3 * power.mean())
         response = np.fft.irfft(ratio, size)[: 4 * SPEECH_RATE_HZ]
-        lag = int(np.argmax(np.abs(response[: SPEECH_RATE_HZ // 2])))
+        lag = int(np.argmax(np.abs(response[: 3 * SPEECH_RATE_HZ])))
         direct = float(np.abs(response[lag]))
-        if direct < 1e-4:
-            raise ValueError("the recording holds nothing of what was played")
+        noise = float(np.median(np.abs(response[: 3 * SPEECH_RATE_HZ])))
+        if direct < 1e-4 or direct < 20 * noise:
+            raise ValueError("the recording holds nothing that stands out of what was played")
+        if lag > SPEECH_RATE_HZ // 2:
+            raise ValueError(
+                f"the robot's voice comes {lag / SPEECH_RATE_HZ:.2f} s into the recording, "
+                "later than 0.5 s: start the recording and the playing together"
+            )
         return cls(
             delay_s=lag / SPEECH_RATE_HZ,
             gain_db=float(np.clip(20 * np.log10(direct), -60.0, 20.0)),

@@ -104,6 +104,7 @@ class Listener:
         detector.on_pause = self._draft
         self._deaf_since_s: float | None = None
         self._held_back: list[tuple[Utterance, float | None]] | None = None
+        self._deaf_spans: list[list[float]] = []
         self._listening_since_s: float | None = None
 
     def hear(self, audio: Audio, ends_at_s: float) -> None:
@@ -129,6 +130,7 @@ class Listener:
         if speaking:
             if self.detector.in_speech:
                 self.detector.reset()  # what was being heard ran into the robot's voice
+            self._not_listening(starts_at_s, ends_at_s)
             self.ignored_s += audio.seconds
             if self._deaf_since_s is None:
                 self._deaf_since_s = starts_at_s
@@ -153,6 +155,8 @@ class Listener:
         ends_at_s -= self.canceller.lag_samples / audio.rate_hz  # still in the canceller
         self.detector.strict = speaking
         self.detector.held = speaking and not self.canceller.learned
+        if self.detector.held:  # nobody can be told from the robot yet: not listening
+            self._not_listening(starts_at_s, ends_at_s)
         utterances = self.detector.feed(samples)
         onset = self.detector.take_onset()
         if onset is not None and self.on_barge_in is not None:
@@ -163,6 +167,20 @@ class Listener:
         for utterance in utterances:
             late_s = (self.detector.position - utterance.end_sample) / audio.rate_hz
             self._submit(utterance, ends_at_s - late_s)
+
+    def _not_listening(self, from_s: float, until_s: float) -> None:
+        """It does not listen from ``from_s`` to ``until_s`` (clock seconds)."""
+        with self._lock:
+            if self._deaf_spans and self._deaf_spans[-1][1] >= from_s - 1e-6:
+                self._deaf_spans[-1][1] = until_s
+            else:
+                self._deaf_spans = [*self._deaf_spans[-15:], [from_s, until_s]]
+
+    def deaf_at(self, at_s: float) -> bool:
+        """Whether it was not listening at ``at_s`` (the robot was speaking and it could
+        not tell a person from the robot's voice)."""
+        with self._lock:
+            return any(start <= at_s < end for start, end in self._deaf_spans)
 
     def _already_speaking(self, now_s: float) -> None:
         """Speech found within :data:`ALREADY_S` of the robot falling silent began while

@@ -28,11 +28,17 @@ ROOT = Path(__file__).resolve().parents[2]
 STORY = "Once upon a time a little robot told a very long story to everyone it met."
 
 
-def run(tmp_path: Path, capsys: pytest.CaptureFixture[str], events: str, *trees: str) -> list[dict]:
+def run(tmp_path: Path, capsys: pytest.CaptureFixture[str], events: str, *given: str) -> list[dict]:
     scenario = tmp_path / "scenario.yaml"
     scenario.write_text(f"duration_s: 12\nevents:\n{events}", encoding="utf-8")
-    chosen = trees or ("trees/dialog.yaml", "trees/iot_command.yaml")
-    args = ["run", "--fast", "--json", "--trees", *chosen, "--scenario", str(scenario)]
+    options = [
+        arg
+        for index, arg in enumerate(given)
+        if arg.startswith("--") or (index > 0 and given[index - 1].startswith("--"))
+    ]
+    trees = [arg for arg in given if arg not in options]
+    chosen = trees or ["trees/dialog.yaml", "trees/iot_command.yaml"]
+    args = ["run", "--fast", "--json", "--trees", *chosen, "--scenario", str(scenario), *options]
     assert main(args) == 0
     return [json.loads(line) for line in capsys.readouterr().out.splitlines() if line]
 
@@ -156,3 +162,79 @@ def test_a_room_with_its_echo_off_never_hears_the_robot() -> None:
     RoomSpeaker(room, EchoPath(on=False)).start(Audio(np.ones(1600, np.float32), 16000), 0.0)
     clock.advance(0.2)
     assert float(np.max(np.abs(room.capture(clock.now()).samples))) < 1e-4
+
+
+def test_a_sentence_quoting_the_child_stays_withheld_when_it_is_spoken_over(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # the robot repeats what the child said (two sentences at once: one plays, one waits);
+    # the child's guardian did not consent to keeping speech as text
+    folder = tmp_path / "trees"
+    folder.mkdir()
+    (folder / "echo_back.yaml").write_text(
+        "name: echo_back\npriority: 50\nwait_for_turn_s: 3\nwake_on: [/speech/heard]\n"
+        "root:\n  Sequence:\n"
+        "    - OnEvent: {key: /speech/heard, save_as: /vars/heard}\n"
+        "    - Parallel:\n"
+        '        - Say: {text: "I think you said {/vars/heard}. That is very interesting, '
+        'tell me more about it please, I would love to hear all about it."}\n'
+        '        - Say: {text: "Great!"}\n',
+        encoding="utf-8",
+    )
+    consent = ["data", "consent", "kid-1", "--given-by", "guardian", "--covers", "sensors"]
+    assert main(consent) == 0
+    capsys.readouterr()
+    lines = run(
+        tmp_path,
+        capsys,
+        """\
+  - {at: 1.0, hear: "my secret is pizza"}
+  - {at: 5.5, hear: "what is your name"}
+""",
+        str(folder),
+        "--person",
+        "kid-1",
+    )
+    [stop] = [e for e in lines if e["event"] == "spoken_over"]
+    assert "pizza" not in json.dumps(lines).lower()
+    assert stop["saying"] == "(words not kept: no consent for speech as text)"
+    [cut] = [e for e in lines if e["event"] == "outcome" and e["action_id"] == stop["action_id"]]
+    assert cut["outcome"] == "cut"  # the sentence that was playing, not "Great!" waiting
+
+
+def test_a_therapist_s_phrase_spoken_over_is_not_said_again_over_the_child(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    lines = run(
+        tmp_path,
+        capsys,
+        """\
+  - {at: 0.2, cloud: {type: say, args: {text: "Hello! I am the robot, so happy to meet you."}}}
+  - {at: 6.0, press: Hello}
+  - {at: 6.6, hear: "what is your name"}
+""",
+        "--buttons",
+        "trees/buttons/session.yaml",
+    )
+    hello = [e for e in lines if e["event"] == "action" and e["tree"] == "buttons"]
+    assert [e["args"].get("text") for e in hello if e["action"] == "say"] == [
+        "Hello! I am happy to see you."
+    ]  # once: cut short, never again from the top
+    assert said(lines)[-1] == "My name is H B S 2"
+
+
+def test_a_voice_over_the_robot_before_it_learned_the_room_is_told_as_not_listened_to(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # the robot's very first sentence: its canceller has not yet learned the room
+    lines = run(
+        tmp_path,
+        capsys,
+        f"""\
+  - {{at: 0.5, cloud: {{type: say, args: {{text: "{STORY}"}}}}}}
+  - {{at: 1.0, hear: "what is your name"}}
+""",
+    )
+    assert [e for e in lines if e["event"] == "spoken_over"] == []
+    [missed] = [e for e in lines if e["event"] == "not_listened"]
+    assert "it could not yet tell a voice from its own" in missed["why"]

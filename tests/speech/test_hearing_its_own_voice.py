@@ -68,7 +68,7 @@ def test_the_owner_is_told_the_room_and_that_the_robot_would_not_stop_for_itself
     ("args", "why"),
     [
         (["--mic"], "--echo-of PLAYED.wav goes with one FILE.wav"),
-        (["silence.wav"], "holds nothing of what was played"),
+        (["silence.wav"], "holds nothing that stands out of what was played"),
     ],
 )
 def test_a_recording_that_cannot_say_is_refused_in_words(
@@ -84,3 +84,19 @@ def test_a_recording_that_cannot_say_is_refused_in_words(
     code = main(["hear", *given, "--echo-of", str(tmp_path / "played.wav")])
     assert code != 0
     assert why in capsys.readouterr().err
+
+
+def test_a_recording_started_too_late_or_a_silent_sentence_is_named(
+    played: np.ndarray, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    late = EchoPath(delay_s=0.0).apply(played)
+    write_wav(tmp_path / "played.wav", Audio(played, SPEECH_RATE_HZ))
+    write_wav(tmp_path / "quiet.wav", Audio(np.zeros(16000, np.float32), 16000))
+    heard = np.concatenate([np.zeros(12000, np.float32), late])  # 0.75 s in: recorded first
+    write_wav(tmp_path / "late.wav", Audio(heard, 16000))
+    assert (
+        main(["hear", str(tmp_path / "late.wav"), "--echo-of", str(tmp_path / "played.wav")]) != 0
+    )
+    assert "0.75 s into the recording, later than 0.5 s" in capsys.readouterr().err
+    assert main(["hear", str(tmp_path / "late.wav"), "--echo-of", str(tmp_path / "quiet.wav")]) != 0
+    assert "quiet.wav: silent" in capsys.readouterr().err
