@@ -293,7 +293,7 @@ def barge_ins(sentences: list[np.ndarray], vad: SileroVad, quick: bool) -> None:
             over_right += words(heard) == words(text)
     tried = len(people) * len(levels)
     every = [latency for each in latencies.values() for latency in each]
-    print(f"barge-in: {len(people)} people over the robot at {levels} dB: {tried} sentences")
+    print(f"barge-in: {len(people)} clips over the robot at {levels} dB: {tried} sentences")
     print(f"  not stopped: {missed}")
     for level_db, found in [*latencies.items(), ("all", every)]:
         p50, p90 = np.quantile(found, 0.5), np.quantile(found, 0.9)
