@@ -66,7 +66,9 @@ def test_an_operator_s_cancel_stops_the_tree_carrying_the_command_out(
     [ended] = [e for e in robot.events if e["event"] == "outcome"]
     assert (ended["action"], ended["outcome"]) == ("say", "cut")
     assert ended["why"] == "canceled by the operator"
-    assert ended["t"] - ended["started"] < 3.0  # within a progress report (2 s) and a tick
+    # well before the 12 s sentence would have ended (a progress report comes every 2 s;
+    # a loaded machine takes longer, never as long as the sentence)
+    assert ended["t"] - ended["started"] < 6.0
     [report] = [a for a in robot.actions if a["action"] == "report"]
     assert report["args"]["result"] == {"error": "canceled by the operator"}
     finished = store.ledger.get(robot_id, command.id)  # that report is not sent: it ended
