@@ -27,7 +27,7 @@ from engine.sim.echo_path import EchoPath
 from engine.sim.room import RoomSpeaker, SimulatedRoom
 from engine.speech.listener import Heard, Listener, NotListenedListener
 from engine.speech.settling import Settling
-from engine.speech.speaker import SelfHearing, Speaker
+from engine.speech.speaker import Speaker
 from engine.speech.voices import Voice, steady_voice
 
 log = logging.getLogger(__name__)
@@ -104,7 +104,6 @@ class RobotSpeech:
     _spoken: dict[str, Audio] = field(default_factory=dict)
     heard: deque[Heard] = field(default_factory=lambda: deque(maxlen=HEARD_KEPT))
     """The last utterances heard (text and times), for whoever inspects the robot."""
-    self_hearing: SelfHearing = field(default_factory=SelfHearing)
     blackboard: Blackboard | None = None
     on_not_listened: NotListenedListener | None = None
     _spoken_in_room: list[tuple[float, float]] = field(default_factory=list)

@@ -153,7 +153,6 @@ def build_speech(
         settle,
         voice,
         problems,
-        self_hearing=self_hearing,
         room_speaker=room_speaker,
     )
     for part in (playback, *getattr(playback, "parts", ())):

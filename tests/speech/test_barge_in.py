@@ -28,16 +28,16 @@ ROOT = Path(__file__).resolve().parents[2]
 STORY = "Once upon a time a little robot told a very long story to everyone it met."
 
 
-def run(tmp_path: Path, capsys: pytest.CaptureFixture[str], events: str, *given: str) -> list[dict]:
+def run(
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    events: str,
+    *trees: str,
+    options: tuple[str, ...] = (),
+) -> list[dict]:
     scenario = tmp_path / "scenario.yaml"
     scenario.write_text(f"duration_s: 12\nevents:\n{events}", encoding="utf-8")
-    options = [
-        arg
-        for index, arg in enumerate(given)
-        if arg.startswith("--") or (index > 0 and given[index - 1].startswith("--"))
-    ]
-    trees = [arg for arg in given if arg not in options]
-    chosen = trees or ["trees/dialog.yaml", "trees/iot_command.yaml"]
+    chosen = trees or ("trees/dialog.yaml", "trees/iot_command.yaml")
     args = ["run", "--fast", "--json", "--trees", *chosen, "--scenario", str(scenario), *options]
     assert main(args) == 0
     return [json.loads(line) for line in capsys.readouterr().out.splitlines() if line]
@@ -192,8 +192,7 @@ def test_a_sentence_quoting_the_child_stays_withheld_when_it_is_spoken_over(
   - {at: 5.5, hear: "what is your name"}
 """,
         str(folder),
-        "--person",
-        "kid-1",
+        options=("--person", "kid-1"),
     )
     [stop] = [e for e in lines if e["event"] == "spoken_over"]
     assert "pizza" not in json.dumps(lines).lower()
@@ -213,8 +212,7 @@ def test_a_therapist_s_phrase_spoken_over_is_not_said_again_over_the_child(
   - {at: 6.0, press: Hello}
   - {at: 6.6, hear: "what is your name"}
 """,
-        "--buttons",
-        "trees/buttons/session.yaml",
+        options=("--buttons", "trees/buttons/session.yaml"),
     )
     hello = [e for e in lines if e["event"] == "action" and e["tree"] == "buttons"]
     assert [e["args"].get("text") for e in hello if e["action"] == "say"] == [
