@@ -14,6 +14,8 @@ Two ways to run them, same code:
   :class:`~engine.hardware.branching_clock.BranchingClock` each poll's waits stay in its branch;
 - on threads (:class:`PollerThreads`), one per poller, for the robot.
 
+Both are :mod:`engine.periodic`'s runners: a poller is a worker that says when it is due.
+
 A device that fails is not the end: the poller drops its driver, stages the readings of a
 device that senses nothing (no pad touched, no force, nothing in range) so that a stale
 "touched" does not keep a behavior firing, and ``/devices/<name>/ok`` goes false (the bus
@@ -45,6 +47,7 @@ from engine.hardware.config import DeviceConfig
 from engine.hardware.device_health import DeviceHealth
 from engine.hardware.readings import PollSetup, Staged
 from engine.hardware.xshut import XshutChain
+from engine.periodic import WorkerHook, WorkerThread
 
 _log = logging.getLogger("vest.pollers")
 
@@ -96,6 +99,7 @@ class Poller(Generic[D]):
         self.last_error: str | None = None
         self._resting = False
         self._lock = threading.Lock()  # one poll at a time (a hook and `vest devices`)
+        self._hook = WorkerHook(self)
 
     def __repr__(self) -> str:
         return f"<Poller {self.name} {self.rate_hz:g} Hz>"
@@ -111,16 +115,19 @@ class Poller(Generic[D]):
             return float("-inf")
         return self.origin_s + self.period_index * self.period_s
 
-    # -- as a scheduler hook ---------------------------------------------------------------
+    # -- as a worker (engine.periodic): a scheduler hook inline, a thread for the robot ----
     def __call__(self, now_s: float) -> None:
         """Poll if due at ``now_s`` (clock seconds); a scheduler hook.
 
         The first call sets the phase, so the polls fall on the scheduler's steps.
         """
-        if self.origin_s is None:
-            self.origin_s = now_s
-        elif now_s + 1e-9 < self.next_due_s:
-            return
+        self._hook(now_s)
+
+    def due_s(self) -> float:
+        return self.next_due_s
+
+    def run(self, now_s: float) -> None:
+        """One poll, due at ``now_s``, inside the clock's branch when inline."""
         with branch_of(self.clock):
             self.poll_once()
         self._advance(now_s)
@@ -221,10 +228,34 @@ POLL_MARGIN_S = 0.003
 POLL_DURATION_WINDOW = 16
 
 
-class PollerThreads:
-    """Runs pollers on threads of their own, each at its rate, until :meth:`stop`.
+class _PollAhead:
+    """A poller as a thread's worker: each poll starts early by the longest recent poll,
+    so the reading is staged at the trees' deadline rather than just after it."""
 
-    Each thread waits on ``clock`` for its own stop event (:meth:`Clock.wait`), so a
+    def __init__(self, poller: Poller[Any], clock: Clock) -> None:
+        self.poller = poller
+        self.clock = clock
+        self.name = f"poller-{poller.name}"
+        self._durations_s: deque[float] = deque(maxlen=POLL_DURATION_WINDOW)
+
+    def due_s(self) -> float:
+        if self.poller.origin_s is None:
+            self.poller.origin_s = self.clock.now()
+        lead_s = max(self._durations_s, default=0.0) + POLL_MARGIN_S
+        return self.poller.next_due_s - lead_s
+
+    def run(self, now_s: float) -> None:
+        self.poller.poll_once()
+        finished_s = self.clock.now()
+        self._durations_s.append(finished_s - now_s)
+        self.poller._advance(finished_s)
+
+
+class PollerThreads:
+    """Runs pollers on threads of their own (:class:`~engine.periodic.WorkerThread`), each
+    at its rate, until :meth:`stop`.
+
+    Each thread waits on ``clock`` for its own stop event, so a
     :class:`~engine.clock.VirtualClock` drives the threads as a real clock does, and
     stopping the scheduler never cuts short a driver's sleep inside a poll (which made
     the devices look offline after Ctrl-C).
@@ -233,8 +264,7 @@ class PollerThreads:
     def __init__(self, pollers: Sequence[Poller[Any]], clock: Clock) -> None:
         self.pollers = list(pollers)
         self.clock = clock
-        self._stop = clock.event()
-        self._threads: list[threading.Thread] = []
+        self._workers: list[WorkerThread] = []
 
     def start(self, origin_s: float | None = None) -> None:
         """Start one thread per poller.
@@ -243,44 +273,24 @@ class PollerThreads:
         its device so that the reading is staged just before the trees' deadlines rather
         than just after them, which would cost the reading a whole tree period.
         """
-        if self._threads:
+        if self._workers:
             return
-        self._stop.clear()
         for poller in self.pollers:
             if origin_s is not None:
                 poller.origin_s, poller.period_index = origin_s, 0
-            thread = threading.Thread(
-                target=self._run, args=(poller,), name=f"poller-{poller.name}", daemon=True
-            )
-            self._threads.append(thread)
-            thread.start()
+            worker = WorkerThread(_PollAhead(poller, self.clock), self.clock)
+            self._workers.append(worker)
+            worker.start()
 
-    def _run(self, poller: Poller[Any]) -> None:
-        if poller.origin_s is None:
-            poller.origin_s = self.clock.now()
-        durations_s: deque[float] = deque(maxlen=POLL_DURATION_WINDOW)
-        while not self._stop.is_set():
-            # start early by the longest recent poll, so the reading is ready at the deadline
-            lead_s = max(durations_s, default=0.0) + POLL_MARGIN_S
-            wait_s = poller.next_due_s - lead_s - self.clock.now()
-            if self.clock.wait(self._stop, wait_s):
-                return
-            started_s = self.clock.now()
-            poller.poll_once()
-            finished_s = self.clock.now()
-            durations_s.append(finished_s - started_s)
-            poller._advance(finished_s)
-
-    def stop(self, timeout_s: float = 2.0) -> None:
-        """Ask every thread to end and wait for them (``timeout_s`` real seconds each)."""
-        self._stop.set()
-        for thread in self._threads:
-            thread.join(timeout_s)
-        self._threads.clear()
+    def stop(self) -> None:
+        """Ask every thread to end and wait for them (the workers' one join policy)."""
+        for worker in self._workers:
+            worker.stop()
+        self._workers.clear()
 
     @property
     def running(self) -> bool:
-        return any(thread.is_alive() for thread in self._threads)
+        return any(worker.running for worker in self._workers)
 
 
 # -- the pollers of each role -------------------------------------------------------------------

@@ -27,7 +27,6 @@ change too small for the grid is never missed for long.
 from __future__ import annotations
 
 import logging
-import threading
 
 import cv2
 import numpy as np
@@ -40,10 +39,11 @@ from engine.blackboard.catalogue import (
     HAND_HELD,
     HAND_SHOWN,
 )
-from engine.clock import Clock, ClockEvent
+from engine.clock import Clock
 from engine.hardware.device_health import DeviceHealth
 from engine.media.camera import Camera, CameraError
 from engine.media.images import Frame
+from engine.periodic import WorkerHook, WorkerThread
 from engine.vision.classifier import FingerCounter, HandReading
 
 log = logging.getLogger(__name__)
@@ -58,8 +58,6 @@ detector costs about 15 ms a frame, so once in 10 s keeps an idle robot's camera
 cost with the paper's network once a second (bench/bench_cpu.py: once a second, 4.9 % of
 a core against 3.8 %; once in 5 s, 3.9 % against 3.7 %)."""
 REOPEN_S = 2.0
-STOP_WAIT_S = 5.0
-"""How long stopping waits for a frame being read (a webcam gives one within a second)."""
 
 
 def _box(reading: HandReading, frame: Frame) -> dict[str, int] | None:
@@ -121,6 +119,7 @@ class HandWatcher:
         steady_frames: int,
         reopen_s: float = REOPEN_S,
     ) -> None:
+        self.name = "vision"
         self.camera, self.model = camera, model
         self.blackboard, self.clock, self.health = blackboard, clock, health
         self.period_s = 1.0 / fps
@@ -136,8 +135,8 @@ class HandWatcher:
         self._open = False
         self._next_s: float | None = None
         self._retry_s = 0.0
-        self._stop: ClockEvent | None = None
-        self._thread: threading.Thread | None = None
+        self._hook = WorkerHook(self)
+        self._worker: WorkerThread | None = None
 
     # -- one frame ------------------------------------------------------------------------
     def process(self, frame: Frame) -> HandReading:
@@ -209,61 +208,65 @@ class HandWatcher:
         self.health.driver_status(False, why)
         self._retry_s = now_s + self.reopen_s
 
-    # -- on a virtual clock: a scheduler hook ---------------------------------------------
-    def __call__(self, now_s: float) -> None:
-        """Take every frame due by ``now_s`` (clock seconds)."""
+    # -- as a worker (engine.periodic): a scheduler hook inline, a thread on a real clock --
+    def due_s(self) -> float:
+        """When the next frame is due (clock seconds)."""
         if self._next_s is None:
-            self._next_s = now_s
-        while self._next_s <= now_s + 1e-9:
-            self.take_frame()
-            self._next_s += self.period_s
+            self._next_s = self.clock.now()
+        return self._next_s
 
-    # -- on a real clock: a thread ---------------------------------------------------------
+    def run(self, now_s: float) -> None:
+        """Take the frame due at ``now_s``."""
+        try:
+            self.take_frame()
+        finally:
+            self._next_s = self.due_s() + self.period_s
+
+    def __call__(self, now_s: float) -> None:
+        """On a virtual clock, a scheduler hook: every frame due by ``now_s``, in order."""
+        self._hook(now_s)
+
     def start(self) -> None:
         """Start the worker thread (real clock)."""
-        if self._thread is not None:
-            return
-        self._stop = self.clock.event()
-        self._thread = threading.Thread(target=self._run, name="vision", daemon=True)
-        self._thread.start()
-
-    def _run(self) -> None:
-        assert self._stop is not None
-        try:
-            self._frames_until_stopped(self._stop)
-        finally:
-            self.camera.close()  # by the thread that reads it, never under its feet
-            self._open = False
-
-    def _frames_until_stopped(self, stop: ClockEvent) -> None:
-        next_s = self.clock.now()
-        while not stop.is_set():
-            if self.clock.sleep_until(next_s, stop):
-                break
-            try:
-                self.take_frame()
-            except Exception:  # a bug must not end the robot's sight silently
-                log.exception("the vision worker failed on a frame")
-            next_s += self.period_s
-            now = self.clock.now()
-            if next_s < now:  # behind: drop the frames we had no time for
-                missed = int((now - next_s) / self.period_s) + 1
-                self.dropped += missed
-                next_s += missed * self.period_s
+        if self._worker is None:
+            self._next_s = None
+            self._worker = WorkerThread(_InRealTime(self), self.clock, after=self._close)
+            self._worker.start()
 
     def stop(self) -> None:
-        """Stop the worker (if running: it closes the camera when its read returns) or
-        close the camera."""
-        if self._stop is not None:
-            self._stop.set()
-        if self._thread is not None:
-            self._thread.join(timeout=STOP_WAIT_S)
-            if self._thread.is_alive():  # a read stuck on a dying camera: it closes it after
-                log.warning("%s: still reading; it closes when its read returns", self.camera.name)
-            self._thread = None
+        """Stop the worker (if running: the thread closes the camera, when a read still in
+        progress returns) or close the camera."""
+        if self._worker is not None:
+            self._worker.stop()
+            self._worker = None
             return
+        self._close()
+
+    def _close(self) -> None:
         self.camera.close()
         self._open = False
+
+
+class _InRealTime:
+    """The watcher on a thread: a frame that came due while the network was still busy is
+    dropped (counted in ``dropped``), never queued."""
+
+    name = "vision"
+
+    def __init__(self, watcher: HandWatcher) -> None:
+        self.watcher = watcher
+
+    def due_s(self) -> float:
+        return self.watcher.due_s()
+
+    def run(self, now_s: float) -> None:
+        watcher = self.watcher
+        watcher.run(now_s)
+        late_s = watcher.clock.now() - watcher.due_s()
+        if late_s > 0:
+            missed = int(late_s / watcher.period_s) + 1
+            watcher.dropped += missed
+            watcher._next_s = watcher.due_s() + missed * watcher.period_s
 
 
 def _grid(frame: Frame) -> np.ndarray:

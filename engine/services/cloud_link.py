@@ -40,6 +40,7 @@ import requests
 from engine.blackboard.board import Blackboard
 from engine.blackboard.catalogue import IOT_CANCELED, IOT_INBOX, NOTHING, Carries
 from engine.clock import Clock
+from engine.periodic import Periodic
 from engine.privacy.consent import without_record
 from engine.privacy.consent_gate import RESULT_WITHHELD, ConsentGate, Exit
 from engine.services.done_commands import DoneCommands
@@ -106,7 +107,10 @@ class CloudLink:
         self._canceled: set[str] = set()  # canceled by the operator while carried out
         self._reports: queue.Queue[tuple[str, dict[str, Any]] | None] = queue.Queue()
         self._stop = clock.event()
-        self._threads: list[threading.Thread] = []
+        self._threads: list[threading.Thread] = []  # the long-poll and the reporter
+        self._telemetry = Periodic(
+            clock, TELEMETRY_EVERY_S, self.push_telemetry, name="cloud-telemetry"
+        )
         self._from_cloud: set[str] = set()  # received, being carried out
         self._carrying_out = threading.Lock()
         self._idle = clock.event()
@@ -127,11 +131,8 @@ class CloudLink:
         sent.subscribe(self.telemetry, (KeyChanged.kind,))
 
     def start(self) -> None:
-        for name, target in (
-            ("cloud-poll", self._poll),
-            ("cloud-report", self._send_reports),
-            ("cloud-telemetry", self._push_telemetry),
-        ):
+        self._telemetry.start()
+        for name, target in (("cloud-poll", self._poll), ("cloud-report", self._send_reports)):
             thread = threading.Thread(target=target, name=name, daemon=True)
             thread.start()
             self._threads.append(thread)
@@ -142,6 +143,7 @@ class CloudLink:
         delivered again once its lease runs out."""
         self._stop.set()
         self._reports.put(None)
+        self._telemetry.stop()
         for thread in self._threads:
             thread.join(timeout=5.0 if thread.name == "cloud-report" else 0.5)
 
@@ -350,10 +352,6 @@ class CloudLink:
                     )
                 delay_s = FIRST_BACKOFF_S
                 break
-
-    def _push_telemetry(self) -> None:
-        while not self.clock.wait(self._stop, TELEMETRY_EVERY_S):
-            self.push_telemetry()
 
     def push_telemetry(self) -> bool:
         """Push the latest committed sensor and device values once; False when the push
