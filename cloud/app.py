@@ -13,7 +13,7 @@ from fastapi.responses import JSONResponse
 from sqlalchemy.exc import SQLAlchemyError
 from starlette.exceptions import HTTPException as StarletteHTTPException
 
-from cloud.api import commands, events, robot_side, robots
+from cloud.api import commands, events, presses, robot_side, robots
 from cloud.api.page import add_page
 from cloud.api.schemas import ERRORS
 from cloud.services import CloudStore
@@ -49,7 +49,14 @@ def create_app(
 
     app = FastAPI(title="vest cloud", version="1", lifespan=lifespan)
     app.state.store = store
-    for router in (robots.me, robots.router, commands.router, robot_side.router, events.router):
+    for router in (
+        robots.me,
+        robots.router,
+        commands.router,
+        presses.router,
+        robot_side.router,
+        events.router,
+    ):
         app.include_router(router, prefix=API, responses=ERRORS)
     add_page(app)
 

@@ -3,12 +3,12 @@
 Robots have no role: a robot's token reaches only its own endpoints. A person's account has
 one role; the service checks it on every endpoint (403 naming the role and what it lacks).
 
-| role | robots | commands | telemetry |
-|---|---|---|---|
-| admin | every robot | sees, sends, cancels | sees |
-| operator | those granted to it | sees, sends, cancels | sees |
-| therapist | those granted to it | sees | sees |
-| viewer | those granted to it | sees (not their results) | never (a child's data) |
+| role | robots | commands | telemetry | live session | buttons |
+|---|---|---|---|---|---|
+| admin | every robot | sees, sends, cancels | sees | sees | presses |
+| operator | those granted to it | sees, sends, cancels | sees | sees | presses |
+| therapist | those granted to it | sees | sees | sees | presses |
+| viewer | those granted to it | sees (not their results) | never (a child's data) | sees | never |
 """
 
 from __future__ import annotations
@@ -32,12 +32,13 @@ class Permission(StrEnum):
     EVERY_ROBOT = "see every robot"
     COMMAND = "send or cancel commands"
     TELEMETRY = "see telemetry (sensor values are a child's data)"
+    PRESS = "press the robot's buttons"
 
 
 ALLOWED: dict[Role, frozenset[Permission]] = {
     Role.ADMIN: frozenset(Permission),
-    Role.OPERATOR: frozenset({Permission.COMMAND, Permission.TELEMETRY}),
-    Role.THERAPIST: frozenset({Permission.TELEMETRY}),
+    Role.OPERATOR: frozenset({Permission.COMMAND, Permission.TELEMETRY, Permission.PRESS}),
+    Role.THERAPIST: frozenset({Permission.TELEMETRY, Permission.PRESS}),
     Role.VIEWER: frozenset(),
 }
 DEFAULT_ROLE = Role.OPERATOR

@@ -11,6 +11,7 @@ from cloud.store.doorbell import Doorbell
 from cloud.store.ledger import CommandLedger
 from cloud.store.notifications import Announcer, PostgresListener
 from cloud.store.principal_cache import PrincipalCache
+from cloud.store.session_views import SessionViews
 from cloud.store.telemetry import Telemetry
 from engine.clock import Clock
 
@@ -24,6 +25,7 @@ class CloudStore:
     ledger: CommandLedger
     telemetry: Telemetry
     doorbell: Doorbell
+    sessions: SessionViews
     listener: PostgresListener | None = None
 
     def __post_init__(self) -> None:
@@ -36,12 +38,13 @@ class CloudStore:
     def open(cls, settings: Settings, clock: Clock) -> CloudStore:
         db = Database(settings.db_url)
         doorbell = Doorbell(clock)
+        announcer = Announcer(doorbell, postgresql=db.is_postgresql)
         ledger = CommandLedger(
             db,
             clock,
             lease_s=settings.lease_s,
             default_timeout_s=settings.default_timeout_s,
-            listener=Announcer(doorbell, postgresql=db.is_postgresql),
+            listener=announcer,
         )
         listener = PostgresListener(db.engine, doorbell, clock) if db.is_postgresql else None
         return cls(
@@ -52,6 +55,7 @@ class CloudStore:
             ledger,
             Telemetry(db, clock),
             doorbell,
+            SessionViews(db, clock, announcer),
             listener,
         )
 

@@ -93,6 +93,8 @@ def allowed_to(permission: Permission) -> Callable[[Principal], Awaitable[Princi
 
 Commander = Annotated[Principal, Depends(allowed_to(Permission.COMMAND))]
 """A person whose role may send and cancel commands (admin, operator)."""
+Presser = Annotated[Principal, Depends(allowed_to(Permission.PRESS))]
+"""A person whose role may press a robot's buttons (admin, operator, therapist)."""
 TelemetryReader = Annotated[Principal, Depends(allowed_to(Permission.TELEMETRY))]
 """A person whose role may see telemetry (admin, operator, therapist)."""
 

@@ -9,10 +9,12 @@
   values came in since the last one (all of them first); never to a role that may not see
   telemetry (a viewer);
 - ``command``: a command (as ``GET .../commands/{id}`` answers it) whenever its version
-  grows; the newest 50 of each robot first.
+  grows; the newest 50 of each robot first;
+- ``session``: ``{"robot", "view", "at_s"}``, the robot's live session (its trees, what
+  happened, its buttons: cloud/api/presses.py) whenever the robot pushed a new one.
 
-The stream wakes at once when a robot's commands change (the same doorbell as the
-long-polls) and looks for new telemetry every ``TELEMETRY_EVERY_S``. A comment line every
+The stream wakes at once when a robot's commands or its session change (the same doorbell
+as the long-polls) and looks for new telemetry every ``TELEMETRY_EVERY_S``. A comment line every
 ``KEEPALIVE_S`` keeps proxies from closing an idle stream. It ends after ``STREAM_S`` (the
 page then opens a new one), when the service stops, and when the operator's token is
 revoked or expires. A role changed meanwhile is taken up within the token cache time.
@@ -50,6 +52,7 @@ class OperatorView:
         self._robots: list[dict[str, Any]] | None = None
         self._versions: dict[str, int] = {}
         self._telemetry: dict[tuple[int, str], float] = {}
+        self._sessions: dict[int, float] = {}
 
     def changes(self) -> list[str]:
         """The events to send now (server-sent event text, one string each)."""
@@ -73,6 +76,12 @@ class OperatorView:
                             "command",
                         )
                     )
+            stored = self.store.sessions.get(row.id)
+            if stored is not None and self._sessions.get(row.id) != stored[1]:
+                view, self._sessions[row.id] = stored
+                events.append(
+                    frame({"robot": row.name, "view": view, "at_s": stored[1]}, "session")
+                )
             if not sees_telemetry:
                 continue
             fresh = {

@@ -2,14 +2,20 @@
 
 from __future__ import annotations
 
-from typing import Annotated
+from typing import Annotated, Literal
 
 from fastapi import APIRouter, HTTPException, Query, Request, Response, status
 from sqlalchemy.orm import Session
 from starlette.concurrency import run_in_threadpool
 
 from cloud.api.deps import CurrentRobot, StoreDep
-from cloud.api.schemas import ClaimedCommand, CommandPublic, ResultReport, TelemetryReport
+from cloud.api.schemas import (
+    ClaimedCommand,
+    CommandPublic,
+    ResultReport,
+    SessionViewReport,
+    TelemetryReport,
+)
 from cloud.store.ledger import ConflictError
 from cloud.store.telemetry import TelemetryFullError
 
@@ -22,9 +28,11 @@ async def next_command(
     store: StoreDep,
     robot: CurrentRobot,
     wait_s: Annotated[float, Query(ge=0, le=60)] = 0.0,
+    only: Annotated[Literal["press"] | None, Query()] = None,
 ) -> ClaimedCommand | Response:
     """The next command, now IN_PROGRESS under a lease of ``lease_s``; 204 when none came within
-    ``wait_s`` (at most the service's max_wait_s).
+    ``wait_s`` (at most the service's max_wait_s). ``only=press``: a press of a button alone
+    (a robot still carrying out another command takes the therapist's presses meanwhile).
 
     A command is only taken for a caller still there: a long-poll whose client went away,
     or that the same robot replaced with a newer one, ends without taking anything (else the
@@ -41,7 +49,9 @@ async def next_command(
                     raise PermissionError("this robot's token is revoked")
 
             try:
-                command = await run_in_threadpool(store.ledger.claim_next, robot.id, still_valid)
+                command = await run_in_threadpool(
+                    store.ledger.claim_next, robot.id, still_valid, only_type=only
+                )
             except PermissionError as error:
                 raise HTTPException(status.HTTP_401_UNAUTHORIZED, str(error)) from None
             if command is not None:
@@ -94,3 +104,9 @@ async def push_telemetry(body: TelemetryReport, store: StoreDep, robot: CurrentR
     except TelemetryFullError as error:
         problem = {"field": "values", "message": str(error)}
         raise HTTPException(422, [problem]) from None
+
+
+@router.post("/session", status_code=status.HTTP_204_NO_CONTENT)
+async def push_session(body: SessionViewReport, store: StoreDep, robot: CurrentRobot) -> None:
+    """The robot's live session as it stands (kept whole; the pages hear of it at once)."""
+    await run_in_threadpool(store.sessions.put, robot.id, body.view)

@@ -69,6 +69,7 @@ def who_am_i(operator: CurrentOperator) -> AccountPublic:
         name=operator.name,
         role=operator.role or "",
         can_command=may(operator.role, Permission.COMMAND),
+        can_press=may(operator.role, Permission.PRESS),
         sees_telemetry=may(operator.role, Permission.TELEMETRY),
         expires_at_s=operator.expires_at_s,
     )

@@ -166,6 +166,24 @@ class TelemetryReport(BaseModel):
     values: Annotated[dict[TelemetryKey, Any], AfterValidator(small_values)] = Field(max_length=500)
 
 
+class SessionViewReport(BaseModel):
+    """The robot's live session as its page would show it (trees, what happened, its
+    buttons), in the live view's words; the body limit bounds it."""
+
+    model_config = ConfigDict(extra="forbid")
+
+    view: dict[str, Any]
+
+
+class PressCreate(BaseModel):
+    """A press of the robot's button ``button`` (its number on the board, as the board
+    in the session view numbers it, from 0)."""
+
+    model_config = ConfigDict(extra="forbid")
+
+    button: int = Field(ge=0, le=999)
+
+
 class RobotPublic(BaseModel):
     name: str
     online: bool
@@ -179,6 +197,7 @@ class AccountPublic(BaseModel):
     name: str
     role: str
     can_command: bool
+    can_press: bool
     sees_telemetry: bool
     expires_at_s: float | None
 

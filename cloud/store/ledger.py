@@ -253,25 +253,30 @@ class CommandLedger:
         return self._transition(robot_id, command_id, cancel)
 
     def claim_next(
-        self, robot_id: int, before_taking: Callable[[Session], None] = lambda session: None
+        self,
+        robot_id: int,
+        before_taking: Callable[[Session], None] = lambda session: None,
+        *,
+        only_type: str | None = None,
     ) -> Command | None:
-        """The oldest QUEUED command of this robot, now IN_PROGRESS under a lease (one
-        another claim or a cancel took first is passed over). ``before_taking`` is called
-        when there is one to take, before it is taken, with the claim's session (to read
-        on it, never on a second connection): what it raises leaves it QUEUED (a robot
-        revoked meanwhile takes nothing)."""
+        """The oldest QUEUED command of this robot (of ``only_type``, when given), now
+        IN_PROGRESS under a lease (one another claim or a cancel took first is passed
+        over). ``before_taking`` is called when there is one to take, before it is taken,
+        with the claim's session (to read on it, never on a second connection): what it
+        raises leaves it QUEUED (a robot revoked meanwhile takes nothing)."""
         self.expire_due()
         for _ in range(CHANGE_ATTEMPTS):
             try:
                 with self._changing() as (session, changed):
+                    queued = select(CommandRow).where(
+                        CommandRow.robot_id == robot_id,
+                        CommandRow.state == QUEUED,
+                        CommandRow.timeout_at_s > self.clock.now(),
+                    )
+                    if only_type is not None:
+                        queued = queued.where(CommandRow.type == only_type)
                     row = session.scalar(
-                        select(CommandRow)
-                        .where(
-                            CommandRow.robot_id == robot_id,
-                            CommandRow.state == QUEUED,
-                            CommandRow.timeout_at_s > self.clock.now(),
-                        )
-                        .order_by(CommandRow.created_s, CommandRow.id)
+                        queued.order_by(CommandRow.created_s, CommandRow.id)
                         .limit(1)
                         .with_for_update(skip_locked=True)
                     )

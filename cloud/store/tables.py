@@ -111,3 +111,14 @@ class AuditRow(Table):
     robot: Mapped[str | None] = mapped_column(String(64), default=None)
     detail: Mapped[str] = mapped_column(String(500), default="")
     client: Mapped[str] = mapped_column(String(64), default="")
+
+
+class SessionViewRow(Table):
+    """The live session of one robot as it last pushed it (``view``: trees, what happened,
+    its button board, in the live view's words) and when (``at_s``)."""
+
+    __tablename__ = "robot_session_view"
+
+    robot_id: Mapped[int] = mapped_column(ForeignKey("robots.id"), primary_key=True)
+    view: Mapped[dict[str, Any]] = mapped_column(JSON)
+    at_s: Mapped[float] = mapped_column(Float)

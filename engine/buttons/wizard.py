@@ -1,6 +1,7 @@
 """The therapist's buttons at run time (wizard of oz).
 
-A press comes from the buttons page (any thread), a key on the page, or a scenario; it is
+A press comes from the buttons page (any thread), a key on the page, a scenario, or the
+cloud's page (engine/services/cloud_session.py: a therapist in another room); it is
 carried out between ticks by the scheduler hook :meth:`Wizard.__call__`:
 
 - a button that acts (say, led, move, play) runs on the buttons' own tree, which ticks
@@ -53,7 +54,7 @@ class Wizard:
         self.paused = False
         self.doing: Button | None = None
         self.presses = 0
-        self._pressed: queue.SimpleQueue[tuple[int, PressedBy]] = queue.SimpleQueue()
+        self._pressed: queue.SimpleQueue[tuple[int, PressedBy, str]] = queue.SimpleQueue()
         self._lock = threading.Lock()
         self.states: Broadcast[dict[str, Any]] = Broadcast(robot.clock, PAGE_QUEUE)
         """Each new state, for the pages' streams (the state now: :meth:`state`)."""
@@ -61,11 +62,12 @@ class Wizard:
         self._state: dict[str, Any] = self._current_state()
 
     # -- from any thread ----------------------------------------------------------------------
-    def press(self, number: int, *, by: PressedBy = "page") -> Button | None:
-        """Queue a press of button ``number`` for the next step; None when there is none."""
+    def press(self, number: int, *, by: PressedBy = "page", who: str = "") -> Button | None:
+        """Queue a press of button ``number`` for the next step; None when there is none.
+        ``who``: the account that pressed it from the cloud ("" for a press here)."""
         button = self.board.button(number)
         if button is not None:
-            self._pressed.put((number, by))
+            self._pressed.put((number, by, who))
         return button
 
     def press_label(self, label: str, *, by: PressedBy = "scenario") -> Button | None:
@@ -96,10 +98,10 @@ class Wizard:
     def __call__(self, now_s: float) -> None:
         while True:
             try:
-                number, by = self._pressed.get_nowait()
+                number, by, who = self._pressed.get_nowait()
             except queue.Empty:
                 break
-            self._carry_out(self.board.buttons[number], now_s, by)
+            self._carry_out(self.board.buttons[number], now_s, by, who)
         status = self.tree.status.name
         if self.doing is not None and status != "INVALID":
             self._begun = True
@@ -112,11 +114,11 @@ class Wizard:
             self.doing = None
         self._publish()
 
-    def _carry_out(self, button: Button, now_s: float, by: PressedBy) -> None:
+    def _carry_out(self, button: Button, now_s: float, by: PressedBy, who: str) -> None:
         self.presses += 1
         shown = self._shown(button)
         control = button.control or ""
-        self.robot.session.publish(ButtonPressed(now_s, button.label, by, shown, control))
+        self.robot.session.publish(ButtonPressed(now_s, button.label, by, shown, control, who))
         if not shown:
             return
         if button.control == "pause":

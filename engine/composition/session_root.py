@@ -41,6 +41,7 @@ from engine.runtime.robot_factory import AssembledRobot, build_robot
 from engine.scenario.player import ScenarioPlayer
 from engine.scenario.scenario_file import Scenario, ScenarioEvent
 from engine.services.cloud_link import CloudLink
+from engine.services.cloud_session import CloudSession
 from engine.services.simulated import simulated_services
 from engine.session.events import WorldEvent
 from engine.session.stream import SessionStream
@@ -322,8 +323,13 @@ def _around(assembled: AssembledRobot, plan: SessionPlan, link: CloudLink | None
     assembled.add_runners()  # the pollers and the camera, phased on the first tick
     if link is not None:
 
+        cloud_hub = ViewHub(clock)  # the cloud's page: what may leave the robot, in words
+        cloud_hub.begin(start_s, robot.trees)
+        shown = CloudSession(cloud_hub, running.wizard)
+        gates.sent.subscribe(shown)  # from the start: it hears of every tree
+
         def start_link() -> None:
-            link.bind(assembled.blackboard, gates.sent, gates.sending)
+            link.bind(assembled.blackboard, gates.sent, gates.sending, shown)
             link.start()
 
         lifecycle.add("cloud link", start=start_link, stop=link.stop)

@@ -1,16 +1,19 @@
 """The robot's link to the cloud service (``vest run --cloud URL --token-file FILE``).
 
-Three worker threads, none of them in a tick:
+Four workers, none of them in a tick:
 - the *poller* long-polls ``GET /robot/commands/next``, stages each command on
   ``/iot/inbox`` for the iot_command tree, and backs off (0.5 s doubling to 30 s) while the
-  service cannot be reached;
+  service cannot be reached. A ``press`` (a therapist's, on the cloud's page) goes to the
+  buttons at once (:class:`~engine.services.cloud_session.CloudSession`), also while
+  another command is carried out: the robot then long-polls for presses alone;
 - the *reporter* sends each result (``report``, the :class:`IotResults` service) until the
   service has it, in order, retrying the same way;
-- the *telemetry* thread pushes the sensor and device keys about once a second: the
-  latest values as the scheduler committed them, handed over by a reader of the consent
-  gate's ``sent`` exit (:class:`TelemetrySnapshot`: readings only with the person's
-  consent), never read from the live blackboard on this thread. A push that fails is
-  logged (once per streak) and counted (``telemetry_failures``).
+- two pushes (:class:`~engine.services.cloud_push.Push`, each on its
+  :class:`~engine.periodic.Periodic`): the sensor and device keys about once a second, the
+  latest values as the scheduler committed them (:class:`TelemetrySnapshot`, a reader of
+  the consent gate's ``sent`` exit: readings only with the person's consent); and the
+  session's view, when it changed, four times a second. A push that fails is logged (once
+  per streak) and counted (``telemetry_failures``).
 
 A command's result leaves the robot only when the consent gate lets it
 (:meth:`~engine.privacy.consent_gate.ConsentGate.lets_result_out`): a read's values
@@ -43,6 +46,8 @@ from engine.clock import Clock
 from engine.periodic import Periodic
 from engine.privacy.consent import without_record
 from engine.privacy.consent_gate import RESULT_WITHHELD, ConsentGate, Exit
+from engine.services.cloud_push import Push, json_object, positive_s
+from engine.services.cloud_session import NO_BOARD, PRESS, CloudSession
 from engine.services.done_commands import DoneCommands
 from engine.services.jobs import ImmediateJob, Job
 from engine.services.telemetry import TelemetrySnapshot
@@ -53,6 +58,11 @@ from engine.session.stream import SessionStream
 log = logging.getLogger(__name__)
 FIRST_BACKOFF_S, MAX_BACKOFF_S = 0.5, 30.0
 TELEMETRY_EVERY_S = 1.0
+SESSION_EVERY_S = 0.25
+"""How often the session's view is pushed, when it changed (the cloud page's lag)."""
+BUSY_POLL_S = 1.0
+"""While a command is carried out the robot long-polls for presses alone, this long at a
+time: the next command is taken at most this late after the last one is reported."""
 BUSY_AT_MOST_S = 65.0
 """The robot takes one command at a time: the next long-poll waits until the one taken is
 reported, or this long (CarryOut gives up on a command after 60 s), so a command that waits
@@ -66,13 +76,6 @@ the lease): an operator's cancel stops the robot within this."""
 PROGRESS_AT_MOST_EVERY_S = 0.1
 """However short a lease the service gives, the robot says it is still at a command at most
 ten times a second (a lease of 1 ms would otherwise be a storm of requests)."""
-
-
-def _positive(value: Any, default: float) -> float:
-    """``value`` as a positive number of seconds, else ``default``."""
-    if isinstance(value, int | float) and not isinstance(value, bool) and value > 0:
-        return float(value)
-    return default
 
 
 class CloudLink:
@@ -98,9 +101,6 @@ class CloudLink:
         self.gate = ConsentGate(without_record(""), Exit.SENT)
         """What may leave the robot (until bound: nothing of anyone)."""
         self.telemetry = TelemetrySnapshot()
-        self.telemetry_failures = 0
-        """Pushes of telemetry that failed (the service unreachable or refusing)."""
-        self._telemetry_failing = False
         self.bad_replies = 0
         """Replies to a poll that were not a command (not JSON, not the contract's)."""
         self._replies_bad = False
@@ -108,30 +108,52 @@ class CloudLink:
         self._reports: queue.Queue[tuple[str, dict[str, Any]] | None] = queue.Queue()
         self._stop = clock.event()
         self._threads: list[threading.Thread] = []  # the long-poll and the reporter
-        self._telemetry = Periodic(
-            clock, TELEMETRY_EVERY_S, self.push_telemetry, name="cloud-telemetry"
+        self._telemetry_push = Push(
+            self.http, f"{self.api}/robot/telemetry", "telemetry", self._telemetry_body
         )
+        self.session: CloudSession | None = None
+        """The session as the cloud's page shows it, and its presses (bound)."""
+        self._session_push = Push(
+            self.http, f"{self.api}/robot/session", "the session's view", self._session_body
+        )
+        self._pushes = [
+            Periodic(clock, TELEMETRY_EVERY_S, self._telemetry_push.once, name="cloud-telemetry"),
+            Periodic(clock, SESSION_EVERY_S, self._session_push.once, name="cloud-session"),
+        ]
         self._from_cloud: set[str] = set()  # received, being carried out
         self._carrying_out = threading.Lock()
         self._idle = clock.event()
         self._idle.set()
         self._lease_s = DEFAULT_LEASE_S
+        self._busy_until_s = self._extend_at_s = 0.0
         self.reachable = False
 
-    def bind(self, blackboard: Blackboard, sent: SessionStream, gate: ConsentGate) -> None:
+    def bind(
+        self,
+        blackboard: Blackboard,
+        sent: SessionStream,
+        gate: ConsentGate,
+        session: CloudSession | None = None,
+    ) -> None:
         """The blackboard commands are staged on; ``sent``, the consent gate's exit off
         the robot, whose committed sensor and device values are pushed as telemetry; and
-        ``gate``, which says whether a command's result may leave."""
+        ``gate``, which says whether a command's result may leave; ``session``: the view
+        the cloud's page shows (a reader of ``sent`` from the session's start), and where
+        its presses go."""
         self.blackboard = blackboard
         self.gate = gate
         self.telemetry_from(sent)
+        if session is not None:
+            self.session = session
+            self._session_push.failed = session.forget_sent
 
     def telemetry_from(self, sent: SessionStream) -> None:
         """Push the sensor and device values ``sent`` tells as committed."""
         sent.subscribe(self.telemetry, (KeyChanged.kind,))
 
     def start(self) -> None:
-        self._telemetry.start()
+        for push in self._pushes:
+            push.start()
         for name, target in (("cloud-poll", self._poll), ("cloud-report", self._send_reports)):
             thread = threading.Thread(target=target, name=name, daemon=True)
             thread.start()
@@ -143,7 +165,8 @@ class CloudLink:
         delivered again once its lease runs out."""
         self._stop.set()
         self._reports.put(None)
-        self._telemetry.stop()
+        for push in self._pushes:
+            push.stop()
         for thread in self._threads:
             thread.join(timeout=5.0 if thread.name == "cloud-report" else 0.5)
 
@@ -181,14 +204,17 @@ class CloudLink:
     def _poll(self) -> None:
         delay_s = FIRST_BACKOFF_S
         while not self._stop.is_set():
-            if not self._idle.is_set():  # one command at a time
-                self._wait_idle()
-                continue
+            params: dict[str, Any] = {"wait_s": self.wait_s}
+            if not self._idle.is_set():  # one command at a time; presses meanwhile
+                left_s = self._while_busy()
+                if left_s is None:
+                    continue
+                params = {"wait_s": min(self.wait_s, left_s, BUSY_POLL_S), "only": PRESS}
             try:
                 answer = self.http.get(
                     f"{self.api}/robot/commands/next",
-                    params={"wait_s": self.wait_s},
-                    timeout=self.wait_s + 10.0,
+                    params=params,
+                    timeout=params["wait_s"] + 10.0,
                 )
             except requests.RequestException as error:
                 self._unreachable(error)
@@ -240,10 +266,14 @@ class CloudLink:
         with self._carrying_out:  # a report between these checks would let it run twice
             earlier = self.done.get(command_id)
             running = command_id in self._from_cloud
+            pressed = command.get("type") == PRESS
             if earlier is None and not running and self.blackboard is not None:
                 self._from_cloud.add(command_id)
-                self._idle.clear()
-                self._lease_s = _positive(command.get("lease_s"), DEFAULT_LEASE_S)
+                if not pressed:  # a press is carried out at once, beside any other
+                    self._idle.clear()
+                    self._lease_s = positive_s(command.get("lease_s"), DEFAULT_LEASE_S)
+                    self._busy_until_s = self.clock.now() + BUSY_AT_MOST_S
+                    self._extend_at_s = self.clock.now() + self._extend_every_s()
         if earlier is not None:  # delivered again: answer as before, never twice
             if earlier.get("status") != "CANCELED":  # the service knows it ended so
                 self._reports.put((command_id, earlier))
@@ -253,7 +283,14 @@ class CloudLink:
         if running:  # delivered again while still being carried out
             log.debug("command %s is still being carried out; its report will follow", command_id)
             return
-        if self.blackboard is not None:
+        if pressed:
+            status, result = (
+                self.session.press(command.get("args") or {})
+                if self.session
+                else ("FAILED", {"error": NO_BOARD})
+            )
+            self.report(command_id, status, result)
+        elif self.blackboard is not None:
             self.blackboard.stage_event(
                 IOT_INBOX,
                 {"id": command_id, "type": command.get("type"), "args": command.get("args") or {}},
@@ -280,23 +317,23 @@ class CloudLink:
         self._reports.put((command_id, report))
         return True
 
-    def _wait_idle(self) -> None:
-        """Until the command being carried out is reported (or BUSY_AT_MOST_S passed: a
-        robot without the iot_command tree must not stop taking commands for good)."""
-        deadline_s = self.clock.now() + BUSY_AT_MOST_S
-        extend_every_s = max(min(self._lease_s / 3, PROGRESS_EVERY_S), PROGRESS_AT_MOST_EVERY_S)
-        extend_at_s = self.clock.now() + extend_every_s
-        while not self._idle.is_set() and not self._stop.is_set():
-            now_s = self.clock.now()
-            if now_s >= deadline_s:
-                log.warning("no report after %.0f s; taking the next command", BUSY_AT_MOST_S)
-                self._idle.set()
-                return
-            if now_s >= extend_at_s:
-                self._extend_leases()
-                extend_at_s = now_s + extend_every_s
-            # looks at the stop flag at least each second
-            self.clock.wait(self._idle, min(deadline_s - now_s, extend_at_s - now_s, 1.0))
+    def _while_busy(self) -> float | None:
+        """While a command is carried out: extend its lease when due, and give up waiting
+        for its report after BUSY_AT_MOST_S (a robot without the iot_command tree must not
+        stop taking commands for good). Seconds until the next of these; None when the
+        robot takes the next command now."""
+        now_s = self.clock.now()
+        if now_s >= self._busy_until_s:
+            log.warning("no report after %.0f s; taking the next command", BUSY_AT_MOST_S)
+            self._idle.set()
+            return None
+        if now_s >= self._extend_at_s:
+            self._extend_leases()
+            self._extend_at_s = now_s + self._extend_every_s()
+        return max(0.0, min(self._busy_until_s, self._extend_at_s) - now_s)
+
+    def _extend_every_s(self) -> float:
+        return max(min(self._lease_s / 3, PROGRESS_EVERY_S), PROGRESS_AT_MOST_EVERY_S)
 
     def _extend_leases(self) -> None:
         """Tells the service the robot is still carrying its commands out (one that fails is
@@ -357,40 +394,22 @@ class CloudLink:
         """Push the latest committed sensor and device values once; False when the push
         failed (counted in ``telemetry_failures``, logged once per streak: the next push
         carries the latest values anyway)."""
+        return self._telemetry_push.once()
+
+    @property
+    def telemetry_failures(self) -> int:
+        """Pushes of telemetry that failed (the service unreachable or refusing)."""
+        return self._telemetry_push.failures
+
+    def _telemetry_body(self) -> dict[str, Any] | None:
         values = self.telemetry.take()
-        if not values:
-            return True
-        why = ""
-        try:
-            answer = self.http.post(
-                f"{self.api}/robot/telemetry", json={"values": values}, timeout=5.0
-            )
-            if answer.status_code >= 300:
-                why = f"the service answered {answer.status_code}: {answer.text[:200]}"
-        except requests.RequestException as error:
-            why = str(error)
-        if why:
-            self.telemetry_failures += 1
-            if not self._telemetry_failing:
-                log.warning("telemetry could not be pushed (%s); the robot retries", why)
-            self._telemetry_failing = True
-            return False
-        if self._telemetry_failing:
-            log.info("telemetry is pushed again after %d failures", self.telemetry_failures)
-            self._telemetry_failing = False
-        return True
+        return {"values": values} if values else None
+
+    def _session_body(self) -> dict[str, Any] | None:
+        view = self.session.changed_view() if self.session is not None else None
+        return {"view": view} if view is not None else None
 
     def _unreachable(self, error: Exception) -> None:
         if self.reachable:
             log.warning("the cloud cannot be reached (%s); the robot goes on and retries", error)
         self.reachable = False
-
-
-def json_object(answer: requests.Response) -> dict[str, Any] | None:
-    """The JSON object ``answer`` carries; None for anything else (not JSON, nested too
-    deep to read, a list or a number): a peer's reply never ends the thread reading it."""
-    try:
-        body = answer.json()
-    except (ValueError, RecursionError):
-        return None
-    return body if isinstance(body, dict) else None

@@ -143,8 +143,9 @@ class TurnTaken:
         return f"yields the {self.resource} to {self.other}: not {self.what}"
 
 
-PressedBy = Literal["page", "key", "scenario"]
-"""Where a button was pressed: on the buttons page, by its keyboard key, or a scenario's press."""
+PressedBy = Literal["page", "key", "scenario", "cloud"]
+"""Where a button was pressed: on the buttons page, by its keyboard key, a scenario's press,
+or on the cloud's page (remote wizard of oz)."""
 ButtonControl = Literal["", "pause", "resume", "stop"]
 """What a control button did ("": none, the button has the robot do something)."""
 SafetyKind = Literal["refused", "stopped", "slowed", "held"]
@@ -185,6 +186,8 @@ class ButtonPressed:
     by: PressedBy
     done: bool = True
     control: ButtonControl = ""
+    who: str = ""
+    """The cloud account that pressed it (``by`` cloud); "" for a press at the robot."""
 
 
 @dataclass(frozen=True, slots=True)

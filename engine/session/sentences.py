@@ -83,7 +83,8 @@ def event_line(event: SessionEvent) -> tuple[str, str] | None:
             if event.control == "stop" and event.done
             else ""
         )
-        return who, f"presses the button {event.label!r}{nothing}{stops}"
+        where = f" from the cloud ({event.who})" if event.by == "cloud" else ""
+        return who, f"presses the button {event.label!r}{where}{nothing}{stops}"
     if isinstance(event, BehaviorsPaused):
         return "buttons", "pauses the behaviors" if event.paused else "resumes the behaviors"
     if isinstance(event, ActionStarted):

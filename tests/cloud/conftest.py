@@ -116,9 +116,16 @@ class Robot:
     pipe)."""
 
     def __init__(
-        self, url: str, token_file: Path, scenario: Path, trees: list[str], person: str = ""
+        self,
+        url: str,
+        token_file: Path,
+        scenario: Path,
+        trees: list[str],
+        person: str = "",
+        buttons: str = "",
     ) -> None:
         whose = ["--person", person] if person else []  # their consent decides the telemetry
+        board = ["--buttons", buttons, "--view-port", "0"] if buttons else []
         self.process = subprocess.Popen(
             [
                 *VEST,
@@ -135,6 +142,7 @@ class Robot:
                 str(token_file),
                 "--json",
                 *whose,
+                *board,
             ],
             cwd=ROOT,
             stdout=subprocess.PIPE,
@@ -189,9 +197,14 @@ def start_robot() -> Iterator[Callable[..., Robot]]:
     robots: list[Robot] = []
 
     def start(
-        url: str, token_file: Path, scenario: Path, trees: list[str], person: str = ""
+        url: str,
+        token_file: Path,
+        scenario: Path,
+        trees: list[str],
+        person: str = "",
+        buttons: str = "",
     ) -> Robot:
-        robots.append(Robot(url, token_file, scenario, trees, person))
+        robots.append(Robot(url, token_file, scenario, trees, person, buttons))
         return robots[-1]
 
     yield start

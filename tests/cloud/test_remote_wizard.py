@@ -1,0 +1,136 @@
+"""A therapist in the next room: she opens the robot on the cloud's page, sees its session
+(its trees, what happened, its buttons) and presses a button; the robot carries the press
+out as a press on its own buttons page, credited to her. A viewer sees, never presses; a
+press the robot cannot take in time is dropped, and said so."""
+
+from __future__ import annotations
+
+import signal
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import requests
+
+from cloud.api.presses import PRESS_WITHIN_S
+from cloud.settings import Settings
+from cloud.store.ledger import SUCCEEDED, TIMED_OUT
+from engine.clock import RealClock, VirtualClock
+from tests.cloud.conftest import Robot, Running, StartService
+
+REAL = RealClock()
+
+
+def until(what: Callable[[], Any], limit_s: float = 120.0) -> Any:
+    """``what()`` once it is truthy; the limit only ends a broken test (real seconds)."""
+    deadline_s = REAL.now() + limit_s
+    while not (found := what()):
+        assert REAL.now() < deadline_s, "never came"
+        REAL.sleep(0.05)
+    return found
+
+
+def people(running: Running, tmp_path: Path) -> tuple[dict[str, str], Path]:
+    """tess (therapist) and val (viewer) may see hbs2; its token file."""
+    directory = running.store.directory
+    directory.add_operator("ana")
+    token_file = tmp_path / "robot.token"
+    token_file.write_text(directory.add_robot("hbs2", operator="ana") + "\n")
+    tokens = {}
+    for name, role in (("tess", "therapist"), ("val", "viewer")):
+        tokens[name] = directory.add_operator(name, role=role)
+        directory.grant(name, "hbs2")
+    return tokens, token_file
+
+
+def as_(token: str) -> dict[str, str]:
+    return {"Authorization": f"Bearer {token}"}
+
+
+def test_a_therapist_in_the_next_room_watches_the_session_and_presses_a_button(
+    start_service: StartService,
+    start_robot: Callable[..., Robot],
+    tmp_path: Path,
+) -> None:
+    running = start_service(Settings(db_url=f"sqlite:///{tmp_path / 'c.db'}", recheck_s=0.2))
+    tokens, token_file = people(running, tmp_path)
+    (tmp_path / "long.yaml").write_text("duration_s: 600\nevents: []\n")
+    robot = start_robot(
+        running.url,
+        token_file,
+        tmp_path / "long.yaml",
+        ["trees/touch_thanks.yaml"],
+        buttons="trees/buttons/session.yaml",
+    )
+    session_url = f"{running.api}/robots/hbs2/session"
+
+    def board() -> dict[str, Any] | None:
+        answer = requests.get(session_url, headers=as_(tokens["tess"]), timeout=10)
+        return answer.json()["view"] if answer.status_code == 200 else None
+
+    view = until(board)
+    assert [tree["tree"] for tree in view["trees"]] == ["buttons", "touch_thanks"]
+    labels = [button["label"] for button in view["board"]["buttons"]]
+    hello = labels.index("Hello")
+    assert hello in view["board"]["shown"] and view["board"]["paused"] is False
+
+    # the viewer sees the same session, and cannot press
+    assert requests.get(session_url, headers=as_(tokens["val"]), timeout=10).status_code == 200
+    refused = requests.post(
+        f"{running.api}/robots/hbs2/press", json={"button": hello}, headers=as_(tokens["val"])
+    )
+    assert refused.status_code == 403 and "press the robot's buttons" in refused.text
+
+    pressed = requests.post(
+        f"{running.api}/robots/hbs2/press", json={"button": hello}, headers=as_(tokens["tess"])
+    )
+    assert pressed.status_code == 202, pressed.text
+    said = robot.until(lambda action: action["action"] == "say")
+    assert said["tree"] == "buttons" and said["args"]["text"] == "Hello! I am happy to see you."
+    robot_id = running.store.directory.granted_robot  # noqa: F841 (documentation)
+    command_id = pressed.json()["id"]
+    row = until(
+        lambda: next(
+            (
+                c
+                for c in running.store.ledger.recent(1)
+                if c.id == command_id and c.state == SUCCEEDED
+            ),
+            None,
+        )
+    )
+    assert row.result == {"pressed": "Hello"}
+
+    # the page's "what happened" says who pressed, in the live view's words
+    told = until(
+        lambda: [
+            line["what"]
+            for line in (board() or {"happened": []})["happened"]
+            if "from the cloud" in line["what"]
+        ]
+    )
+    assert told == ["presses the button 'Hello' from the cloud (tess)"]
+
+    robot.process.send_signal(signal.SIGINT)
+    robot.finish()
+    presses = [event for event in robot.events if event["event"] == "press"]
+    assert [(p["label"], p["by"], p["who"]) for p in presses] == [("Hello", "cloud", "tess")]
+    audit = [(e.actor, e.action, e.detail) for e in running.store.directory.audit.since()]
+    assert ("tess", "press", f"button {hello}") in audit
+
+
+def test_a_press_the_robot_does_not_take_in_time_is_dropped_never_carried_out_late(
+    start_service: StartService, tmp_path: Path
+) -> None:
+    clock = VirtualClock(start_s=1000.0)
+    running = start_service(Settings(db_url=f"sqlite:///{tmp_path / 'c.db'}"), clock)
+    tokens, _ = people(running, tmp_path)
+    pressed = requests.post(
+        f"{running.api}/robots/hbs2/press", json={"button": 0}, headers=as_(tokens["tess"])
+    )
+    assert pressed.status_code == 202
+    clock.advance(PRESS_WITHIN_S + 0.01)  # the robot was away all along
+    ledger = running.store.ledger
+    assert ledger.claim_next(1) is None  # never handed to it now
+    (command,) = ledger.recent(1)
+    assert command.id == pressed.json()["id"] and command.state == TIMED_OUT
