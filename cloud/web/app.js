@@ -1,9 +1,10 @@
 // The operator's page: log in with your token, see the robots granted to you, their live
-// sensor values (if your role may see them), send commands (if your role may) and follow
-// each one to its end.
+// session (and press their buttons, if your role may), their live sensor values (if your
+// role may see them), send commands (if your role may) and follow each one to its end.
 
 import { Api, ApiError } from "./api.js";
 import { buildArgs, readCommand, typeOptions } from "./forms.js";
+import { renderSession } from "./session.js";
 
 const $ = (selector) => document.querySelector(selector);
 const TOKEN_KEY = "vest-operator-token";
@@ -11,12 +12,14 @@ const FINISHED = new Set(["SUCCEEDED", "FAILED", "TIMED_OUT", "CANCELED"]);
 
 const state = {
   api: null,
-  me: null, // {name, role, can_command, sees_telemetry, expires_at_s}
+  me: null, // {name, role, can_command, can_press, sees_telemetry, expires_at_s}
   robots: [],
   selected: null,
   commands: new Map(), // robot -> Map(id -> command)
   telemetry: new Map(), // robot -> {key: {value, at_s}}
   catalogues: new Map(), // robot -> {type: [params]}
+  sessions: new Map(), // robot -> {view, at_s}: its live session as it last sent it
+  presses: new Map(), // robot -> {label, command}: this page's last press
   stream: null,
 };
 
@@ -105,7 +108,15 @@ function onEvent(name, data) {
     if (!state.commands.has(data.robot)) state.commands.set(data.robot, new Map());
     const known = state.commands.get(data.robot).get(data.id);
     if (!known || known.version <= data.version) state.commands.get(data.robot).set(data.id, data);
-    if (data.robot === state.selected) renderCommands();
+    const press = state.presses.get(data.robot);
+    if (press && press.command.id === data.id) press.command = data;
+    if (data.robot === state.selected) {
+      renderCommands();
+      if (press) showSession();
+    }
+  } else if (name === "session") {
+    state.sessions.set(data.robot, data);
+    if (data.robot === state.selected) showSession();
   } else if (name === "telemetry") {
     state.telemetry.set(data.robot, { ...(state.telemetry.get(data.robot) || {}), ...data.values });
     if (data.robot === state.selected) renderTelemetry();
@@ -163,6 +174,32 @@ async function select(name) {
   renderRobots();
   renderCommands();
   renderTelemetry();
+  showSession();
+}
+
+// -- the live session and its buttons --------------------------------------------------------
+
+function showSession() {
+  renderSession($("#session"), state.sessions.get(state.selected), {
+    canPress: state.me.can_press,
+    onPress: press,
+    lastPress: state.presses.get(state.selected),
+  });
+}
+
+async function press(button) {
+  const robot = state.selected;
+  $("#press-error").textContent = "";
+  try {
+    const command = await state.api.call("POST", `/robots/${encodeURIComponent(robot)}/press`, {
+      button: button.id,
+    });
+    const known = state.commands.get(robot) && state.commands.get(robot).get(command.id);
+    state.presses.set(robot, { label: button.label, command: known && known.version > command.version ? known : command });
+    showSession();
+  } catch (error) {
+    $("#press-error").textContent = error.message;
+  }
 }
 
 // -- commands --------------------------------------------------------------------------------

@@ -11,6 +11,7 @@ from pathlib import Path
 from typing import Any
 
 import requests
+from playwright.sync_api import Page, expect
 
 from cloud.api.presses import PRESS_WITHIN_S
 from cloud.settings import Settings
@@ -134,3 +135,40 @@ def test_a_press_the_robot_does_not_take_in_time_is_dropped_never_carried_out_la
     assert ledger.claim_next(1) is None  # never handed to it now
     (command,) = ledger.recent(1)
     assert command.id == pressed.json()["id"] and command.state == TIMED_OUT
+
+
+def test_on_the_cloud_page_a_therapist_presses_and_a_viewer_only_watches(
+    start_service: StartService,
+    start_robot: Callable[..., Robot],
+    tmp_path: Path,
+    page: Page,
+) -> None:
+    running = start_service(Settings(db_url=f"sqlite:///{tmp_path / 'c.db'}", recheck_s=0.2))
+    tokens, token_file = people(running, tmp_path)
+    (tmp_path / "long.yaml").write_text("duration_s: 600\nevents: []\n")
+    start_robot(
+        running.url,
+        token_file,
+        tmp_path / "long.yaml",
+        ["trees/touch_thanks.yaml"],
+        buttons="trees/buttons/session.yaml",
+    )
+    page.goto(running.url)
+    page.fill("#token", tokens["tess"])
+    page.click("#login button[type=submit]")
+    hello = page.locator('#session-board button:text-is("Hello")')
+    expect(hello).to_be_enabled(timeout=60_000)
+    expect(page.locator('#session-board button:text-is("Show me your hand")')).to_be_disabled()
+    expect(page.locator('#session-trees li[data-tree="touch_thanks"]')).to_be_visible()
+    hello.click()
+    expect(page.locator("#press-outcome")).to_have_text("Hello: done by the robot")
+    expect(page.locator("#session-happened")).to_contain_text(
+        "presses the button 'Hello' from the cloud (tess)"
+    )
+    expect(page.locator("#session-happened")).to_contain_text('says "Hello! I am happy')
+
+    page.click("#logout")
+    page.fill("#token", tokens["val"])
+    page.click("#login button[type=submit]")
+    expect(page.locator("#session-happened")).to_contain_text("from the cloud (tess)")
+    expect(page.locator('#session-board button:text-is("Hello")')).to_be_disabled()
