@@ -14,7 +14,7 @@ from engine.blackboard.catalogue import READINGS
 from engine.cli.output import tell
 from engine.cli.view_options import port_number
 from engine.errors import UsageError
-from engine.interop.ros2_plan import ROUTER, Ros2Plan
+from engine.interop.ros2_plan import ROUTER, Ros2Plan, namespace_from, namespace_problem
 
 if TYPE_CHECKING:
     from engine.interop.foxglove_live import FoxgloveLive
@@ -76,18 +76,36 @@ def add_interop_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--ros2-commands",
         action="store_true",
-        help="also take commands (say, led, move, read) on /vest/command, carried out by the "
-        "iot_command tree as an operator's are; anyone on the graph may then send them",
+        help="also take commands (say, led, move, read) on /<namespace>/vest/command, carried "
+        "out by the iot_command tree as an operator's are; anyone on the graph may then send them",
+    )
+    parser.add_argument(
+        "--ros2-namespace",
+        default=None,
+        metavar="NAME",
+        help="the robot's ROS 2 namespace: its node is /NAME/vest and its topics /NAME/vest/... "
+        "(default: the robot config's name, e.g. sim; '' for none), so two robots on one "
+        "graph do not share topics",
     )
 
 
-def ros2_plan(args: argparse.Namespace) -> Ros2Plan | None:
-    """The graph the options name (UsageError for a bad ROS_DOMAIN_ID or --ros2-commands
-    alone); None without --ros2."""
+def ros2_plan(args: argparse.Namespace, robot_name: str) -> Ros2Plan | None:
+    """The graph the options name (UsageError for a bad ROS_DOMAIN_ID, a namespace ROS 2
+    refuses, or --ros2-commands or --ros2-namespace alone); None without --ros2. The
+    namespace is ``robot_name``'s unless --ros2-namespace says."""
     if args.ros2 is None:
         if args.ros2_commands:
             raise UsageError("--ros2-commands takes commands from a ROS 2 graph: add --ros2")
+        if args.ros2_namespace is not None:
+            raise UsageError("--ros2-namespace names the robot on a ROS 2 graph: add --ros2")
         return None
+    if args.ros2_namespace is None:
+        namespace = namespace_from(robot_name)
+    else:
+        namespace = args.ros2_namespace.strip("/")
+        problem = namespace_problem(args.ros2_namespace)
+        if problem is not None:
+            raise UsageError(f"--ros2-namespace {problem}")
     if not _ENDPOINT.fullmatch(args.ros2) or not 0 < int(args.ros2.rpartition(":")[2]) < 65536:
         raise UsageError(
             f"--ros2 {args.ros2!r}: the router's Zenoh endpoint, like tcp/192.168.1.20:7447 "
@@ -99,7 +117,7 @@ def ros2_plan(args: argparse.Namespace) -> Ros2Plan | None:
     config_file = os.environ.get("ZENOH_SESSION_CONFIG_URI") or None
     if config_file is not None:
         _check_config_file(Path(config_file))
-    return Ros2Plan(args.ros2, int(domain_text), args.ros2_commands, config_file)
+    return Ros2Plan(args.ros2, int(domain_text), args.ros2_commands, config_file, namespace)
 
 
 def _check_config_file(path: Path) -> None:
@@ -120,9 +138,10 @@ def tell_foxglove(live: FoxgloveLive) -> None:
 
 
 def tell_ros2(bridge: Ros2Bridge) -> None:
-    taking = "; commands on /vest/command" if bridge.plan.commands else ""
+    node = f"{bridge.plan.prefix}/vest"
+    taking = f"; commands on {node}/command" if bridge.plan.commands else ""
     tell(
-        f"ros2: node /vest on domain {bridge.plan.domain} through {bridge.where}{taking} "
+        f"ros2: node {node} on domain {bridge.plan.domain} through {bridge.where}{taking} "
         "(ros2 topic list, with RMW_IMPLEMENTATION=rmw_zenoh_cpp)"
     )
     sent = (

@@ -284,7 +284,7 @@ def _run_for_site(
     if args.audio_out is not None and args.person:  # the robot's voice may quote them
         held = [args.record] if args.record is not None else []
         site.output_written(args.audio_out, args.person, "robot's voice", held)
-    ros2 = ros2_plan(args)
+    ros2 = ros2_plan(args, config.name)
     leaving = args.record is not None or args.cloud is not None or ros2 is not None
     if leaving or consent.left_out:  # what the timeline and the pages leave out, and why
         tell(f"privacy: {consent.describe()}")

@@ -322,7 +322,6 @@ def _around(assembled: AssembledRobot, plan: SessionPlan, link: CloudLink | None
     lifecycle.add("session", start=begin, stop=_nothing)
     assembled.add_runners()  # the pollers and the camera, phased on the first tick
     if link is not None:
-
         cloud_hub = ViewHub(clock)  # the cloud's page: what may leave the robot, in words
         cloud_hub.begin(start_s, robot.trees)
         shown = CloudSession(cloud_hub, running.wizard)

@@ -103,7 +103,7 @@ class Ros2Bridge:
         consent gate's exit off the robot (a command's result passes it too)."""
         self.plan, self.clock, self.epoch_offset_s = plan, clock, epoch_offset_s
         self.catalogue = catalogue
-        self.node = NodeName("vest")
+        self.node = NodeName("vest", plan.prefix)
         self.wire = Wire()
         self._session: zenoh.Session | None = None
         self._zid = ""
@@ -131,7 +131,7 @@ class Ros2Bridge:
         self._zid = str(self._session.zid())
         self._tokens.append(self._declare_token(self.node.token(self.plan.domain, self._zid)))
         if self.plan.commands:
-            command = self.wire.endpoint(COMMAND_TOPIC, STRING)
+            command = self.wire.endpoint(self.plan.prefix + COMMAND_TOPIC, STRING)
             entity = self._next_entity()
             self._publisher(RESULT_TOPIC, STRING)  # declared now: a sender can wait for it
             self._tokens.append(
@@ -248,7 +248,7 @@ class Ros2Bridge:
         if found is not None:
             return found
         assert self._session is not None
-        endpoint = self.wire.endpoint(topic, typename)
+        endpoint = self.wire.endpoint(self.plan.prefix + topic, typename)
         entity = self._next_entity()
         domain = self.plan.domain
         publisher = self._session.declare_publisher(endpoint.key(domain))

@@ -70,10 +70,13 @@ class CloudSession:
         number, by = args.get("button"), args.get("by")
         if not isinstance(number, int) or isinstance(number, bool):
             return "FAILED", {"error": f"button: {number!r} is not a button's number"}
-        button = self.wizard.press(number, by="cloud", who=str(by or "someone"))
+        button = self.wizard.board.button(number)
         if button is None:
             count = len(self.wizard.board.buttons)
             return "FAILED", {"error": f"no button {number} (this board has 0 to {count - 1})"}
+        if number not in self.wizard.state()["shown"]:  # as the robot's own page refuses it
+            return "FAILED", {"error": f"{button.label!r} is not shown now: nothing done"}
+        self.wizard.press(number, by="cloud", who=str(by or "someone"))
         return "SUCCEEDED", {"pressed": button.label}
 
     def _board(self) -> dict[str, Any] | None:

@@ -15,7 +15,7 @@ import socket
 import subprocess
 import sys
 import threading
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
@@ -68,7 +68,8 @@ class Lab:
         self.samples: list[tuple[str, bytes, bytes | None]] = []
         self.tokens: list[str] = []
         self.arrived = threading.Condition()
-        self._subscriber = self.session.declare_subscriber("0/vest/**", self._sample)
+        self.prefix = ""  # the robot's namespace, as its topics begin ('' or /sim)
+        self._subscriber = self.session.declare_subscriber("0/**", self._sample)
         self._tokens = self.session.liveliness().declare_subscriber(
             "@ros2_lv/**", self._token, history=True
         )
@@ -108,11 +109,12 @@ class Lab:
         return self.wait_for(what, lambda: len(self.results()) > 1 and self.results())
 
     def results(self) -> list[dict[str, Any]]:
-        return [json.loads(m.data) for m in self.messages("/vest/command/result", STRING)]
+        topic = f"{self.prefix}/vest/command/result"
+        return [json.loads(m.data) for m in self.messages(topic, STRING)]
 
     def send(self, text: str) -> None:
         """A command, as `ros2 topic pub /vest/command std_msgs/msg/String` sends it."""
-        key = f"0/vest/command/std_msgs::msg::dds_::String_/{STRING_HASH}"
+        key = f"0{self.prefix}/vest/command/std_msgs::msg::dds_::String_/{STRING_HASH}"
         payload = WIRE.encode(STRING, {"data": text})
         self.session.put(key, payload, attachment=attachment(1, 0, bytes(16)))
 
@@ -145,13 +147,13 @@ class GatedBridge:
 
 
 def bridge_on(
-    lab: Lab, *covers: str, commands: bool = False
+    lab: Lab, *covers: str, commands: bool = False, namespace: str = ""
 ) -> tuple[GatedBridge, Blackboard, VirtualClock]:
     clock = VirtualClock()
     catalogue = default_catalogue()
     stream = SessionStream(clock)
     gates = ConsentGates(stream, Consent("kid-17", frozenset(covers)))
-    plan = Ros2Plan(lab.endpoint, 0, commands)
+    plan = Ros2Plan(lab.endpoint, 0, commands, namespace=namespace)
     bridge = Ros2Bridge(plan, clock, 1.7e9, gates.sending, catalogue)
     gates.sent.subscribe(bridge)
     board = Blackboard(catalogue, clock)
@@ -327,6 +329,27 @@ def test_a_second_command_under_a_waiting_id_is_refused(lab: Lab) -> None:
     assert "still waiting" in results[1]["result"]["error"]
 
 
+def test_two_robots_on_one_graph_keep_to_their_own_namespaces(lab: Lab) -> None:
+    def leds_of(robot: str) -> Callable[[], list[Any]]:
+        return lambda: lab.messages(f"/{robot}/vest/devices/leds/color", STRING)
+
+    left, _, _ = bridge_on(lab, namespace="hbs2")
+    right, _, _ = bridge_on(lab, namespace="hbs3")
+    try:
+        left.on_event(KeyChanged(0.1, "/devices/leds/color", "pink", '"pink"', False, "leds"))
+        right.on_event(KeyChanged(0.1, "/devices/leds/color", "blue", '"blue"', False, "leds"))
+        colors = {robot: lab.wait_for(robot, leds_of(robot)) for robot in ("hbs2", "hbs3")}
+    finally:
+        left.stop()
+        right.stop()
+    assert {robot: [m.data for m in found] for robot, found in colors.items()} == {
+        "hbs2": ["pink"],
+        "hbs3": ["blue"],
+    }
+    nodes = sorted(token.split("/NN/")[1] for token in lab.tokens if "/NN/" in token)
+    assert nodes == ["%/%hbs2/vest", "%/%hbs3/vest"]  # /hbs2/vest and /hbs3/vest
+
+
 def test_without_ros2_commands_the_robot_takes_none(lab: Lab) -> None:
     bridge, board, _ = bridge_on(lab)
     try:
@@ -352,12 +375,14 @@ def test_vest_run_carries_out_a_say_sent_from_the_graph(lab: Lab) -> None:
     try:
         assert robot.stderr is not None
         said = next(line for line in robot.stderr if line.startswith("ros2: "))
-        assert "node /vest on domain 0" in said and "commands on /vest/command" in said
+        # the robot's namespace is its config's name (the simulated vest's: sim)
+        assert "node /sim/vest on domain 0" in said and "commands on /sim/vest/command" in said
+        lab.prefix = "/sim"
         lab.listening_for_commands()
         lab.send(json.dumps({"id": "hello-1", "type": "say", "args": {"text": "hello there"}}))
         results = lab.two_results("the say's result")
         log_type = "nav2_msgs/msg/BehaviorTreeLog"
-        iot_log = lab.messages("/vest/trees/iot_command/log", log_type)
+        iot_log = lab.messages("/sim/vest/trees/iot_command/log", log_type)
     finally:
         robot.terminate()
         robot.wait(timeout=60)
@@ -376,6 +401,9 @@ def test_vest_run_carries_out_a_say_sent_from_the_graph(lab: Lab) -> None:
         (["--ros2", "tcp/127.0.0.1:99999"], {}, r"a port 1..65535"),
         (["--ros2"], {"ZENOH_SESSION_CONFIG_URI": "/dev/zero"}, r"/dev/zero: not a file"),
         (["--ros2-commands"], {}, r"--ros2-commands .* add --ros2"),
+        (["--ros2-namespace", "hbs2"], {}, r"--ros2-namespace names .* add --ros2"),
+        (["--ros2", "--ros2-namespace", "2fast"], {}, r"'2fast' is not a ROS 2 namespace"),
+        (["--ros2", "--ros2-namespace", "a b"], {}, r"'a b' is not a ROS 2 namespace"),
         (["--ros2"], {"ROS_DOMAIN_ID": "abc"}, r"ROS_DOMAIN_ID='abc': a number 0..232"),
         (["--ros2"], {"ZENOH_SESSION_CONFIG_URI": "/no/such.json5"}, r"cannot read it"),
         (["--ros2", "--ros2-commands", "--trees", "trees/hug.yaml"], {}, r"no tree carries"),
