@@ -49,7 +49,9 @@ class PostgresListener:
     """Rings ``doorbell`` for every notification another worker (or this one) sends."""
 
     def __init__(self, engine: Engine, doorbell: Doorbell, clock: Clock) -> None:
-        self.dsn = engine.url.set(drivername="postgresql").render_as_string(hide_password=False)
+        # as the engine connects: several hosts (?host=db1&host=db2) stay several
+        _, self.connect_args = engine.dialect.create_connect_args(engine.url)
+        self.connect_args.pop("context", None)
         self.doorbell = doorbell
         self.clock = clock
         self._stop = clock.event()
@@ -68,7 +70,7 @@ class PostgresListener:
     def _listen(self) -> None:
         while not self._stop.is_set():
             try:
-                with psycopg.connect(self.dsn, autocommit=True) as connection:
+                with psycopg.connect(autocommit=True, **self.connect_args) as connection:
                     connection.execute(f"LISTEN {CHANNEL}")
                     self._listening.set()
                     while not self._stop.is_set():

@@ -4,9 +4,11 @@ robot's long-poll in another, through LISTEN/NOTIFY."""
 from __future__ import annotations
 
 import asyncio
+import socket
 import threading
 
 import pytest
+from sqlalchemy.engine import make_url
 
 from cloud.services import CloudStore
 from cloud.settings import Settings
@@ -50,3 +52,24 @@ def test_sqlite_has_no_notifications_to_listen_for(tmp_path: object) -> None:
         assert store.listener is None
     finally:
         store.close()
+
+
+def test_a_url_that_names_a_standby_too_finds_the_server_that_answers(postgres: object) -> None:
+    """The failover form of docs/cloud.md: two servers in one URL (here the first one is
+    down); the store and its listener both use the one that answers."""
+    url = make_url(postgres.new_database())  # type: ignore[attr-defined]
+    down = socket.socket()
+    down.bind(("127.0.0.1", 0))  # a port nobody listens on: a primary that died
+    dead_port = down.getsockname()[1]
+    both = url.set(host=None, port=None).update_query_pairs(
+        [("host", f"127.0.0.1:{dead_port}"), ("host", f"{url.host}:{url.port}")]
+    )
+    store = CloudStore.open(
+        Settings(db_url=both.render_as_string(hide_password=False)), EpochClock()
+    )
+    try:
+        store.directory.add_operator("ana")  # written through the one that answers
+        assert store.listener is not None and store.listener.wait_listening(10.0)
+    finally:
+        store.close()
+        down.close()
