@@ -25,9 +25,9 @@ NGINX = shutil.which("nginx") or "/usr/sbin/nginx"
 DOCS_BLOCK = re.compile(r"```nginx\n(.*?)```", re.S)
 
 
-def docs_server_block() -> str:
-    [block] = DOCS_BLOCK.findall((ROOT / "docs" / "cloud.md").read_text())
-    return block
+def docs_server_block(number: int = 0) -> str:
+    """The ``number``-th nginx block of docs/cloud.md (0: one host, 1: several hosts)."""
+    return str(DOCS_BLOCK.findall((ROOT / "docs" / "cloud.md").read_text())[number])
 
 
 def free_port() -> int:
