@@ -1,7 +1,7 @@
 """The therapist's buttons at run time (wizard of oz).
 
 A press comes from the buttons page (any thread), a key on the page, a scenario, or the
-cloud's page (engine/services/cloud_session.py: a therapist in another room); it is
+cloud's page (engine/view/cloud_session.py: a therapist in another room); it is
 carried out between ticks by the scheduler hook :meth:`Wizard.__call__`:
 
 - a button that acts (say, led, move, play) runs on the buttons' own tree, which ticks

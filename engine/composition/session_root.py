@@ -41,10 +41,10 @@ from engine.runtime.robot_factory import AssembledRobot, build_robot
 from engine.scenario.player import ScenarioPlayer
 from engine.scenario.scenario_file import Scenario, ScenarioEvent
 from engine.services.cloud_link import CloudLink
-from engine.services.cloud_session import CloudSession
 from engine.services.simulated import simulated_services
 from engine.session.events import WorldEvent
 from engine.session.stream import SessionStream
+from engine.view.cloud_session import CloudSession
 from engine.view.hub import ViewHub
 from engine.view.server import LiveSource, ViewServer
 

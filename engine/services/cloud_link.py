@@ -4,7 +4,7 @@ Four workers, none of them in a tick:
 - the *poller* long-polls ``GET /robot/commands/next``, stages each command on
   ``/iot/inbox`` for the iot_command tree, and backs off (0.5 s doubling to 30 s) while the
   service cannot be reached. A ``press`` (a therapist's, on the cloud's page) goes to the
-  buttons at once (:class:`~engine.services.cloud_session.CloudSession`), also while
+  buttons at once (:class:`~engine.view.cloud_session.CloudSession`), also while
   another command is carried out: the robot then long-polls for presses alone;
 - the *reporter* sends each result (``report``, the :class:`IotResults` service) until the
   service has it, in order, retrying the same way;
@@ -46,8 +46,7 @@ from engine.clock import Clock
 from engine.periodic import Periodic
 from engine.privacy.consent import without_record
 from engine.privacy.consent_gate import RESULT_WITHHELD, ConsentGate, Exit
-from engine.services.cloud_push import Push, json_object, positive_s
-from engine.services.cloud_session import NO_BOARD, PRESS, CloudSession
+from engine.services.cloud_push import NO_BOARD, PRESS, Push, SessionShown, json_object, positive_s
 from engine.services.done_commands import DoneCommands
 from engine.services.jobs import ImmediateJob, Job
 from engine.services.telemetry import TelemetrySnapshot
@@ -111,7 +110,7 @@ class CloudLink:
         self._telemetry_push = Push(
             self.http, f"{self.api}/robot/telemetry", "telemetry", self._telemetry_body
         )
-        self.session: CloudSession | None = None
+        self.session: SessionShown | None = None
         """The session as the cloud's page shows it, and its presses (bound)."""
         self._session_push = Push(
             self.http, f"{self.api}/robot/session", "the session's view", self._session_body
@@ -133,7 +132,7 @@ class CloudLink:
         blackboard: Blackboard,
         sent: SessionStream,
         gate: ConsentGate,
-        session: CloudSession | None = None,
+        session: SessionShown | None = None,
     ) -> None:
         """The blackboard commands are staged on; ``sent``, the consent gate's exit off
         the robot, whose committed sensor and device values are pushed as telemetry; and

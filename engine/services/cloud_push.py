@@ -11,12 +11,32 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Callable
-from typing import Any
+from typing import Any, Protocol
 
 import requests
 
 log = logging.getLogger("engine.services.cloud_link")
 PUSH_TIMEOUT_S = 5.0
+PRESS = "press"
+"""The type of the cloud's command that presses one of the robot's buttons."""
+NO_BOARD = "this robot runs no buttons (start it with vest run --buttons FILE)"
+
+
+class SessionShown(Protocol):
+    """The session as the cloud's page shows it, and where the page's presses go
+    (:class:`engine.view.cloud_session.CloudSession`)."""
+
+    def changed_view(self) -> dict[str, Any] | None:
+        """The view when it changed since the last one returned, else None."""
+        ...
+
+    def forget_sent(self) -> None:
+        """The last view did not reach the cloud: the next look returns it again."""
+        ...
+
+    def press(self, args: dict[str, Any]) -> tuple[str, dict[str, Any]]:
+        """Carry out a press (``{"button", "by"}``): its report's status and result."""
+        ...
 
 
 class Push:

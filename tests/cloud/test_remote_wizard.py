@@ -15,7 +15,7 @@ from playwright.sync_api import Page, expect
 
 from cloud.api.presses import PRESS_WITHIN_S
 from cloud.settings import Settings
-from cloud.store.ledger import SUCCEEDED, TIMED_OUT
+from cloud.store.ledger import FAILED, SUCCEEDED, TIMED_OUT
 from engine.clock import RealClock, VirtualClock
 from tests.cloud.conftest import Robot, Running, StartService
 
@@ -42,6 +42,12 @@ def people(running: Running, tmp_path: Path) -> tuple[dict[str, str], Path]:
         tokens[name] = directory.add_operator(name, role=role)
         directory.grant(name, "hbs2")
     return tokens, token_file
+
+
+def failed(running: Running, command_id: str) -> Any:
+    """The command once it ended FAILED, else None."""
+    found = running.store.ledger.get(1, command_id)
+    return found if found is not None and found.state == FAILED else None
 
 
 def as_(token: str) -> dict[str, str]:
@@ -112,12 +118,57 @@ def test_a_therapist_in_the_next_room_watches_the_session_and_presses_a_button(
     )
     assert told == ["presses the button 'Hello' from the cloud (tess)"]
 
+    # what the robot's own page would refuse, it refuses, saying why; nothing is done
+    for number, why in (
+        (labels.index("Show me your hand"), "is not shown now"),
+        (99, "no button 99"),
+    ):
+        refused_id = requests.post(
+            f"{running.api}/robots/hbs2/press", json={"button": number}, headers=as_(tokens["tess"])
+        ).json()["id"]
+        ended = until(lambda i=refused_id: failed(running, i))
+        assert why in ended.result["error"]
+
     robot.process.send_signal(signal.SIGINT)
     robot.finish()
     presses = [event for event in robot.events if event["event"] == "press"]
     assert [(p["label"], p["by"], p["who"]) for p in presses] == [("Hello", "cloud", "tess")]
     audit = [(e.actor, e.action, e.detail) for e in running.store.directory.audit.since()]
     assert ("tess", "press", f"button {hello}") in audit
+
+
+def test_a_press_reaches_a_robot_busy_with_an_operator_s_long_command(
+    start_service: StartService, start_robot: Callable[..., Robot], tmp_path: Path
+) -> None:
+    running = start_service(Settings(db_url=f"sqlite:///{tmp_path / 'c.db'}", recheck_s=0.2))
+    tokens, token_file = people(running, tmp_path)
+    long_say, _ = running.store.ledger.submit(1, "say", {"text": " ".join(["one two three"] * 20)})
+    (tmp_path / "long.yaml").write_text("duration_s: 600\nevents: []\n")
+    robot = start_robot(
+        running.url,
+        token_file,
+        tmp_path / "long.yaml",
+        ["trees/iot_command.yaml"],
+        buttons="trees/buttons/session.yaml",
+    )
+    robot.until(lambda action: action["action"] == "say")  # the long sentence has begun
+    view = until(
+        lambda: (
+            requests.get(f"{running.api}/robots/hbs2/session", headers=as_(tokens["tess"]))
+            .json()
+            .get("view")
+        )
+    )
+    calm = [button["label"] for button in view["board"]["buttons"]].index("Calm face")
+    requests.post(
+        f"{running.api}/robots/hbs2/press", json={"button": calm}, headers=as_(tokens["tess"])
+    )
+    lit = robot.until(lambda action: action["action"] == "led" and action["tree"] == "buttons")
+    assert lit["args"]["color"] == "blue"
+    still = running.store.ledger.get(1, long_say.id)
+    assert still is not None and still.state == "IN_PROGRESS"  # the press did not wait for it
+    robot.process.send_signal(signal.SIGINT)
+    robot.finish()
 
 
 def test_a_press_the_robot_does_not_take_in_time_is_dropped_never_carried_out_late(

@@ -132,10 +132,12 @@ def test_each_person_learns_their_role_and_what_it_allows(team: Team) -> None:
         "name": "vic",
         "role": "viewer",
         "can_command": False,
+        "can_press": False,
         "sees_telemetry": False,
         "expires_at_s": 1_800_000_000.0 + 90 * 86_400,
     }
     assert team.get("ada", "/me").json()["can_command"] is True
+    assert team.get("tess", "/me").json()["can_press"] is True  # a therapist presses buttons
     assert team.get("hbs2", "/me").status_code == 404  # robots have no account
 
 

@@ -16,19 +16,18 @@ from __future__ import annotations
 from typing import Any
 
 from engine.buttons.wizard import Wizard
+from engine.services.cloud_push import NO_BOARD
 from engine.session.events import SessionEvent
 from engine.view.hub import ViewHub
 
-PRESS = "press"
-"""The type of the cloud's command that presses a button."""
 HAPPENED_SENT = 30
 """How many of the latest "what happened" lines the view carries."""
-NO_BOARD = "this robot runs no buttons (start it with vest run --buttons FILE)"
 
 
 class CloudSession:
     """A reader of the session's exit off the robot (``on_event``) that keeps the view
-    the cloud shows; ``wizard``: the robot's buttons, None when it runs none."""
+    the cloud shows; ``wizard``: the robot's buttons, None when it runs none (the cloud
+    link's :class:`~engine.services.cloud_push.SessionShown`)."""
 
     def __init__(self, hub: ViewHub, wizard: Wizard | None) -> None:
         self.hub = hub
