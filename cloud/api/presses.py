@@ -48,7 +48,18 @@ def press_button(
     command, _ = store.ledger.submit(
         row.id, PRESS, {"button": body.button, "by": person.name}, timeout_s=PRESS_WITHIN_S
     )
+    label = _label(store.sessions.get(row.id), body.button)
     store.directory.audit.record(
-        actor(person, request), "press", robot=row.name, detail=f"button {body.button}"
+        actor(person, request), "press", robot=row.name, detail=f"button {body.button}{label}"
     )
     return CommandPublic.of(command, row.name)
+
+
+def _label(stored: tuple[dict[str, Any], float] | None, number: int) -> str:
+    """`` 'Hello'``: the button's label on the board the robot last showed ("" unknown)."""
+    board = stored[0].get("board") if stored is not None else None
+    buttons = board.get("buttons") if isinstance(board, dict) else None
+    for button in buttons if isinstance(buttons, list) else []:
+        if isinstance(button, dict) and button.get("id") == number:
+            return f" {str(button.get('label'))[:80]!r}"
+    return ""

@@ -104,6 +104,7 @@ function onEvent(name, data) {
   if (name === "robots") {
     state.robots = data;
     renderRobots();
+    showSession();
   } else if (name === "command") {
     if (!state.commands.has(data.robot)) state.commands.set(data.robot, new Map());
     const known = state.commands.get(data.robot).get(data.id);
@@ -149,7 +150,7 @@ function renderStatus() {
   if (!robot) return;
   $("#robot-status").textContent = robot.online
     ? "Online"
-    : `Offline: last seen ${ago(robot.last_seen_s)}. Commands wait for it (until they time out).`;
+    : `Offline: last seen ${ago(robot.last_seen_s)}. Commands wait for it (until they time out); presses are dropped.`;
 }
 
 async function select(name) {
@@ -180,8 +181,11 @@ async function select(name) {
 // -- the live session and its buttons --------------------------------------------------------
 
 function showSession() {
+  const robot = state.robots.find((r) => r.name === state.selected);
   renderSession($("#session"), state.sessions.get(state.selected), {
     canPress: state.me.can_press,
+    online: Boolean(robot && robot.online),
+    role: state.me.role,
     onPress: press,
     lastPress: state.presses.get(state.selected),
   });
@@ -190,6 +194,8 @@ function showSession() {
 async function press(button) {
   const robot = state.selected;
   $("#press-error").textContent = "";
+  state.presses.set(robot, { label: button.label, command: { id: null, state: "QUEUED" } });
+  showSession();
   try {
     const command = await state.api.call("POST", `/robots/${encodeURIComponent(robot)}/press`, {
       button: button.id,
@@ -198,6 +204,8 @@ async function press(button) {
     state.presses.set(robot, { label: button.label, command: known && known.version > command.version ? known : command });
     showSession();
   } catch (error) {
+    state.presses.delete(robot);
+    showSession();
     $("#press-error").textContent = error.message;
   }
 }
@@ -244,6 +252,16 @@ async function cancel(command) {
   }
 }
 
+// A command's arguments as the page shows them: a press names its button and who pressed.
+function described(command) {
+  if (command.type !== "press") return el("code", { textContent: shown(command.args) });
+  const session = state.sessions.get(command.robot);
+  const board = session && session.view.board;
+  const button = board && board.buttons.find((b) => b.id === command.args.button);
+  const name = button ? `'${button.label}'` : `button ${command.args.button}`;
+  return `${name} by ${command.args.by}`;
+}
+
 function renderCommands() {
   const commands = [...(state.commands.get(state.selected) || new Map()).values()].sort(
     (a, b) => b.created_s - a.created_s,
@@ -255,7 +273,7 @@ function renderCommands() {
         "tr",
         {},
         el("td", { textContent: clock(c.created_s) }),
-        el("td", {}, el("strong", { textContent: c.type }), " ", el("code", { textContent: shown(c.args) })),
+        el("td", {}, el("strong", { textContent: c.type }), " ", described(c)),
         el("td", {}, el("span", { className: `state ${c.state}`, textContent: c.state })),
         el("td", {}, el("pre", {
           textContent: c.result_hidden ? "(not shown to a viewer)"

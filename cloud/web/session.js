@@ -32,7 +32,14 @@ export function pressOutcome(command) {
   return PRESS_OUTCOME[command.state] || command.state;
 }
 
-export function renderSession(root, session, { canPress, onPress, lastPress }) {
+// Why nothing can be pressed now ("" when the board is live).
+function notLive(session, online) {
+  if (session.view.ended) return "The session has ended: the robot stopped. Its last state is shown.";
+  if (!online) return "The robot is offline: a press now would be dropped. Its last state is shown.";
+  return "";
+}
+
+export function renderSession(root, session, { canPress, online, role, onPress, lastPress }) {
   const trees = root.querySelector("#session-trees");
   const happened = root.querySelector("#session-happened");
   const board = root.querySelector("#session-board");
@@ -41,9 +48,14 @@ export function renderSession(root, session, { canPress, onPress, lastPress }) {
   root.querySelector("#session-live").hidden = !session;
   if (!session) return;
   const view = session.view;
+  const stale = notLive(session, online);
+  root.querySelector("#session-stale").textContent = stale;
+  root.querySelector("#session-live").classList.toggle("stale", Boolean(stale));
+  const paused = Boolean(view.board && view.board.paused);
   trees.replaceChildren(
     ...view.trees.map((tree) => {
-      const doing = tree.doing.length ? tree.doing.join("; ") : tree.status === "RUNNING" ? "" : "waiting";
+      const idle = paused && tree.tree !== "buttons" ? "paused" : "waiting";
+      const doing = tree.doing.length ? tree.doing.join("; ") : tree.status === "RUNNING" ? "" : idle;
       const item = el(
         "li",
         { className: `tree ${tree.status}` },
@@ -79,14 +91,17 @@ export function renderSession(root, session, { canPress, onPress, lastPress }) {
       type: "button",
       className: button.control ? "press control" : "press",
       textContent: button.label,
-      disabled: !canPress || !shown.has(button.id),
-      title: !canPress ? "your role does not press buttons" : shown.has(button.id) ? "" : "not shown now",
+      disabled: !canPress || Boolean(stale) || !shown.has(button.id),
+      title: shown.has(button.id) ? "" : "not shown now",
     });
     press.dataset.button = String(button.id);
     press.addEventListener("click", () => onPress(button));
     board.append(press);
   }
-  const status = [buttons.paused ? "The behaviours are paused." : "", buttons.doing ? `Doing: ${buttons.doing}.` : ""];
+  root.querySelector("#board-role").textContent = canPress
+    ? ""
+    : `Your role, ${role}, sees the buttons; it does not press them.`;
+  const status = [buttons.paused ? "The behaviors are paused." : "", buttons.doing ? `Doing: ${buttons.doing}.` : ""];
   root.querySelector("#board-status").textContent = status.filter(Boolean).join(" ");
   root.querySelector("#press-outcome").textContent = lastPress
     ? `${lastPress.label}: ${pressOutcome(lastPress.command)}`

@@ -159,13 +159,16 @@ class CloudLink:
             self._threads.append(thread)
 
     def stop(self) -> None:
-        """Stop polling and pushing; reports still queued get a few seconds to be sent. A
-        long-poll in flight is left to end by itself: a command it claims now is
-        delivered again once its lease runs out."""
+        """Stop polling and pushing (the last view says the session ended); reports still
+        queued get a few seconds to be sent. A long-poll in flight is left to end by
+        itself: a command it claims now is delivered again once its lease runs out."""
         self._stop.set()
         self._reports.put(None)
         for push in self._pushes:
             push.stop()
+        if self.session is not None:  # the page stops offering what the robot no longer does
+            self.session.end()
+            self._session_push.once()
         for thread in self._threads:
             thread.join(timeout=5.0 if thread.name == "cloud-report" else 0.5)
 

@@ -34,6 +34,10 @@ class SessionShown(Protocol):
         """The last view did not reach the cloud: the next look returns it again."""
         ...
 
+    def end(self) -> None:
+        """The robot stops: the next view says the session ended."""
+        ...
+
     def press(self, args: dict[str, Any]) -> tuple[str, dict[str, Any]]:
         """Carry out a press (``{"button", "by"}``): its report's status and result."""
         ...

@@ -33,20 +33,22 @@ class CloudSession:
         self.hub = hub
         self.wizard = wizard
         self._sent: dict[str, Any] | None = None
+        self.ended = False
 
     def on_event(self, event: SessionEvent) -> None:
         self.hub.on_event(event)
 
     def view(self) -> dict[str, Any]:
         """The session now: ``trees`` (name, priority, status, ``doing``: what its running
-        leaves do, in words), ``happened`` (the latest lines), ``board`` (None: no buttons)."""
+        leaves do, in words), ``happened`` (the latest lines), ``board`` (None: no buttons),
+        ``ended`` (the robot stopped: nothing on the page is current any more)."""
         snapshot = self.hub.snapshot()
         trees = [_tree(tree) for tree in snapshot["trees"]]
         happened = [
             {key: line[key] for key in ("at", "who", "what", "tone")}
             for line in snapshot["happened"][-HAPPENED_SENT:]
         ]
-        return {"trees": trees, "happened": happened, "board": self._board()}
+        return {"trees": trees, "happened": happened, "board": self._board(), "ended": self.ended}
 
     def changed_view(self) -> dict[str, Any] | None:
         """The view when it changed since the last one this returned, else None."""
@@ -55,6 +57,10 @@ class CloudSession:
             return None
         self._sent = view
         return view
+
+    def end(self) -> None:
+        """The robot stops: the next view says the session ended."""
+        self.ended = True
 
     def forget_sent(self) -> None:
         """The last view did not reach the cloud: the next look sends the view again."""

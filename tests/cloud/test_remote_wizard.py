@@ -134,7 +134,7 @@ def test_a_therapist_in_the_next_room_watches_the_session_and_presses_a_button(
     presses = [event for event in robot.events if event["event"] == "press"]
     assert [(p["label"], p["by"], p["who"]) for p in presses] == [("Hello", "cloud", "tess")]
     audit = [(e.actor, e.action, e.detail) for e in running.store.directory.audit.since()]
-    assert ("tess", "press", f"button {hello}") in audit
+    assert ("tess", "press", f"button {hello} 'Hello'") in audit
 
 
 def test_a_press_reaches_a_robot_busy_with_an_operator_s_long_command(
@@ -197,7 +197,7 @@ def test_on_the_cloud_page_a_therapist_presses_and_a_viewer_only_watches(
     running = start_service(Settings(db_url=f"sqlite:///{tmp_path / 'c.db'}", recheck_s=0.2))
     tokens, token_file = people(running, tmp_path)
     (tmp_path / "long.yaml").write_text("duration_s: 600\nevents: []\n")
-    start_robot(
+    robot = start_robot(
         running.url,
         token_file,
         tmp_path / "long.yaml",
@@ -223,3 +223,10 @@ def test_on_the_cloud_page_a_therapist_presses_and_a_viewer_only_watches(
     page.click("#login button[type=submit]")
     expect(page.locator("#session-happened")).to_contain_text("from the cloud (tess)")
     expect(page.locator('#session-board button:text-is("Hello")')).to_be_disabled()
+    expect(page.locator("#board-role")).to_have_text(
+        "Your role, viewer, sees the buttons; it does not press them."
+    )
+
+    robot.process.send_signal(signal.SIGINT)  # the robot stops: the page says so at once
+    robot.finish()
+    expect(page.locator("#session-stale")).to_contain_text("The session has ended")
