@@ -9,6 +9,14 @@ PostgreSQL (2 workers, a throwaway cluster). Target: p99 <= 50 ms without teleme
 ms with it. Baseline in the same run: the paper's way, robots asking once a second
 (short polls), on the same service.
 
+Question 3 (issue 42): how many robots does a host hold? 1, 2 and 3 hosts (`vest cloud
+serve`, one worker each, processes of their own) on one PostgreSQL database; the robots
+spread over them as a load balancer spreads them, each long-polling and pushing telemetry
+once a second, 20 commands a second. Robots are added (100, 200, 300, 400, 600, 800) until
+p99 command -> robot passes 100 ms; the last count that held is printed, and per host.
+On a 2-core machine the hosts, the database and this load generator share the cores, so
+more hosts add processes, not cores: the figure is this machine's, not a host's.
+
 Question 2: how many telemetry posts a second does the service answer? 64 clients post as
 fast as they can; baseline in the same run: a bare uvicorn app on the same machine that
 answers 204 without reading the body (the ceiling of the server stack itself).
@@ -20,6 +28,7 @@ CPU as the service.
 
     .venv/bin/python bench/bench_cloud.py            # ~3 min
     .venv/bin/python bench/bench_cloud.py --quick    # a short run that shows it still works
+    .venv/bin/python bench/bench_cloud.py --only hosts   # question 3 alone, ~5 min
 """
 
 from __future__ import annotations
@@ -128,12 +137,12 @@ class Service:
             self.process.wait(timeout=30)
 
 
-def prepare(db_url: str) -> tuple[str, list[str]]:
-    """An operator and ROBOTS robots granted to it: (operator token, robot tokens)."""
+def prepare(db_url: str, count: int = ROBOTS) -> tuple[str, list[str]]:
+    """An operator and ``count`` robots granted to it: (operator token, robot tokens)."""
     store = CloudStore.open(Settings(db_url=db_url), EpochClock())
     try:
         operator = store.directory.add_operator("bench")
-        robots = [store.directory.add_robot(f"r{i:03d}", operator="bench") for i in range(ROBOTS)]
+        robots = [store.directory.add_robot(f"r{i:04d}", operator="bench") for i in range(count)]
     finally:
         store.close()
     return operator, robots
@@ -206,14 +215,19 @@ async def telemetry(
 
 
 async def operator(
-    port: int, token: str, sent_at: dict[str, float], seconds: float, stop: asyncio.Event
+    port: int,
+    token: str,
+    sent_at: dict[str, float],
+    seconds: float,
+    stop: asyncio.Event,
+    robots: int = ROBOTS,
 ) -> int:
     connection = Connection(port, token)
     sent = 0
     start = time.perf_counter()
     try:
         while time.perf_counter() - start < seconds:
-            robot_name = f"r{random.randrange(ROBOTS):03d}"
+            robot_name = f"r{random.randrange(robots):04d}"
             key = f"c{sent}"
             sent_at[key] = time.perf_counter()
             status, _ = await connection.request(
@@ -237,24 +251,32 @@ async def operator(
 
 
 async def command_phase(
-    port: int,
+    port: int | list[int],
     tokens: tuple[str, list[str]],
     seconds: float,
     *,
     with_telemetry: bool,
     short_poll_s: float | None = None,
 ) -> tuple[Results, int]:
+    """``port``: the service's, or several hosts' (robot i on host i % hosts, as a load
+    balancer spreads them; the operator on the first)."""
+    ports = port if isinstance(port, list) else [port]
     operator_token, robot_tokens = tokens
     results, sent_at, stop = Results(), {}, asyncio.Event()
     tasks = [
-        asyncio.create_task(robot(port, t, i, sent_at, results, stop, short_poll_s=short_poll_s))
+        asyncio.create_task(
+            robot(ports[i % len(ports)], t, i, sent_at, results, stop, short_poll_s=short_poll_s)
+        )
         for i, t in enumerate(robot_tokens)
     ]
     if with_telemetry:
-        tasks += [asyncio.create_task(telemetry(port, t, results, stop, 1.0)) for t in robot_tokens]
+        tasks += [
+            asyncio.create_task(telemetry(ports[i % len(ports)], t, results, stop, 1.0))
+            for i, t in enumerate(robot_tokens)
+        ]
     await asyncio.sleep(2.0)  # every robot is polling
     posts_before, started = results.telemetry_posts, time.perf_counter()
-    sent = await operator(port, operator_token, sent_at, seconds, stop)
+    sent = await operator(ports[0], operator_token, sent_at, seconds, stop, len(robot_tokens))
     results.telemetry_rate = (results.telemetry_posts - posts_before) / (
         time.perf_counter() - started
     )
@@ -391,12 +413,59 @@ async def on_postgresql(seconds: float) -> float:
         cluster.stop()
 
 
+HOST_STEPS = (100, 200, 300, 400, 600, 800)
+"""Robots tried on 1, 2 and 3 hosts, fewest first, until p99 passes the target."""
+HOST_TARGET_P99_MS = 100.0
+
+
+async def per_host(seconds: float) -> None:
+    """Question 3: how many robots 1, 2 and 3 hosts (one worker each, processes of their
+    own on one PostgreSQL database) hold with telemetry 1/s and p99 command -> robot at
+    most 100 ms, robots spread over the hosts as a load balancer spreads them."""
+    cluster = PostgresCluster()
+    cluster.start()
+    try:
+        postgres = cluster.new_database()
+        operator_token, robot_tokens = prepare(postgres, max(HOST_STEPS))
+        for hosts in (1, 2, 3):
+            services = [Service(postgres, workers=1) for _ in range(hosts)]
+            for service in services:
+                service.start()
+            held = 0
+            try:
+                for count in HOST_STEPS:
+                    results, sent = await command_phase(
+                        [service.port for service in services],
+                        (operator_token, robot_tokens[:count]),
+                        seconds,
+                        with_telemetry=True,
+                    )
+                    print(line(f"{hosts} host(s), {count} robots, telemetry 1/s", results, sent))
+                    lat = results.latencies_ms + [float("inf")] * (sent - len(results.latencies_ms))
+                    if percentile(lat, 0.99) > HOST_TARGET_P99_MS:
+                        break
+                    held = count
+            finally:
+                for service in services:
+                    service.stop()
+            print(
+                f"{'':<48} {hosts} host(s) held {held} robots (p99 <= "
+                f"{HOST_TARGET_P99_MS:g} ms): {held / hosts:.0f} a host"
+            )
+    finally:
+        cluster.stop()
+
+
 async def run(quick: bool, only: str | None) -> None:
     seconds = 3.0 if quick else 20.0
     print(
         f"{ROBOTS} robots, {COMMANDS_PER_S:g} commands/s for {seconds:g} s per phase; "
         f"{os.cpu_count()} cores shared by the service and this load\n"
     )
+    if only == "hosts":
+        print(f"Question 3: robots per host, 1 to 3 hosts on one PostgreSQL ({HOST_STEPS})")
+        await per_host(seconds)
+        return
     print("Question 1: command -> the robot has it")
     rates: dict[str, float] = {}
     with tempfile.TemporaryDirectory() as folder:
@@ -418,6 +487,9 @@ async def run(quick: bool, only: str | None) -> None:
         name = f"vest cloud, {label}"
         print(f"{name:<48} {value:7.0f} /s  ({value / bare_rate:.2f} x baseline)")
     print(f"{ROBOTS} robots pushing once a second need {ROBOTS} posts/s")
+    if only is None:
+        print(f"\nQuestion 3: robots per host, 1 to 3 hosts on one PostgreSQL ({HOST_STEPS})")
+        await per_host(seconds)
 
 
 def main() -> None:
@@ -425,7 +497,9 @@ def main() -> None:
         description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
     )
     parser.add_argument("--quick", action="store_true", help="3 s phases instead of 20 s")
-    parser.add_argument("--only", choices=("sqlite", "postgresql"), help="one database")
+    parser.add_argument(
+        "--only", choices=("sqlite", "postgresql", "hosts"), help="one database, or the hosts"
+    )
     args = parser.parse_args()
     asyncio.run(run(args.quick, args.only))
 
