@@ -10,6 +10,7 @@ import shutil
 import socket
 import subprocess
 from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
@@ -66,7 +67,14 @@ def proxy(
             "http://127.0.0.1:8080": running.url,
         },
     )
-    prefix = tmp_path / "nginx"
+    with nginx(tmp_path / "nginx", server):
+        yield f"https://127.0.0.1:{port}", running.store, token, cert
+
+
+@contextmanager
+def nginx(prefix: Path, server: str) -> Iterator[None]:
+    """Debian's nginx running ``server`` (a server block, with any upstream) from
+    ``prefix``, until the block ends."""
     (prefix / "temp").mkdir(parents=True)
     temp = " ".join(
         f"{kind}_temp_path {prefix / 'temp' / kind};"
@@ -75,13 +83,17 @@ def proxy(
     conf = prefix / "nginx.conf"
     conf.write_text(
         f"pid {prefix / 'nginx.pid'};\nerror_log {prefix / 'error.log'};\n"
-        f"events {{}}\nhttp {{\n access_log off;\n {temp}\n{server}}}\n"
+        f"events {{ worker_connections 1024; }}\nhttp {{\n access_log off;\n {temp}\n{server}}}\n"
     )
     # the master binds its sockets before it leaves for the background: up once it returns
     started = subprocess.run([NGINX, "-p", str(prefix), "-c", str(conf)], capture_output=True)
     assert started.returncode == 0, started.stderr.decode()
-    yield f"https://127.0.0.1:{port}", running.store, token, cert
-    subprocess.run([NGINX, "-p", str(prefix), "-c", str(conf), "-s", "stop"], capture_output=True)
+    try:
+        yield
+    finally:
+        subprocess.run(
+            [NGINX, "-p", str(prefix), "-c", str(conf), "-s", "stop"], capture_output=True
+        )
 
 
 def test_a_command_through_nginx_is_audited_with_the_real_client_not_a_forged_one(

@@ -44,6 +44,17 @@ def people(running: Running, tmp_path: Path) -> tuple[dict[str, str], Path]:
     return tokens, token_file
 
 
+def with_buttons(
+    start_robot: Callable[..., Robot], running: Running, token_file: Path, tree: str
+) -> Robot:
+    """`vest run --buttons --cloud` with ``tree`` on the simulated vest, for ten minutes."""
+    scenario = token_file.parent / "long.yaml"
+    scenario.write_text("duration_s: 600\nevents: []\n")
+    return start_robot(
+        running.url, token_file, scenario, [tree], buttons="trees/buttons/session.yaml"
+    )
+
+
 def failed(running: Running, command_id: str) -> Any:
     """The command once it ended FAILED, else None."""
     found = running.store.ledger.get(1, command_id)
@@ -61,14 +72,7 @@ def test_a_therapist_in_the_next_room_watches_the_session_and_presses_a_button(
 ) -> None:
     running = start_service(Settings(db_url=f"sqlite:///{tmp_path / 'c.db'}", recheck_s=0.2))
     tokens, token_file = people(running, tmp_path)
-    (tmp_path / "long.yaml").write_text("duration_s: 600\nevents: []\n")
-    robot = start_robot(
-        running.url,
-        token_file,
-        tmp_path / "long.yaml",
-        ["trees/touch_thanks.yaml"],
-        buttons="trees/buttons/session.yaml",
-    )
+    robot = with_buttons(start_robot, running, token_file, "trees/touch_thanks.yaml")
     session_url = f"{running.api}/robots/hbs2/session"
 
     def board() -> dict[str, Any] | None:
@@ -143,14 +147,7 @@ def test_a_press_reaches_a_robot_busy_with_an_operator_s_long_command(
     running = start_service(Settings(db_url=f"sqlite:///{tmp_path / 'c.db'}", recheck_s=0.2))
     tokens, token_file = people(running, tmp_path)
     long_say, _ = running.store.ledger.submit(1, "say", {"text": " ".join(["one two three"] * 20)})
-    (tmp_path / "long.yaml").write_text("duration_s: 600\nevents: []\n")
-    robot = start_robot(
-        running.url,
-        token_file,
-        tmp_path / "long.yaml",
-        ["trees/iot_command.yaml"],
-        buttons="trees/buttons/session.yaml",
-    )
+    robot = with_buttons(start_robot, running, token_file, "trees/iot_command.yaml")
     robot.until(lambda action: action["action"] == "say")  # the long sentence has begun
     view = until(
         lambda: (
@@ -196,14 +193,7 @@ def test_on_the_cloud_page_a_therapist_presses_and_a_viewer_only_watches(
 ) -> None:
     running = start_service(Settings(db_url=f"sqlite:///{tmp_path / 'c.db'}", recheck_s=0.2))
     tokens, token_file = people(running, tmp_path)
-    (tmp_path / "long.yaml").write_text("duration_s: 600\nevents: []\n")
-    robot = start_robot(
-        running.url,
-        token_file,
-        tmp_path / "long.yaml",
-        ["trees/touch_thanks.yaml"],
-        buttons="trees/buttons/session.yaml",
-    )
+    robot = with_buttons(start_robot, running, token_file, "trees/touch_thanks.yaml")
     page.goto(running.url)
     page.fill("#token", tokens["tess"])
     page.click("#login button[type=submit]")

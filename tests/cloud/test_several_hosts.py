@@ -22,7 +22,7 @@ from cloud.settings import Settings
 from cloud.store.ledger import SUCCEEDED
 from engine.clock import EpochClock, RealClock
 from tests.cloud.conftest import ROOT, VEST
-from tests.cloud.test_behind_nginx import NGINX, docs_server_block, free_port, placed
+from tests.cloud.test_behind_nginx import docs_server_block, free_port, nginx, placed
 
 pytestmark = pytest.mark.realtime
 
@@ -157,21 +157,8 @@ def hosts(postgres: Any, tmp_path: Path) -> Iterator[tuple[str, list[subprocess.
     server = placed(
         docs_server_block(1), {"listen 443 ssl;": f"listen 127.0.0.1:{port};", **upstreams}
     )
-    prefix = tmp_path / "nginx"
-    (prefix / "temp").mkdir(parents=True)
-    temp = " ".join(
-        f"{kind}_temp_path {prefix / 'temp' / kind};"
-        for kind in ("client_body", "proxy", "fastcgi", "uwsgi", "scgi")
-    )
-    conf = prefix / "nginx.conf"
-    conf.write_text(
-        f"pid {prefix / 'nginx.pid'};\nerror_log {prefix / 'error.log'};\n"
-        f"events {{ worker_connections 1024; }}\nhttp {{\n access_log off;\n {temp}\n{server}}}\n"
-    )
-    started = subprocess.run([NGINX, "-p", str(prefix), "-c", str(conf)], capture_output=True)
-    assert started.returncode == 0, started.stderr.decode()
-    yield f"http://127.0.0.1:{port}", processes, db_url
-    subprocess.run([NGINX, "-p", str(prefix), "-c", str(conf), "-s", "stop"], capture_output=True)
+    with nginx(tmp_path / "nginx", server):
+        yield f"http://127.0.0.1:{port}", processes, db_url
     for process in processes:
         if process.poll() is None:
             process.send_signal(signal.SIGINT)
