@@ -367,30 +367,29 @@ class CloudLink:
             self.blackboard.stage_event(IOT_CANCELED, command_id)
 
     def _send_reports(self) -> None:
+        """Each report in order, retried with back-off until the service has it; once the
+        link stops, the reports still queued get one try each (a command whose report is
+        lost is delivered again later and answered from the record of finished ones)."""
         delay_s = FIRST_BACKOFF_S
-        while True:
-            item = self._reports.get()
-            if item is None:
-                return
-            command_id, report = item
-            while not self._stop.is_set():
-                try:
-                    answer = self.http.post(
-                        f"{self.api}/robot/commands/{command_id}/result", json=report, timeout=10.0
-                    )
-                except requests.RequestException as error:
-                    self._unreachable(error)
-                    delay_s = self._backoff(delay_s)
-                    continue
-                if answer.status_code >= 500:
-                    delay_s = self._backoff(delay_s)
-                    continue
-                if answer.status_code != 200:  # 404 or 409: the service knows better; said once
-                    log.warning(
-                        "report for %s: %s %s", command_id, answer.status_code, answer.text[:200]
-                    )
-                delay_s = FIRST_BACKOFF_S
-                break
+        while (item := self._reports.get()) is not None:
+            while not self._sent(*item) and not self._stop.is_set():
+                delay_s = self._backoff(delay_s)
+            delay_s = FIRST_BACKOFF_S
+
+    def _sent(self, command_id: str, report: dict[str, Any]) -> bool:
+        """One try at sending a report; False when it is to be tried again."""
+        try:
+            answer = self.http.post(
+                f"{self.api}/robot/commands/{command_id}/result", json=report, timeout=10.0
+            )
+        except requests.RequestException as error:
+            self._unreachable(error)
+            return False
+        if answer.status_code >= 500:
+            return False
+        if answer.status_code != 200:  # 404 or 409: the service knows better; said once
+            log.warning("report for %s: %s %s", command_id, answer.status_code, answer.text[:200])
+        return True
 
     def push_telemetry(self) -> bool:
         """Push the latest committed sensor and device values once; False when the push

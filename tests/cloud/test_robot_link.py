@@ -3,6 +3,7 @@ reports it; it keeps behaving while the service is away."""
 
 from __future__ import annotations
 
+import signal
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -14,6 +15,7 @@ from cloud.settings import Settings
 from cloud.store.ledger import SUCCEEDED
 from engine.cli import main
 from engine.services.done_commands import DoneCommands
+from tests.cloud.conftest import Robot
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -27,7 +29,7 @@ def cloud(tmp_path: Path, start_service: Callable[..., Any]) -> tuple[str, Cloud
 
 @pytest.mark.realtime
 def test_vest_run_carries_out_a_say_from_the_cloud_and_reports_it(
-    cloud: tuple[str, CloudStore], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+    cloud: tuple[str, CloudStore], tmp_path: Path, start_robot: Callable[..., Robot]
 ) -> None:
     url, store = cloud
     store.directory.add_operator("ana")
@@ -35,25 +37,11 @@ def test_vest_run_carries_out_a_say_from_the_cloud_and_reports_it(
     token_file.write_text(store.directory.add_robot("hbs2", operator="ana") + "\n")
     robot_id = store.directory.authenticate(token_file.read_text().strip()).id  # type: ignore[union-attr]
     command, _ = store.ledger.submit(robot_id, "say", {"text": "hello from the page"})
-    (tmp_path / "quiet.yaml").write_text("duration_s: 3\nevents: []\n")
-    monkeypatch.chdir(ROOT)
-    code = main(
-        [
-            "run",
-            "--trees",
-            "trees/iot_command.yaml",
-            "--scenario",
-            str(tmp_path / "quiet.yaml"),
-            "--speech",
-            "text",
-            "--cloud",
-            url,
-            "--token-file",
-            str(token_file),
-            "--json",
-        ]
-    )
-    assert code == 0
+    (tmp_path / "long.yaml").write_text("duration_s: 600\nevents: []\n")
+    robot = start_robot(url, token_file, tmp_path / "long.yaml", ["trees/iot_command.yaml"])
+    robot.until(lambda action: action["action"] == "report")  # however loaded the machine
+    robot.process.send_signal(signal.SIGINT)  # its report is sent before it stops
+    robot.finish()
     finished = store.ledger.get(robot_id, command.id)
     assert finished is not None and finished.state == SUCCEEDED
     assert DoneCommands(tmp_path / "robot.token.done.json").get(command.id) is not None
