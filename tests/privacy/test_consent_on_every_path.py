@@ -70,8 +70,9 @@ events:
 """
 KEPT = ("recording", "report", "export", "json", "timeline", "view", "foxglove")
 SENT = ("cloud", "ros2")
-WORDS_SENT = ("ros2",)
-"""The cloud is never sent what was heard (its telemetry is the sensors and devices)."""
+WORDS_SENT = ("ros2", "cloud")
+"""What was heard leaves with consent: on ROS 2, and in the session the cloud's page shows
+(its "what happened"; the cloud's telemetry is the sensors and devices)."""
 
 
 FORCE_N = 8.375000000000014
@@ -162,6 +163,13 @@ def session_under(
         put(robot_id, values)
 
     cloud.store.telemetry.put = kept_put  # type: ignore[method-assign]
+    shown = cloud.store.sessions.put
+
+    def kept_view(robot_id: int, view: dict[str, Any]) -> None:  # the cloud page's session
+        sent_to_cloud.extend(json.dumps(view).encode())
+        shown(robot_id, view)
+
+    cloud.store.sessions.put = kept_view  # type: ignore[method-assign]
     cloud.store.directory.add_operator("ana")
     token = folder / "robot.token"
     token.write_text(cloud.store.directory.add_robot("hbs2", operator="ana") + "\n")
