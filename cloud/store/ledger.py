@@ -323,6 +323,8 @@ class CommandLedger:
                 if row.state == status and row.result == result:
                     return False
                 raise ConflictError(f"command {command_id} already ended {row.state}")
+            if row.timeout_at_s <= self.clock.now():  # ended, though the upkeep has not said so
+                raise ConflictError(f"command {command_id} already ended {TIMED_OUT}")
             self._change(row, status)
             row.result = result
             row.lease_until_s = None

@@ -33,7 +33,6 @@ delivered again is refused (reported FAILED with why) rather than risk running i
 from __future__ import annotations
 
 import logging
-import queue
 import threading
 from pathlib import Path
 from typing import Any
@@ -47,6 +46,7 @@ from engine.periodic import Periodic
 from engine.privacy.consent import without_record
 from engine.privacy.consent_gate import RESULT_WITHHELD, ConsentGate, Exit
 from engine.services.cloud_push import NO_BOARD, PRESS, Push, SessionShown, json_object, positive_s
+from engine.services.cloud_reports import FIRST_BACKOFF_S, MAX_BACKOFF_S, Reporter
 from engine.services.done_commands import DoneCommands
 from engine.services.jobs import ImmediateJob, Job
 from engine.services.telemetry import TelemetrySnapshot
@@ -55,7 +55,6 @@ from engine.session.json_values import json_value
 from engine.session.stream import SessionStream
 
 log = logging.getLogger(__name__)
-FIRST_BACKOFF_S, MAX_BACKOFF_S = 0.5, 30.0
 TELEMETRY_EVERY_S = 1.0
 SESSION_EVERY_S = 0.25
 """How often the session's view is pushed, when it changed (the cloud page's lag)."""
@@ -69,6 +68,7 @@ in the service stays QUEUED, and an operator can still cancel it. Meanwhile the 
 extends the lease of the one it carries out three times a lease (``lease_s`` comes with
 the command), so the service neither delivers it again nor shows it QUEUED."""
 DEFAULT_LEASE_S = 30.0
+TOO_LATE = "dropped: the service did not confirm it in time (a press is never carried out late)"
 PROGRESS_EVERY_S = 2.0
 """How often the robot tells the service it is still at a command (at most a third of
 the lease): an operator's cancel stops the robot within this."""
@@ -104,9 +104,9 @@ class CloudLink:
         """Replies to a poll that were not a command (not JSON, not the contract's)."""
         self._replies_bad = False
         self._canceled: set[str] = set()  # canceled by the operator while carried out
-        self._reports: queue.Queue[tuple[str, dict[str, Any]] | None] = queue.Queue()
+        self._reports = Reporter(self.http, self.api, clock, self._unreachable)
         self._stop = clock.event()
-        self._threads: list[threading.Thread] = []  # the long-poll and the reporter
+        self._poller: threading.Thread | None = None
         self._telemetry_push = Push(
             self.http, f"{self.api}/robot/telemetry", "telemetry", self._telemetry_body
         )
@@ -153,24 +153,23 @@ class CloudLink:
     def start(self) -> None:
         for push in self._pushes:
             push.start()
-        for name, target in (("cloud-poll", self._poll), ("cloud-report", self._send_reports)):
-            thread = threading.Thread(target=target, name=name, daemon=True)
-            thread.start()
-            self._threads.append(thread)
+        self._reports.start()
+        self._poller = threading.Thread(target=self._poll, name="cloud-poll", daemon=True)
+        self._poller.start()
 
     def stop(self) -> None:
         """Stop polling and pushing (the last view says the session ended); reports still
         queued get a few seconds to be sent. A long-poll in flight is left to end by
         itself: a command it claims now is delivered again once its lease runs out."""
         self._stop.set()
-        self._reports.put(None)
         for push in self._pushes:
             push.stop()
         if self.session is not None:  # the page stops offering what the robot no longer does
             self.session.end()
             self._session_push.once()
-        for thread in self._threads:
-            thread.join(timeout=5.0 if thread.name == "cloud-report" else 0.5)
+        self._reports.stop()
+        if self._poller is not None:
+            self._poller.join(timeout=0.5)
 
     # -- IotResults ------------------------------------------------------------------------
     def report(
@@ -182,10 +181,18 @@ class CloudLink:
         report = {"status": status.upper(), "result": json_value(result)}
         if not self.gate.lets_result_out(result, carries):
             report = {"status": "FAILED", "result": {"error": RESULT_WITHHELD}}
+        settled = self._settle(command_id, report)
+        if settled is not None:
+            self._reports.put(command_id, settled)
+        return ImmediateJob()
+
+    def _settle(self, command_id: str, report: dict[str, Any]) -> dict[str, Any] | None:
+        """Keep ``report`` as the command's end here; the report the service is to get,
+        None when none (a command not from the cloud, or one the operator canceled)."""
         with self._carrying_out:
             if command_id not in self._from_cloud:
                 log.debug("command %s did not come from the cloud; not reported there", command_id)
-                return ImmediateJob()
+                return None
             canceled = command_id in self._canceled
             self._canceled.discard(command_id)
             if canceled:  # it ended CANCELED at the service; that is its end here too
@@ -194,9 +201,27 @@ class CloudLink:
             self._from_cloud.discard(command_id)
             if not self._from_cloud:
                 self._idle.set()
-        if not canceled:
-            self._reports.put((command_id, report))
-        return ImmediateJob()
+        return None if canceled else report
+
+    def _press(self, command_id: str, args: dict[str, Any]) -> None:
+        """A press from the cloud's page, checked here, then confirmed with the service
+        before it is carried out: the service refuses a press past its 2 s, so one that
+        reached the robot late is dropped, never carried out late."""
+        if self.session is None:
+            status, result, press = "FAILED", {"error": NO_BOARD}, None
+        else:
+            status, result, press = self.session.press(args)
+        report = {"status": status, "result": result}
+        if press is None:  # refused here: reported as any command is
+            self.report(command_id, status, result)
+            return
+        confirmed = self._reports.confirm(command_id, report)
+        if not confirmed:
+            log.warning("a press from the cloud came too late (or unconfirmed): dropped")
+            report = {"status": "FAILED", "result": {"error": TOO_LATE}}
+        self._settle(command_id, report)  # the service has it, or has it TIMED_OUT
+        if confirmed:
+            press()
 
     # -- workers -----------------------------------------------------------------------------
     def _backoff(self, delay_s: float) -> float:
@@ -278,7 +303,7 @@ class CloudLink:
                     self._extend_at_s = self.clock.now() + self._extend_every_s()
         if earlier is not None:  # delivered again: answer as before, never twice
             if earlier.get("status") != "CANCELED":  # the service knows it ended so
-                self._reports.put((command_id, earlier))
+                self._reports.put(command_id, earlier)
             return
         if self._unsure_if_done(command, command_id, running):
             return
@@ -286,12 +311,7 @@ class CloudLink:
             log.debug("command %s is still being carried out; its report will follow", command_id)
             return
         if pressed:
-            status, result = (
-                self.session.press(command.get("args") or {})
-                if self.session
-                else ("FAILED", {"error": NO_BOARD})
-            )
-            self.report(command_id, status, result)
+            self._press(command_id, command.get("args") or {})
         elif self.blackboard is not None:
             self.blackboard.stage_event(
                 IOT_INBOX,
@@ -316,7 +336,7 @@ class CloudLink:
         log.warning("command %s delivered again: %s", command_id, why)
         report = {"status": "FAILED", "result": {"error": why}}
         self.done.add(command_id, report)
-        self._reports.put((command_id, report))
+        self._reports.put(command_id, report)
         return True
 
     def _while_busy(self) -> float | None:
@@ -365,31 +385,6 @@ class CloudLink:
         log.info("command %s was canceled by the operator; the robot stops it", command_id)
         if self.blackboard is not None:
             self.blackboard.stage_event(IOT_CANCELED, command_id)
-
-    def _send_reports(self) -> None:
-        """Each report in order, retried with back-off until the service has it; once the
-        link stops, the reports still queued get one try each (a command whose report is
-        lost is delivered again later and answered from the record of finished ones)."""
-        delay_s = FIRST_BACKOFF_S
-        while (item := self._reports.get()) is not None:
-            while not self._sent(*item) and not self._stop.is_set():
-                delay_s = self._backoff(delay_s)
-            delay_s = FIRST_BACKOFF_S
-
-    def _sent(self, command_id: str, report: dict[str, Any]) -> bool:
-        """One try at sending a report; False when it is to be tried again."""
-        try:
-            answer = self.http.post(
-                f"{self.api}/robot/commands/{command_id}/result", json=report, timeout=10.0
-            )
-        except requests.RequestException as error:
-            self._unreachable(error)
-            return False
-        if answer.status_code >= 500:
-            return False
-        if answer.status_code != 200:  # 404 or 409: the service knows better; said once
-            log.warning("report for %s: %s %s", command_id, answer.status_code, answer.text[:200])
-        return True
 
     def push_telemetry(self) -> bool:
         """Push the latest committed sensor and device values once; False when the push

@@ -38,8 +38,11 @@ class SessionShown(Protocol):
         """The robot stops: the next view says the session ended."""
         ...
 
-    def press(self, args: dict[str, Any]) -> tuple[str, dict[str, Any]]:
-        """Carry out a press (``{"button", "by"}``): its report's status and result."""
+    def press(
+        self, args: dict[str, Any]
+    ) -> tuple[str, dict[str, Any], Callable[[], object] | None]:
+        """Check a press (``{"button", "by"}``): its report's status and result, and what
+        carries it out (None: refused, the result says why)."""
         ...
 
 

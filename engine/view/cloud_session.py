@@ -13,6 +13,7 @@ to the account that pressed.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Any
 
 from engine.buttons.wizard import Wizard
@@ -66,23 +67,30 @@ class CloudSession:
         """The last view did not reach the cloud: the next look sends the view again."""
         self._sent = None
 
-    def press(self, args: dict[str, Any]) -> tuple[str, dict[str, Any]]:
-        """Carry out a press from the cloud (``{"button": N, "by": account}``): queued for the
-        next step as a local press is. The report: (``SUCCEEDED``, the button's label) or
-        (``FAILED``, why)."""
-        if self.wizard is None:
-            return "FAILED", {"error": NO_BOARD}
+    def press(
+        self, args: dict[str, Any]
+    ) -> tuple[str, dict[str, Any], Callable[[], object] | None]:
+        """Check a press from the cloud (``{"button": N, "by": account}``): (``SUCCEEDED``,
+        the button's label, what queues it for the next step as a local press is) or
+        (``FAILED``, why, None)."""
+        wizard = self.wizard
+        if wizard is None:
+            return "FAILED", {"error": NO_BOARD}, None
         number, by = args.get("button"), args.get("by")
         if not isinstance(number, int) or isinstance(number, bool):
-            return "FAILED", {"error": f"button: {number!r} is not a button's number"}
-        button = self.wizard.board.button(number)
+            return "FAILED", {"error": f"button: {number!r} is not a button's number"}, None
+        button = wizard.board.button(number)
         if button is None:
-            count = len(self.wizard.board.buttons)
-            return "FAILED", {"error": f"no button {number} (this board has 0 to {count - 1})"}
-        if number not in self.wizard.state()["shown"]:  # as the robot's own page refuses it
-            return "FAILED", {"error": f"{button.label!r} is not shown now: nothing done"}
-        self.wizard.press(number, by="cloud", who=str(by or "someone"))
-        return "SUCCEEDED", {"pressed": button.label}
+            count = len(wizard.board.buttons)
+            why = f"no button {number} (this board has 0 to {count - 1})"
+            return "FAILED", {"error": why}, None
+        if number not in wizard.state()["shown"]:  # as the robot's own page refuses it
+            return "FAILED", {"error": f"{button.label!r} is not shown now: nothing done"}, None
+        return (
+            "SUCCEEDED",
+            {"pressed": button.label},
+            lambda: wizard.press(number, by="cloud", who=str(by or "someone")),
+        )
 
     def _board(self) -> dict[str, Any] | None:
         if self.wizard is None:

@@ -153,6 +153,22 @@ def test_a_command_past_its_timeout_is_timed_out_and_never_delivered(
     assert ledger.get(one, command.id).state == TIMED_OUT  # type: ignore[union-attr]
 
 
+def test_a_report_past_the_timeout_is_refused_before_the_upkeep_has_said_so(
+    ledger: CommandLedger, robots: tuple[int, int], clock: VirtualClock
+) -> None:
+    """A finished state never changes once readers saw it: a press taken at 1.9 s and
+    reported at 2.1 s stays TIMED_OUT (the robot then never carries it out)."""
+    one, _ = robots
+    press, _ = ledger.submit(one, "press", {"button": 0, "by": "tess"}, timeout_s=2.0)
+    clock.advance(1.9)
+    assert ledger.claim_next(one) is not None
+    clock.advance(0.2)
+    assert ledger.get(one, press.id).state == TIMED_OUT  # type: ignore[union-attr]
+    with pytest.raises(ConflictError, match="already ended TIMED_OUT"):
+        ledger.report(one, press.id, SUCCEEDED, {"pressed": "Hello"})
+    assert ledger.get(one, press.id).state == TIMED_OUT  # type: ignore[union-attr]
+
+
 def test_a_canceled_command_is_not_delivered_and_its_late_report_conflicts(
     ledger: CommandLedger, robots: tuple[int, int]
 ) -> None:

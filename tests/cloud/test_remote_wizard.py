@@ -5,7 +5,9 @@ press the robot cannot take in time is dropped, and said so."""
 
 from __future__ import annotations
 
+import http.server
 import signal
+import threading
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -17,6 +19,7 @@ from cloud.api.presses import PRESS_WITHIN_S
 from cloud.settings import Settings
 from cloud.store.ledger import FAILED, SUCCEEDED, TIMED_OUT
 from engine.clock import RealClock, VirtualClock
+from engine.services.done_commands import DoneCommands
 from tests.cloud.conftest import Robot, Running, StartService
 
 REAL = RealClock()
@@ -220,3 +223,83 @@ def test_on_the_cloud_page_a_therapist_presses_and_a_viewer_only_watches(
     robot.process.send_signal(signal.SIGINT)  # the robot stops: the page says so at once
     robot.finish()
     expect(page.locator("#session-stale")).to_contain_text("The session has ended")
+
+
+class HoldingProxy:
+    """The robot's network to the service, on loopback: it passes every request on, and
+    holds a claimed command's reply while ``holding`` is clear (a slow wifi link)."""
+
+    def __init__(self, service: str) -> None:
+        self.holding = threading.Event()
+        self.holding.set()
+        self.held = threading.Event()
+        proxy = self
+        upstream = requests.Session()
+        upstream.trust_env = False
+
+        class Handler(http.server.BaseHTTPRequestHandler):
+            def _pass_on(self) -> None:
+                length = int(self.headers.get("content-length") or 0)
+                answer = upstream.request(
+                    self.command,
+                    service + self.path,
+                    data=self.rfile.read(length) if length else None,
+                    headers={k: v for k, v in self.headers.items() if k.lower() != "host"},
+                    timeout=60,
+                )
+                if answer.status_code == 200 and "/commands/next" in self.path:
+                    proxy.held.set()
+                    proxy.holding.wait(60)
+                self.send_response(answer.status_code)
+                for name in ("content-type",):
+                    if name in answer.headers:
+                        self.send_header(name, answer.headers[name])
+                self.send_header("content-length", str(len(answer.content)))
+                self.end_headers()
+                self.wfile.write(answer.content)
+
+            def do_GET(self) -> None:
+                self._pass_on()
+
+            def do_POST(self) -> None:
+                self._pass_on()
+
+            def log_message(self, *args: Any) -> None:
+                pass
+
+        self.server = http.server.ThreadingHTTPServer(("127.0.0.1", 0), Handler)
+        self.url = f"http://127.0.0.1:{self.server.server_address[1]}"
+        threading.Thread(target=self.server.serve_forever, daemon=True).start()
+
+    def close(self) -> None:
+        self.holding.set()
+        self.server.shutdown()
+
+
+def test_a_press_that_reaches_the_robot_too_late_is_dropped_not_carried_out(
+    start_service: StartService, start_robot: Callable[..., Robot], tmp_path: Path
+) -> None:
+    running = start_service(Settings(db_url=f"sqlite:///{tmp_path / 'c.db'}", recheck_s=0.2))
+    tokens, token_file = people(running, tmp_path)
+    network = HoldingProxy(running.url)
+    try:
+        slow = Running(network.url, running.store)  # the robot reaches the service through it
+        robot = with_buttons(start_robot, slow, token_file, "trees/touch_thanks.yaml")
+        view = until(lambda: running.store.sessions.get(1))[0]
+        hello = [button["label"] for button in view["board"]["buttons"]].index("Hello")
+        network.holding.clear()
+        press = requests.post(
+            f"{running.api}/robots/hbs2/press", json={"button": hello}, headers=as_(tokens["tess"])
+        ).json()
+        assert network.held.wait(60)  # the robot claimed it; its reply is on the slow link
+        until(lambda: running.store.ledger.get(1, press["id"]).state == TIMED_OUT)  # type: ignore[union-attr]
+        network.holding.set()  # the press reaches the robot, past its 2 s
+        done = DoneCommands(token_file.parent / "robot.token.done.json")
+        dropped = until(lambda: DoneCommands(done.path).get(press["id"]))  # its record says
+        robot.process.send_signal(signal.SIGINT)
+        robot.finish()
+    finally:
+        network.close()
+    assert dropped["status"] == "FAILED" and "never carried out late" in dropped["result"]["error"]
+    assert not [e for e in robot.events if e["event"] == "press"]  # never carried out
+    assert running.store.ledger.get(1, press["id"]).state == TIMED_OUT  # type: ignore[union-attr]
