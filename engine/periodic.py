@@ -31,6 +31,9 @@ log = logging.getLogger(__name__)
 
 STOP_WAIT_S = 5.0
 """The one join policy: how long (real seconds) stopping waits for a round in progress."""
+AFTER_FAILURE_S = 1.0
+"""After a round that failed, the next comes this long after it at the soonest (clock
+seconds): a work that fails before moving its deadline on never spins."""
 DUE_SLACK_S = 1e-9
 """A round due within this of a step counts as due (deadlines are sums of periods)."""
 
@@ -55,6 +58,18 @@ class Rounds:
         self.rounds = 0
         self.failures = 0
         self._streak = 0
+        self._failed_at_s = float("-inf")
+
+    def due_s(self, now_s: float) -> float:
+        """When the work is next due (clock seconds): :data:`AFTER_FAILURE_S` after a round
+        that failed at the soonest; a work that cannot say (it raised) is asked again then,
+        counted as a failed round (never a dead worker)."""
+        try:
+            due_s = self.work.due_s()
+        except Exception:
+            self._failed(now_s)
+            return now_s + AFTER_FAILURE_S
+        return max(due_s, self._failed_at_s + AFTER_FAILURE_S) if self._streak else due_s
 
     def once(self, now_s: float) -> bool:
         """One round at ``now_s`` (clock seconds); False when it raised."""
@@ -62,15 +77,20 @@ class Rounds:
         try:
             self.work.run(now_s)
         except Exception:
-            self.failures += 1
-            self._streak += 1
-            if self._streak == 1:
-                log.exception("%s: a round failed; the next comes when due", self.work.name)
+            self._failed(now_s)
             return False
         if self._streak:
             log.info("%s works again after %d failed rounds", self.work.name, self._streak)
             self._streak = 0
         return True
+
+    def _failed(self, now_s: float) -> None:
+        """(In an ``except``.) Counted; logged with its traceback once per streak."""
+        self._failed_at_s = now_s
+        self.failures += 1
+        self._streak += 1
+        if self._streak == 1:
+            log.exception("%s: a round failed; the next comes when due", self.work.name)
 
 
 class WorkerHook:
@@ -80,8 +100,9 @@ class WorkerHook:
         self.rounds = Rounds(work)
 
     def __call__(self, now_s: float) -> None:
-        while self.rounds.work.due_s() <= now_s + DUE_SLACK_S:
-            self.rounds.once(now_s)
+        while self.rounds.due_s(now_s) <= now_s + DUE_SLACK_S:
+            if not self.rounds.once(now_s):  # it may not have moved on: the next step tries
+                return
 
 
 class WorkerThread:
@@ -103,7 +124,10 @@ class WorkerThread:
         return self._thread is not None and self._thread.is_alive()
 
     def start(self) -> None:
-        """Begin (again, after a stop); a worker already running is left as it is."""
+        """Begin (again, after a stop); a worker already running, or still ending its last
+        round after a stop, is left as it is."""
+        if self._thread is not None and not self._thread.is_alive():
+            self._thread = None
         if self._thread is None:
             self._stop.clear()
             self._thread = threading.Thread(
@@ -113,21 +137,24 @@ class WorkerThread:
 
     def stop(self) -> bool:
         """Ask the thread to end and wait for it (:data:`STOP_WAIT_S` at most); False when
-        a round was still running then (it ends by itself, ``after`` with it)."""
+        a round was still running then: it ends by itself (``after`` with it), and until
+        it has, :meth:`start` starts no second thread beside it."""
         self._stop.set()
-        thread, self._thread = self._thread, None
+        thread = self._thread
         if thread is None:
             return True
         thread.join(STOP_WAIT_S)
         if thread.is_alive():
             log.warning("%s: still in a round; it ends by itself", thread.name)
             return False
+        self._thread = None
         return True
 
     def _run(self) -> None:
-        work = self.rounds.work
         try:
-            while not self.clock.wait(self._stop, work.due_s() - self.clock.now()):
+            while not self.clock.wait(
+                self._stop, self.rounds.due_s(self.clock.now()) - self.clock.now()
+            ):
                 self.rounds.once(self.clock.now())
         finally:
             if self.after is not None:

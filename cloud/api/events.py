@@ -30,6 +30,7 @@ from starlette.concurrency import run_in_threadpool
 from starlette.responses import Response
 
 from cloud.api.deps import CurrentOperator, StoreDep
+from cloud.api.presses import shown_to
 from cloud.api.robots import robot_public
 from cloud.api.schemas import CommandPublic
 from cloud.roles import Permission, may
@@ -79,6 +80,7 @@ class OperatorView:
             stored = self.store.sessions.get(row.id)
             if stored is not None and self._sessions.get(row.id) != stored[1]:
                 view, self._sessions[row.id] = stored
+                view = shown_to(self.operator.role, view)  # a viewer: not what happened
                 events.append(
                     frame({"robot": row.name, "view": view, "at_s": stored[1]}, "session")
                 )

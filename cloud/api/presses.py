@@ -2,11 +2,13 @@
 
 ``GET /robots/{robot}/session`` is the robot's session as it last pushed it (its trees and
 what they do, what happened lately, its button board; every role that sees the robot sees
-it). ``POST /robots/{robot}/press`` ``{"button": N}`` presses one of its buttons (the roles
-that may press: admin, operator, therapist): a command of type ``press`` that the robot
-carries out exactly as a press on its own buttons page, credited to the account. A press
-that the robot has not taken within :data:`PRESS_WITHIN_S` is never carried out: it ends
-TIMED_OUT, and the page says it was dropped.
+it, a viewer without what happened: it can quote the child).
+
+``POST /robots/{robot}/press`` ``{"button": N}`` presses one of its buttons (the roles that
+may press: admin, operator, therapist): a command of type ``press`` that the robot carries
+out exactly as a press on its own buttons page, credited to the account. A press that the
+robot has not taken and confirmed within :data:`PRESS_WITHIN_S` is never carried out: it
+ends TIMED_OUT, and the page says it was dropped.
 """
 
 from __future__ import annotations
@@ -19,6 +21,7 @@ from starlette.concurrency import run_in_threadpool
 from cloud.api.deps import CurrentOperator, Presser, StoreDep, actor
 from cloud.api.robots import granted
 from cloud.api.schemas import CommandPublic, PressCreate
+from cloud.roles import Permission, may
 
 router = APIRouter(prefix="/robots/{robot}", tags=["operator"])
 PRESS_WITHIN_S = 2.0
@@ -34,7 +37,16 @@ async def robot_session(robot: str, store: StoreDep, operator: CurrentOperator) 
     if stored is None:
         raise HTTPException(status.HTTP_404_NOT_FOUND, f"{robot!r} has sent no session yet")
     view, at_s = stored
-    return {"view": view, "at_s": at_s}
+    return {"view": shown_to(operator.role, view), "at_s": at_s}
+
+
+def shown_to(role: str | None, view: dict[str, Any]) -> dict[str, Any]:
+    """The view as ``role`` may see it: "what happened" can quote the child (what they
+    said, their readings), so a role that may not see telemetry (a viewer) sees the
+    buttons and the behaviors without it."""
+    if may(role, Permission.TELEMETRY):
+        return view
+    return {**view, "happened": [], "happened_hidden": True}
 
 
 @router.post("/press", status_code=status.HTTP_202_ACCEPTED)

@@ -109,4 +109,4 @@ async def push_telemetry(body: TelemetryReport, store: StoreDep, robot: CurrentR
 @router.post("/session", status_code=status.HTTP_204_NO_CONTENT)
 async def push_session(body: SessionViewReport, store: StoreDep, robot: CurrentRobot) -> None:
     """The robot's live session as it stands (kept whole; the pages hear of it at once)."""
-    await run_in_threadpool(store.sessions.put, robot.id, body.view)
+    await run_in_threadpool(store.sessions.put, robot.id, body.view.model_dump())

@@ -6,7 +6,15 @@ import json
 import math
 from typing import Annotated, Any, Literal
 
-from pydantic import AfterValidator, BaseModel, ConfigDict, Field, StringConstraints
+from pydantic import (
+    AfterValidator,
+    BaseModel,
+    ConfigDict,
+    Field,
+    StrictBool,
+    StrictInt,
+    StringConstraints,
+)
 
 from cloud.store.ledger import Command, CommandState
 
@@ -166,13 +174,66 @@ class TelemetryReport(BaseModel):
     values: Annotated[dict[TelemetryKey, Any], AfterValidator(small_values)] = Field(max_length=500)
 
 
-class SessionViewReport(BaseModel):
-    """The robot's live session as its page would show it (trees, what happened, its
-    buttons), in the live view's words; the body limit bounds it."""
+Words = Annotated[str, Field(max_length=2000)]
+
+
+class ViewTree(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+
+    tree: Words
+    priority: StrictInt
+    status: Words
+    doing: list[Words] = Field(max_length=100)
+
+
+class ViewLine(BaseModel):
+    """One line of "what happened": when (seconds into the session), who, what, its tone."""
 
     model_config = ConfigDict(extra="forbid")
 
-    view: dict[str, Any]
+    at: float = Field(allow_inf_nan=False)
+    who: Words
+    what: Words
+    tone: Words
+
+
+class ViewButton(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+
+    id: StrictInt
+    label: Words
+    key: Words | None = None
+    control: Words | None = None
+
+
+class ViewBoard(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+
+    buttons: list[ViewButton] = Field(max_length=200)
+    shown: list[StrictInt] = Field(max_length=200)
+    paused: StrictBool
+    doing: Words | None = None
+
+
+class SessionView(BaseModel):
+    """The robot's live session as the cloud's page shows it (engine/view/cloud_session.py):
+    every tree and what it does, the latest lines of what happened, its buttons."""
+
+    model_config = ConfigDict(extra="forbid")
+
+    trees: list[ViewTree] = Field(max_length=200)
+    happened: list[ViewLine] = Field(max_length=100)
+    board: ViewBoard | None = None
+    ended: StrictBool = False
+
+
+class SessionViewReport(BaseModel):
+    """A robot's push of its session; the page renders what this checks, and nothing
+    else (a view of another shape is a 422, never a page that breaks)."""
+
+    model_config = ConfigDict(extra="forbid")
+
+    view: SessionView
 
 
 class PressCreate(BaseModel):
@@ -181,7 +242,7 @@ class PressCreate(BaseModel):
 
     model_config = ConfigDict(extra="forbid")
 
-    button: int = Field(ge=0, le=999)
+    button: StrictInt = Field(ge=0, le=999)
 
 
 class RobotPublic(BaseModel):

@@ -80,6 +80,9 @@ export function renderSession(root, session, { canPress, online, role, onPress, 
       ),
     ),
   );
+  root.querySelector("#no-happened").textContent = view.happened_hidden
+    ? `What happened is not shown to your role, ${role}: it can quote the child.`
+    : "Nothing yet.";
   root.querySelector("#no-happened").hidden = view.happened.length > 0;
   const buttons = view.board;
   root.querySelector("#no-board").hidden = Boolean(buttons);

@@ -34,7 +34,7 @@ _NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 def namespace_problem(namespace: str) -> str | None:
     """Why ``namespace`` is not a ROS 2 namespace (None when it is): names of letters,
     digits and underscores, not starting with a digit, joined by ``/``."""
-    if namespace == "":
+    if namespace.strip("/") == "":  # '' or '/': the root
         return None
     parts = namespace.strip("/").split("/")
     bad = next((part for part in parts if not _NAME.fullmatch(part)), None)
@@ -47,7 +47,9 @@ def namespace_problem(namespace: str) -> str | None:
 
 
 def namespace_from(robot_name: str) -> str:
-    """A ROS 2 namespace made from a robot's name (``hbs-2`` -> ``hbs_2``)."""
+    """A ROS 2 namespace made from a robot's name (``hbs-2`` -> ``hbs_2``; a name with no
+    letter or digit -> ``robot``). Names that differ only in other characters give the same
+    namespace: give such robots --ros2-namespace."""
     name = re.sub(r"[^A-Za-z0-9_]", "_", robot_name)
-    name = re.sub(r"_+", "_", name).strip("_")
+    name = re.sub(r"_+", "_", name).strip("_") or "robot"
     return f"r{name}" if name[:1].isdigit() else name

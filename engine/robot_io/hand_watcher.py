@@ -231,14 +231,14 @@ class HandWatcher:
         if self._worker is None:
             self._next_s = None
             self._worker = WorkerThread(_InRealTime(self), self.clock, after=self._close)
-            self._worker.start()
+        self._worker.start()
 
     def stop(self) -> None:
         """Stop the worker (if running: the thread closes the camera, when a read still in
         progress returns) or close the camera."""
         if self._worker is not None:
-            self._worker.stop()
-            self._worker = None
+            if self._worker.stop():  # else still reading: a start waits for it to end
+                self._worker = None
             return
         self._close()
 

@@ -88,8 +88,11 @@ def test_a_therapist_in_the_next_room_watches_the_session_and_presses_a_button(
     hello = labels.index("Hello")
     assert hello in view["board"]["shown"] and view["board"]["paused"] is False
 
-    # the viewer sees the same session, and cannot press
-    assert requests.get(session_url, headers=as_(tokens["val"]), timeout=10).status_code == 200
+    # the viewer sees the buttons and the behaviors, not what happened (it can quote the
+    # child), and cannot press
+    as_viewer = requests.get(session_url, headers=as_(tokens["val"]), timeout=10).json()["view"]
+    assert as_viewer["board"] == view["board"] and as_viewer["trees"]
+    assert as_viewer["happened"] == [] and as_viewer["happened_hidden"] is True
     refused = requests.post(
         f"{running.api}/robots/hbs2/press", json={"button": hello}, headers=as_(tokens["val"])
     )
@@ -171,6 +174,34 @@ def test_a_press_reaches_a_robot_busy_with_an_operator_s_long_command(
     robot.finish()
 
 
+def test_a_view_or_a_press_of_another_shape_is_refused_by_name(
+    start_service: StartService, tmp_path: Path
+) -> None:
+    running = start_service(Settings(db_url=f"sqlite:///{tmp_path / 'c.db'}"))
+    tokens, token_file = people(running, tmp_path)
+    robot = {"Authorization": f"Bearer {token_file.read_text().strip()}"}
+    for view, field in (
+        ({}, "view.trees"),
+        ({"trees": [], "happened": [{"at": 1, "who": "x", "what": 3, "tone": ""}]}, "what"),
+        (
+            {
+                "trees": [],
+                "happened": [],
+                "board": {"buttons": [], "shown": ["1"], "paused": False},
+            },
+            "shown",
+        ),
+    ):
+        refused = requests.post(f"{running.api}/robot/session", json={"view": view}, headers=robot)
+        assert refused.status_code == 422 and field in refused.text, refused.text
+    assert running.store.sessions.get(1) is None  # nothing a page would trip over was kept
+    for button in (True, "1", -1, 1.5):
+        pressed = requests.post(
+            f"{running.api}/robots/hbs2/press", json={"button": button}, headers=as_(tokens["tess"])
+        )
+        assert pressed.status_code == 422, (button, pressed.text)
+
+
 def test_a_press_the_robot_does_not_take_in_time_is_dropped_never_carried_out_late(
     start_service: StartService, tmp_path: Path
 ) -> None:
@@ -214,7 +245,9 @@ def test_on_the_cloud_page_a_therapist_presses_and_a_viewer_only_watches(
     page.click("#logout")
     page.fill("#token", tokens["val"])
     page.click("#login button[type=submit]")
-    expect(page.locator("#session-happened")).to_contain_text("from the cloud (tess)")
+    expect(page.locator("#no-happened")).to_have_text(
+        "What happened is not shown to your role, viewer: it can quote the child."
+    )
     expect(page.locator('#session-board button:text-is("Hello")')).to_be_disabled()
     expect(page.locator("#board-role")).to_have_text(
         "Your role, viewer, sees the buttons; it does not press them."
