@@ -23,6 +23,9 @@ from engine.services.done_commands import DoneCommands
 from tests.cloud.conftest import Robot, Running, StartService
 
 REAL = RealClock()
+WAITS_MS = 60_000
+"""How long the page may take to show what the robot did (only ends a broken test: a
+loaded machine is slow, never wrong)."""
 
 
 def until(what: Callable[[], Any], limit_s: float = 120.0) -> Any:
@@ -236,9 +239,11 @@ def test_on_the_cloud_page_a_therapist_presses_and_a_viewer_only_watches(
     expect(page.locator('#session-board button:text-is("Show me your hand")')).to_be_disabled()
     expect(page.locator('#session-trees li[data-tree="touch_thanks"]')).to_be_visible()
     hello.click()
-    expect(page.locator("#press-outcome")).to_have_text("Hello: done by the robot")
+    expect(page.locator("#press-outcome")).to_have_text(
+        "Hello: done by the robot", timeout=WAITS_MS
+    )
     expect(page.locator("#session-happened")).to_contain_text(
-        "presses the button 'Hello' from the cloud (tess)"
+        "presses the button 'Hello' from the cloud (tess)", timeout=WAITS_MS
     )
     expect(page.locator("#session-happened")).to_contain_text('says "Hello! I am happy')
 
@@ -246,7 +251,8 @@ def test_on_the_cloud_page_a_therapist_presses_and_a_viewer_only_watches(
     page.fill("#token", tokens["val"])
     page.click("#login button[type=submit]")
     expect(page.locator("#no-happened")).to_have_text(
-        "What happened is not shown to your role, viewer: it can quote the child."
+        "What happened is not shown to your role, viewer: it can quote the child.",
+        timeout=WAITS_MS,  # logging in again and the stream's first event
     )
     expect(page.locator('#session-board button:text-is("Hello")')).to_be_disabled()
     expect(page.locator("#board-role")).to_have_text(
@@ -255,7 +261,9 @@ def test_on_the_cloud_page_a_therapist_presses_and_a_viewer_only_watches(
 
     robot.process.send_signal(signal.SIGINT)  # the robot stops: the page says so at once
     robot.finish()
-    expect(page.locator("#session-stale")).to_contain_text("The session has ended")
+    expect(page.locator("#session-stale")).to_contain_text(
+        "The session has ended", timeout=WAITS_MS
+    )
 
 
 class HoldingProxy:
