@@ -458,8 +458,9 @@ async def per_host(seconds: float) -> None:
 
 async def run(quick: bool, only: str | None) -> None:
     seconds = 3.0 if quick else 20.0
+    robots = "robots as below" if only == "hosts" else f"{ROBOTS} robots"
     print(
-        f"{ROBOTS} robots, {COMMANDS_PER_S:g} commands/s for {seconds:g} s per phase; "
+        f"{robots}, {COMMANDS_PER_S:g} commands/s for {seconds:g} s per phase; "
         f"{os.cpu_count()} cores shared by the service and this load\n"
     )
     if only == "hosts":
