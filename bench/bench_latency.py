@@ -2,11 +2,11 @@
 
 Run: ``.venv/bin/python bench/bench_latency.py`` (``--events N``, ``--help``); about 200 s.
 
-The robot is wired as ``vest run`` wires it without ``--fast``: every tree in trees/ on a
-``RealClock``, the simulated vest of examples/robots/sim.yaml (register-level chips behind
-simulated buses), ``build_hardware`` with one worker thread per bus and one thread per
-poller, the hardware hooks (LED timer) and the hot-reload hook, simulated speech with
-realistic durations. The scheduler runs on its own thread.
+The robot is built as ``vest run`` builds it without ``--fast``, by the composition root
+(``build_session``): every tree in trees/ on a ``RealClock``, the simulated vest of
+examples/robots/sim.yaml (register-level chips behind simulated buses) with one worker
+thread per bus and one thread per poller, the hardware hooks (LED timer) and hot reload,
+simulated speech with realistic durations. The scheduler runs on its own thread.
 
 Three kinds of events, each changing the ``World`` at random moments from a thread (as
 a person would; a scenario hook would only change it at the scheduler's wake-ups, which
@@ -54,9 +54,10 @@ A poller and a tree of the same rate keep a fixed phase for the whole run, so "p
 tick" is nearly the same for every event: it is that phase. Hence the model printed at the
 end of each such line: at this run's phase, p50 = half a poll period + the rest's p50, and
 max = one poll period + the rest's p99. The phases themselves are printed too (when each
-poller polls after the trees' deadlines). ``vest run`` starts the poller threads just
-before the scheduler, so the polls start a few ms before the deadlines; a poll that takes
-longer than that misses the tick and its news waits a whole tree period.
+poller polls after the trees' deadlines). ``vest run`` phases the pollers on the trees'
+first deadline (+0.0), each poll starting early by its longest recent duration, so its
+reading is staged just before the tick; a poll that takes longer than that lead misses the
+tick and its news waits a whole tree period.
 
 ``--align-polls MS`` is a what-if, not what ``vest run`` does: the scheduler starts first,
 then every poller is phased so that its polls end MS ms before the trees' deadlines (its
@@ -76,6 +77,7 @@ from __future__ import annotations
 import argparse
 import bisect
 import dataclasses
+import math
 import os
 import platform
 import queue
@@ -93,20 +95,19 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # run from a check
 
 from py_trees.common import Status
 
-from engine.clock import RealClock, stopwatch
+from engine.clock import Clock, stopwatch
+from engine.composition.session_root import RunningSession, SessionPlan, build_session
 from engine.drivers.srf02_registers import RANGING_TIME_S
 from engine.hardware.config import RobotConfig
 from engine.hardware.config_file import load_robot_config
 from engine.hardware.robot_hardware import Hardware
 from engine.hardware.sim_vest import SimVest
 from engine.nodes.decorators import Cooldown
-from engine.runtime.reload import TreeReloader
 from engine.runtime.robot import Robot, load_behaviors
-from engine.runtime.robot_factory import build_robot
 from engine.runtime.scheduler import RunningTree
 from engine.runtime.stats import percentile
+from engine.scenario.scenario_file import Scenario
 from engine.scenario.world import World
-from engine.services.simulated import simulated_services
 from engine.session.events import ActionStarted, SessionEvent
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -137,7 +138,7 @@ ULTRASOUND_TARGET_S = 0.100
 class Instruments:
     """When every poll started and ended, every tree tick started, every scheduler step ran."""
 
-    def __init__(self, clock: RealClock) -> None:
+    def __init__(self, clock: Clock) -> None:
         self.clock = clock
         self.polls: dict[str, list[tuple[float, float]]] = {}
         self.ticks: dict[str, list[float]] = {}
@@ -177,37 +178,38 @@ class Instruments:
 
 @dataclass
 class Rig:
-    clock: RealClock
+    clock: Clock
     config: RobotConfig
     world: World
     vest: SimVest
     hardware: Hardware
     robot: Robot
     instruments: Instruments
+    running: RunningSession
     scheduler_thread: threading.Thread | None = None
 
     def start(self, align_margin_s: float | None = None) -> None:
-        """Pollers, then the scheduler, as ``vest run`` starts them.
+        """Every part, then the scheduler, as ``vest run`` starts them (the pollers phased
+        on the trees' first deadline).
 
-        With ``align_margin_s`` (``--align-polls``, not what ``vest run`` does): the
-        scheduler first, then each poller phased so that its polls end that long before
+        With ``align_margin_s`` (``--align-polls``, not what ``vest run`` does): once the
+        trees tick, each poller is phased again so that its polls end that long before
         the trees' deadlines (its duration measured by one read beforehand).
         """
-        if align_margin_s is None:
-            self.hardware.start()
-        else:
-            took_s = {}
+        took_s = {}
+        if align_margin_s is not None:
             for poller in self.hardware.pollers:
                 started = stopwatch()
                 poller.read_now()
                 took_s[poller.name] = stopwatch() - started
         self.scheduler_thread = threading.Thread(
-            target=self.robot.scheduler.run, name="scheduler", daemon=True
+            target=self.running.run, args=(math.inf,), name="scheduler", daemon=True
         )
         self.scheduler_thread.start()
         if align_margin_s is not None:
             while not any(tree.stats.ticks for tree in self.robot.trees):
                 self.clock.sleep(0.001)
+            self.hardware.stop()
             origin_s = self.robot.trees[0].origin_s
             for poller in self.hardware.pollers:
                 poller.origin_s = origin_s - took_s[poller.name] - align_margin_s
@@ -217,42 +219,38 @@ class Rig:
         self.robot.scheduler.stop()
         if self.scheduler_thread is not None:
             self.scheduler_thread.join(5.0)
-        self.hardware.close()
-        self.vest.close()
+        self.running.close()
 
 
 def build_rig(profile: Path, *, wake: bool = True) -> Rig:
-    """The robot as vest run wires it; ``wake``: the trees' ``wake_on`` as shipped, else
-    taken out (every tree ticks at its rate, as before issue 24)."""
-    clock = RealClock()
+    """The robot as vest run builds it (the composition root's ``build_session``, in real
+    time, with hot reload); ``wake``: the trees' ``wake_on`` as shipped, else taken out
+    (every tree ticks at its rate, as before issue 24)."""
     behaviors = load_behaviors([TREES_DIR], dialogs_dir=DIALOGS_DIR, profile=profile)
     if not wake:
         behaviors.trees[:] = [dataclasses.replace(tree, wake_on=()) for tree in behaviors.trees]
     config = load_robot_config(SIM_CONFIG)
-    instruments = Instruments(clock)
-    simulated = simulated_services(clock, realistic=True)
-    assembled = build_robot(
-        behaviors,
-        config,
-        clock=clock,
-        speech=simulated.speech,
-        iot=simulated.iot,
-        fallback=simulated,
+    moved_here = Scenario(duration_s=math.inf, events=(), path=Path("(the bench moves it)"))
+    running = build_session(SessionPlan(behaviors, config, moved_here))
+    assembled = running.assembled
+    robot, world, hardware, clock = (
+        assembled.robot,
+        assembled.world,
+        assembled.hardware,
+        assembled.clock,
     )
-    assembled.robot.session.subscribe(instruments, (ActionStarted.kind,))
-    robot, world, hardware = assembled.robot, assembled.world, assembled.hardware
     assert assembled.vest is not None
-    vest = assembled.vest
     if hardware.startup_problems:
-        assembled.close()
+        running.close()
         raise SystemExit(f"the simulated vest did not start: {hardware.startup_problems}")
-    robot.scheduler.add_hook(TreeReloader(behaviors.loader, robot.trees, clock))
+    instruments = Instruments(clock)
+    running.gates.kept.subscribe(instruments, (ActionStarted.kind,))
     robot.scheduler.add_hook(instruments.step_hook)
     for poller in hardware.pollers:
         instruments.watch_poller(poller)
     for tree in robot.trees:
         instruments.watch_tree(tree)
-    return Rig(clock, config, world, vest, hardware, robot, instruments)
+    return Rig(clock, config, world, assembled.vest, hardware, robot, instruments, running)
 
 
 # -- the events ----------------------------------------------------------------------------------
