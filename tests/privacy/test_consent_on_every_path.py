@@ -62,7 +62,7 @@ root:
     - Say: {text: "You squeezed with {/sensors/force/left_n:.1f} newtons"}
 """
 SCENARIO = """\
-duration_s: 6
+duration_s: 10
 events:
   - {at: 1.5, squeeze: {left_n: 8.3, right_n: 8.3, seconds: 1.6}}
   - {at: 2.0, hear: {text: "my brother hits me every night"}}
@@ -221,7 +221,7 @@ def session_under(
     exported = folder / "export"
     assert main(["data", "export", "--person", "kid-17", "-o", str(exported)]) == 0
     export = b"".join(path.read_bytes() for path in sorted(exported.rglob("*")) if path.is_file())
-    fast = ["--fast", "--speech", "text", "--person", "kid-17"]
+    fast = ["--fast", "--speech", "text", "--person", "kid-17"]  # the whole scenario
     timeline = subprocess.run(
         [*VEST, "run", *fast, "--trees", *trees, "--scenario", str(folder / "scenario.yaml")],
         cwd=ROOT,
