@@ -350,9 +350,14 @@ def percentile(values: list[float], p: float) -> float:
     return ordered[min(len(ordered) - 1, int(len(ordered) * p))] if ordered else float("nan")
 
 
+def every_latency_ms(results: Results, sent: int) -> list[float]:
+    """One latency a command sent: one that never came counts as slower than all."""
+    return results.latencies_ms + [float("inf")] * (sent - len(results.latencies_ms))
+
+
 def line(label: str, results: Results, sent: int) -> str:
-    """p50 and p99 over every command sent: one that never came counts as slower than all."""
-    lat = results.latencies_ms + [float("inf")] * (sent - len(results.latencies_ms))
+    """p50 and p99 over every command sent."""
+    lat = every_latency_ms(results, sent)
     rate = results.telemetry_rate
     told = f"  telemetry {rate:4.0f} posts/s" if rate else ""
     return (
@@ -442,8 +447,7 @@ async def per_host(seconds: float, quick: bool = False) -> None:
                         with_telemetry=True,
                     )
                     print(line(f"{hosts} host(s), {count} robots, telemetry 1/s", results, sent))
-                    lat = results.latencies_ms + [float("inf")] * (sent - len(results.latencies_ms))
-                    if percentile(lat, 0.99) > HOST_TARGET_P99_MS:
+                    if percentile(every_latency_ms(results, sent), 0.99) > HOST_TARGET_P99_MS:
                         break
                     held = count
             finally:

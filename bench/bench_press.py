@@ -29,7 +29,6 @@ import subprocess
 import sys
 import tempfile
 import threading
-import time
 from pathlib import Path
 from typing import IO
 
@@ -40,13 +39,15 @@ sys.path.insert(0, str(ROOT))
 
 from cloud.services import CloudStore  # noqa: E402
 from cloud.settings import Settings  # noqa: E402
-from engine.clock import EpochClock  # noqa: E402
+from engine.clock import EpochClock, RealClock  # noqa: E402
+from engine.runtime.stats import percentile  # noqa: E402
 
 VEST = [sys.executable, "-c", "from engine.cli import main; raise SystemExit(main())"]
 BUTTON = "Calm face"
 TARGET_P99_S = 0.300
 
 
+CLOCK = RealClock()  # the one module that reads time and sleeps
 HTTP = requests.Session()
 HTTP.trust_env = False  # loopback, never through a proxy the environment names
 
@@ -58,21 +59,16 @@ def free_port() -> int:
 
 
 def wait_for(url: str, process: subprocess.Popen[str], log: Path, limit_s: float = 60.0) -> None:
-    deadline = time.monotonic() + limit_s
-    while time.monotonic() < deadline:
+    deadline = CLOCK.now() + limit_s
+    while CLOCK.now() < deadline:
         if process.poll() is not None:
             raise SystemExit(f"{process.args[3:5]} ended: {log.read_text()[-2000:]}")
         try:
             HTTP.get(url, timeout=1)
             return
         except requests.RequestException:
-            time.sleep(0.1)
+            CLOCK.sleep(0.1)
     raise SystemExit(f"{url} never answered")
-
-
-def percentile(values: list[float], p: float) -> float:
-    ordered = sorted(values)
-    return ordered[min(len(ordered) - 1, round(p / 100 * (len(ordered) - 1)))]
 
 
 def main() -> None:
@@ -125,7 +121,7 @@ def measure(folder: Path, presses: int, cloud_log: IO[str], robot_log: IO[str]) 
                 and event["action"] == "led"
                 and event["tree"] == "buttons"
             ):
-                actions.put(time.monotonic())
+                actions.put(CLOCK.now())
 
     threading.Thread(target=read, daemon=True).start()
     local = f"http://127.0.0.1:{view_port}"
@@ -133,10 +129,10 @@ def measure(folder: Path, presses: int, cloud_log: IO[str], robot_log: IO[str]) 
     page_token = (folder / "robot.log").read_text().split("?token=")[1].split()[0]
     beside = {"Authorization": f"Bearer {page_token}"}  # the robot's own page's token
     therapist = {"Authorization": f"Bearer {tess}"}
-    deadline = time.monotonic() + 60
+    deadline = CLOCK.now() + 60
     while HTTP.get(f"{cloud}/api/v1/robots/hbs2/session", headers=therapist).status_code != 200:
-        assert time.monotonic() < deadline, "the robot never sent its session"
-        time.sleep(0.1)
+        assert CLOCK.now() < deadline, "the robot never sent its session"
+        CLOCK.sleep(0.1)
     view = HTTP.get(f"{cloud}/api/v1/robots/hbs2/session", headers=therapist).json()["view"]
     number = [b["label"] for b in view["board"]["buttons"]].index(BUTTON)
     took: dict[str, list[float]] = {"cloud": [], "local": []}
@@ -145,10 +141,10 @@ def measure(folder: Path, presses: int, cloud_log: IO[str], robot_log: IO[str]) 
     random.Random(42).shuffle(order)
     try:
         for way in order:
-            time.sleep(random.uniform(0.2, 0.4))
+            CLOCK.sleep(random.uniform(0.2, 0.4))
             while not actions.empty():  # a late line of an earlier press: not this one's
                 actions.get_nowait()
-            started = time.monotonic()
+            started = CLOCK.now()
             if way == "cloud":
                 answer = HTTP.post(
                     f"{cloud}/api/v1/robots/hbs2/press", json={"button": number}, headers=therapist
@@ -171,10 +167,10 @@ def measure(folder: Path, presses: int, cloud_log: IO[str], robot_log: IO[str]) 
         values = took[way]
         print(
             f"{way:7} {len(values):7d} {statistics.median(values) * 1e3:7.1f} "
-            f"{percentile(values, 90) * 1e3:7.1f} {percentile(values, 99) * 1e3:7.1f} "
+            f"{percentile(values, 0.90) * 1e3:7.1f} {percentile(values, 0.99) * 1e3:7.1f} "
             f"{max(values) * 1e3:7.1f} {lost[way]:5d}"
         )
-    p99_cloud, p99_local = percentile(took["cloud"], 99), percentile(took["local"], 99)
+    p99_cloud, p99_local = percentile(took["cloud"], 0.99), percentile(took["local"], 0.99)
     print(
         f"cloud / local p99: {p99_cloud / p99_local:.2f}; target p99 <= {TARGET_P99_S * 1e3:.0f} "
         f"ms through the cloud: {'met' if p99_cloud <= TARGET_P99_S else 'NOT met'}"

@@ -44,7 +44,7 @@ from engine.services.cloud_link import CloudLink
 from engine.services.simulated import simulated_services
 from engine.session.events import WorldEvent
 from engine.session.stream import SessionStream
-from engine.view.cloud_session import CloudSession
+from engine.view.cloud_session import SHOWN_KINDS, CloudSession
 from engine.view.hub import ViewHub
 from engine.view.server import LiveSource, ViewServer
 
@@ -325,7 +325,7 @@ def _around(assembled: AssembledRobot, plan: SessionPlan, link: CloudLink | None
         cloud_hub = ViewHub(clock)  # the cloud's page: what may leave the robot, in words
         cloud_hub.begin(start_s, robot.trees)
         shown = CloudSession(cloud_hub, running.wizard)
-        gates.sent.subscribe(shown)  # from the start: it hears of every tree
+        gates.sent.subscribe(shown, SHOWN_KINDS)  # from the start: it hears of every tree
 
         def start_link() -> None:
             link.bind(assembled.blackboard, gates.sent, gates.sending, shown)

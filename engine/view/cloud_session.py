@@ -18,15 +18,20 @@ from typing import Any
 
 from engine.buttons.wizard import Wizard
 from engine.services.cloud_push import NO_BOARD
-from engine.session.events import SessionEvent
+from engine.session.events import NodeStatus, SessionEvent, TreeStarted
+from engine.session.sentences import TOLD_KINDS
 from engine.view.hub import ViewHub
 
+SHOWN_KINDS = (TreeStarted.kind, NodeStatus.kind, *TOLD_KINDS)
+"""What the view is made of: trees, their nodes' statuses, what is told in words (never the
+blackboard's changes, which come at every tick)."""
 HAPPENED_SENT = 30
 """How many of the latest "what happened" lines the view carries."""
 
 
 class CloudSession:
-    """A reader of the session's exit off the robot (``on_event``) that keeps the view
+    """A reader of the session's exit off the robot (``on_event``, for
+    :data:`SHOWN_KINDS`) that keeps the view
     the cloud shows; ``wizard``: the robot's buttons, None when it runs none (the cloud
     link's :class:`~engine.services.cloud_push.SessionShown`)."""
 

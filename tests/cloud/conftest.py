@@ -196,15 +196,8 @@ def start_robot() -> Iterator[Callable[..., Robot]]:
     """Starts `vest run --cloud` robots on the simulated vest (stopped after the test)."""
     robots: list[Robot] = []
 
-    def start(
-        url: str,
-        token_file: Path,
-        scenario: Path,
-        trees: list[str],
-        person: str = "",
-        buttons: str = "",
-    ) -> Robot:
-        robots.append(Robot(url, token_file, scenario, trees, person, buttons))
+    def start(*args: Any, **kwargs: Any) -> Robot:  # as Robot takes them
+        robots.append(Robot(*args, **kwargs))
         return robots[-1]
 
     yield start
