@@ -20,16 +20,12 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import Protocol, runtime_checkable
 
-from smbus2 import i2c_msg
-
 __all__ = ["I2CBus", "SerialPort", "SpiDevice"]
 
 
 @runtime_checkable
 class I2CBus(Protocol):
     """An ``smbus2.SMBus``-compatible I2C bus (``i2c_addr`` is the chip's 7-bit address)."""
-
-    def write_quick(self, i2c_addr: int, force: bool | None = None) -> None: ...
 
     def read_byte(self, i2c_addr: int, force: bool | None = None) -> int: ...
 
@@ -41,12 +37,6 @@ class I2CBus(Protocol):
         self, i2c_addr: int, register: int, value: int, force: bool | None = None
     ) -> None: ...
 
-    def read_word_data(self, i2c_addr: int, register: int, force: bool | None = None) -> int: ...
-
-    def write_word_data(
-        self, i2c_addr: int, register: int, value: int, force: bool | None = None
-    ) -> None: ...
-
     def read_i2c_block_data(
         self, i2c_addr: int, register: int, length: int, force: bool | None = None
     ) -> list[int]: ...
@@ -54,8 +44,6 @@ class I2CBus(Protocol):
     def write_i2c_block_data(
         self, i2c_addr: int, register: int, data: Sequence[int], force: bool | None = None
     ) -> None: ...
-
-    def i2c_rdwr(self, *i2c_msgs: i2c_msg) -> None: ...
 
     def close(self) -> None: ...
 

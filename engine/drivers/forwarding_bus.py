@@ -10,8 +10,6 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import Any
 
-from smbus2 import i2c_msg
-
 from engine.drivers.bus_protocols import I2CBus
 
 WRITE_EACH = "write_byte_data_each"
@@ -50,9 +48,6 @@ class ForwardingI2C(I2CBus):
         """Each ``(register, value)`` written in order, as one access of this wrapper."""
         self._forward(WRITE_EACH, i2c_addr, tuple(writes))
 
-    def write_quick(self, i2c_addr: int, force: bool | None = None) -> None:
-        self._forward("write_quick", i2c_addr)
-
     def read_byte(self, i2c_addr: int, force: bool | None = None) -> int:
         value: int = self._forward("read_byte", i2c_addr)
         return value
@@ -69,15 +64,6 @@ class ForwardingI2C(I2CBus):
     ) -> None:
         self._forward("write_byte_data", i2c_addr, register, value)
 
-    def read_word_data(self, i2c_addr: int, register: int, force: bool | None = None) -> int:
-        value: int = self._forward("read_word_data", i2c_addr, register)
-        return value
-
-    def write_word_data(
-        self, i2c_addr: int, register: int, value: int, force: bool | None = None
-    ) -> None:
-        self._forward("write_word_data", i2c_addr, register, value)
-
     def read_i2c_block_data(
         self, i2c_addr: int, register: int, length: int, force: bool | None = None
     ) -> list[int]:
@@ -89,9 +75,6 @@ class ForwardingI2C(I2CBus):
     ) -> None:
         # a copy: the transaction may run later, on another thread
         self._forward("write_i2c_block_data", i2c_addr, register, list(data))
-
-    def i2c_rdwr(self, *i2c_msgs: i2c_msg) -> None:
-        self._forward("i2c_rdwr", *i2c_msgs)
 
     def close(self) -> None:
         """Nothing to release: the wrapped bus belongs to whoever opened it."""

@@ -17,6 +17,7 @@ from pathlib import Path
 from typing import Any
 
 from engine.blackboard.catalogue import KeyCatalogue
+from engine.files.fields import converted, declared_fields
 from engine.files.problems import Mark, Problems
 from engine.files.yaml_source import YMap, YScalar, YValue, describe, plain
 from engine.hardware.chips import ChipRegistry, default_chips
@@ -36,7 +37,7 @@ from engine.hardware.config_camera import check_camera
 from engine.hardware.config_cross_checks import CrossChecks
 from engine.hardware.config_keys import check_device_keys
 from engine.hardware.config_safety import check_safety
-from engine.values.param_problems import CheckContext, ParamProblem, did_you_mean
+from engine.values.param_problems import CheckContext, did_you_mean
 from engine.values.params import RATE_HZ, Boolean, Integer, Param, ParamType, Text
 
 TOP_FIELDS: tuple[str, ...] = ("name", "description", "simulated", "buses", "gpio", "audio")
@@ -67,32 +68,14 @@ class ConfigChecker:
     # -- small helpers ---------------------------------------------------------------------
     def convert(self, kind: ParamType[Any], raw: YValue, what: str) -> Any:
         """``kind.convert`` of a value, or None after adding the problem at its place."""
-        try:
-            return kind.convert(plain(raw), self.ctx)
-        except ParamProblem as problem:
-            self.problems.add(raw.mark, f"{what!r} {problem.message}", problem.hint)
-            return None
+        return converted(kind, raw, what, self.ctx, self.problems)
 
     def unknown_fields(self, raw: YMap, known: Sequence[str], what: str) -> None:
         self.problems.unknown_fields(raw.key_marks, known, what)
 
     def fields(self, raw: YMap, params: tuple[Param[Any], ...], what: str) -> dict[str, Any] | None:
         """Convert the declared ``params`` of ``raw`` (unknown fields are checked apart)."""
-        values: dict[str, Any] = {}
-        ok = True
-        for param in params:
-            value = raw.get(param.name)
-            if value is None:
-                if param.required:
-                    self.problems.add(raw.mark, f"{what} needs {param.name!r}", param.doc)
-                    ok = False
-                else:
-                    values[param.name] = param.default
-                continue
-            converted = self.convert(param.type, value, param.name)
-            ok = ok and converted is not None
-            values[param.name] = converted
-        return values if ok else None
+        return declared_fields(raw, params, what, self.ctx, self.problems)
 
     def mapping(self, raw: YValue | None, what: str, example: str) -> YMap | None:
         if raw is None:

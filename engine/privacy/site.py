@@ -20,20 +20,29 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from engine.blackboard.catalogue import KeyCatalogue
 from engine.clock import Clock
 from engine.errors import ConfigError
+from engine.files.fields import settings
 from engine.files.problems import Problems
 from engine.files.yaml_source import load_yaml
-from engine.files.yaml_values import YMap, YScalar
 from engine.privacy.consent import PSEUDONYM, Consent, ConsentBook
 from engine.privacy.sealed_sqlite import connect_sealed, rekey
 from engine.privacy.site_data import KEY_FILE, SiteKey, make_key_file, read_key_file, site_key
 from engine.privacy.site_records import RECORDS_FILE, SessionEntry, SiteRecords
+from engine.values.param_problems import CheckContext
+from engine.values.params import Number, Param
 
 SETTINGS_FILE = "site.yaml"
 KEEP_DAYS = 365
 NEW_KEY_FILE = "site.key.new"
 DAY_S = 86_400.0
+
+
+SITE_FIELDS = (
+    Param("keep_sessions_days", Number(1e-5, 36500.0, "days"), float(KEEP_DAYS), "days kept"),
+)
+"""What ``site.yaml`` may say: how long a session's recording is kept before it is purged."""
 
 
 @dataclass(frozen=True)
@@ -50,21 +59,10 @@ class SiteSettings:
         if document is None:
             return cls()
         problems = Problems()
-        if not isinstance(document, YMap):
-            problems.add(document.mark, "site settings are a mapping: keep_sessions_days: N")
-            problems.raise_if_any()
-        assert isinstance(document, YMap)
-        problems.unknown_fields(document.key_marks, ("keep_sessions_days",), "site")
-        days = document.get("keep_sessions_days")
-        keep = float(KEEP_DAYS)
-        if days is not None:
-            value = days.value if isinstance(days, YScalar) else None
-            if isinstance(value, bool) or not isinstance(value, int | float) or not value > 0:
-                problems.add(days.mark, "keep_sessions_days: a number of days above 0")
-            else:
-                keep = float(value)
+        values = settings(document, SITE_FIELDS, "site", CheckContext(KeyCatalogue(())), problems)
         problems.raise_if_any()
-        return cls(keep)
+        assert values is not None
+        return cls(values["keep_sessions_days"])
 
 
 @dataclass(frozen=True)

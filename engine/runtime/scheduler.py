@@ -237,10 +237,6 @@ class Scheduler:
         self._stop.set()
         self._attention.set()
 
-    @property
-    def stopping(self) -> bool:
-        return self._stop.is_set()
-
     def next_deadline_s(self) -> float:
         return min(tree.next_deadline_s for tree in self.trees)
 

@@ -27,12 +27,13 @@ from pathlib import Path
 from typing import Any
 
 from engine.blackboard.catalogue import default_catalogue
+from engine.files.fields import converted, settings
 from engine.files.problems import LoadError, Mark, Problems
-from engine.files.yaml_source import YList, YMap, YValue, describe, load_yaml, plain
+from engine.files.yaml_source import YList, YMap, YValue, describe, load_yaml
 from engine.media.audio import AudioFileError, read_wav
 from engine.scenario.event_fields import EVENT_FIELDS
-from engine.values.param_problems import CheckContext, ParamProblem, did_you_mean
-from engine.values.params import SECONDS, Number, Param, ParamType, Text
+from engine.values.param_problems import CheckContext, did_you_mean
+from engine.values.params import SECONDS, Number, ParamType, Text
 
 
 @dataclass(frozen=True)
@@ -126,7 +127,7 @@ def check_scenario(document: YValue | None, name: str, path: Path) -> Scenario:
         problems.add(document.mark, "a scenario needs 'duration_s:'", "seconds, e.g. 20")
     else:
         duration = (
-            _convert(Number(0.01, 24 * 3600.0, "s"), raw_duration, "duration_s", ctx, problems)
+            converted(Number(0.01, 24 * 3600.0, "s"), raw_duration, "duration_s", ctx, problems)
             or 0.0
         )
     events: list[ScenarioEvent] = []
@@ -150,16 +151,6 @@ def check_scenario(document: YValue | None, name: str, path: Path) -> Scenario:
     return Scenario(duration, tuple(events), path)
 
 
-def _convert(
-    kind: ParamType[Any], raw: YValue, what: str, ctx: CheckContext, problems: Problems
-) -> Any:
-    try:
-        return kind.convert(plain(raw), ctx)
-    except ParamProblem as problem:
-        problems.add(raw.mark, f"{what!r} {problem.message}", problem.hint)
-        return None
-
-
 def _event(
     raw: YValue, ctx: CheckContext, problems: Problems, index: int, folder: Path
 ) -> ScenarioEvent | None:
@@ -172,7 +163,7 @@ def _event(
     if at is None:
         problems.add(raw.mark, "event has no 'at:'", "seconds from the start, e.g. at: 1.5")
     else:
-        at_s = _convert(SECONDS, at, "at", ctx, problems)
+        at_s = converted(SECONDS, at, "at", ctx, problems)
     if len(kinds) != 1:
         problems.add(
             raw.mark,
@@ -191,12 +182,12 @@ def _event(
         return None
     body = raw.entries[kind]
     if kind == "hear" and not isinstance(body, YMap):  # hear: "text" is hear: {text: ...}
-        text = _convert(Text(), body, kind, ctx, problems)
+        text = converted(Text(), body, kind, ctx, problems)
         value = None if text is None else {"text": text, "wav": None, "snr_db": None}
     elif isinstance(fields, ParamType):
-        value = _convert(fields, body, kind, ctx, problems)
+        value = converted(fields, body, kind, ctx, problems)
     else:
-        value = _fields(kind, fields, body, ctx, problems)
+        value = settings(body, fields, kind, ctx, problems)
     if value is None or at_s is None:
         return None
     if kind == "temperature":
@@ -276,33 +267,3 @@ def _check_showing(value: dict[str, Any], body: YValue, folder: Path, problems: 
         return False
     value[given[0]] = str(path)
     return True
-
-
-def _fields(
-    kind: str, params: tuple[Param[Any], ...], body: YValue, ctx: CheckContext, problems: Problems
-) -> dict[str, Any] | None:
-    if not isinstance(body, YMap):
-        problems.add(
-            body.mark,
-            f"{kind} takes a mapping of "
-            + ", ".join(p.name for p in params)
-            + f", got {describe(body)}",
-        )
-        return None
-    values: dict[str, Any] = {}
-    ok = problems.unknown_fields(body.key_marks, [p.name for p in params], kind)
-    for key, value in body.items():
-        param = next((p for p in params if p.name == key), None)
-        if param is None:
-            continue
-        converted = _convert(param.type, value, key, ctx, problems)
-        ok = ok and converted is not None
-        values[key] = converted
-    for param in params:
-        if param.name not in values:
-            if param.required:
-                problems.add(body.mark, f"{kind} needs {param.name!r}", param.doc)
-                ok = False
-            else:
-                values[param.name] = param.default
-    return values if ok else None

@@ -81,10 +81,6 @@ class SessionStream:
         self._subscriptions.append(_Subscription(observer, chosen, relay))
         self._remember_wanted()
 
-    def unsubscribe(self, observer: SessionObserver) -> None:
-        self._subscriptions = [s for s in self._subscriptions if s.observer is not observer]
-        self._remember_wanted()
-
     def _remember_wanted(self) -> None:
         readers = [s for s in self._subscriptions if not s.relay]
         self._everything = any(s.kinds is None for s in readers)

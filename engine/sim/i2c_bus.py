@@ -18,8 +18,6 @@ import threading
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 
-from smbus2 import i2c_msg
-
 from engine.clock import Clock
 from engine.drivers.bus_protocols import I2CBus
 
@@ -187,9 +185,6 @@ class SimI2CBus(I2CBus):
         return self.transfer([(address, False, bytes([register])), (address, True, length)])[0]
 
     # -- smbus2.SMBus interface -----------------------------------------------------------
-    def write_quick(self, i2c_addr: int, force: bool | None = None) -> None:
-        self._write(i2c_addr, b"")
-
     def read_byte(self, i2c_addr: int, force: bool | None = None) -> int:
         return self.transfer([(i2c_addr, True, 1)])[0][0]
 
@@ -204,15 +199,6 @@ class SimI2CBus(I2CBus):
     ) -> None:
         self._write(i2c_addr, [register & 0xFF, value & 0xFF])
 
-    def read_word_data(self, i2c_addr: int, register: int, force: bool | None = None) -> int:
-        low, high = self._write_read(i2c_addr, register, 2)
-        return low | (high << 8)  # SMBus words travel least significant byte first
-
-    def write_word_data(
-        self, i2c_addr: int, register: int, value: int, force: bool | None = None
-    ) -> None:
-        self._write(i2c_addr, [register & 0xFF, value & 0xFF, (value >> 8) & 0xFF])
-
     def read_i2c_block_data(
         self, i2c_addr: int, register: int, length: int, force: bool | None = None
     ) -> list[int]:
@@ -226,20 +212,6 @@ class SimI2CBus(I2CBus):
         if len(data) > 32:
             raise ValueError(f"I2C block length must be at most 32, got {len(data)}")
         self._write(i2c_addr, [register & 0xFF, *(b & 0xFF for b in data)])
-
-    def i2c_rdwr(self, *i2c_msgs: i2c_msg) -> None:
-        plan: list[tuple[int, bool, bytes | int]] = []
-        for msg in i2c_msgs:
-            if msg.flags & I2C_M_RD:
-                plan.append((msg.addr, True, msg.len))
-            else:
-                plan.append((msg.addr, False, bytes(msg)))
-        reads = iter(self.transfer(plan))
-        for msg in i2c_msgs:
-            if msg.flags & I2C_M_RD:
-                data = next(reads)
-                for index, value in enumerate(data):
-                    msg.buf[index] = bytes([value])
 
     def close(self) -> None:
         """Nothing to release: the bus was not opened from a device file."""

@@ -166,12 +166,6 @@ class MaestroEmulator:
             self._advance_to(self._clock.now())
             return [channel.target / QUARTER_US_PER_US for channel in self._channels]
 
-    def position_us(self, channel: int) -> float:
-        """The pulse width ``channel`` sends now, in us (0.0: off)."""
-        with self._lock:
-            self._advance_to(self._clock.now())
-            return round(self._channels[channel].position) / QUARTER_US_PER_US
-
     def inject_error(self, name: str) -> None:
         """Raise one of the Maestro's errors by name (see ``ERROR_NAMES``), as if it occurred."""
         masks = {error_name: mask for mask, error_name in ERROR_NAMES.items()}

@@ -138,9 +138,6 @@ class SimMCP9808(SimI2CDevice):
         return (bytes([word >> 8, word & 0xFF]) * (length // 2 + 1))[:length]
 
     # -- chip internals -----------------------------------------------------------------
-    def _locked(self) -> bool:
-        return bool(self._config & CONFIG_LOCKS)
-
     def _read_word(self, pointer: int) -> int:
         if pointer == CONFIG:
             return self._config

@@ -6,7 +6,7 @@ clocked in on MOSI while chip select is low, most significant bit of each byte f
 answers one MISO bit per clock, or ``None`` where it leaves MISO floating (high
 impedance); the node fills floating bits with random ones, as a floating line reads.
 
-Transfer semantics follow the py-spidev documentation: ``xfer2`` (and ``xfer3``,
+Transfer semantics follow the py-spidev documentation: ``xfer2`` (and
 ``writebytes``, ``readbytes``) hold chip select low for the whole list, while ``xfer``
 releases and re-asserts it between bytes, so each byte is a frame of its own.
 
@@ -110,22 +110,9 @@ class SimSpiDev(SpiDevice):
         """Exchange ``values`` with chip select held low throughout."""
         return self._frame(self._checked(values), speed_hz)
 
-    def xfer3(
-        self,
-        values: Sequence[int],
-        speed_hz: int = 0,
-        delay_usec: int = 0,
-        bits_per_word: int = 0,
-    ) -> list[int]:
-        """As :meth:`xfer2` (spidev splits long lists; one frame here)."""
-        return self.xfer2(values, speed_hz, delay_usec, bits_per_word)
-
     def writebytes(self, values: Sequence[int]) -> None:
         """Send ``values`` in one frame, discarding what comes back."""
         self._frame(self._checked(values), 0)
-
-    def writebytes2(self, values: Sequence[int]) -> None:
-        self.writebytes(values)
 
     def readbytes(self, length: int) -> list[int]:
         """Clock ``length`` bytes in one frame with MOSI held low."""

@@ -102,10 +102,6 @@ class SimZXGesture(SimI2CDevice):
         self._tick()
         self._hand_since_s = None
 
-    @property
-    def hand_in_view(self) -> bool:
-        return self._hand_since_s is not None
-
     def _tick(self) -> None:
         """A new coordinate every sample period while a hand is in view."""
         if self._hand_since_s is None:
