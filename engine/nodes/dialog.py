@@ -11,6 +11,7 @@ from engine.dialogs.confirming import REPROMPT_WITHIN_S, maybe_meant, reprompt
 from engine.dialogs.model import Dialog, FollowUp, Verdict
 from engine.errors import ServiceError
 from engine.nodes.base import Leaf
+from engine.services.actions import SPOKEN_OVER
 from engine.services.jobs import ImmediateJob, Job
 from engine.services.turns import SPEAKER
 from engine.session.events import NotUnderstood
@@ -135,6 +136,15 @@ class Reply(Leaf):
         # the answer is the robot's own words, with what its fields fill in (a reading,
         # or what was heard when the dialog echoes it): not the utterance that chose it
         self.job = self.ctx.actions.say(text, carries=self.ctx.blackboard.carried_by(template.keys))
+
+    def terminate(self, new_status: Status) -> None:
+        """Halted while asking its question because the person spoke over it: their words
+        are the answer, so the follow-up listens from now, as after a question said whole."""
+        super().terminate(new_status)
+        spoken_over = self.ctx.actions.stop_reason == SPOKEN_OVER
+        if new_status == Status.INVALID and spoken_over and self.phase == "speaking":
+            if self.follow_up is not None:
+                self.follow_up_until_s = self.ctx.clock.now() + self.follow_up.listen_s
 
     def update(self) -> Status:
         if self.job is None:

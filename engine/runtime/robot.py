@@ -18,7 +18,7 @@ from engine.nodes.context import NodeErrorHandler, NodeErrorLog, TreeContext
 from engine.nodes.registry import NodeRegistry, default_registry
 from engine.runtime.scheduler import RunningTree, Scheduler
 from engine.runtime.tree_watch import TreeNews
-from engine.services.actions import ActionLog, TreeActions, TurnTaking
+from engine.services.actions import SPOKEN_OVER, ActionLog, TreeActions, TurnTaking
 from engine.services.interfaces import Services
 from engine.services.jobs import Job
 from engine.services.staged_readings import with_staged_readings
@@ -259,7 +259,7 @@ class Robot:
             )
         )
         if tree:
-            self.scheduler.tree(tree).halt("a person spoke over it")
+            self.scheduler.tree(tree).halt(SPOKEN_OVER)
         self.turns.hold((SPEAKER,), THE_PERSON, PERSONS_PRIORITY, floor)
 
     def interrupt(self, name: str, by: str, resource: str) -> None:

@@ -34,6 +34,9 @@ from engine.session.stream import SessionStream
 
 _log = logging.getLogger("vest.actions")
 
+SPOKEN_OVER = "a person spoke over it"
+"""The :attr:`TreeActions.stop_reason` of a tree halted because a person spoke over it."""
+
 
 @dataclass
 class ActionRecord:

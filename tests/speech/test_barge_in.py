@@ -201,6 +201,28 @@ def test_a_sentence_quoting_the_child_stays_withheld_when_it_is_spoken_over(
     assert cut["outcome"] == "cut"  # the sentence that was playing, not "Great!" waiting
 
 
+def test_a_child_who_answers_yes_over_the_robot_s_question_is_answered_in_its_context(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # children answer before a question ends: "yes" over "... Do you have a pet?" answers it
+    lines = run(
+        tmp_path,
+        capsys,
+        """\
+  - {at: 1.0, hear: "do you like animals"}
+  - {at: 4.2, hear: "yes"}
+""",
+        "trees/dialog.yaml",
+    )
+    [stop] = [e for e in lines if e["event"] == "spoken_over"]
+    assert stop["saying"] == "I love animals. Do you have a pet?"
+    assert [e for e in lines if e["event"] == "not_understood"] == []
+    assert said(lines) == [
+        "I love animals. Do you have a pet?",
+        "How lovely! Pets are good friends.",
+    ]
+
+
 def test_a_therapist_s_phrase_spoken_over_is_not_said_again_over_the_child(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
