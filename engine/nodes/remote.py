@@ -147,6 +147,21 @@ class CarryOut(ServiceAction):
         self.feedback_message = why
         return Status.FAILURE
 
+    def terminate(self, new_status: Status) -> None:
+        """Halted under way (spoken over, interrupted, paused, stopped): the action is cut
+        short and the operator told at once that the command failed, with why, unless the
+        round starts again and carries the command out anew."""
+        under_way = new_status == Status.INVALID and self.status == Status.RUNNING
+        super().terminate(new_status)
+        if not under_way or self.ctx.actions.round_tried_again:
+            return
+        command = self.read(self.command)
+        if isinstance(command, Mapping) and "id" in command:
+            why = f"cut short: {self.ctx.actions.stop_reason or 'its tree was halted'}"
+            self.ctx.actions.report_result(
+                str(command["id"]), "failed", {"error": why}, carries=self.made_of
+            )
+
     def finished(self, job: Job) -> Status:
         result = job.result()  # a reading is staged by the sensor service, not written here
         if self.save_result_as:

@@ -269,9 +269,10 @@ class Robot:
         if name == THE_PERSON:
             return  # the person's turn is over: nothing of theirs to halt
         tree = self.scheduler.tree(name)
-        tree.halt(f"{by} interrupted it")
         # once: a round cut short again while trying again lets go (no stutter), and
         # without wait_for_turn_s there would be no waiting for the turn at all
-        if tree.tries_again and tree.definition.wait_for_turn_s > 0 and not tree.retrying:
+        again = tree.tries_again and tree.definition.wait_for_turn_s > 0 and not tree.retrying
+        tree.halt(f"{by} interrupted it", tried_again=again)
+        if again:
             tree.try_again()
             self.session.publish(TurnTaken(self.clock.now(), name, "tries_again", resource, by))

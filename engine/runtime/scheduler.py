@@ -149,18 +149,19 @@ class RunningTree:
                 interruptible=definition.interruptible,
             )
 
-    def halt(self, why: str = "its tree was stopped") -> None:
+    def halt(self, why: str = "its tree was stopped", *, tried_again: bool = False) -> None:
         """Stop whatever is running (cancels service jobs: speech, moves, lights; each is
         told as cut short, ``why``), then send the joints it moved back to rest and turn
-        off the LEDs it lit."""
+        off the LEDs it lit. ``tried_again``: the round will start again at once (its nodes
+        see it while they stop)."""
         root = self.tree.root
         if root.status == py_trees.common.Status.RUNNING:
             actions = self.context.actions
-            actions.stop_reason = why
+            actions.stop_reason, actions.round_tried_again = why, tried_again
             try:
                 root.stop(py_trees.common.Status.INVALID)
             finally:
-                actions.stop_reason = ""
+                actions.stop_reason, actions.round_tried_again = "", False
             actions.settle()
 
 

@@ -224,6 +224,8 @@ class TreeActions:
         self._lit = False
         self.stop_reason = ""
         """Why the tree is being halted, while it is (its cut actions say so)."""
+        self.round_tried_again = False
+        """While the tree is halted: whether the round cut short starts again at once."""
         self.acting: Acting | None = None
         """The node whose lifecycle method runs now (its reads decide a call's carries)."""
         self._gave_way: dict[str, Turn] = {}

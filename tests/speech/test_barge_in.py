@@ -72,6 +72,10 @@ def test_a_child_who_speaks_over_the_robot_stops_it_and_is_answered(
     [cut] = [e for e in lines if e["event"] == "outcome" and e["args"].get("text") == STORY]
     assert cut["outcome"] == "cut" and cut["why"] == "a person spoke over it"
     assert said(lines) == [STORY, "My name is H B S 2"]  # heard, and answered
+    # and the operator who sent the story is told at once, not left waiting for it
+    [report] = [e for e in lines if e["event"] == "action" and e["action"] == "report"]
+    assert (report["t"], report["args"]["status"]) == (pytest.approx(3.8), "failed")
+    assert report["args"]["result"] == {"error": "cut short: a person spoke over it"}
 
 
 def test_the_robot_at_full_volume_in_a_loud_echoing_room_never_stops_itself(
