@@ -377,4 +377,22 @@ class TreeLoader:
             root.name = str(raw_name.value)
         if root is not None:
             root.subtree = str(file_value.value)
+            _part_interruptible(document, root, params, problems, self.check_context)
         return root
+
+
+def _part_interruptible(
+    document: YMap,
+    root: NodeDefinition,
+    params: dict[str, ParamValue],
+    problems: Problems,
+    ctx: CheckContext,
+) -> None:
+    """A part's ``interruptible:`` holds for the sentences in it that do not say their own
+    (a part nested in it has said its own first); the tree's setting for the rest."""
+    if "interruptible" not in document:
+        return
+    part = read_settings(document, params, problems, ctx).interruptible
+    for node in root.walk():
+        if node.type.param("interruptible") is not None and node.args.get("interruptible") is None:
+            node.args["interruptible"] = part

@@ -141,10 +141,9 @@ class Reply(Leaf):
         """Halted while asking its question because the person spoke over it: their words
         are the answer, so the follow-up listens from now, as after a question said whole."""
         super().terminate(new_status)
-        spoken_over = self.ctx.actions.stop_reason == SPOKEN_OVER
-        if new_status == Status.INVALID and spoken_over and self.phase == "speaking":
-            if self.follow_up is not None:
-                self.follow_up_until_s = self.ctx.clock.now() + self.follow_up.listen_s
+        asked, spoken_over = self.follow_up, self.ctx.actions.stop_reason == SPOKEN_OVER
+        if new_status == Status.INVALID and spoken_over and self.phase == "speaking" and asked:
+            self.follow_up_until_s = self.ctx.clock.now() + asked.listen_s
 
     def update(self) -> Status:
         if self.job is None:

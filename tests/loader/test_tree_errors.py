@@ -239,6 +239,44 @@ def test_a_subtree_parameter_it_does_not_declare_suggests_the_nearest(tmp_path: 
     ) == ["tree.yaml:2:53: Subtree passes unknown parameter 'phrse' (did you mean 'phrase'?)"]
 
 
+def test_a_part_that_must_be_heard_out_keeps_its_own_sentences_whole(tmp_path: Path) -> None:
+    # interruptible: false in a part holds for its sentences, not the including tree's;
+    # a sentence that says its own keeps it
+    write(
+        tmp_path,
+        "parts/exercise.yaml",
+        """\
+        interruptible: false
+        root:
+          Sequence:
+            - Say: {text: "Breathe in slowly"}
+            - Say: {text: "Any questions?", interruptible: true}
+        """,
+    )
+    tree = write(
+        tmp_path,
+        "tree.yaml",
+        """\
+        root:
+          Sequence:
+            - Subtree: {file: parts/exercise.yaml}
+            - Say: {text: "Well done"}
+        """,
+    )
+    says = [n for n in load(tmp_path, tree).root.walk() if n.type.name == "Say"]
+    assert [(n.args["text"].source, n.args["interruptible"]) for n in says] == [
+        ("Breathe in slowly", False),
+        ("Any questions?", True),
+        ("Well done", None),  # as the tree says: true unless it sets otherwise
+    ]
+
+
+def test_a_part_s_interruptible_that_is_no_yes_or_no_is_named(tmp_path: Path) -> None:
+    write(tmp_path, "parts/p.yaml", 'interruptible: sometimes\nroot:\n  Say: {text: "Hi"}\n')
+    [problem] = problems_of(tmp_path, "root:\n  Subtree: {file: parts/p.yaml}\n")
+    assert problem.startswith("parts/p.yaml:1:16: 'interruptible' must be")
+
+
 def test_a_missing_tree_file_is_named(tmp_path: Path) -> None:
     assert problems(tmp_path, tmp_path / "nope.yaml") == [
         "nope.yaml:1:1: file not found (check the path)"
