@@ -22,6 +22,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, TypeVar
 
 from engine.blackboard.catalogue import IOT_INBOX
+from engine.buttons.acting import ActingNow
 from engine.buttons.button_file import ButtonBoard
 from engine.buttons.wizard import Wizard
 from engine.clock import Clock, RealClock, VirtualClock
@@ -227,6 +228,10 @@ def _around(assembled: AssembledRobot, plan: SessionPlan, link: CloudLink | None
         running.wizard = Wizard(plan.buttons, robot)
         robot.scheduler.add_hook(running.wizard)
         assembled.world.add_listener(running.wizard)
+    player = ScenarioPlayer(
+        plan.scenario, assembled.world, start_s=start_s, on_event=_world_events(session)
+    )
+    robot.scheduler.add_hook(player, first=True)
     if plan.view is not None:
         hub = ViewHub(clock, device_stats=assembled.hardware.stats)
         hub.begin(start_s, robot.trees)
@@ -238,6 +243,7 @@ def _around(assembled: AssembledRobot, plan: SessionPlan, link: CloudLink | None
             port=plan.view.port,
             token=plan.view.token,
             wizard=running.wizard,
+            acting=_acting(plan, player, clock),
         )
         running.view = view
         lifecycle.add("view", start=_telling(view.start, view, plan.on_view_up), stop=view.stop)
@@ -304,10 +310,6 @@ def _around(assembled: AssembledRobot, plan: SessionPlan, link: CloudLink | None
             "ros2", start=_telling(start_bridge, bridge, plan.on_ros2_up), stop=bridge.stop
         )
         gates.sent.subscribe(bridge)
-    player = ScenarioPlayer(
-        plan.scenario, assembled.world, start_s=start_s, on_event=_world_events(session)
-    )
-    robot.scheduler.add_hook(player, first=True)
     if not plan.fast:  # reload work runs beside the scheduler, swaps between ticks
         wizard_tree = running.wizard.tree if running.wizard is not None else None
         behaving = [tree for tree in robot.trees if tree is not wizard_tree]
@@ -360,6 +362,14 @@ def _takes_commands(behaviors: Behaviors) -> bool:
 
 def _nothing() -> None:
     """A part with nothing to stop."""
+
+
+def _acting(plan: SessionPlan, player: ScenarioPlayer, clock: Clock) -> ActingNow | None:
+    """The buttons page's hand on a simulated vest, in real time (nobody acts on a real
+    vest from a page, nor on a run at full speed)."""
+    if plan.fast or not plan.config.simulated:
+        return None
+    return ActingNow(player, clock, plan.config)
 
 
 def _world_events(session: SessionStream) -> Callable[[float, ScenarioEvent], None]:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import heapq
 import itertools
+import threading
 from collections.abc import Callable
 from typing import Any
 
@@ -127,13 +128,19 @@ class ScenarioPlayer:
         self.world = world
         self.start_s = start_s
         self.on_event = on_event
-        order = itertools.count()
+        self._order = itertools.count()
         self._pending: list[tuple[float, int, Change, ScenarioEvent | None]] = []
+        self._lock = threading.Lock()  # add() comes from a page's request, any thread
         for event in scenario.events:
+            self.add(event)
+
+    def add(self, event: ScenarioEvent) -> None:
+        """Play ``event`` too, at its ``at_s`` (seconds from ``start_s``; one already past
+        is played at the next call)."""
+        with self._lock:
             for index, (at, change) in enumerate(changes_of(event)):
                 announce = event if index == 0 else None
-                self._pending.append((at, next(order), change, announce))
-        heapq.heapify(self._pending)
+                heapq.heappush(self._pending, (at, next(self._order), change, announce))
 
     def __call__(self, now_s: float) -> None:
         self.advance_to(now_s)
@@ -141,8 +148,11 @@ class ScenarioPlayer:
     def advance_to(self, now_s: float) -> None:
         """Apply every change due at or before ``now_s`` (clock seconds), in order."""
         elapsed = now_s - self.start_s
-        while self._pending and self._pending[0][0] <= elapsed + 1e-9:
-            at, _, change, event = heapq.heappop(self._pending)
+        while True:
+            with self._lock:
+                if not self._pending or self._pending[0][0] > elapsed + 1e-9:
+                    return
+                at, _, change, event = heapq.heappop(self._pending)
             if event is not None and self.on_event is not None:
                 self.on_event(self.start_s + at, event)
             change(self.world)

@@ -136,7 +136,7 @@ def check_scenario(document: YValue | None, name: str, path: Path) -> Scenario:
         problems.add(raw_events.mark, f"'events' must be a list, got {describe(raw_events)}")
     elif raw_events is not None:
         for index, raw in enumerate(raw_events):
-            event = _event(raw, ctx, problems, index, path.parent)
+            event = scenario_event(raw, ctx, problems, index, path.parent)
             if event is None:
                 continue
             if duration and event.at_s > duration:
@@ -151,9 +151,11 @@ def check_scenario(document: YValue | None, name: str, path: Path) -> Scenario:
     return Scenario(duration, tuple(events), path)
 
 
-def _event(
+def scenario_event(
     raw: YValue, ctx: CheckContext, problems: Problems, index: int, folder: Path
 ) -> ScenarioEvent | None:
+    """One event of a scenario's ``events:`` (the ``index``-th), or None after adding its
+    problems; files it names are relative to ``folder``."""
     if not isinstance(raw, YMap):
         problems.add(raw.mark, "an event is a mapping like {at: 1.0, touch: {pad: 3}}")
         return None

@@ -15,7 +15,10 @@ beside the robot:
 - with buttons (``vest run --buttons``): ``GET /buttons`` the therapist's page,
   ``GET /api/buttons`` the buttons and what shows, ``GET /api/buttons/events`` the shown
   set as it changes, ``POST /api/press`` ``{"button": N}`` presses one (JSON only; the
-  guard refuses another site's page: it cannot press for the therapist).
+  guard refuses another site's page: it cannot press for the therapist);
+- on a simulated vest, beside the buttons: ``POST /api/act`` one scenario event without
+  ``at`` (``{"squeeze": {"left_n": 6}}``), played now (:mod:`engine.buttons.acting`);
+  422 with each problem's place when it is not one.
 
 Every request asks for the server's token, on loopback too (:mod:`engine.web.guard`): the
 address ``vest run --view`` prints carries it, and opening it keeps the browser in with a
@@ -39,8 +42,11 @@ from starlette.requests import Request
 from starlette.responses import FileResponse, JSONResponse, PlainTextResponse, Response
 from starlette.routing import BaseRoute, Route
 
+from engine.buttons.acting import ACTS, ActingNow
 from engine.buttons.wizard import Wizard
 from engine.errors import ConfigError
+from engine.files.problems import LoadError
+from engine.hardware.touch_pads import robot_pad_names
 from engine.loader.tree_drawing import svg_of, without_title_and_legend
 from engine.view.hub import Change, ViewHub
 from engine.web.body_limit import BodyLimit
@@ -110,10 +116,12 @@ class ViewServer:
         port: int = 8765,
         token: str | None = None,
         wizard: Wizard | None = None,
+        acting: ActingNow | None = None,
     ) -> None:
         self.source = source
         self.token = token or new_token()
         self.wizard = wizard
+        self.acting = acting if wizard is not None else None  # a page beside the buttons
         self._svg: dict[tuple[str, int], bytes] = {}
         self._svg_lock = threading.Lock()
         self._streams = 0  # open now; counted on the event loop
@@ -165,6 +173,8 @@ class ViewServer:
                 Route("/api/buttons/events", self._button_events),
                 Route("/api/press", self._press, methods=["POST"]),
             ]
+        if self.acting is not None:
+            routes.append(Route("/api/act", self._act, methods=["POST"]))
         return Starlette(
             routes=routes,
             middleware=[
@@ -232,7 +242,9 @@ class ViewServer:
     def _buttons(self, request: Request) -> Response:
         assert self.wizard is not None
         buttons = [button.to_json() for button in self.wizard.board.buttons]
-        return JSONResponse({"buttons": buttons, "state": self.wizard.state()})
+        acting = self.acting
+        acts = {"acts": list(ACTS), "pads": list(robot_pad_names(acting.config))} if acting else {}
+        return JSONResponse({"buttons": buttons, "state": self.wizard.state(), **acts})
 
     async def _button_events(self, request: Request) -> Response:
         assert self.wizard is not None
@@ -274,6 +286,21 @@ class ViewServer:
         button = wizard.press(number)
         assert button is not None
         return JSONResponse({"pressed": button.label}, status_code=202)
+
+    async def _act(self, request: Request) -> Response:
+        """Play one event on the simulated vest now: 202 with what it was, told in words."""
+        acting = self.acting
+        assert acting is not None
+        kind = request.headers.get("content-type", "").split(";")[0].strip()
+        if kind != "application/json":
+            return PlainTextResponse('send JSON: {"squeeze": {"left_n": 6}}\n', status_code=400)
+        try:
+            event = acting.act((await request.body()).decode("utf-8"))
+        except UnicodeDecodeError:
+            return PlainTextResponse("send the event as UTF-8 JSON\n", status_code=400)
+        except LoadError as error:
+            return PlainTextResponse(f"{error}\n", status_code=422)
+        return JSONResponse({"acted": event.describe()}, status_code=202)
 
 
 async def _changes(hub: ViewHub, reader: Reader) -> AsyncIterator[str]:

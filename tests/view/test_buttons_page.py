@@ -46,6 +46,7 @@ class Session:
                 self.address = line.removeprefix("buttons: ").strip()
                 break
         self.lines: queue.Queue[str] = queue.Queue()
+        self.seen: list[str] = []  # every timeline line read so far
         stdout = self.process.stdout
         threading.Thread(target=lambda: [self.lines.put(x) for x in stdout], daemon=True).start()
 
@@ -58,6 +59,7 @@ class Session:
             except queue.Empty:
                 raise AssertionError(f"no line with {text!r}; saw {seen}") from None
             seen.append(line.rstrip())
+            self.seen.append(line.rstrip())
             if text in line:
                 return line
 
@@ -132,3 +134,34 @@ def test_another_site_cannot_press_a_button_and_bad_presses_are_refused(
     assert post(session.address, json.dumps({"button": 99}).encode(), as_json) == 404
     assert post(session.address, press, as_json) == 202  # the page's own way
     session.wait_for('buttons        says "Hello! I am happy to see you."')
+
+
+def test_on_the_simulated_vest_the_page_squeezes_and_speaks_for_the_child(
+    page: Page, session: Session
+) -> None:
+    page.goto(session.address)
+    vest = page.get_by_role("region", name="Act on the simulated vest")
+    expect(vest).to_be_visible()
+    vest.get_by_role("button", name="Squeeze").click()
+    session.wait_for("world          squeezed left 6 N, right 6 N for 1.5 s")
+    expect(page.locator("#acted")).to_contain_text("done: squeezed left 6 N")
+    # typing the child's words presses no button, even letters that are buttons' keys
+    vest.get_by_label("Say as the child").press_sequentially("what is your name")
+    vest.get_by_role("button", name="Say it").click()
+    session.wait_for("world          someone says 'what is your name'")
+    session.wait_for('dialog         says "My name is H B S 2"')
+    assert not [line for line in session.seen if "presses the button" in line]
+    vest.get_by_label("for").first.fill("0")  # below what the page allows: the robot says
+    page.evaluate("document.querySelector('#act-squeeze input[name=seconds]').min = ''")
+    vest.get_by_role("button", name="Squeeze").click()
+    expect(page.locator("#acted")).to_contain_text("'seconds' must be")
+
+
+def test_a_bad_act_is_refused_with_its_place(session: Session) -> None:
+    url = session.address.replace("/buttons", "/api/act")
+    as_json = {"Content-Type": "application/json"}
+    request = urllib.request.Request(url, data=b'{"cloud": {}}', headers=as_json, method="POST")
+    with pytest.raises(urllib.error.HTTPError) as refused:
+        urllib.request.urlopen(request, timeout=10)
+    assert refused.value.code == 422
+    assert refused.value.read().decode().startswith("the request:1:2: the page cannot act")

@@ -36,6 +36,7 @@ function show(state) {
     $("#state").textContent = "the session ended";
     $("#state").className = "ended";
     for (const element of elements.values()) element.disabled = true;
+    for (const element of document.querySelectorAll("#vest button")) element.disabled = true;
     return;
   }
   const shown = new Set(state.shown);
@@ -46,6 +47,58 @@ function show(state) {
   const what = state.doing ? `doing "${state.doing}"` : "ready";
   $("#state").textContent = state.paused ? `behaviors paused; ${what}` : what;
   $("#state").className = state.paused ? "paused" : "";
+}
+
+// On a simulated vest: a squeeze, a touch or a child's words, acted now (POST /api/act
+// takes one scenario event; the robot feels it at its next tick).
+async function act(event) {
+  const response = await fetch(api("/api/act"), {
+    method: "POST",
+    headers: { "Content-Type": "application/json" },
+    body: JSON.stringify(event),
+  });
+  const told = $("#acted");
+  if (response.ok) {
+    told.textContent = `done: ${(await response.json()).acted}`;
+    told.className = "";
+  } else {
+    told.textContent = `not done: ${await response.text()}`;
+    told.className = "refused";
+  }
+}
+
+function actsOn(board) {
+  if (!board.acts || ended) return;
+  $("#vest").hidden = false;
+  const pads = $("#act-touch select");
+  const names = board.pads.length ? board.pads : [...Array(12).keys()].map(String);
+  names.forEach((name, index) => {
+    const option = document.createElement("option");
+    option.value = board.pads.length ? name : String(index);
+    option.textContent = board.pads.length ? name.replaceAll("_", " ") : `pad ${index}`;
+    pads.append(option);
+  });
+  const submitted = (id, build) =>
+    $(id).addEventListener("submit", (event) => {
+      event.preventDefault();
+      if (!ended) act(build(new FormData(event.target)));
+    });
+  submitted("#act-squeeze", (form) => {
+    const newtons = Number(form.get("newtons"));
+    const side = form.get("side");
+    return {
+      squeeze: {
+        left_n: side === "right" ? 0 : newtons,
+        right_n: side === "left" ? 0 : newtons,
+        seconds: Number(form.get("seconds")),
+      },
+    };
+  });
+  submitted("#act-touch", (form) => {
+    const pad = form.get("pad");
+    return { touch: { pad: board.pads.length ? pad : Number(pad), seconds: Number(form.get("seconds")) } };
+  });
+  submitted("#act-hear", (form) => ({ hear: { text: String(form.get("text")) } }));
 }
 
 async function start() {
@@ -75,6 +128,7 @@ async function start() {
   }
   $("#trees-link").href = api("/");
   show(board.state);
+  actsOn(board);
   const onEvent = (name, state) => {
     show(state);
     return !ended;
@@ -87,6 +141,7 @@ async function start() {
 
 document.addEventListener("keydown", (event) => {
   if (event.ctrlKey || event.metaKey || event.altKey || event.repeat) return;
+  if (event.target.closest("input, select, textarea")) return; // typing, not pressing
   const id = byKey.get(keyName(event));
   if (id !== undefined) {
     event.preventDefault();
