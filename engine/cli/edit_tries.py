@@ -6,6 +6,7 @@ said and heard as the robot hears them."""
 
 from __future__ import annotations
 
+import contextlib
 import json
 import shutil
 import subprocess
@@ -17,7 +18,9 @@ from typing import IO
 
 import yaml
 
-from engine.files.yaml_source import resolved
+from engine.errors import ConfigError
+from engine.files.yaml_source import plain, resolved
+from engine.loader.substitution import load_profile
 from engine.session.codec import decode
 from engine.session.sentences import event_line
 
@@ -175,8 +178,33 @@ class TryOnSimulatedVest:
             lines.append(
                 f"{tree} did nothing: what it waits for did not happen (look at its first "
                 "question: the pad, the threshold, the words) or another tree had its turn"
+                + self._settings_in_use(text, profile)
             )
         return lines
+
+    def _settings_in_use(self, text: str, profile: str | None) -> str:
+        """``; its settings in this try: hug_threshold_n 2.5 (profile child)``: the tree's
+        numeric ``params:`` as the try set them (empty when it has none)."""
+        try:
+            document = yaml.safe_load(text)
+        except yaml.YAMLError:
+            return ""
+        declared = document.get("params") if isinstance(document, dict) else None
+        if not isinstance(declared, dict):
+            return ""
+        chosen: dict[str, object] = {}
+        if profile is not None:
+            path = self.folder / "trees" / "profiles" / f"{profile}.yaml"
+            with contextlib.suppress(ConfigError):
+                given = load_profile(path).params
+                chosen = {name: plain(value.value) for name, value in given.items()}
+        told = [  # the numbers: thresholds and times, what decides whether it acts
+            f"{name} {chosen[name]} (profile {profile})" if name in chosen else f"{name} {value}"
+            for name, value in declared.items()
+            if isinstance(chosen.get(name, value), int | float)
+            and not isinstance(chosen.get(name, value), bool)
+        ]
+        return "; its settings in this try: " + ", ".join(told) if told else ""
 
     def watch(self, name: str, text: str, asked: object, host: str) -> str:
         """Run ``text`` in real time with the event ``asked`` at :data:`WATCH_AT_S` under

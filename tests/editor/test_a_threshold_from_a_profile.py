@@ -60,6 +60,7 @@ def test_a_new_setting_its_profiles_and_a_try_as_the_child_s_session(
     page.get_by_label("How many times").fill("2")
     page.get_by_role("button", name="Try it").click()
     expect(page.locator("#tried")).to_contain_text("two_squeezes did nothing", timeout=60_000)
+    expect(page.locator("#tried")).to_contain_text("its settings in this try: left_squeeze_n 3")
     page.get_by_label("Settings").select_option("child")
     page.get_by_role("button", name="Try it").click()
     expect(page.locator("#tried-what")).to_contain_text(

@@ -153,3 +153,16 @@ def test_axe_finds_nothing_serious_in_the_editor(
     assert accessibility(page) == []
     page.get_by_role("button", name="Add a node after").click()
     assert accessibility(page) == []  # the palette
+
+
+def test_the_palette_knows_the_robot_s_senses_by_their_words(page: Page, editor: str) -> None:
+    # no node is called "squeeze": the palette says where a squeeze is, and which nodes ask
+    page.goto(editor)
+    expect(page.locator("body")).to_have_attribute("data-ready", "true")
+    page.get_by_label("New tree (a name)").fill("squeezes")
+    page.get_by_role("button", name="Start a new tree").click()
+    page.get_by_role("button", name="Add a node inside").click()
+    page.get_by_label("Find").fill("squeeze")
+    expect(page.locator("#palette .palette-keys")).to_contain_text("/sensors/force/squeeze")
+    expect(page.locator('#palette .palette-node[data-node="OnEvent"]')).to_be_visible()
+    expect(page.locator('#palette .palette-node[data-node="Say"]')).to_be_hidden()

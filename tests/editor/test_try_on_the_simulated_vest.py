@@ -75,6 +75,9 @@ def test_a_pat_among_the_folder_s_trees_is_answered_by_the_tree_that_has_the_tur
     timeline = try_out("trees/hug.yaml", text, {"kind": "pat", "pad": "middle_back"})
     assert '1.00 s touch_thanks: says "Thank you"' in timeline
     assert timeline[-1].startswith("hug did nothing: what it waits for did not happen")
+    assert timeline[-1].endswith(
+        "; its settings in this try: hug_threshold_n 3.0, volume 0.8, hug_rest_s 10.0"
+    )
 
 
 def test_words_said_reach_a_dialog_tree(project: Path) -> None:

@@ -488,9 +488,18 @@ function openPalette(where) {
 function drawPalette(filter) {
   const groups = $("#palette-groups");
   const wanted = filter.trim().toLowerCase();
-  groups.replaceChildren(...Object.entries(palette.kinds).map(([kind, words]) => {
+  // a word of the robot's senses ("squeeze", "pat"): the blackboard keys that hold it, and
+  // the nodes that read a key, which ask about them
+  const named = (node) => `${node.name} ${node.words ?? ""} ${node.summary}`.toLowerCase().includes(wanted);
+  const found = !wanted || palette.nodes.some(named);
+  const keys = found || wanted.length < 3 ? [] : palette.keys.filter((key) => key.toLowerCase().includes(wanted));
+  const readsKeys = (node) => keys.length && node.params.some((param) => param.kind === "key" && param.access !== "write");
+  const sensed = keys.length
+    ? [make("p", { className: "palette-keys", textContent: `"${filter.trim()}" is on the blackboard as ${keys.slice(0, 4).join(", ")}${keys.length > 4 ? "..." : ""}: the nodes below ask about it (choose the key in the node's form).` })]
+    : [];
+  groups.replaceChildren(...sensed, ...Object.entries(palette.kinds).map(([kind, words]) => {
     const nodes = palette.nodes.filter((node) => node.kind === kind
-      && (!wanted || `${node.name} ${node.words ?? ""} ${node.summary}`.toLowerCase().includes(wanted)));
+      && (!wanted || readsKeys(node) || named(node)));
     if (!nodes.length) return "";
     return make("section", {}, make("h3", { textContent: words }), ...nodes.map((node) => {
       const button = make("button", { type: "button", className: "palette-node" },
