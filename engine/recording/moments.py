@@ -10,6 +10,7 @@ the robot was speaking, and so was not listened to, is a row of its own.
 from __future__ import annotations
 
 import dataclasses
+from collections import Counter
 from dataclasses import dataclass
 
 from engine.blackboard.catalogue import (
@@ -340,3 +341,14 @@ def not_understood(recording: Recording) -> list[NotUnderstood]:
         heard = feedback.split("no rule matches ", 1)[1].split(": ", 1)[0]
         found.append(NotUnderstood(at, "", heard, ""))
     return found
+
+
+def done_by_kind(moments: list[Moment]) -> list[tuple[str, str, int]]:
+    """How many times each did each kind of thing (who, the kind in words, times): the
+    person's first, so the therapist's presses are never read as the person's activity;
+    the most done first."""
+    kinds = Counter(
+        (m.who, KINDS_IN_WORDS.get(m.kind, "other")) for m in moments if not m.of_its_own
+    )
+    rows = [(who, kind, count) for (who, kind), count in kinds.items()]
+    return sorted(rows, key=lambda row: (row[0] != "the person", row[0], -row[2]))

@@ -27,7 +27,7 @@ from engine.blackboard.catalogue import (
     RANGE_CENTER_MM,
     TOUCH_ANY,
 )
-from engine.recording.moments import KINDS_IN_WORDS, Moment, not_understood, person_moments
+from engine.recording.moments import Moment, done_by_kind, not_understood, person_moments
 from engine.recording.replay import RecordedAction, Recording
 from engine.recording.report_plots import numbers, plot
 from engine.recording.told import told_events
@@ -223,11 +223,10 @@ def report_html(recording: Recording, note: str = "") -> str:
         f"<td class='num'>{answering[tree]}</td><td class='num'>{count}</td></tr>"
         for tree, count in sorted(fired.items(), key=lambda item: (-answering[item[0]], -item[1]))
     )
-    kinds = Counter(KINDS_IN_WORDS.get(m.kind, "other") for m in moments if not m.of_its_own)
     by_kind = "".join(
-        f"<tr><td>{html.escape(kind)}</td><td class='num'>{count}</td>"
-        f"<td class='num'>{count / (end / 60):.1f}</td></tr>"
-        for kind, count in kinds.most_common()
+        f"<tr><td>{html.escape(who)}</td><td>{html.escape(kind)}</td>"
+        f"<td class='num'>{count}</td><td class='num'>{count / (end / 60):.1f}</td></tr>"
+        for who, kind, count in done_by_kind(moments)
         if end > 0
     )
     misses = not_understood(recording)
@@ -330,9 +329,12 @@ def report_html(recording: Recording, note: str = "") -> str:
                     "nothing",
                     numeric={0, 4},
                 ),
-                "<h2>What was done, by kind</h2>",
+                "<h2>What was done, by whom and kind</h2>",
                 _table(
-                    ["kind", "times", "per minute"], by_kind, "nothing was done", numeric={1, 2}
+                    ["who", "kind", "times", "per minute"],
+                    by_kind,
+                    "nothing was done",
+                    numeric={2, 3},
                 ),
                 "<h2>How often each behaviour answered</h2>",
                 "<p>Times it answered something done (a row above), and its actions: each light, "
