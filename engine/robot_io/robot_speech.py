@@ -50,6 +50,9 @@ where the sound stops must not depend on a frame more or less on another machine
 FLOOR_AT_MOST_S = 10.0
 """A person who spoke over the robot has the speaker's turn until what they said is heard,
 and at most this long (seconds)."""
+PersonSpeaks = Callable[[float, Job], None]
+"""Told ``(onset_s, floor)`` on the scheduler's thread: a person began to speak at
+``onset_s`` while the robot was silent; ``floor`` is done when what they said is heard."""
 Interrupted = Callable[[float, str, Job], None]
 """Told ``(onset_s, saying, floor)`` on the scheduler's thread: a person's voice began at
 ``onset_s`` (clock seconds) over the robot saying ``saying``, which stopped; ``floor`` is
@@ -111,12 +114,16 @@ class RobotSpeech:
     against when the robot was not listening."""
     _lines: list[tuple[float, float]] = field(default_factory=list)
     """When each scripted line is spoken in the simulated room (clock seconds)."""
-    _due: list[tuple[float, str]] = field(default_factory=list)
-    """On a virtual clock: what was heard, and when it is staged."""
+    _due: list[tuple[float, float, str]] = field(default_factory=list)
+    """On a virtual clock: when it is staged, when it ended, and what was heard."""
     _due_lock: threading.Lock = field(default_factory=threading.Lock)
     room_speaker: RoomSpeaker | None = None
     on_interrupted: Interrupted | None = None
     """Told each time a person stopped the robot talking (the robot halts the tree)."""
+    on_person_speaks: PersonSpeaks | None = None
+    """Told each time a person began to speak while the robot was silent."""
+    _voices: list[tuple[float, float]] = field(default_factory=list)
+    """(when it is told, when the voice began) of voices begun while the robot was silent."""
     _barge_ins: list[tuple[float, float]] = field(default_factory=list)
     """On a virtual clock: (when the robot stops talking, when the voice began)."""
     _stopped: list[tuple[float, str]] = field(default_factory=list)
@@ -146,9 +153,21 @@ class RobotSpeech:
             self._stop_when_due(now_s)
         with self._due_lock:
             stopped, self._stopped = self._stopped, []
+            voices = [item for item in self._voices if item[0] <= now_s + 1e-9]
+            self._voices = [item for item in self._voices if item[0] > now_s + 1e-9]
         for onset_s, saying in stopped:
             if self.on_interrupted is not None:
                 self.on_interrupted(onset_s, saying, PersonsTurn(self, onset_s))
+        for _, onset_s in sorted(voices):
+            if self.on_person_speaks is not None:
+                self.on_person_speaks(onset_s, PersonsTurn(self, onset_s))
+
+    def voice_began(self, at_s: float) -> None:
+        """A person began to speak while the robot was silent (the listener's thread): told
+        at the next tick (on a virtual clock: as :meth:`snapped` says, on every machine
+        alike)."""
+        with self._due_lock:
+            self._voices.append(self.snapped(at_s) if self.settle else (at_s, at_s))
 
     def barged_in(self, onset_s: float) -> None:
         """A person's voice began at ``onset_s`` over the robot's (the listener's thread):
@@ -212,7 +231,7 @@ class RobotSpeech:
         with self._due_lock:
             due = [item for item in self._due if item[0] <= now_s + 1e-9]
             self._due = [item for item in self._due if item[0] > now_s + 1e-9]
-        for _, text in sorted(due):
+        for _, _, text in sorted(due):  # the parts of one line in the order they were said
             if self.blackboard is not None:
                 self.blackboard.stage_event(SPEECH_HEARD, text)
 
@@ -290,7 +309,7 @@ class RobotSpeech:
                 blackboard.stage_event(SPEECH_HEARD, heard.text)
                 return
             with self._due_lock:  # staged by the tick hook at its time
-                self._due.append((due_s, heard.text))
+                self._due.append((due_s, heard.ended_s, heard.text))
 
         def not_listened(from_s: float, until_s: float, why: str) -> None:
             blackboard.stage_event(
@@ -301,6 +320,7 @@ class RobotSpeech:
         if self.listener is not None:
             self.listener.on_heard = stage
             self.listener.on_barge_in = self.barged_in
+            self.listener.on_voice = self.voice_began
             if self.room is None:  # a real microphone: what the listener can tell
                 self.listener.on_not_listened = not_listened
 

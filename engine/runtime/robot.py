@@ -262,6 +262,15 @@ class Robot:
             self.scheduler.tree(tree).halt(SPOKEN_OVER)
         self.turns.hold((SPEAKER,), THE_PERSON, PERSONS_PRIORITY, floor)
 
+    def person_speaks(self, from_s: float, floor: Job) -> None:
+        """A person began to speak at ``from_s`` (clock seconds) while the robot was
+        silent: until ``floor`` is done (what they said is heard) the speaker is theirs
+        (priority :data:`PERSONS_PRIORITY`), so no tree starts a sentence over them; a
+        tree waits for its turn or lets its sentence go, as it would for another tree. A
+        sentence that began meanwhile is left to finish (a voice over it stops it)."""
+        if self.turns.holder(SPEAKER, THE_PERSON) is None:
+            self.turns.hold((SPEAKER,), THE_PERSON, PERSONS_PRIORITY, floor)
+
     def interrupt(self, name: str, by: str, resource: str) -> None:
         """Halt tree ``name`` cleanly because ``by`` takes ``resource``: its actions stop
         (cut short), its joints go back to rest and its LEDs off. It starts afresh at its

@@ -137,6 +137,7 @@ def build_robot(
     if robot_speech is not None:  # the microphone hears the room the world just changed
         robot.scheduler.add_hook(robot_speech)
         robot_speech.on_interrupted = robot.spoken_over  # a person spoke over the robot
+        robot_speech.on_person_speaks = robot.person_speaks  # the robot waits for them
     vision = None
     if config.camera is not None:  # the camera sees the world just changed, as the chips do
         try:

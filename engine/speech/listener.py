@@ -19,7 +19,8 @@ canceller (:mod:`engine.speech.echo_canceller`) takes what the speaker plays (kn
 detector is stricter while the robot speaks and just after
 (:attr:`~engine.speech.vad.SpeechDetector.strict`). A person who speaks over the robot is
 heard like anyone else, and told at once to ``on_barge_in(onset_s)`` (when their voice
-began, clock seconds), so the robot can stop talking.
+began, clock seconds), so the robot can stop talking. A voice that begins while the robot
+is silent is told to ``on_voice(at_s)``, so the robot starts no sentence over it.
 
 Without a canceller the microphone is ignored while the robot speaks. Someone who speaks
 over it is then not heard; what can be known of it is told to
@@ -51,6 +52,9 @@ NotListenedListener = Callable[[float, float, str], None]
 """Told ``(from_s, until_s, why)`` (clock seconds) of speech the robot did not listen to."""
 BargeInListener = Callable[[float], None]
 """Told when a person's voice began over the robot's (clock seconds)."""
+VoiceListener = Callable[[float], None]
+"""Told when a person's voice began while the robot was silent (clock seconds: the end of
+the microphone's piece in which it was found)."""
 
 
 @dataclass(frozen=True)
@@ -79,6 +83,7 @@ class Listener:
         whole_turn: Callable[[str], bool] | None = None,
         canceller: EchoCanceller | None = None,
         on_barge_in: BargeInListener | None = None,
+        on_voice: VoiceListener | None = None,
     ) -> None:
         """``whole_turn(text)``: whether a draft's text is all a person means to say (None:
         the robot always waits ``detector.end_silence_s``); ``canceller``: the robot
@@ -101,6 +106,7 @@ class Listener:
         self.whole_turn = whole_turn
         self.canceller = canceller
         self.on_barge_in = on_barge_in
+        self.on_voice = on_voice
         detector.on_pause = self._draft
         self._deaf_since_s: float | None = None
         self._held_back: list[tuple[Utterance, float | None]] | None = None
@@ -138,7 +144,9 @@ class Listener:
             return
         if self._deaf_since_s is not None:  # the robot stopped speaking: listening again
             self._listening_since_s, self._deaf_since_s = starts_at_s, None
+        was_speech = self.detector.in_speech
         utterances = self.detector.feed(audio.samples)
+        self._voice_began(was_speech, utterances, ends_at_s)
         self._already_speaking(ends_at_s)
         for utterance in utterances:
             late_s = (self.detector.position - utterance.end_sample) / audio.rate_hz
@@ -157,7 +165,10 @@ class Listener:
         self.detector.held = speaking and not self.canceller.learned
         if self.detector.held:  # nobody can be told from the robot yet: not listening
             self._not_listening(starts_at_s, ends_at_s)
+        was_speech = self.detector.in_speech
         utterances = self.detector.feed(samples)
+        if not speaking:
+            self._voice_began(was_speech, utterances, ends_at_s)
         onset = self.detector.take_onset()
         if onset is not None and self.on_barge_in is not None:
             try:
@@ -167,6 +178,16 @@ class Listener:
         for utterance in utterances:
             late_s = (self.detector.position - utterance.end_sample) / audio.rate_hz
             self._submit(utterance, ends_at_s - late_s)
+
+    def _voice_began(self, was_speech: bool, utterances: list[Utterance], at_s: float) -> None:
+        """A voice that began in the piece ending at ``at_s`` while the robot was silent is
+        told to ``on_voice``: the robot holds its tongue while a person talks."""
+        if was_speech or not (self.detector.in_speech or utterances) or self.on_voice is None:
+            return
+        try:
+            self.on_voice(at_s)
+        except Exception:  # whoever listens must not stop the robot hearing
+            log.exception("telling a person began to speak failed")
 
     def _not_listening(self, from_s: float, until_s: float) -> None:
         """It does not listen from ``from_s`` to ``until_s`` (clock seconds)."""

@@ -227,6 +227,29 @@ def test_a_child_who_answers_yes_over_the_robot_s_question_is_answered_in_its_co
     ]
 
 
+def test_the_robot_starts_no_sentence_while_a_child_is_talking(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # a hug in the middle of the child's long sentence: the hug's words wait for no one
+    # (wait_for_turn_s 0), so they are let go rather than said over the child
+    lines = run(
+        tmp_path,
+        capsys,
+        """\
+  - {at: 1.0, hear: "I went to the park with my mother and we saw a big brown dog"}
+  - {at: 2.5, squeeze: {left_n: 8, right_n: 8, seconds: 1.0}}
+""",
+        "trees/dialog.yaml",
+        "trees/hug.yaml",
+    )
+    [turn, *_] = [e for e in lines if e["event"] == "turn" and e["tree"] == "hug"]
+    assert (turn["t"], turn["turn"], turn["other"]) == (2.5, "yields", "the person")
+    says = [e["t"] for e in lines if e["event"] == "action" and e["action"] == "say"]
+    heard = [e["t"] for e in lines if e["event"] == "heard"]
+    assert heard and says and min(says) >= heard[0]  # nothing said before the child was heard
+    assert "I love hugs!" not in said(lines)
+
+
 def test_a_therapist_s_phrase_spoken_over_is_not_said_again_over_the_child(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
