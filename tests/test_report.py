@@ -161,7 +161,9 @@ def test_the_therapist_s_note_is_in_the_report_as_written(supervised: Path) -> N
 
 
 def test_a_scripted_session_s_report_says_it_was_simulated(supervised: Path) -> None:
-    assert "A simulated session: a scenario played the person" in supervised.read_text()
+    assert "A simulated session: on the simulated vest, a scenario or the buttons page played" in (
+        supervised.read_text()
+    )
 
 
 @pytest.mark.parametrize(

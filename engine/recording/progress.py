@@ -127,7 +127,7 @@ def progress_html(
     if left_out:
         parts.append(
             f"<p class='meta'>{left_out} simulated session{'s' if left_out != 1 else ''} "
-            "(a scenario played on the simulated vest) left out: vest report --person "
+            "(on the simulated vest: no child) left out: vest report --person "
             f"{name} --with-simulated counts {'them' if left_out != 1 else 'it'}, marked.</p>"
         )
     if gone:
@@ -164,7 +164,7 @@ def _in_words(sessions: list[SessionSummary], left_out: int = 0) -> str:
     if not sessions and left_out:
         return (
             "No real session of this person yet: only simulated ones, where a scenario "
-            "played the person's part (see below)."
+            "or the buttons page played the person's part (see below)."
         )
     if not sessions:
         return "No session of this person is held."

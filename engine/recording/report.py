@@ -182,8 +182,11 @@ SCENARIO_OF_NONE = ("", "(the buttons alone)")
 
 
 def simulated(meta: dict[str, str]) -> bool:
-    """Whether a recording is of a scripted session: on a virtual clock (``--fast``), or
-    a scenario played on the simulated vest (recordings before the clock was kept)."""
+    """Whether a recording is of no child: on the simulated vest (a practice, what the
+    person did acted on the buttons page), on a virtual clock (``--fast``), or with a
+    scenario playing the person (recordings before the clock and the vest were kept)."""
+    if meta.get("vest") == "simulated":
+        return True
     if "clock" in meta:
         return meta["clock"] == "virtual" or meta.get("scenario", "") not in SCENARIO_OF_NONE
     return meta.get("scenario", "") not in SCENARIO_OF_NONE
@@ -274,8 +277,8 @@ def report_html(recording: Recording, note: str = "") -> str:
     )
     if simulated(recording.meta):
         summary += (
-            " A simulated session: a scenario played the person's part on the simulated "
-            "vest (progress reports leave it out unless asked)."
+            " A simulated session: on the simulated vest, a scenario or the buttons page "
+            "played the person's part (progress reports leave it out unless asked)."
         )
     cut = recording.cut_short
     plots = [

@@ -151,7 +151,7 @@ def test_the_site_lists_each_person_s_sessions_and_reports_their_progress(
     progress = tmp_path / "kid-17.html"
     assert main(["report", "--person", "kid-17", "-o", str(progress)]) == 0
     page = progress.read_text()  # a scenario played the child's part: no real session
-    assert "0 sessions" in page and "2 simulated sessions (a scenario played" in page
+    assert "0 sessions" in page and "2 simulated sessions (on the simulated vest: no child)" in page
     args = ["report", "--person", "kid-17", "-o", str(progress), "--with-simulated"]
     assert main(args) == 0
     page = progress.read_text()
