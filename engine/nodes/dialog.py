@@ -138,10 +138,13 @@ class Reply(Leaf):
         self.job = self.ctx.actions.say(text, carries=self.ctx.blackboard.carried_by(template.keys))
 
     def terminate(self, new_status: Status) -> None:
-        """Halted while asking its question because the person spoke over it: their words
-        are the answer, so the follow-up listens from now, as after a question said whole."""
+        """Halted while asking its question because the person spoke over it once the
+        question had begun (its answer's last sentence): their words are the answer, so the
+        follow-up listens from now, as after a question said whole. Over what came before
+        the question, the person never heard it: their words are new."""
         super().terminate(new_status)
-        asked, spoken_over = self.follow_up, self.ctx.actions.stop_reason == SPOKEN_OVER
+        actions, asked = self.ctx.actions, self.follow_up
+        spoken_over = actions.stop_reason == SPOKEN_OVER and actions.last_sentence_heard
         if new_status == Status.INVALID and spoken_over and self.phase == "speaking" and asked:
             self.follow_up_until_s = self.ctx.clock.now() + asked.listen_s
 

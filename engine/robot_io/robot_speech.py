@@ -53,10 +53,11 @@ and at most this long (seconds)."""
 PersonSpeaks = Callable[[float, Job], None]
 """Told ``(onset_s, floor)`` on the scheduler's thread: a person began to speak at
 ``onset_s`` while the robot was silent; ``floor`` is done when what they said is heard."""
-Interrupted = Callable[[float, str, Job], None]
-"""Told ``(onset_s, saying, floor)`` on the scheduler's thread: a person's voice began at
-``onset_s`` (clock seconds) over the robot saying ``saying``, which stopped; ``floor`` is
-done when the person's turn is over (what they said was heard)."""
+Interrupted = Callable[[float, str, bool, Job], None]
+"""Told ``(onset_s, saying, heard_last, floor)`` on the scheduler's thread: a person's
+voice began at ``onset_s`` (clock seconds) over the robot saying ``saying``, which stopped;
+``heard_last``: its last sentence had begun by then (a question ending it was put);
+``floor`` is done when the person's turn is over (what they said was heard)."""
 
 
 class PersonsTurn:
@@ -126,8 +127,9 @@ class RobotSpeech:
     """(when it is told, when the voice began) of voices begun while the robot was silent."""
     _barge_ins: list[tuple[float, float]] = field(default_factory=list)
     """On a virtual clock: (when the robot stops talking, when the voice began)."""
-    _stopped: list[tuple[float, str]] = field(default_factory=list)
-    """(when the voice began, what the robot was saying), until the scheduler's hook."""
+    _stopped: list[tuple[float, str, bool]] = field(default_factory=list)
+    """(when the voice began, what the robot was saying, whether its last sentence had
+    begun), until the scheduler's hook."""
 
     def describe(self) -> str:
         """Which voice speaks and which recognizer hears, in words (told at start-up)."""
@@ -155,9 +157,9 @@ class RobotSpeech:
             stopped, self._stopped = self._stopped, []
             voices = [item for item in self._voices if item[0] <= now_s + 1e-9]
             self._voices = [item for item in self._voices if item[0] > now_s + 1e-9]
-        for onset_s, saying in stopped:
+        for onset_s, saying, heard_last in stopped:
             if self.on_interrupted is not None:
-                self.on_interrupted(onset_s, saying, PersonsTurn(self, onset_s))
+                self.on_interrupted(onset_s, saying, heard_last, PersonsTurn(self, onset_s))
         for _, onset_s in sorted(voices):
             if self.on_person_speaks is not None:
                 self.on_person_speaks(onset_s, PersonsTurn(self, onset_s))
@@ -208,10 +210,11 @@ class RobotSpeech:
             self.settling.wait(self.settled)
 
     def _hush(self, onset_s: float) -> None:
-        saying = self.speaker.hush()
-        if saying is not None:
+        hushed = self.speaker.hush()
+        if hushed is not None:
+            began = hushed.last_sentence_s
             with self._due_lock:
-                self._stopped.append((onset_s, saying))
+                self._stopped.append((onset_s, hushed.text, began is not None and began <= onset_s))
 
     def heard_when(self, ended_s: float) -> float | None:
         """On a virtual clock, when an utterance whose end the VAD found at ``ended_s``

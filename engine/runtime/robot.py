@@ -227,11 +227,12 @@ class Robot:
         for tree in self.trees:
             self.tree_news.started(tree)
 
-    def spoken_over(self, from_s: float, saying: str, floor: Job) -> None:
+    def spoken_over(self, from_s: float, saying: str, heard_last: bool, floor: Job) -> None:
         """A person's voice began at ``from_s`` (clock seconds) over the robot saying
         ``saying``, which has stopped: the tree that was saying it is halted as an
         interruption halts it (its other actions stop, its joints go to rest), without
-        trying again: the person's words are what comes next. Until ``floor`` is done the
+        trying again: the person's words are what comes next (``heard_last``: the sentence's
+        last part had begun, so a question ending it was put). Until ``floor`` is done the
         speaker is the person's (priority :data:`PERSONS_PRIORITY`): a tree waits for its
         turn or lets its sentence go, as it would for another tree."""
         speaking = [
@@ -259,7 +260,7 @@ class Robot:
             )
         )
         if tree:
-            self.scheduler.tree(tree).halt(SPOKEN_OVER)
+            self.scheduler.tree(tree).halt(SPOKEN_OVER, heard_last=heard_last)
         self.turns.hold((SPEAKER,), THE_PERSON, PERSONS_PRIORITY, floor)
 
     def person_speaks(self, from_s: float, floor: Job) -> None:

@@ -149,19 +149,28 @@ class RunningTree:
                 interruptible=definition.interruptible,
             )
 
-    def halt(self, why: str = "its tree was stopped", *, tried_again: bool = False) -> None:
+    def halt(
+        self,
+        why: str = "its tree was stopped",
+        *,
+        tried_again: bool = False,
+        heard_last: bool = False,
+    ) -> None:
         """Stop whatever is running (cancels service jobs: speech, moves, lights; each is
         told as cut short, ``why``), then send the joints it moved back to rest and turn
-        off the LEDs it lit. ``tried_again``: the round will start again at once (its nodes
-        see it while they stop)."""
+        off the LEDs it lit. Its nodes see, while they stop: ``tried_again``, the round
+        starts again at once; ``heard_last``, a person spoke over the last sentence of
+        what it was saying."""
         root = self.tree.root
         if root.status == py_trees.common.Status.RUNNING:
             actions = self.context.actions
             actions.stop_reason, actions.round_tried_again = why, tried_again
+            actions.last_sentence_heard = heard_last
             try:
                 root.stop(py_trees.common.Status.INVALID)
             finally:
                 actions.stop_reason, actions.round_tried_again = "", False
+                actions.last_sentence_heard = False
             actions.settle()
 
 

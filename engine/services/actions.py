@@ -226,6 +226,9 @@ class TreeActions:
         """Why the tree is being halted, while it is (its cut actions say so)."""
         self.round_tried_again = False
         """While the tree is halted: whether the round cut short starts again at once."""
+        self.last_sentence_heard = False
+        """While the tree is halted because a person spoke over it: whether the last
+        sentence of what it said had begun (a question ending it was put)."""
         self.acting: Acting | None = None
         """The node whose lifecycle method runs now (its reads decide a call's carries)."""
         self._gave_way: dict[str, Turn] = {}

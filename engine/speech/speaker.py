@@ -129,6 +129,8 @@ class SpeechJob:
         """When it was cancelled (clock seconds): its sound stops there, wherever the
         worker is when it notices."""
         self.ends_s: float | None = None
+        self.last_sentence_s: float | None = None
+        """When its last sentence began to play (clock seconds; None: not yet)."""
         self._done = threading.Event()
         self._error: BaseException | None = None
 
@@ -231,11 +233,11 @@ class Speaker:
             if job is not None:
                 job.finish(CancelledError("the speaker was closed"))
 
-    def hush(self) -> str | None:
+    def hush(self) -> SpeechJob | None:
         """A person spoke over the robot: silence the utterance playing now, if it may be
-        interrupted, and return what it was saying (None: nothing that may be interrupted
-        plays). Its job stays unfinished until it is cancelled (its tree is halted, the
-        robot's other actions of the round with it), so no tree takes it for said."""
+        interrupted, and return its job (None: nothing that may be interrupted plays). The
+        job stays unfinished until it is cancelled (its tree is halted, the robot's other
+        actions of the round with it), so no tree takes it for said."""
         current = self._current
         now_s = self.clock.now()
         if current is None or not current.interruptible or current.done() or current.hushed:
@@ -246,7 +248,7 @@ class Speaker:
         self.playback.stop(now_s)
         self.self_hearing.quiet(now_s)
         self._free_from_s = min(self._free_from_s, now_s)
-        return current.text
+        return current
 
     def settled(self) -> bool:
         """Nothing to do now: idle with nothing queued, or waiting on the clock for a sound
@@ -318,6 +320,7 @@ class Speaker:
                 said.append(audio)
                 ends_s = at_s + audio.seconds
                 if index == len(parts) - 1:
+                    job.last_sentence_s = at_s
                     job.ends_s = self._free_from_s = ends_s
                     self.self_hearing.speaking(started_s, ends_s)
             self._wait_until(ends_s, job)

@@ -227,6 +227,26 @@ def test_a_child_who_answers_yes_over_the_robot_s_question_is_answered_in_its_co
     ]
 
 
+def test_a_yes_said_before_the_question_began_answers_no_question(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # the robot learned the room on its hello; "yes" comes 0.25 s into "I love animals.",
+    # before "Do you have a pet?" was put: it is no answer to it
+    lines = run(
+        tmp_path,
+        capsys,
+        """\
+  - {at: 0.5, cloud: {type: say, args: {text: "Hello! I am the robot, so happy to meet you."}}}
+  - {at: 5.0, hear: "do you like animals"}
+  - {at: 6.9, hear: "yes"}
+""",
+    )
+    [stop] = [e for e in lines if e["event"] == "spoken_over"]
+    assert stop["saying"] == "I love animals. Do you have a pet?"
+    assert "How lovely! Pets are good friends." not in said(lines)
+    assert [e["text"] for e in lines if e["event"] == "not_understood"] == ["Yes,"]
+
+
 def test_the_robot_starts_no_sentence_while_a_child_is_talking(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
