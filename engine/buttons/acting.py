@@ -65,6 +65,15 @@ class ActingNow:
         raw = YMap({"at": at, kind: body}, document.mark, {"at": start, **document.key_marks})
         ctx = CheckContext(default_catalogue())
         event = scenario_event(raw, ctx, problems, self._count, Path.cwd())
+        said = event.value["text"] if event is not None and kind == "hear" else None
+        if said is not None and any(ord(c) < 32 for c in said):
+            problems.add(body.mark, "write the child's words, in plain text", "hear: hello")
+        if (
+            event is not None
+            and kind == "squeeze"
+            and not (event.value["left_n"] or event.value["right_n"])
+        ):
+            problems.add(body.mark, "a squeeze needs a force on one side at least", "left_n: 6")
         if event is not None:
             problems.extend(name_scenario_pads([event], self.config))
         problems.raise_if_any()

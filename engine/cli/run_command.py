@@ -320,7 +320,7 @@ def _run_for_site(
                 "scenario": str(scenario.path),
                 "started": f"{EpochClock().now():.3f}",
                 "clock": "virtual" if args.fast else "real",
-                "vest": "simulated" if config.simulated else "real",
+                "vest": "real" if config.senses_people else "simulated",
             },
             foxglove_port=args.foxglove,
             foxglove_origins=tuple(args.foxglove_origin),

@@ -365,9 +365,9 @@ def _nothing() -> None:
 
 
 def _acting(plan: SessionPlan, player: ScenarioPlayer, clock: Clock) -> ActingNow | None:
-    """The buttons page's hand on a simulated vest, in real time (nobody acts on a real
-    vest from a page, nor on a run at full speed)."""
-    if plan.fast or not plan.config.simulated:
+    """The buttons page's hand on a simulated vest, in real time: never where a real
+    person may be sensed (real chips, a microphone, a real camera), nor at full speed."""
+    if plan.fast or plan.config.senses_people:  # a real child may be there
         return None
     return ActingNow(player, clock, plan.config)
 

@@ -42,20 +42,18 @@ def declared_fields(
     """
     declared = {param.name: param for param in params}
     values: dict[str, Any] = {}
-    ok = True
+    before = len(problems)  # a value may well convert to None (null for "any value")
     for name, value in raw.items():  # in the file's order: what a recording of them shows
         if name in declared:
             values[name] = converted(declared[name].type, value, name, ctx, problems)
-            ok = ok and values[name] is not None
     for param in params:
         if param.name in values:
             continue
         if param.required:
             problems.add(raw.mark, f"{what} needs {param.name!r}", param.doc or None)
-            ok = False
         else:
             values[param.name] = param.default
-    return values if ok else None
+    return values if len(problems) == before else None
 
 
 def settings(

@@ -45,7 +45,7 @@ from engine.loader.substitution import (
     substitute,
 )
 from engine.loader.tree_definition import NodeDefinition, TreeDefinition
-from engine.loader.tree_settings import SETTINGS, read_settings
+from engine.loader.tree_settings import SETTINGS, read_setting, read_settings
 from engine.nodes.registry import NodeRegistry
 from engine.nodes.spec import NodeType
 from engine.values.param_problems import CheckContext, did_you_mean
@@ -389,10 +389,12 @@ def _part_interruptible(
     ctx: CheckContext,
 ) -> None:
     """A part's ``interruptible:`` holds for the sentences in it that do not say their own
-    (a part nested in it has said its own first); the tree's setting for the rest."""
-    if "interruptible" not in document:
+    (a part nested in it has said its own first); the tree's setting for the rest. A
+    part's other settings are its including tree's, and not read here."""
+    [setting] = [param for param in SETTINGS if param.name == "interruptible"]
+    part = read_setting(document, setting, params, problems, ctx)
+    if part is None:
         return
-    part = read_settings(document, params, problems, ctx).interruptible
     for node in root.walk():
         if node.type.param("interruptible") is not None and node.args.get("interruptible") is None:
             node.args["interruptible"] = part

@@ -92,16 +92,29 @@ def read_settings(
     """The settings of a tree file (defaults where absent or wrong; problems added)."""
     values: dict[str, Any] = {}
     for param in SETTINGS:
-        values[param.name] = param.default
-        raw = document.get(param.name)
-        if raw is None:
-            continue
-        raw = substitute(raw, params, problems)
-        if unresolved(raw):
-            continue
-        try:
-            values[param.name] = param.type.convert(plain(raw), ctx)
-        except ParamProblem as problem:
-            problems.add(raw.mark, f"{param.name!r} {problem.message}", param.doc)
+        value = read_setting(document, param, params, problems, ctx)
+        values[param.name] = param.default if value is None else value
     values["wake_on"] = tuple(dict.fromkeys(values["wake_on"]))  # each key once
     return TreeSettings(**values)
+
+
+def read_setting(
+    document: YMap,
+    param: Param[Any],
+    params: dict[str, ParamValue],
+    problems: Problems,
+    ctx: CheckContext,
+) -> Any:
+    """One setting of a tree (or part) file, its ``${parameters}`` filled: None when it is
+    absent or wrong (the problem added, with the setting's doc as the hint)."""
+    raw = document.get(param.name)
+    if raw is None:
+        return None
+    raw = substitute(raw, params, problems)
+    if unresolved(raw):
+        return None
+    try:
+        return param.type.convert(plain(raw), ctx)
+    except ParamProblem as problem:
+        problems.add(raw.mark, f"{param.name!r} {problem.message}", param.doc)
+        return None

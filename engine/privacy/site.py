@@ -40,7 +40,7 @@ DAY_S = 86_400.0
 
 
 SITE_FIELDS = (
-    Param("keep_sessions_days", Number(1e-5, 36500.0, "days"), float(KEEP_DAYS), "days kept"),
+    Param("keep_sessions_days", Number(1e-5, None, "days"), float(KEEP_DAYS), "days kept"),
 )
 """What ``site.yaml`` may say: how long a session's recording is kept before it is purged."""
 

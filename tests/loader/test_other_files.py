@@ -144,6 +144,14 @@ def test_an_unknown_event_kind_suggests_the_nearest(tmp_path: Path) -> None:
     ) == ["file.yaml:3:15: unknown event 'gesure' (did you mean 'gesture'?)"]
 
 
+def test_a_field_that_may_be_empty_keeps_its_event(tmp_path: Path) -> None:
+    # a cloud command's args: null is "no arguments", not a problem: the event is played
+    path = tmp_path / "scenario.yaml"
+    path.write_text("duration_s: 4\nevents:\n  - {at: 1.0, cloud: {type: read, args: null}}\n")
+    [event] = load_scenario(path).events
+    assert (event.kind, event.value["args"]) == ("cloud", None)
+
+
 def test_an_unknown_gesture_suggests_the_nearest(tmp_path: Path) -> None:
     [problem] = problems(
         tmp_path,

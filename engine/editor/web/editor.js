@@ -493,7 +493,8 @@ function drawPalette(filter) {
   const named = (node) => `${node.name} ${node.words ?? ""} ${node.summary}`.toLowerCase().includes(wanted);
   const found = !wanted || palette.nodes.some(named);
   const keys = found || wanted.length < 3 ? [] : palette.keys.filter((key) => key.toLowerCase().includes(wanted));
-  const readsKeys = (node) => keys.length && node.params.some((param) => param.kind === "key" && param.access !== "write");
+  // a node that asks about any key names it "key" (Check, Fresh, OnEvent, WaitForEvent)
+  const readsKeys = (node) => keys.length && node.params.some((param) => param.name === "key" && param.kind === "key" && param.access !== "write");
   const sensed = keys.length
     ? [make("p", { className: "palette-keys", textContent: `"${filter.trim()}" is on the blackboard as ${keys.slice(0, 4).join(", ")}${keys.length > 4 ? "..." : ""}: the nodes below ask about it (choose the key in the node's form).` })]
     : [];
