@@ -16,6 +16,7 @@ const make = (tag, props = {}, ...children) => {
 let palette = { nodes: [], pads: [], joints: [], colors: [], keys: [], kinds: {} };
 let profiles = {}; // profile name -> {param: value}: what each profile sets
 let profileProblems = []; // "trees/profiles/x.yaml:2:3: ... (left out)": profiles that do not load
+let pendingProfiles = new Map(); // "profile setting" -> [profile, setting, raw]: written at Save
 let priorities = {}; // tree name -> its priority, among the folder's trees
 const types = new Map(); // node type name -> its declaration
 let file = null; // {name, version (null: new), outline}
@@ -373,11 +374,28 @@ function profileValues(name) {
   const row = make("div", { className: "profile-values" });
   for (const [profile, values] of Object.entries(profiles)) {
     const id = `profile-${profile}-${name}`;
-    const input = make("input", { id, type: "text", maxLength: 60, value: values[name] === undefined ? "" : shown(values[name]), placeholder: "the tree's own" });
-    input.addEventListener("change", () => setInProfile(profile, name, input.value.trim()));
+    const held = pendingProfiles.get(`${profile} ${name}`);
+    const value = held ? held[2] : values[name] === undefined ? "" : shown(values[name]);
+    const input = make("input", { id, type: "text", maxLength: 60, value, placeholder: "the tree's own" });
+    input.addEventListener("change", () => changeProfile(profile, name, input.value.trim()));
     row.append(make("label", { htmlFor: id, textContent: `${profile} profile` }), " ", input, " ");
   }
   return row;
+}
+
+// a profile may only set what a saved tree declares (vest validate and the robot refuse
+// the rest): while the tree has changes, what is typed for a profile waits for Save
+function changeProfile(profile, setting, raw) {
+  if (document.body.dataset.dirty !== "true") { setInProfile(profile, setting, raw).catch(unreachable); return; }
+  pendingProfiles.set(`${profile} ${setting}`, [profile, setting, raw]);
+  say(`The ${profile} profile will set ${setting} to ${raw || "the tree's own value"} when you save the tree (its file is written then).`);
+}
+
+async function savePendingProfiles() {
+  const pending = [...pendingProfiles.values()];
+  pendingProfiles = new Map();
+  for (const [profile, setting, raw] of pending) await setInProfile(profile, setting, raw);
+  return pending.length;
 }
 
 async function setInProfile(profile, setting, raw) {
@@ -550,7 +568,8 @@ async function save(overProblems = false) {
   if (status === 200) {
     const message = `saved ${file.name}${body.problems.length ? ` with ${body.problems.length} problems` : ""}`;
     await open(file.name, true);
-    say(message, "good");
+    const profilesSet = await savePendingProfiles();
+    say(profilesSet ? `${message}, and the profiles' values (${profilesSet})` : message, "good");
     await listFiles();
     return;
   }
@@ -653,6 +672,7 @@ async function loadProfiles() { // what each profile sets, read again: a profile
 }
 
 async function open(name, keepMessage = false) {
+  if (!keepMessage) pendingProfiles = new Map(); // another tree: what waited for its Save goes
   await loadProfiles();
   const read = await getJson("/api/file", { name });
   if (!keepMessage) say("");
