@@ -97,7 +97,9 @@ def test_a_damaged_record_is_kept_aside_and_a_command_delivered_again_is_not_run
 
     assert "hello twice?" not in capsys.readouterr().out  # never said, rather than twice
     finished = store.ledger.get(robot_id, command.id)
-    assert finished is not None and finished.state == FAILED and finished.deliveries == 2
+    # delivered again at least once (once more if the 0.5 s lease ran out on a loaded
+    # machine before the robot's report came): never carried out, always reported failed
+    assert finished is not None and finished.state == FAILED and finished.deliveries >= 2
     assert "record of finished commands was damaged" in finished.result["error"]
     aside = tmp_path / "robot.token.done.json.damaged"
     assert aside.read_text() == '{"cmd-1": {"status": "SUCC'  # kept for whoever looks into it
