@@ -151,6 +151,8 @@ def test_on_the_simulated_vest_the_page_squeezes_and_speaks_for_the_child(
     session.wait_for("world          someone says 'what is your name'")
     session.wait_for('dialog         says "My name is H B S 2"')
     assert not [line for line in session.seen if "presses the button" in line]
+    # the page tells what the robot said, without its terminal
+    expect(page.locator("#happened")).to_contain_text('dialog: says "My name is H B S 2"')
     vest.get_by_label("for").first.fill("0")  # below what the page allows: the robot says
     page.evaluate("document.querySelector('#act-squeeze input[name=seconds]').min = ''")
     vest.get_by_role("button", name="Squeeze").click()

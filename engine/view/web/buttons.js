@@ -101,6 +101,37 @@ function actsOn(board) {
   submitted("#act-hear", (form) => ({ hear: { text: String(form.get("text")) } }));
 }
 
+// what the robot and the world did lately, newest first, so the therapist sees the robot's
+// answers without its terminal (the live view's words, from the same stream)
+const SHOWN_HAPPENINGS = 8;
+let happenings = [];
+
+function drawHappenings() {
+  $("#happened").replaceChildren(...happenings.slice(-SHOWN_HAPPENINGS).reverse().map((entry) => {
+    const item = document.createElement("li");
+    item.textContent = `${entry.at.toFixed(1)} s ${entry.who}: ${entry.what}`; // text, never markup
+    return item;
+  }));
+}
+
+async function watchHappenings() {
+  const snapshot = async () => {
+    const response = await fetch(api("/api/snapshot"));
+    if (response.ok) happenings = (await response.json()).happened ?? [];
+    drawHappenings();
+  };
+  const onEvent = async (name, change) => {
+    if (change.kind === "end") return false;
+    if (change.kind === "resync") await snapshot();
+    if (change.kind === "happened") {
+      happenings = [...happenings, change].slice(-50);
+      drawHappenings();
+    }
+    return !ended;
+  };
+  follow(api("/api/events"), { onEvent, onState: () => {} });
+}
+
 async function start() {
   const response = await fetch(api("/api/buttons"));
   if (!response.ok) {
@@ -129,6 +160,7 @@ async function start() {
   $("#trees-link").href = api("/");
   show(board.state);
   actsOn(board);
+  watchHappenings();
   const onEvent = (name, state) => {
     show(state);
     return !ended;
