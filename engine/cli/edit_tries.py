@@ -174,16 +174,19 @@ class TryOnSimulatedVest:
         told = (_sentence(line) for line in done.stdout.splitlines() if line.strip())
         lines = [sentence for sentence in told if sentence is not None]
         tree = _tree_name(name, text)
+        settings = self._settings_in_use(text, profile)
         if not any(f" s {tree}: " in line for line in lines):
             lines.append(
                 f"{tree} did nothing: what it waits for did not happen (look at its first "
                 "question: the pad, the threshold, the words) or another tree had its turn"
-                + self._settings_in_use(text, profile)
+                + (f"; {settings}" if settings else "")
             )
+        elif settings:  # what it answered with, to compare with another profile's try
+            lines.append(f"{tree} answered; {settings}")
         return lines
 
     def _settings_in_use(self, text: str, profile: str | None) -> str:
-        """``; its settings in this try: hug_threshold_n 2.5 (profile child)``: the tree's
+        """``its settings in this try: hug_threshold_n 2.5 (profile child)``: the tree's
         numeric ``params:`` as the try set them (empty when it has none)."""
         try:
             document = yaml.safe_load(text)
@@ -204,7 +207,7 @@ class TryOnSimulatedVest:
             if isinstance(chosen.get(name, value), int | float)
             and not isinstance(chosen.get(name, value), bool)
         ]
-        return "; its settings in this try: " + ", ".join(told) if told else ""
+        return "its settings in this try: " + ", ".join(told) if told else ""
 
     def watch(self, name: str, text: str, asked: object, host: str) -> str:
         """Run ``text`` in real time with the event ``asked`` at :data:`WATCH_AT_S` under

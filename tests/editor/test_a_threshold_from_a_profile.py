@@ -76,3 +76,6 @@ def test_a_new_setting_its_profiles_and_a_try_as_the_child_s_session(
     expect(page.locator("#tried")).to_contain_text(
         'two_squeezes: says "Two squeezes!"', timeout=60_000
     )
+    expect(page.locator("#tried")).to_contain_text(
+        "two_squeezes answered; its settings in this try: left_squeeze_n 2 (profile child)"
+    )
