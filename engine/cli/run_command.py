@@ -288,6 +288,10 @@ def _run_for_site(
     leaving = args.record is not None or args.cloud is not None or ros2 is not None
     if leaving or consent.left_out:  # what the timeline and the pages leave out, and why
         tell(f"privacy: {consent.describe()}")
+    if args.person or args.record is not None:  # a session with someone: which settings
+        profile = _profile_name(behaviors)
+        used = f"profile {profile}" if profile else "the trees' own (no --profile)"
+        tell(f"settings: {used}")
     cloud = _cloud_plan(args)
     paged = args.view or (args.buttons is not None and not args.fast)  # a page when asked
     duration = args.duration if args.duration is not None else scenario.duration_s

@@ -114,7 +114,9 @@ def progress_html(
         REPORT_HEAD,
         f"<title>Progress: {name}</title>",
         f"<style>{STYLE(encoding='utf-8')}</style></head><body>",
-        f"<h1>Progress of {name}</h1>",
+        f"<h1>Progress of {name}"
+        + (" (simulated sessions counted)" if any(s.simulated for s in sessions) else "")
+        + "</h1>",
         f'<p class="meta">{len(sessions)} session{"" if len(sessions) == 1 else "s"}'
         + (f" from {sessions[0].day} to {sessions[-1].day}" if sessions else "")
         + "</p>",

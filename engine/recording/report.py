@@ -316,7 +316,7 @@ def report_html(recording: Recording, note: str = "") -> str:
                 REPORT_HEAD,
                 f"<title>Session report: {recorded}</title>",
                 f"<style>{STYLE(encoding='utf-8')}</style></head><body>",
-                "<h1>Session report</h1>",
+                f"<h1>Session report{' (simulated: no child)' if simulated(meta) else ''}</h1>",
                 f'<p class="meta">{when} &middot; {person} &middot; {end:.1f} s &middot; '
                 f"{html.escape(profile)} &middot; robot {robot} &middot; {recorded}</p>",
                 f"<p>{html.escape(summary)}</p>",
