@@ -65,7 +65,8 @@ def test_the_live_page_draws_every_tree_and_the_hug_lights_up(
     )
     node(page, "hug", 1).click()
     expect(page.locator("#node-facts")).to_contain_text("Check key=/sensors/force/left_n above=3.0")
-    expect(page.locator("#node-changes li").first).to_contain_text("answered yes")
+    # its changes, newest first: on a loaded machine the squeeze may be over by now
+    expect(page.locator("#node-changes")).to_contain_text("answered yes")
     expect(page.locator('#devices tr[data-key="touch"]')).to_contain_text("online")
 
 
