@@ -37,8 +37,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--with-simulated",
         action="store_true",
-        help="with --person: count their simulated sessions too (scenarios played on the "
-        "simulated vest; left out by default), marked as such",
+        help="with --person: count their simulated sessions too (on the simulated vest, "
+        "a scenario or the buttons page played the child; left out by default), marked",
     )
     parser.add_argument(
         "--note",
