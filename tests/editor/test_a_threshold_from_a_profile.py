@@ -44,6 +44,9 @@ def test_a_new_setting_its_profiles_and_a_try_as_the_child_s_session(
     )
     page.get_by_label("adult profile").fill("4")
     page.get_by_label("adult profile").press("Tab")
+    expect(page.locator("#params")).to_contain_text(
+        "profiles set it: adult: 4 (when you save), child: 2 (when you save)"
+    )
     assert "left_squeeze_n" not in (project / "trees" / "profiles" / "child.yaml").read_text()
 
     node(page, "root/0").click()  # the Sequence's first child: the counting

@@ -354,8 +354,11 @@ function drawParams() {
     const uses = usesOf(name);
     const like = uses.find((use) => use.field)?.field ?? { kind: "any" };
     const where = uses.length ? `used by ${uses.map((use) => `${use.node} ${use.arg}`).join(", ")}` : "not used by any node";
-    const set = Object.entries(profiles).filter(([, values]) => name in values)
-      .map(([profile, values]) => `${profile}: ${shown(values[name])}`);
+    const set = Object.entries(profiles).map(([profile, values]) => {
+      const held = pendingProfiles.get(`${profile} ${name}`); // typed, written at Save
+      if (held) return held[2] === "" ? null : `${profile}: ${held[2]} (when you save)`;
+      return name in values ? `${profile}: ${shown(values[name])}` : null;
+    }).filter(Boolean);
     const field = {
       ...like, name, label: name.replaceAll("_", " "), required: true,
       doc: `${where}; ${set.length ? `profiles set it: ${set.join(", ")}` : "no profile changes it"}`,
@@ -388,6 +391,7 @@ function profileValues(name) {
 function changeProfile(profile, setting, raw) {
   if (document.body.dataset.dirty !== "true") { setInProfile(profile, setting, raw).catch(unreachable); return; }
   pendingProfiles.set(`${profile} ${setting}`, [profile, setting, raw]);
+  drawParams();
   say(`The ${profile} profile will set ${setting} to ${raw || "the tree's own value"} when you save the tree (its file is written then).`);
 }
 
