@@ -79,6 +79,33 @@ def test_while_paused_a_pat_is_not_answered_not_even_after_resuming(tmp_path, ca
     assert [line.split()[0] for line in said] == ["4.00"]
 
 
+def test_an_operator_s_commands_while_paused_are_refused_and_told_at_once(
+    tmp_path, capsys, monkeypatch
+):
+    # the operator is never left waiting: the command the pause cut, the one queued behind
+    # it and the one sent during the pause are each reported; after Resume one is carried out
+    monkeypatch.chdir(ROOT)
+    story = "Once upon a time a little robot told a very long story to everyone it met."
+    out, _ = run(
+        tmp_path,
+        capsys,
+        f'{{at: 1.0, cloud: {{id: c1, type: say, args: {{text: "{story}"}}}}}}',
+        "{at: 1.5, cloud: {id: c2, type: led, args: {color: red}}}",
+        "{at: 2.0, press: Pause}",
+        "{at: 2.5, cloud: {id: c3, type: led, args: {color: blue}}}",
+        "{at: 3.0, press: Resume}",
+        "{at: 4.0, cloud: {id: c4, type: led, args: {color: green}}}",
+    )
+    reports = [" ".join(line.split()[1:]) for line in out.splitlines() if " reports " in line]
+    paused = "the therapist paused the behaviors"
+    assert reports == [
+        f"iot_command reports c1 failed: {{'error': 'cut short: {paused}'}}",
+        f"iot_command reports c2 failed: {{'error': 'not carried out: {paused}'}}",
+        f"iot_command reports c3 failed: {{'error': 'not carried out: {paused}'}}",
+        "iot_command reports c4 succeeded",
+    ]
+
+
 def test_stop_everything_ends_a_buttons_action_and_pauses_the_behaviors(
     tmp_path, capsys, monkeypatch
 ):

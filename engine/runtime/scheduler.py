@@ -107,6 +107,18 @@ class RunningTree:
             self._readers_of = self.tree.root
         return self._readers
 
+    def take_unread(self, key: str) -> list[Any]:
+        """The values of ``key``'s events that no node of the tree has handled yet, oldest
+        first; from now on its nodes take them as handled (they are the caller's)."""
+        readers = [node for node in self._event_readers() if node.events.key == key]
+        if not readers:
+            return []
+        log = self.context.blackboard.event_log(key)
+        unread = log.after(min(node.events.handled_seq for node in readers))
+        for node in readers:
+            node.events.handled_seq = max(node.events.handled_seq, log.last_seq)
+        return [event.value for event in unread]
+
     def has_unread_events(self) -> bool:
         """Whether an event came that a node of the tree has not handled yet (a second
         pat in one round, a command that came while another was carried out)."""
