@@ -164,6 +164,7 @@ def test_the_palette_knows_the_robot_s_senses_by_their_words(page: Page, editor:
     page.get_by_role("button", name="Add a node inside").click()
     page.get_by_label("Find").fill("squeeze")
     expect(page.locator("#palette .palette-keys")).to_contain_text("/sensors/force/squeeze")
+    expect(page.locator("#palette .palette-keys")).to_contain_text("/sensors/force/left_n")
     expect(page.locator('#palette .palette-node[data-node="OnEvent"]')).to_be_visible()
     expect(page.locator('#palette .palette-node[data-node="Say"]')).to_be_hidden()
     expect(page.locator('#palette .palette-node[data-node="CarryOut"]')).to_be_hidden()

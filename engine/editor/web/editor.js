@@ -514,11 +514,13 @@ function drawPalette(filter) {
   // the nodes that read a key, which ask about them
   const named = (node) => `${node.name} ${node.words ?? ""} ${node.summary}`.toLowerCase().includes(wanted);
   const found = !wanted || palette.nodes.some(named);
-  const keys = found || wanted.length < 3 ? [] : palette.keys.filter((key) => key.toLowerCase().includes(wanted));
+  // the words people use for what a sense measures: a squeeze or a hug is a side's force
+  const sense = { squeeze: "/sensors/force/", hug: "/sensors/force/", press: "/sensors/force/", pat: "/sensors/touch/" }[wanted];
+  const keys = found || wanted.length < 3 ? [] : palette.keys.filter((key) => key.toLowerCase().includes(wanted) || (sense && key.startsWith(sense)));
   // a node that asks about any key names it "key" (Check, Fresh, OnEvent, WaitForEvent)
   const readsKeys = (node) => keys.length && node.params.some((param) => param.name === "key" && param.kind === "key" && param.access !== "write");
   const sensed = keys.length
-    ? [make("p", { className: "palette-keys", textContent: `"${filter.trim()}" is on the blackboard as ${keys.slice(0, 4).join(", ")}${keys.length > 4 ? "..." : ""}: the nodes below ask about it (choose the key in the node's form).` })]
+    ? [make("p", { className: "palette-keys", textContent: `"${filter.trim()}" is on the blackboard as ${keys.slice(0, 6).join(", ")}${keys.length > 6 ? "..." : ""}: the nodes below ask about it (choose the key in the node's form; a threshold a profile sets is a Check of a side's force, /sensors/force/left_n or right_n, in newtons).` })]
     : [];
   groups.replaceChildren(...sensed, ...Object.entries(palette.kinds).map(([kind, words]) => {
     const nodes = palette.nodes.filter((node) => node.kind === kind
