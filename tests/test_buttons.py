@@ -106,6 +106,24 @@ def test_an_operator_s_commands_while_paused_are_refused_and_told_at_once(
     ]
 
 
+def test_a_command_that_came_too_late_for_the_session_is_told_not_carried_out(
+    tmp_path, capsys, monkeypatch
+):
+    monkeypatch.chdir(ROOT)
+    story = "Once upon a time a little robot told a very long story to everyone it met."
+    out, _ = run(
+        tmp_path,
+        capsys,
+        f'{{at: 7.5, cloud: {{id: c1, type: say, args: {{text: "{story}"}}}}}}',
+        "{at: 7.6, cloud: {id: c2, type: led, args: {color: red}}}",  # behind it: unread
+    )
+    reports = [" ".join(line.split()[1:]) for line in out.splitlines() if " reports " in line]
+    assert reports == [
+        "iot_command reports c1 failed: {'error': 'cut short: its tree was stopped'}",
+        "iot_command reports c2 failed: {'error': 'not carried out: the session ended'}",
+    ]
+
+
 def test_stop_everything_ends_a_buttons_action_and_pauses_the_behaviors(
     tmp_path, capsys, monkeypatch
 ):

@@ -27,10 +27,8 @@ from __future__ import annotations
 import dataclasses
 import queue
 import threading
-from collections.abc import Mapping
 from typing import Any
 
-from engine.blackboard.catalogue import IOT_INBOX, NOTHING
 from engine.buttons.button_file import Button, ButtonBoard, When
 from engine.loader.tree_definition import TreeDefinition
 from engine.runtime.robot import Robot
@@ -104,8 +102,8 @@ class Wizard:
             except queue.Empty:
                 break
             self._carry_out(self.board.buttons[number], now_s, by, who)
-        if self.paused:
-            self._refuse_commands()
+        if self.paused:  # the operator is told at once, not left waiting
+            self.robot.refuse_commands(self.autonomous, "the therapist paused the behaviors")
         status = self.tree.status.name
         if self.doing is not None and status != "INVALID":
             self._begun = True
@@ -149,18 +147,6 @@ class Wizard:
                 tree.replace(dataclasses.replace(tree.definition))
             tree.paused = paused
         self.robot.session.publish(BehaviorsPaused(self.robot.clock.now(), paused))
-
-    def _refuse_commands(self) -> None:
-        """While paused, an operator's command that came (or waited behind one the pause
-        cut short) is not carried out, and the operator is told at once rather than left
-        waiting: it is reported failed, with why."""
-        for tree in self.autonomous:
-            for command in tree.take_unread(IOT_INBOX):
-                if isinstance(command, Mapping) and "id" in command:
-                    why = {"error": "not carried out: the therapist paused the behaviors"}
-                    tree.context.actions.report_result(
-                        str(command["id"]), "failed", why, carries=NOTHING
-                    )
 
     def _swap(self, definition: TreeDefinition) -> None:
         self.tree.swap(definition, definition.build(self.tree.context))

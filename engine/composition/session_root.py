@@ -153,7 +153,10 @@ class RunningSession:
         are phased on it."""
         self.assembled.lifecycle.start()
         robot = self.assembled.robot
-        robot.scheduler.run(until_s=until_s, start_s=self.assembled.first_tick_s)
+        try:
+            robot.scheduler.run(until_s=until_s, start_s=self.assembled.first_tick_s)
+        finally:  # commands that came too late are told, before the cloud link stops
+            robot.refuse_commands(robot.trees, "the session ended")
 
     def close(self) -> None:
         """Stop every part, last started first (the robot's buses and the vest at the end)."""

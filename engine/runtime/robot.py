@@ -2,11 +2,12 @@
 
 from __future__ import annotations
 
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
 from engine.blackboard.board import Blackboard
-from engine.blackboard.catalogue import NOTHING, KeyCatalogue
+from engine.blackboard.catalogue import IOT_INBOX, NOTHING, KeyCatalogue
 from engine.clock import Clock
 from engine.dialogs.library import DialogLibrary
 from engine.files.problems import LoadError, Mark, Problem, Problems
@@ -271,6 +272,17 @@ class Robot:
         sentence that began meanwhile is left to finish (a voice over it stops it)."""
         if self.turns.holder(SPEAKER, THE_PERSON) is None:
             self.turns.hold((SPEAKER,), THE_PERSON, PERSONS_PRIORITY, floor)
+
+    def refuse_commands(self, trees: Iterable[RunningTree], why: str) -> None:
+        """Each operator's command that came to ``trees`` and that none of their nodes
+        took is reported failed at once (``not carried out: why``): an operator is never
+        left waiting for a command that will not be carried out."""
+        for tree in trees:
+            for command in tree.take_unread(IOT_INBOX):
+                if isinstance(command, Mapping) and "id" in command:
+                    tree.context.actions.report_result(
+                        str(command["id"]), "failed", {"error": f"not carried out: {why}"}
+                    )
 
     def interrupt(self, name: str, by: str, resource: str) -> None:
         """Halt tree ``name`` cleanly because ``by`` takes ``resource``: its actions stop
