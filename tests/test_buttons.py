@@ -30,6 +30,14 @@ def run(tmp_path: Path, capsys, *events: str, extra: tuple[str, ...] = ()) -> tu
     return out, err
 
 
+STORY = "Once upon a time a little robot told a very long story to everyone it met."
+
+
+def reports(out: str) -> list[str]:
+    """The robot's reports to the operator, as the timeline words them (time left out)."""
+    return [" ".join(line.split()[1:]) for line in out.splitlines() if " reports " in line]
+
+
 def lines_after(out: str, text: str) -> list[str]:
     lines = out.splitlines()
     start = next(i for i, line in enumerate(lines) if text in line)
@@ -85,20 +93,18 @@ def test_an_operator_s_commands_while_paused_are_refused_and_told_at_once(
     # the operator is never left waiting: the command the pause cut, the one queued behind
     # it and the one sent during the pause are each reported; after Resume one is carried out
     monkeypatch.chdir(ROOT)
-    story = "Once upon a time a little robot told a very long story to everyone it met."
     out, _ = run(
         tmp_path,
         capsys,
-        f'{{at: 1.0, cloud: {{id: c1, type: say, args: {{text: "{story}"}}}}}}',
+        f'{{at: 1.0, cloud: {{id: c1, type: say, args: {{text: "{STORY}"}}}}}}',
         "{at: 1.5, cloud: {id: c2, type: led, args: {color: red}}}",
         "{at: 2.0, press: Pause}",
         "{at: 2.5, cloud: {id: c3, type: led, args: {color: blue}}}",
         "{at: 3.0, press: Resume}",
         "{at: 4.0, cloud: {id: c4, type: led, args: {color: green}}}",
     )
-    reports = [" ".join(line.split()[1:]) for line in out.splitlines() if " reports " in line]
     paused = "the therapist paused the behaviors"
-    assert reports == [
+    assert reports(out) == [
         f"iot_command reports c1 failed: {{'error': 'cut short: {paused}'}}",
         f"iot_command reports c2 failed: {{'error': 'not carried out: {paused}'}}",
         f"iot_command reports c3 failed: {{'error': 'not carried out: {paused}'}}",
@@ -110,15 +116,13 @@ def test_a_command_that_came_too_late_for_the_session_is_told_not_carried_out(
     tmp_path, capsys, monkeypatch
 ):
     monkeypatch.chdir(ROOT)
-    story = "Once upon a time a little robot told a very long story to everyone it met."
     out, _ = run(
         tmp_path,
         capsys,
-        f'{{at: 7.5, cloud: {{id: c1, type: say, args: {{text: "{story}"}}}}}}',
+        f'{{at: 7.5, cloud: {{id: c1, type: say, args: {{text: "{STORY}"}}}}}}',
         "{at: 7.6, cloud: {id: c2, type: led, args: {color: red}}}",  # behind it: unread
     )
-    reports = [" ".join(line.split()[1:]) for line in out.splitlines() if " reports " in line]
-    assert reports == [
+    assert reports(out) == [
         "iot_command reports c1 failed: {'error': 'cut short: its tree was stopped'}",
         "iot_command reports c2 failed: {'error': 'not carried out: the session ended'}",
     ]

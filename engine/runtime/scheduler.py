@@ -111,7 +111,7 @@ class RunningTree:
         """The values of ``key``'s events that no node of the tree has handled yet, oldest
         first; from now on its nodes take them as handled (they are the caller's)."""
         readers = [node for node in self._event_readers() if node.events.key == key]
-        if not readers:
+        if not any(node.events.unread() for node in readers):  # the usual tick: nothing
             return []
         log = self.context.blackboard.event_log(key)
         unread = log.after(min(node.events.handled_seq for node in readers))
