@@ -247,7 +247,8 @@ def test_on_the_cloud_page_a_therapist_presses_and_a_viewer_only_watches(
     )
     expect(page.locator("#session-happened")).to_contain_text('says "Hello! I am happy')
 
-    page.click("#logout")
+    page.click("#logout")  # the page loads again: log in on the new one, not the old
+    expect(page.locator("#login")).to_be_visible(timeout=WAITS_MS)
     page.fill("#token", tokens["val"])
     page.click("#login button[type=submit]")
     expect(page.locator("#no-happened")).to_have_text(
