@@ -70,3 +70,21 @@ def test_a_file_reached_through_a_link_is_written_and_the_link_kept(tmp_path: Pa
     link.symlink_to(kept)
     write_whole(link, b"new\n")
     assert link.is_symlink() and kept.read_text(encoding="utf-8") == "new\n"
+
+
+def test_a_file_made_only_where_none_is_appears_whole_or_not_at_all(tmp_path: Path) -> None:
+    # the site key: two vests starting at once must keep one key, and neither may read
+    # the other's before its last byte is written
+    key = tmp_path / "site.key"
+    seen_while_writing: list[bool] = []
+    write_whole(
+        key,
+        b"ab" * 32 + b"\n",
+        exclusive=True,
+        check=lambda _: seen_while_writing.append(key.exists()),
+    )
+    assert seen_while_writing == [False]  # not there until it was whole
+    with pytest.raises(FileExistsError):
+        write_whole(key, b"cd" * 32 + b"\n", exclusive=True)
+    assert key.read_bytes() == b"ab" * 32 + b"\n"  # the first key kept
+    assert [p.name for p in tmp_path.iterdir()] == ["site.key"]

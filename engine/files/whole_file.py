@@ -6,7 +6,9 @@ The new bytes go to a temporary file beside the old one, readable by its owner o
 its first byte; they are flushed to the disk, checked (``check``), given their mode, and
 the temporary file is renamed over the old one; then the folder is flushed, so the rename
 outlives a power cut. The tree editor's saves, consent records and the record of finished
-commands are written this way. (A file made new, which must not be there already, is
+commands are written this way. With ``exclusive`` the whole file is linked into place
+only where no file is (the site key: two vests starting at once keep one key, and neither
+reads the other's half-written one). (A file a command makes new and streams into is
 :func:`engine.cli.output.new_file`'s.)
 """
 
@@ -29,12 +31,15 @@ def write_whole(
     *,
     mode: int | None = None,
     check: Callable[[Path], object] | None = None,
+    exclusive: bool = False,
 ) -> None:
     """``data`` into ``path`` at once (see the module's docstring). ``mode``: the file's
     permission bits (None: the old file's, or :data:`NEW_FILE_MODE` for a new one);
     ``check(temporary)`` reads the new file before it replaces the old and raises to keep
     the old one. OSError (and whatever ``check`` raises) leaves ``path`` untouched and no
-    temporary file behind. A link is followed: the file it names is written, the link kept."""
+    temporary file behind. A link is followed: the file it names is written, the link kept.
+    ``exclusive``: FileExistsError when ``path`` is there already, which is then left as it
+    is (the new file appears whole or not at all)."""
     if path.is_symlink():
         path = path.resolve()
     if mode is None:
@@ -49,7 +54,11 @@ def write_whole(
         if check is not None:
             check(temporary)
         os.chmod(temporary, mode)
-        os.replace(temporary, path)
+        if exclusive:
+            os.link(temporary, path)  # atomic, and refuses a path that is there
+            temporary.unlink()
+        else:
+            os.replace(temporary, path)
     except BaseException:
         temporary.unlink(missing_ok=True)
         raise

@@ -10,7 +10,6 @@ Losing the key is losing every recording made with it (docs say so).
 
 from __future__ import annotations
 
-import os
 import secrets
 import stat
 from collections.abc import Mapping
@@ -18,6 +17,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from engine.errors import ConfigError
+from engine.files.whole_file import write_whole
 
 KEY_FILE = "site.key"
 KEY_BYTES = 32
@@ -90,18 +90,17 @@ def read_key_file(path: Path) -> SiteKey:
 
 
 def make_key_file(path: Path) -> SiteKey:
-    """A new random key written to ``path``, owner-only; FileExistsError when a file is
-    there (O_EXCL: two vests starting at once never write two keys over each other)."""
+    """A new random key written whole to ``path``, owner-only; FileExistsError when a file
+    is there (two vests starting at once never write two keys over each other, and neither
+    reads a key the other has only begun to write)."""
     key = secrets.token_bytes(KEY_BYTES)
     try:
-        descriptor = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL, OWNER_ONLY_FILE)
+        write_whole(path, (key.hex() + "\n").encode("ascii"), mode=OWNER_ONLY_FILE, exclusive=True)
     except FileExistsError:
         raise
     except OSError as error:
         why = error.strerror or error
         raise ConfigError(f"{path}: cannot write the site key there ({why})") from None
-    with os.fdopen(descriptor, "w", encoding="ascii") as file:
-        file.write(key.hex() + "\n")
     return SiteKey(key, path)
 
 
