@@ -177,8 +177,10 @@ class OnEvent(Condition):
     Each tick it takes the oldest event this node has not handled yet. SUCCESS once per
     new event (matching ``equals`` / ``one_of`` when given), writing its value to
     ``save_as``; FAILURE when no new event arrived. Events from before the tree started
-    are not reacted to. A key keeps its last 32 events: when more arrive before this node
-    gets to them, the oldest are missed and a warning says how many.
+    are not reacted to, nor one another node of the tree took in a round that is over (the
+    count a game's WaitForEvent took does not start the game again). A key keeps its last
+    32 events: when more arrive before this node gets to them, the oldest are missed and
+    a warning says how many.
     """
 
     key = Param("key", Key(kinds=("event",)), doc="the event key, e.g. /sensors/gesture/last")

@@ -32,13 +32,24 @@ def wanted(equals: Any, one_of: Sequence[Any] | None) -> list[Any] | None:
 class EventReader:
     """The events on ``key`` a node has not handled yet, oldest first; those matching
     ``wanted`` (any, when None) count. A key keeps its last 32 events: when more arrive
-    before the node reads them, the oldest are missed and the node warns how many."""
+    before the node reads them, the oldest are missed and the node warns how many.
+
+    An event another node of the tree took in a round that has ended is passed over
+    (:meth:`passes_over`): a hand count the game's inner wait took does not start the game
+    again at its root."""
 
     def __init__(self, node: Leaf, key: str, wanted: Sequence[Any] | None) -> None:
         self.node, self.key = node, key
         self.wanted = None if wanted is None else list(wanted)
         self.handled_seq = 0
+        self.taken: list[int] = []
+        """The events that counted this round (their numbers)."""
+        self._passed_over: set[int] = set()
         self.skip_past()
+
+    def passes_over(self, seqs: Sequence[int]) -> None:
+        """Those of ``seqs`` (event numbers) this node has not handled yet are not for it."""
+        self._passed_over.update(seq for seq in seqs if seq > self.handled_seq)
 
     def skip_past(self) -> None:
         """Forget the events already on the key: only later ones count."""
@@ -46,7 +57,10 @@ class EventReader:
 
     def unread(self) -> bool:
         """Whether events came on the key that this node has not looked at yet."""
-        return self.node.ctx.blackboard.event_log(self.key).last_seq > self.handled_seq
+        last = self.node.ctx.blackboard.event_log(self.key).last_seq
+        if last - self.handled_seq > len(self._passed_over):
+            return True
+        return any(seq not in self._passed_over for seq in range(self.handled_seq + 1, last + 1))
 
     def take(self) -> tuple[bool, Any]:
         """(True, value) of the oldest new event that counts, or (False, None)."""
@@ -62,9 +76,15 @@ class EventReader:
                 f"missed {missed} event{'s' if missed != 1 else ''} on {self.key}: "
                 f"more than the {EVENT_LOG_LENGTH} a key keeps came before this node read them",
             )
+        found: tuple[bool, Any] = (False, None)
         for event in events:
             self.handled_seq = event.seq
+            if event.seq in self._passed_over:
+                continue
             if self.wanted is None or event.value in self.wanted:
                 self.node.feedback_message = f"event {event.seq}: {event.value!r}"
-                return True, event.value
-        return False, None
+                self.taken.append(event.seq)
+                found = (True, event.value)
+                break
+        self._passed_over = {seq for seq in self._passed_over if seq > self.handled_seq}
+        return found

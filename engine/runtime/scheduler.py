@@ -107,6 +107,18 @@ class RunningTree:
             self._readers_of = self.tree.root
         return self._readers
 
+    def round_ends(self) -> None:
+        """The round is over (done, given up, or halted and let go): an event one of its
+        nodes took is the tree's, and no other of its nodes reacts to it later."""
+        readers = self._event_readers()
+        taken: dict[str, list[int]] = {}
+        for node in readers:
+            if node.events.taken:
+                taken.setdefault(node.events.key, []).extend(node.events.taken)
+                node.events.taken = []
+        for node in readers if taken else ():
+            node.events.passes_over(taken.get(node.events.key, ()))
+
     def take_unread(self, key: str) -> list[Any]:
         """The values of ``key``'s events that no node of the tree has handled yet, oldest
         first; from now on its nodes take them as handled (they are the caller's)."""
@@ -130,6 +142,8 @@ class RunningTree:
         a round ends)."""
         for node, seq in self._round_start:
             node.events.handled_seq = min(node.events.handled_seq, seq)
+        for node in self._event_readers():  # taken again in the round tried again
+            node.events.taken = []
         self.retrying = True
 
     def replace(self, definition: TreeDefinition) -> None:
@@ -184,6 +198,8 @@ class RunningTree:
                 actions.stop_reason, actions.round_tried_again = "", False
                 actions.last_sentence_heard = False
             actions.settle()
+            if not tried_again:
+                self.round_ends()
 
 
 class Scheduler:
@@ -356,9 +372,11 @@ class Scheduler:
         if status == py_trees.common.Status.FAILURE:  # gave up half-way: nothing left raised
             tree.context.actions.settle(lights=False)  # a timed light goes out by itself
             tree.retrying = False
+            tree.round_ends()
         elif status == py_trees.common.Status.SUCCESS:  # done as the tree meant
             tree.context.actions.forget()
             tree.retrying = False
+            tree.round_ends()
         for observer in self.after_tick:
             try:
                 observer(tree)
