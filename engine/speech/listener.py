@@ -181,8 +181,11 @@ class Listener:
 
     def _voice_began(self, was_speech: bool, utterances: list[Utterance], at_s: float) -> None:
         """A voice that began in the piece ending at ``at_s`` while the robot was silent is
-        told to ``on_voice``: the robot holds its tongue while a person talks."""
-        if was_speech or not (self.detector.in_speech or utterances) or self.on_voice is None:
+        told to ``on_voice``: the robot holds its tongue while a person talks. A person who
+        goes on at once after a pause long enough to end what they said has begun anew."""
+        began = (self.detector.in_speech or utterances) if not was_speech else False
+        went_on = was_speech and bool(utterances) and self.detector.in_speech
+        if not (began or went_on) or self.on_voice is None:
             return
         try:
             self.on_voice(at_s)
