@@ -43,6 +43,12 @@ MAYBE_MARGIN = 0.1
 ones the robot cannot tell which to ask about."""
 REPROMPT_WITHIN_S = 60.0
 """A sorry this soon (seconds) after the last one is said in other words, the next reprompt."""
+IN_PARTS_WITHIN_S = 5.0
+"""An utterance heard this soon (seconds) after one that was not understood may be the rest
+of its sentence (a child pauses mid-sentence): when it is not understood alone, the two are
+judged as one."""
+IN_PARTS_WORDS = 16
+"""At most this many of the words not understood so far are kept to join to the next."""
 
 
 def confirmation(

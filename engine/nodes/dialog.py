@@ -7,7 +7,13 @@ from typing import Any, ClassVar
 
 from py_trees.common import Status
 
-from engine.dialogs.confirming import REPROMPT_WITHIN_S, maybe_meant, reprompt
+from engine.dialogs.confirming import (
+    IN_PARTS_WITHIN_S,
+    IN_PARTS_WORDS,
+    REPROMPT_WITHIN_S,
+    maybe_meant,
+    reprompt,
+)
 from engine.dialogs.model import Dialog, FollowUp, Verdict
 from engine.errors import ServiceError
 from engine.nodes.base import Leaf
@@ -30,6 +36,10 @@ class Reply(Leaf):
     RUNNING while reading and speaking; SUCCESS when the answer was said; FAILURE when no
     rule matched and the dialog has no fallback, a field has no value yet, or a sensor or
     the speech service failed.
+
+    A child who pauses mid-sentence is heard in two parts ("do you like" ... "dogs"): an
+    utterance not understood alone, heard within a few seconds of one not understood, is
+    judged joined to it, and answered so when that matches a rule.
 
     When nothing matches but what was heard is like a rule that says how to confirm it,
     the robot asks (``confirm:``) and a yes is answered as that rule; when it does not
@@ -65,6 +75,8 @@ class Reply(Leaf):
         self.misses = 0
         """Utterances not understood in a row, each within REPROMPT_WITHIN_S of the last."""
         self.missed_at_s = -REPROMPT_WITHIN_S
+        self.unmatched = ""
+        """The words of the utterances not understood just before (joined to the next)."""
 
     def dialog(self) -> Dialog:
         dialogs = self.ctx.dialogs
@@ -81,12 +93,23 @@ class Reply(Leaf):
         self.follow_up, self.follow_up_until_s = None, 0.0
         verdict = dialog.judge(str(heard), asked) if heard else None
         match = verdict.match if verdict is not None else None
+        if self.ctx.clock.now() - self.missed_at_s > IN_PARTS_WITHIN_S:
+            self.unmatched = ""  # too long ago to be the start of this sentence
+        parts = ""
+        if match is None and heard and self.unmatched:
+            joined = f"{self.unmatched} {heard}"
+            both = dialog.judge(joined, asked)
+            if both.match is not None:
+                match, parts = both.match, f", heard in parts: {joined!r}"
         if match is None:
+            if heard:
+                words = f"{self.unmatched} {heard}".split()
+                self.unmatched = " ".join(words[-IN_PARTS_WORDS:])
             self._not_understood(dialog, str(heard or ""), verdict, asked)
             return
-        self.misses = 0
+        self.misses, self.unmatched = 0, ""
         self.feedback_message = (
-            f"rule {match.rule.id!r} at line {match.rule.line} ({match.score:.2f})"
+            f"rule {match.rule.id!r} at line {match.rule.line} ({match.score:.2f}){parts}"
         )
         self.answer = match.rule.answer
         if match.rule.follow_up is not None:

@@ -9,6 +9,7 @@ tells each part that begins.
 
 from __future__ import annotations
 
+import json
 import textwrap
 from pathlib import Path
 from typing import Any
@@ -18,6 +19,7 @@ import pytest
 
 from engine.blackboard.board import Blackboard
 from engine.blackboard.catalogue import TOUCH_PAT, default_catalogue
+from engine.cli import main
 from engine.clock import VirtualClock
 from engine.media.audio import SPEECH_RATE_HZ, Audio
 from engine.runtime.robot import Robot, load_behaviors
@@ -94,3 +96,35 @@ def test_the_listener_tells_a_part_that_begins_as_the_first_ends() -> None:
         listener.hear(Audio(audio[end - piece : end], rate), clock.now())
     listener.close()
     assert len(began) == 2
+
+
+@pytest.mark.models
+def test_a_child_who_goes_on_over_the_robot_s_question_is_answered_whole(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # "do you like" ... the robot asks whether it heard a question about animals, and the
+    # child goes on over it: "puppies". The robot stops and answers the whole sentence.
+    monkeypatch.chdir(Path(__file__).resolve().parents[2])
+    scenario = tmp_path / "scenario.yaml"
+    scenario.write_text(
+        """\
+duration_s: 14
+events:
+  - {at: 0.5, hear: "hello robot"}   # the robot speaks once: it learns the room
+  - {at: 5.0, hear: "do you like"}
+  - {at: 7.0, hear: "puppies"}
+""",
+        encoding="utf-8",
+    )
+    args = ["run", "--fast", "--json", "--trees", "trees/dialog.yaml", "--scenario", str(scenario)]
+    assert main([*args, "--profile", "child"]) == 0
+    lines = [json.loads(line) for line in capsys.readouterr().out.splitlines() if line]
+    said = [e["args"]["text"] for e in lines if e["event"] == "action" and e["action"] == "say"]
+    assert said == [
+        "Hello! Nice to see you.",
+        "Did you ask whether I like animals?",  # spoken over
+        "I love animals. Do you have a pet?",
+    ]
+    assert [e["saying"] for e in lines if e["event"] == "spoken_over"] == [
+        "Did you ask whether I like animals?"
+    ]
