@@ -332,6 +332,7 @@ $("#login").addEventListener("submit", (event) => {
   event.preventDefault();
   login($("#token").value.trim());
 });
+$("#login button[type=submit]").disabled = false; // wired: logging in stays in the page
 $("#logout").addEventListener("click", logout);
 $("#send").addEventListener("submit", send);
 $("#type").addEventListener("change", () => {

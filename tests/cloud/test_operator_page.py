@@ -54,6 +54,20 @@ def test_a_wrong_token_is_refused_with_a_message(page: Page, lab: dict[str, Any]
     expect(page.locator("#console")).to_be_hidden()
 
 
+def test_the_token_never_goes_into_the_page_s_address(page: Page, lab: dict[str, Any]) -> None:
+    # before the page's script has come (a slow link), the form cannot be sent: sent as
+    # a plain form, the token would be in the address, the history and the server's logs
+    page.route("**/app.js", lambda route: route.abort())
+    page.goto(lab["url"])
+    page.fill("#token", lab["token"])
+    expect(page.locator("#login button[type=submit]")).to_be_disabled()
+    assert page.locator("#token").get_attribute("name") is None
+    page.unroute("**/app.js")
+    log_in(page, lab["url"], lab["token"])
+    expect(page.locator("#console")).to_be_visible()
+    assert lab["token"] not in page.url
+
+
 def test_an_operator_sends_a_say_from_the_page_and_sees_it_succeed(
     page: Page, lab: dict[str, Any]
 ) -> None:
