@@ -55,6 +55,14 @@ class EventReader:
         """Forget the events already on the key: only later ones count."""
         self.handled_seq = self.node.ctx.blackboard.event_log(self.key).last_seq
 
+    def stands_at(self) -> int:
+        """The number of the last event this node is done with, in order (handled, or
+        passed over): where a new version of it takes up reading."""
+        seq = self.handled_seq
+        while seq + 1 in self._passed_over:
+            seq += 1
+        return seq
+
     def unread(self) -> bool:
         """Whether events came on the key that this node has not looked at yet."""
         last = self.node.ctx.blackboard.event_log(self.key).last_seq

@@ -109,7 +109,7 @@ class TreeReloader:
             problem = prepared.problem
             if problem is None and prepared.definition and prepared.built:
                 try:
-                    prepared.tree.swap(prepared.definition, prepared.built)
+                    prepared.tree.swap(prepared.definition, prepared.built, keep_events=True)
                     reloaded.append(prepared.tree.name)
                 except Exception as error:  # whatever went wrong, the running robot goes on
                     problem = _crashed(self.loader.shown(prepared.tree.definition.path), error)

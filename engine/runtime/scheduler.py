@@ -153,11 +153,23 @@ class RunningTree:
         """
         self.swap(definition, definition.build(self.context))
 
-    def swap(self, definition: TreeDefinition, new_tree: py_trees.trees.BehaviourTree) -> None:
+    def swap(
+        self,
+        definition: TreeDefinition,
+        new_tree: py_trees.trees.BehaviourTree,
+        *,
+        keep_events: bool = False,
+    ) -> None:
         """Swap in ``new_tree``, built from ``definition`` (beside the scheduler, for hot
-        reload), halting the running one cleanly; call between ticks."""
+        reload), halting the running one cleanly; call between ticks. ``keep_events``: its
+        nodes take up each key's events where the old version stood (a word or a command
+        that came while it was built, one handed back to try again, is not lost)."""
         old_root = self.tree.root
         self.halt("its tree was replaced")
+        stood: dict[str, int] = {}
+        for node in self._event_readers() if keep_events else ():
+            key, at = node.events.key, node.events.stands_at()
+            stood[key] = min(stood.get(key, at), at)
         for node in old_root.iterate():  # the old nodes' blackboard clients go with them
             for client in node.blackboards:
                 client.unregister(clear=False)
@@ -166,6 +178,9 @@ class RunningTree:
         self.resting = self.woken = False  # the new version's first round starts now
         self.definition = definition
         self.tree = new_tree
+        for node in self._event_readers() if stood else ():
+            if node.events.key in stood:
+                node.events.handled_seq = stood[node.events.key]
         actions = self.context.actions
         if actions.taking is not None:  # the new version's priority and patience
             actions.taking = replace(

@@ -192,3 +192,55 @@ def test_a_save_that_finishes_while_the_file_is_read_is_loaded_too(tmp_path):
     robot.scheduler.run(until_s=1.05)
     assert said(robot)[-1] == "Good morning"
     assert reports == [("greeter", None)]  # the half-saved file was never reported
+
+
+ANSWERER = """\
+    name: answerer
+    rate_hz: 10
+    root:
+      Sequence:
+        - OnEvent: {key: /speech/heard}
+        - Say: {text: "I heard you"}
+        - Wait: {seconds: 2.0}
+    """
+
+
+def ticking_until(robot, tree, until_s):
+    """The robot's steps up to ``until_s``, the tree never stopped between (``run`` stops
+    the trees when it ends)."""
+    while tree.next_deadline_s <= until_s:
+        robot.clock.sleep_until(tree.next_deadline_s)
+        robot.scheduler.step()
+
+
+def test_a_word_that_came_while_the_old_version_was_busy_is_answered_by_the_new(tmp_path):
+    (tmp_path / "answerer.yaml").write_text(textwrap.dedent(ANSWERER))
+    clock = VirtualClock()
+    board = Blackboard(default_catalogue(), clock)
+    board.reset()
+    services = simulated_services(clock)
+    robot = Robot(load_behaviors([tmp_path]), clock=clock, services=services, blackboard=board)
+    [tree] = robot.trees
+    board.stage_event("/speech/heard", "hello")
+    ticking_until(robot, tree, 0.3)  # it answered, and waits 2 s...
+    board.stage_event("/speech/heard", "and again")  # ...when the child speaks again
+    ticking_until(robot, tree, 0.5)
+    tree.swap(tree.definition, tree.definition.build(tree.context), keep_events=True)
+    ticking_until(robot, tree, 1.0)
+    assert said(robot) == ["I heard you", "I heard you"]  # the new version answers it
+
+
+def test_behaviors_built_afresh_answer_nothing_from_before(tmp_path):
+    # the buttons' resume: what happened while paused is not answered late
+    (tmp_path / "answerer.yaml").write_text(textwrap.dedent(ANSWERER))
+    clock = VirtualClock()
+    board = Blackboard(default_catalogue(), clock)
+    board.reset()
+    services = simulated_services(clock)
+    robot = Robot(load_behaviors([tmp_path]), clock=clock, services=services, blackboard=board)
+    board.stage_event("/speech/heard", "hello")
+    board.commit()
+    [tree] = robot.trees
+    tree.replace(tree.definition)
+    robot.scheduler.run(until_s=2.0)
+    assert said(robot) == []
