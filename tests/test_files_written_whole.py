@@ -88,3 +88,12 @@ def test_a_file_made_only_where_none_is_appears_whole_or_not_at_all(tmp_path: Pa
         write_whole(key, b"cd" * 32 + b"\n", exclusive=True)
     assert key.read_bytes() == b"ab" * 32 + b"\n"  # the first key kept
     assert [p.name for p in tmp_path.iterdir()] == ["site.key"]
+
+
+def test_a_link_where_a_file_is_made_only_where_none_is_counts_as_a_file(tmp_path: Path) -> None:
+    # a link to nowhere at site.key: the key is not written where the link points
+    elsewhere = tmp_path / "elsewhere"
+    (tmp_path / "site.key").symlink_to(elsewhere)
+    with pytest.raises(FileExistsError):
+        write_whole(tmp_path / "site.key", b"ab" * 32 + b"\n", exclusive=True)
+    assert not elsewhere.exists()

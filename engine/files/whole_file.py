@@ -38,9 +38,9 @@ def write_whole(
     ``check(temporary)`` reads the new file before it replaces the old and raises to keep
     the old one. OSError (and whatever ``check`` raises) leaves ``path`` untouched and no
     temporary file behind. A link is followed: the file it names is written, the link kept.
-    ``exclusive``: FileExistsError when ``path`` is there already, which is then left as it
-    is (the new file appears whole or not at all)."""
-    if path.is_symlink():
+    ``exclusive``: FileExistsError when ``path`` is there already (a link too, even one to
+    nothing), which is then left as it is (the new file appears whole or not at all)."""
+    if path.is_symlink() and not exclusive:  # exclusive: a link there, even dangling, is a file
         path = path.resolve()
     if mode is None:
         mode = path.stat().st_mode & 0o777 if path.exists() else NEW_FILE_MODE

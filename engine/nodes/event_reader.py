@@ -91,7 +91,7 @@ class EventReader:
                 continue
             if self.wanted is None or event.value in self.wanted:
                 self.node.feedback_message = f"event {event.seq}: {event.value!r}"
-                self.taken.append(event.seq)
+                self.taken = [*self.taken[-EVENT_LOG_LENGTH:], event.seq]  # older: gone anyway
                 found = (True, event.value)
                 break
         self._passed_over = {seq for seq in self._passed_over if seq > self.handled_seq}

@@ -183,8 +183,9 @@ class Listener:
         """A voice that began in the piece ending at ``at_s`` while the robot was silent is
         told to ``on_voice``: the robot holds its tongue while a person talks. A person who
         goes on at once after a pause long enough to end what they said has begun anew."""
-        began = (self.detector.in_speech or utterances) if not was_speech else False
-        went_on = was_speech and bool(utterances) and self.detector.in_speech
+        in_speech, ended = self.detector.in_speech, bool(utterances)
+        began = not was_speech and (in_speech or ended)
+        went_on = was_speech and ended and in_speech
         if not (began or went_on) or self.on_voice is None:
             return
         try:
