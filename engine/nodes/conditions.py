@@ -230,17 +230,13 @@ class OnTouch(Condition):
 
     def __init__(self, *a: Any) -> None:
         super().__init__(*a)
-        self.events = EventReader(self, TOUCH_PAT, self.pads)
-        self._ignored = set(self.except_pads or ())
+        self.events = EventReader(self, TOUCH_PAT, self.pads, self.except_pads or ())
 
     def check(self) -> bool:
-        while True:
-            found, pad = self.events.take()
-            if not found:
-                self.feedback_message = ""
-                return False
-            if pad not in self._ignored:
-                break
+        found, pad = self.events.take()
+        if not found:
+            self.feedback_message = ""
+            return False
         self.feedback_message = f"a pat on {pad}"
         if self.save_as is not None:
             self.write(self.save_as, pad)

@@ -14,7 +14,7 @@ from engine.dialogs.confirming import (
     maybe_meant,
     reprompt,
 )
-from engine.dialogs.model import Dialog, FollowUp, Verdict
+from engine.dialogs.model import Dialog, FollowUp, Match, Verdict
 from engine.errors import ServiceError
 from engine.nodes.base import Leaf
 from engine.services.actions import SPOKEN_OVER
@@ -76,7 +76,9 @@ class Reply(Leaf):
         """Utterances not understood in a row, each within REPROMPT_WITHIN_S of the last."""
         self.missed_at_s = -REPROMPT_WITHIN_S
         self.unmatched = ""
-        """The words of the utterances not understood just before (joined to the next)."""
+        """The words of the utterance not understood just before (joined to the next)."""
+        self.unmatched_asked: FollowUp | None = None
+        """The question that utterance answered (a follow-up), if any."""
 
     def dialog(self) -> Dialog:
         dialogs = self.ctx.dialogs
@@ -93,18 +95,15 @@ class Reply(Leaf):
         self.follow_up, self.follow_up_until_s = None, 0.0
         verdict = dialog.judge(str(heard), asked) if heard else None
         match = verdict.match if verdict is not None else None
-        if self.ctx.clock.now() - self.missed_at_s > IN_PARTS_WITHIN_S:
-            self.unmatched = ""  # too long ago to be the start of this sentence
         parts = ""
-        if match is None and heard and self.unmatched:
+        if match is None and heard and self._ends_a_sentence(dialog, str(heard), asked):
+            match = self._in_parts(dialog, str(heard), asked)
             joined = f"{self.unmatched} {heard}"
-            both = dialog.judge(joined, asked)
-            if both.match is not None:
-                match, parts = both.match, f", heard in parts: {joined!r}"
+            parts = f", heard in parts: {joined!r}" if match is not None else ""
         if match is None:
-            if heard:
-                words = f"{self.unmatched} {heard}".split()
-                self.unmatched = " ".join(words[-IN_PARTS_WORDS:])
+            if heard:  # perhaps the start of a sentence the next utterance ends
+                self.unmatched = " ".join(str(heard).split()[-IN_PARTS_WORDS:])
+                self.unmatched_asked = asked
             self._not_understood(dialog, str(heard or ""), verdict, asked)
             return
         self.misses, self.unmatched = 0, ""
@@ -119,6 +118,21 @@ class Reply(Leaf):
             self.job = self.ctx.actions.read_sensor(match.rule.read)
         else:
             self._speak(self.answer)
+
+    def _ends_a_sentence(self, dialog: Dialog, heard: str, asked: FollowUp | None) -> bool:
+        """Whether ``heard`` may end the sentence the utterance before began: that one was
+        not understood either, a moment ago."""
+        return bool(self.unmatched) and self.ctx.clock.now() - self.missed_at_s <= IN_PARTS_WITHIN_S
+
+    def _in_parts(self, dialog: Dialog, heard: str, asked: FollowUp | None) -> Match | None:
+        """The rule the two parts match as one sentence (judged with the question the first
+        part answered). Where ``heard`` alone is like a rule the robot would ask about,
+        only that rule: an unrelated start does not turn its question into another answer."""
+        both = dialog.judge(f"{self.unmatched} {heard}", self.unmatched_asked or asked).match
+        maybe = maybe_meant(dialog, heard, asked)
+        if both is None or (maybe is not None and maybe.confirm and both.rule.id != maybe.id):
+            return None
+        return both
 
     def _not_understood(
         self, dialog: Dialog, heard: str, verdict: Verdict | None, asked: FollowUp | None

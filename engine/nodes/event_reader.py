@@ -38,9 +38,17 @@ class EventReader:
     (:meth:`passes_over`): a hand count the game's inner wait took does not start the game
     again at its root."""
 
-    def __init__(self, node: Leaf, key: str, wanted: Sequence[Any] | None) -> None:
+    def __init__(
+        self,
+        node: Leaf,
+        key: str,
+        wanted: Sequence[Any] | None,
+        unwanted: Sequence[Any] = (),
+    ) -> None:
         self.node, self.key = node, key
         self.wanted = None if wanted is None else list(wanted)
+        self.unwanted = list(unwanted)
+        """Values that never count (a pat on a pad the node leaves to others)."""
         self.handled_seq = 0
         self.taken: list[int] = []
         """The events that counted this round (their numbers)."""
@@ -50,6 +58,22 @@ class EventReader:
     def passes_over(self, seqs: Sequence[int]) -> None:
         """Those of ``seqs`` (event numbers) this node has not handled yet are not for it."""
         self._passed_over.update(seq for seq in seqs if seq > self.handled_seq)
+
+    def done_with(self, seq: int) -> bool:
+        """Whether event ``seq`` is behind this node, or one it passes over."""
+        return seq <= self.handled_seq or seq in self._passed_over
+
+    def place(self) -> tuple[int, frozenset[int]]:
+        """Where it stands, to come back to (:meth:`go_back`: a round tried again)."""
+        return self.handled_seq, frozenset(self._passed_over)
+
+    def go_back(self, place: tuple[int, frozenset[int]]) -> None:
+        """Read again from ``place`` (never forward: what it read since stays read when
+        ``place`` is ahead); what it took this round is taken again."""
+        seq, passed = place
+        if seq < self.handled_seq:
+            self.handled_seq, self._passed_over = seq, set(passed) | self._passed_over
+        self.taken = []
 
     def skip_past(self) -> None:
         """Forget the events already on the key: only later ones count."""
@@ -76,7 +100,8 @@ class EventReader:
         if not isinstance(log, EventLog) or log.last_seq <= self.handled_seq:
             return False, None
         events = log.after(self.handled_seq)
-        missed = events[0].seq - self.handled_seq - 1 if events else 0
+        gone = range(self.handled_seq + 1, events[0].seq) if events else range(0)
+        missed = sum(seq not in self._passed_over for seq in gone)  # not ones it passes over
         if missed > 0:
             self.node.ctx.on_node_warning(
                 self.node.ctx.tree,
@@ -89,10 +114,22 @@ class EventReader:
             self.handled_seq = event.seq
             if event.seq in self._passed_over:
                 continue
-            if self.wanted is None or event.value in self.wanted:
+            if (self.wanted is None or event.value in self.wanted) and (
+                event.value not in self.unwanted
+            ):
                 self.node.feedback_message = f"event {event.seq}: {event.value!r}"
                 self.taken = [*self.taken[-EVENT_LOG_LENGTH:], event.seq]  # older: gone anyway
                 found = (True, event.value)
                 break
         self._passed_over = {seq for seq in self._passed_over if seq > self.handled_seq}
         return found
+
+
+def where_they_stand(readers: Sequence[EventReader]) -> dict[str, int]:
+    """Each key's event number the slowest of ``readers`` is done with (:meth:`stands_at`):
+    where a new version of their tree takes up reading."""
+    stood: dict[str, int] = {}
+    for reader in readers:
+        at = reader.stands_at()
+        stood[reader.key] = min(stood.get(reader.key, at), at)
+    return stood

@@ -34,6 +34,7 @@ from engine.clock import Clock, stopwatch
 from engine.errors import ConfigError
 from engine.loader.tree_definition import TreeDefinition
 from engine.nodes.context import TreeContext
+from engine.nodes.event_reader import where_they_stand
 from engine.runtime.stats import TickStats
 from engine.values.params import RATE_HZ
 
@@ -62,7 +63,7 @@ class RunningTree:
     """One of its keys changed since its round began: it ticks (a new round) as soon as
     its rate allows."""
     last_tick_s: float = -math.inf
-    _round_start: list[tuple[Any, int]] = field(default_factory=list)
+    _round_start: list[tuple[Any, tuple[int, frozenset[int]]]] = field(default_factory=list)
     _readers: list[Any] = field(default_factory=list)
     _readers_of: Any = None
 
@@ -98,7 +99,7 @@ class RunningTree:
         that tries again: the others pay nothing)."""
         if not self.tries_again:
             return
-        self._round_start = [(node, node.events.handled_seq) for node in self._event_readers()]
+        self._round_start = [(node, node.events.place()) for node in self._event_readers()]
 
     def _event_readers(self) -> list[Any]:
         """The nodes that read events (found once a version)."""
@@ -126,7 +127,12 @@ class RunningTree:
         if not any(node.events.unread() for node in readers):  # the usual tick: nothing
             return []
         log = self.context.blackboard.event_log(key)
-        unread = log.after(min(node.events.handled_seq for node in readers))
+        took = {seq for node in readers for seq in node.events.taken}  # this round's
+        unread = [
+            event
+            for event in log.after(min(node.events.handled_seq for node in readers))
+            if event.seq not in took and not all(n.events.done_with(event.seq) for n in readers)
+        ]
         for node in readers:
             node.events.handled_seq = max(node.events.handled_seq, log.last_seq)
         return [event.value for event in unread]
@@ -140,10 +146,8 @@ class RunningTree:
         """Hand the events of the round that was cut short back to its nodes: at its next
         tick the tree starts the round again as if they had just come (``retrying`` until
         a round ends)."""
-        for node, seq in self._round_start:
-            node.events.handled_seq = min(node.events.handled_seq, seq)
-        for node in self._event_readers():  # taken again in the round tried again
-            node.events.taken = []
+        for node, place in self._round_start:
+            node.events.go_back(place)
         self.retrying = True
 
     def replace(self, definition: TreeDefinition) -> None:
@@ -166,10 +170,7 @@ class RunningTree:
         that came while it was built, one handed back to try again, is not lost)."""
         old_root = self.tree.root
         self.halt("its tree was replaced")
-        stood: dict[str, int] = {}
-        for node in self._event_readers() if keep_events else ():
-            key, at = node.events.key, node.events.stands_at()
-            stood[key] = min(stood.get(key, at), at)
+        stood = where_they_stand([n.events for n in self._event_readers()] if keep_events else [])
         for node in old_root.iterate():  # the old nodes' blackboard clients go with them
             for client in node.blackboards:
                 client.unregister(clear=False)
@@ -179,8 +180,7 @@ class RunningTree:
         self.definition = definition
         self.tree = new_tree
         for node in self._event_readers() if stood else ():
-            if node.events.key in stood:
-                node.events.handled_seq = stood[node.events.key]
+            node.events.handled_seq = stood.get(node.events.key, node.events.handled_seq)
         actions = self.context.actions
         if actions.taking is not None:  # the new version's priority and patience
             actions.taking = replace(

@@ -46,3 +46,31 @@ def test_words_heard_long_after_are_a_sentence_of_their_own() -> None:
 def test_a_part_understood_alone_is_answered_as_it_is() -> None:
     said = heard_in_two_parts("tell me", "how are you", pause_s=3.0)
     assert said == ["Sorry, I did not understand.", "I am fine, thank you!"]
+
+
+def test_an_unrelated_start_does_not_turn_a_question_into_another_answer() -> None:
+    # "how is it" alone is asked about (the temperature); joined to the sentence before
+    # it would match "how are you": the robot asks, as it would without the start
+    said = heard_in_two_parts("are you a robot", "how is it", pause_s=3.0)
+    assert said == ["Sorry, I did not understand.", "Did you ask how warm it is?"]
+
+
+def test_only_the_part_just_before_is_joined() -> None:
+    robot = TreeHarness.from_file(DIALOG)
+    for part in ("tell me", "and", "so", "well"):  # four sorries: no sentence goes on
+        robot.set("/speech/heard", part)
+        robot.advance(4.5)
+    robot.set("/speech/heard", "your name")
+    robot.advance(6.0)
+    assert robot.said[-1] == "Did you ask my name?"  # not "tell me ... your name"
+
+
+def test_an_answer_to_the_robot_s_question_said_in_parts_is_answered() -> None:
+    robot = TreeHarness.from_file(DIALOG)
+    robot.set("/speech/heard", "do you like dogs")
+    robot.advance(4.0)  # "I love animals. Do you have a pet?"
+    robot.set("/speech/heard", "i have")
+    robot.advance(2.0)
+    robot.set("/speech/heard", "a dog")
+    robot.advance(6.0)
+    assert robot.said[-1] == "How lovely! Pets are good friends."

@@ -77,3 +77,61 @@ def test_an_event_one_rule_passed_by_is_still_new_to_the_other(tmp_path: Path) -
     robot.advance(10.0)
     # the first rule looked past "hi" to take "bye"; "hi" is still the second rule's
     assert robot.said == ["Goodbye", "Hello"]
+
+
+ASK_TWICE_AGAIN = ASK_TWICE.replace(
+    "rate_hz: 10\n", "rate_hz: 10\nwhen_interrupted: try_again\nwait_for_turn_s: 2\n"
+)
+
+PATS = """\
+name: pats
+rate_hz: 10
+root:
+  Selector:
+    - Sequence:
+        - OnTouch: {except_pads: [chest]}
+        - Say: {text: "Thanks for the pat"}
+    - Sequence:
+        - OnTouch: {pads: [chest]}
+        - Say: {text: "A hug!"}
+"""
+
+
+def test_a_round_tried_again_does_not_answer_what_the_round_before_took(tmp_path: Path) -> None:
+    robot = robot_with(tmp_path, ASK_TWICE_AGAIN)
+    robot.set("/speech/heard", "hello")
+    robot.advance(3.0)
+    robot.set("/speech/heard", "again")  # taken by the wait: the round is over
+    robot.tick(1)
+    robot.set("/speech/heard", "third")  # a new round begins on it...
+    robot.tick(1)
+    robot.running.halt("a hug interrupted it", tried_again=True)  # ...and is cut short
+    robot.running.try_again()
+    robot.advance(20.0)
+    assert robot.said == ["Say it again", "Thank you", "Say it again", "Say it again"]
+
+
+def test_a_pat_one_rule_leaves_to_others_is_still_the_other_rule_s(tmp_path: Path) -> None:
+    robot = robot_with(tmp_path, PATS)
+    robot.tick(2)
+    robot.set("/sensors/touch/pat", "chest")  # both hands at once: a chest pat...
+    robot.set("/sensors/touch/pat", "back")  # ...and a back pat, before the next tick
+    robot.advance(10.0)
+    assert sorted(robot.said) == ["A hug!", "Thanks for the pat"]
+
+
+def test_what_a_tree_took_is_neither_unread_nor_missed(tmp_path: Path) -> None:
+    robot = robot_with(tmp_path, ASK_TWICE)
+    robot.set("/speech/heard", "one")
+    robot.advance(3.0)
+    robot.set("/speech/heard", "two")  # the wait took it
+    robot.tick(1)
+    robot.set("/speech/heard", "three")
+    robot.blackboard.commit()
+    # what a pause or the session's end reports as not carried out
+    assert robot.running.take_unread("/speech/heard") == ["three"]
+
+    for n in range(32):  # a burst: "two" leaves the key's last 32, and was the tree's
+        robot.set("/speech/heard", f"burst {n}")
+    robot.tick(1)
+    assert robot.node_warnings == []
