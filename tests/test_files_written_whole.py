@@ -97,3 +97,20 @@ def test_a_link_where_a_file_is_made_only_where_none_is_counts_as_a_file(tmp_pat
     with pytest.raises(FileExistsError):
         write_whole(tmp_path / "site.key", b"ab" * 32 + b"\n", exclusive=True)
     assert not elsewhere.exists()
+
+
+def test_where_files_cannot_be_linked_a_file_is_still_made_only_where_none_is(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # a FAT memory stick has no hard links (a fake link call, as nothing here is FAT)
+    def no_links(source: object, target: object) -> None:
+        raise PermissionError(1, "Operation not permitted")
+
+    monkeypatch.setattr("engine.files.whole_file.os.link", no_links)
+    key = tmp_path / "site.key"
+    write_whole(key, b"ab" * 32 + b"\n", exclusive=True)
+    with pytest.raises(FileExistsError):
+        write_whole(key, b"cd" * 32 + b"\n", exclusive=True)
+    assert key.read_bytes() == b"ab" * 32 + b"\n"
+    assert key.stat().st_mode & 0o777 == 0o600
+    assert [p.name for p in tmp_path.iterdir()] == ["site.key"]

@@ -15,6 +15,7 @@ reads the other's half-written one). (A file a command makes new and streams int
 from __future__ import annotations
 
 import contextlib
+import errno
 import os
 import tempfile
 from collections.abc import Callable
@@ -55,7 +56,7 @@ def write_whole(
             check(temporary)
         os.chmod(temporary, mode)
         if exclusive:
-            os.link(temporary, path)  # atomic, and refuses a path that is there
+            _link_new(temporary, path, data, mode)
             temporary.unlink()
         else:
             os.replace(temporary, path)
@@ -63,6 +64,25 @@ def write_whole(
         temporary.unlink(missing_ok=True)
         raise
     _flush_folder(path.parent)
+
+
+def _link_new(temporary: Path, path: Path, data: bytes, mode: int) -> None:
+    """``temporary`` linked in as ``path``: atomic, and FileExistsError where a file is.
+    A file system without hard links (a FAT memory stick) gets ``path`` made with O_EXCL
+    and written: still never over another's file, though a reader may then meet it half
+    written."""
+    try:
+        os.link(temporary, path)
+    except FileExistsError:
+        raise
+    except OSError as error:
+        if error.errno not in (errno.EPERM, errno.EOPNOTSUPP, errno.ENOTSUP):
+            raise
+        descriptor = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL, mode)
+        with os.fdopen(descriptor, "wb") as file:
+            file.write(data)
+            file.flush()
+            os.fsync(file.fileno())
 
 
 def _flush_folder(folder: Path) -> None:
