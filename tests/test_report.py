@@ -10,8 +10,9 @@ import pytest
 
 from engine.cli import main
 from engine.privacy.site_data import SiteKey
+from engine.recording.moments import outages
 from engine.recording.replay import Recording
-from engine.recording.report import outages, person_moments, printable
+from engine.recording.report import person_moments, printable
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -352,3 +352,20 @@ def done_by_kind(moments: list[Moment]) -> list[tuple[str, str, int]]:
     )
     rows = [(who, kind, count) for (who, kind), count in kinds.items()]
     return sorted(rows, key=lambda row: (row[0] != "the person", row[0], -row[2]))
+
+
+def outages(recording: Recording) -> list[tuple[str, float, float | None]]:
+    """(device, offline at, back at or None) for each time a device dropped out."""
+    found: list[tuple[str, float, float | None]] = []
+    for key in recording.keys_like("/devices/%/ok"):
+        device = key.removeprefix("/devices/").removesuffix("/ok")
+        since: float | None = None
+        for at, ok in recording.key_history(key):
+            if ok is False and since is None:
+                since = at
+            elif ok is True and since is not None:
+                found.append((device, since, at))
+                since = None
+        if since is not None:  # to the end (from the start: never there, or no model)
+            found.append((device, since, None))
+    return sorted(found, key=lambda item: item[1])

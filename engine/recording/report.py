@@ -27,28 +27,17 @@ from engine.blackboard.catalogue import (
     RANGE_CENTER_MM,
     TOUCH_ANY,
 )
-from engine.recording.moments import Moment, done_by_kind, not_understood, person_moments
+from engine.recording.moments import (
+    Moment,
+    done_by_kind,
+    not_understood,
+    outages,
+    person_moments,
+)
 from engine.recording.replay import RecordedAction, Recording
 from engine.recording.report_plots import numbers, plot
 from engine.recording.told import told_events
 from engine.session.events import NotUnderstood, SafetyAction
-
-
-def outages(recording: Recording) -> list[tuple[str, float, float | None]]:
-    """(device, offline at, back at or None) for each time a device dropped out."""
-    found: list[tuple[str, float, float | None]] = []
-    for key in recording.keys_like("/devices/%/ok"):
-        device = key.removeprefix("/devices/").removesuffix("/ok")
-        since: float | None = None
-        for at, ok in recording.key_history(key):
-            if ok is False and since is None:
-                since = at
-            elif ok is True and since is not None:
-                found.append((device, since, at))
-                since = None
-        if since is not None:  # to the end (from the start: never there, or no model)
-            found.append((device, since, None))
-    return sorted(found, key=lambda item: item[1])
 
 
 def _lasted(since: float, back: float | None) -> str:
@@ -85,6 +74,10 @@ def _action_text(action: RecordedAction, *, tried: bool = False) -> str:
     if action.action == "read":
         return f"{verbs[3]} {args.get('sensor', '')} sensor"
     return f"{action.action} {json.dumps(args)}"
+
+
+def _times(count: int) -> str:
+    return f"{count} time{'s' if count != 1 else ''}"
 
 
 def _answer_cell(moment: Moment) -> tuple[str, str]:
@@ -249,28 +242,34 @@ def report_html(recording: Recording, note: str = "") -> str:
     median = sorted(answered)[len(answered) // 2] if answered else None
     acts = [m for m in moments if not m.of_its_own and not m.is_control]
     controls = sum(1 for m in moments if m.is_control)
-    unheard = len(moments) - len(acts) - controls
+    unheard = sum(1 for m in moments if m.not_listened)
+    spoken_over = sum(1 for m in moments if m.stopped_saying is not None)
     summary = (
         f"{len(acts)} things done (by the person, the therapist, the scenario or an "
         f"operator), each a row below; the robot answered {len(answered)}"
         + (f", typically within {median:.2f} s" if median is not None else "")
         + "."
         + (
-            f" Besides, the buttons paused, resumed or stopped the behaviours {controls} "
-            f"time{'s' if controls != 1 else ''} (a row each)."
+            f" Besides, the buttons paused, resumed or stopped the behaviours {_times(controls)}"
+            " (a row each)."
             if controls
             else ""
         )
         + (
-            f" {unheard} time{'s' if unheard != 1 else ''} the person spoke while the robot "
-            "was speaking, and it could not listen (a row each)."
+            f" {_times(spoken_over).capitalize()} the person spoke over the robot, and it "
+            "stopped talking to listen (a row each)."
+            if spoken_over
+            else ""
+        )
+        + (
+            f" {_times(unheard).capitalize()} the person spoke while the robot was speaking, "
+            "and it could not listen (a row each)."
             if unheard
             else ""
         )
         + (
-            f" It did not understand {len(misses)} time{'s' if len(misses) != 1 else ''}: it "
-            f"asked whether it heard right {asked} time{'s' if asked != 1 else ''} and said "
-            f"it in other words {reprompted} time{'s' if reprompted != 1 else ''}."
+            f" It did not understand {_times(len(misses))}: it asked whether it heard right "
+            f"{_times(asked)} and said it in other words {_times(reprompted)}."
             if misses
             else ""
         )

@@ -305,3 +305,17 @@ def test_a_voice_over_the_robot_before_it_learned_the_room_is_told_as_not_listen
     assert [e for e in lines if e["event"] == "spoken_over"] == []
     [missed] = [e for e in lines if e["event"] == "not_listened"]
     assert "it could not yet tell a voice from its own" in missed["why"]
+
+
+def test_the_report_says_the_robot_stopped_to_listen_not_that_it_could_not(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # the demo's child speaks over the finger game's praise, and is listened to
+    recording = tmp_path / "demo.vest"
+    args = ["run", "--fast", "--scenario", "examples/scenarios/demo.yaml", "--record"]
+    assert main([*args, str(recording)]) == 0
+    assert main(["report", str(recording), "-o", str(tmp_path / "demo.html")]) == 0
+    capsys.readouterr()
+    page = (tmp_path / "demo.html").read_text(encoding="utf-8")
+    assert "1 time the person spoke over the robot, and it stopped talking to listen" in page
+    assert "could not listen" not in page
