@@ -46,6 +46,8 @@ from engine.speech.speaker import SelfHearing
 from engine.speech.vad import SpeechDetector, Utterance
 
 log = logging.getLogger(__name__)
+JOINS_WITHIN_S = 0.02
+"""Spans of not listening this close (seconds) are one: two canceller frames."""
 ALREADY_S = 0.15
 """Speech this soon after the robot fell silent was already under way while it spoke."""
 NotListenedListener = Callable[[float, float, str], None]
@@ -194,9 +196,11 @@ class Listener:
             log.exception("telling a person began to speak failed")
 
     def _not_listening(self, from_s: float, until_s: float) -> None:
-        """It does not listen from ``from_s`` to ``until_s`` (clock seconds)."""
+        """It does not listen from ``from_s`` to ``until_s`` (clock seconds). Pieces in a
+        row are one span: a piece ends less than a canceller's frame early (what waits in
+        it), and those gaps split a deafness into pieces that fell out of the last 16."""
         with self._lock:
-            if self._deaf_spans and self._deaf_spans[-1][1] >= from_s - 1e-6:
+            if self._deaf_spans and self._deaf_spans[-1][1] >= from_s - JOINS_WITHIN_S:
                 self._deaf_spans[-1][1] = until_s
             else:
                 self._deaf_spans = [*self._deaf_spans[-15:], [from_s, until_s]]

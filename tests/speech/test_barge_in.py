@@ -290,16 +290,17 @@ def test_a_therapist_s_phrase_spoken_over_is_not_said_again_over_the_child(
     assert said(lines)[-1] == "My name is H B S 2"
 
 
+@pytest.mark.parametrize("says_at", [0.5, 1.0])  # 1.0: a new user's trial, told nothing
 def test_a_voice_over_the_robot_before_it_learned_the_room_is_told_as_not_listened_to(
-    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], says_at: float
 ) -> None:
     # the robot's very first sentence: its canceller has not yet learned the room
     lines = run(
         tmp_path,
         capsys,
         f"""\
-  - {{at: 0.5, cloud: {{type: say, args: {{text: "{STORY}"}}}}}}
-  - {{at: 1.0, hear: "what is your name"}}
+  - {{at: {says_at}, cloud: {{type: say, args: {{text: "{STORY}"}}}}}}
+  - {{at: {says_at + 0.5}, hear: "what is your name"}}
 """,
     )
     assert [e for e in lines if e["event"] == "spoken_over"] == []
