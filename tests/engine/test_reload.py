@@ -213,13 +213,19 @@ def ticking_until(robot, tree, until_s):
         robot.scheduler.step()
 
 
-def test_a_word_that_came_while_the_old_version_was_busy_is_answered_by_the_new(tmp_path):
+def answering_robot(tmp_path):
+    """A robot whose one tree answers each word, then waits 2 s; and its blackboard."""
     (tmp_path / "answerer.yaml").write_text(textwrap.dedent(ANSWERER))
     clock = VirtualClock()
     board = Blackboard(default_catalogue(), clock)
     board.reset()
     services = simulated_services(clock)
     robot = Robot(load_behaviors([tmp_path]), clock=clock, services=services, blackboard=board)
+    return robot, board
+
+
+def test_a_word_that_came_while_the_old_version_was_busy_is_answered_by_the_new(tmp_path):
+    robot, board = answering_robot(tmp_path)
     [tree] = robot.trees
     board.stage_event("/speech/heard", "hello")
     ticking_until(robot, tree, 0.3)  # it answered, and waits 2 s...
@@ -232,12 +238,7 @@ def test_a_word_that_came_while_the_old_version_was_busy_is_answered_by_the_new(
 
 def test_behaviors_built_afresh_answer_nothing_from_before(tmp_path):
     # the buttons' resume: what happened while paused is not answered late
-    (tmp_path / "answerer.yaml").write_text(textwrap.dedent(ANSWERER))
-    clock = VirtualClock()
-    board = Blackboard(default_catalogue(), clock)
-    board.reset()
-    services = simulated_services(clock)
-    robot = Robot(load_behaviors([tmp_path]), clock=clock, services=services, blackboard=board)
+    robot, board = answering_robot(tmp_path)
     board.stage_event("/speech/heard", "hello")
     board.commit()
     [tree] = robot.trees
