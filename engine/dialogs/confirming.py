@@ -74,7 +74,7 @@ def confirmation(
         mark=rule.mark,
     )
     listen_s = rule.follow_up.listen_s if rule.follow_up is not None else DEFAULT_LISTEN_S
-    return FollowUp((agreed, refused), listen_s)
+    return FollowUp((agreed, refused), listen_s, confirms=True)
 
 
 def with_confirmations(

@@ -107,6 +107,8 @@ class FollowUp:
     rules: tuple[DialogRule, ...]
     listen_s: float = DEFAULT_LISTEN_S
     otherwise: CompiledTemplate | None = None
+    confirms: bool = False
+    """The robot asked whether it heard a rule right (yes or no, at once)."""
 
 
 @dataclass(frozen=True)

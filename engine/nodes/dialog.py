@@ -78,7 +78,7 @@ class Reply(Leaf):
         self.unmatched = ""
         """The words of the utterance not understood just before (joined to the next)."""
         self.unmatched_asked: FollowUp | None = None
-        """The question that utterance answered (a follow-up), if any."""
+        """The rule's question that utterance answered (a follow-up), if any."""
 
     def dialog(self) -> Dialog:
         dialogs = self.ctx.dialogs
@@ -103,7 +103,9 @@ class Reply(Leaf):
         if match is None:
             if heard:  # perhaps the start of a sentence the next utterance ends
                 self.unmatched = " ".join(str(heard).split()[-IN_PARTS_WORDS:])
-                self.unmatched_asked = asked
+                # a rule's question stays open for the rest; a yes or no to whether it
+                # heard right is said at once, or the question has passed
+                self.unmatched_asked = asked if asked is not None and not asked.confirms else None
             self._not_understood(dialog, str(heard or ""), verdict, asked)
             return
         self.misses, self.unmatched = 0, ""

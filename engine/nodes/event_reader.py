@@ -79,13 +79,10 @@ class EventReader:
         """Forget the events already on the key: only later ones count."""
         self.handled_seq = self.node.ctx.blackboard.event_log(self.key).last_seq
 
-    def stands_at(self) -> int:
-        """The number of the last event this node is done with, in order (handled, or
-        passed over): where a new version of it takes up reading."""
-        seq = self.handled_seq
-        while seq + 1 in self._passed_over:
-            seq += 1
-        return seq
+    def take_up(self, place: tuple[int, frozenset[int]]) -> None:
+        """Read on from ``place``, as the old version of this node's tree stood (a reload)."""
+        self.handled_seq, self._passed_over = place[0], set(place[1])
+        self.taken = []
 
     def unread(self) -> bool:
         """Whether events came on the key that this node has not looked at yet."""
@@ -125,11 +122,15 @@ class EventReader:
         return found
 
 
-def where_they_stand(readers: Sequence[EventReader]) -> dict[str, int]:
-    """Each key's event number the slowest of ``readers`` is done with (:meth:`stands_at`):
-    where a new version of their tree takes up reading."""
-    stood: dict[str, int] = {}
+def where_they_stand(readers: Sequence[EventReader]) -> dict[str, tuple[int, frozenset[int]]]:
+    """Each key's place (:meth:`EventReader.place`) for a new version of their tree: the
+    slowest of ``readers``' event number, and every event one of them passes over beyond it
+    (the tree took it in a round that is over)."""
+    places: dict[str, tuple[int, frozenset[int]]] = {}
     for reader in readers:
-        at = reader.stands_at()
-        stood[reader.key] = min(stood.get(reader.key, at), at)
-    return stood
+        seq, passed = reader.place()
+        before, passed_before = places.get(reader.key, (seq, frozenset()))
+        places[reader.key] = (min(seq, before), passed | passed_before)
+    return {
+        key: (seq, frozenset(n for n in passed if n > seq)) for key, (seq, passed) in places.items()
+    }

@@ -180,7 +180,8 @@ class RunningTree:
         self.definition = definition
         self.tree = new_tree
         for node in self._event_readers() if stood else ():
-            node.events.handled_seq = stood.get(node.events.key, node.events.handled_seq)
+            if node.events.key in stood:
+                node.events.take_up(stood[node.events.key])
         actions = self.context.actions
         if actions.taking is not None:  # the new version's priority and patience
             actions.taking = replace(

@@ -38,16 +38,16 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 from engine.clock import Clock
-from engine.media.audio import Audio
-from engine.speech.echo_canceller import EchoCanceller
+from engine.media.audio import SPEECH_RATE_HZ, Audio
+from engine.speech.echo_canceller import FRAME, EchoCanceller
 from engine.speech.recognizer import Recognizer
 from engine.speech.settling import Settling
 from engine.speech.speaker import SelfHearing
 from engine.speech.vad import SpeechDetector, Utterance
 
 log = logging.getLogger(__name__)
-JOINS_WITHIN_S = 0.02
-"""Spans of not listening this close (seconds) are one: two canceller frames."""
+JOINS_WITHIN_S = 2 * FRAME / SPEECH_RATE_HZ
+"""Spans of not listening this close (seconds) are one: two canceller frames (20 ms)."""
 ALREADY_S = 0.15
 """Speech this soon after the robot fell silent was already under way while it spoke."""
 NotListenedListener = Callable[[float, float, str], None]

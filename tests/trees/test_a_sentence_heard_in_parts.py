@@ -74,3 +74,12 @@ def test_an_answer_to_the_robot_s_question_said_in_parts_is_answered() -> None:
     robot.set("/speech/heard", "a dog")
     robot.advance(6.0)
     assert robot.said[-1] == "How lovely! Pets are good friends."
+
+
+def test_a_yes_after_a_hesitation_and_a_sorry_answers_no_old_question() -> None:
+    # "Did you ask my name?" ... "um" gets a sorry: the question has passed
+    robot = TreeHarness.from_file(DIALOG)
+    for words in ("what is your aim", "um", "yes"):
+        robot.set("/speech/heard", words)
+        robot.advance(2.0)
+    assert "My name is H B S 2" not in robot.said

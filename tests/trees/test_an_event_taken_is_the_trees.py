@@ -135,3 +135,34 @@ def test_what_a_tree_took_is_neither_unread_nor_missed(tmp_path: Path) -> None:
         robot.set("/speech/heard", f"burst {n}")
     robot.tick(1)
     assert robot.node_warnings == []
+
+
+GATED = """\
+name: greet
+rate_hz: 10
+root:
+  Selector:
+    - Sequence:
+        - Check: {key: /sensors/touch/any, equals: true}
+        - OnEvent: {key: /speech/heard, equals: "stop"}
+        - Say: {text: "Stopping"}
+    - Sequence:
+        - OnEvent: {key: /speech/heard, one_of: ["hello", "hi"]}
+        - Say: {text: "Hello to you"}
+"""
+
+
+def test_a_reloaded_tree_does_not_answer_again_what_the_old_version_took(
+    tmp_path: Path,
+) -> None:
+    # the first rule is never reached (its Check fails), so its reader lags behind
+    # "chatter", which no rule took: the new version reads on from there, past "hello"
+    robot = robot_with(tmp_path, GATED)
+    robot.tick(2)
+    robot.set("/speech/heard", "chatter")
+    robot.set("/speech/heard", "hello")
+    robot.advance(5.0)
+    definition = robot.running.definition  # the therapist saves the file: a reload
+    robot.running.swap(definition, definition.build(robot.context), keep_events=True)
+    robot.advance(5.0)
+    assert robot.said == ["Hello to you"]
