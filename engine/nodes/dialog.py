@@ -96,7 +96,7 @@ class Reply(Leaf):
         verdict = dialog.judge(str(heard), asked) if heard else None
         match = verdict.match if verdict is not None else None
         parts = ""
-        if match is None and heard and self._ends_a_sentence(dialog, str(heard), asked):
+        if match is None and heard and self._ends_a_sentence():
             match = self._in_parts(dialog, str(heard), asked)
             joined = f"{self.unmatched} {heard}"
             parts = f", heard in parts: {joined!r}" if match is not None else ""
@@ -121,9 +121,9 @@ class Reply(Leaf):
         else:
             self._speak(self.answer)
 
-    def _ends_a_sentence(self, dialog: Dialog, heard: str, asked: FollowUp | None) -> bool:
-        """Whether ``heard`` may end the sentence the utterance before began: that one was
-        not understood either, a moment ago."""
+    def _ends_a_sentence(self) -> bool:
+        """Whether what was heard now may end the sentence the utterance before began: that
+        one was not understood either, a moment ago."""
         return bool(self.unmatched) and self.ctx.clock.now() - self.missed_at_s <= IN_PARTS_WITHIN_S
 
     def _in_parts(self, dialog: Dialog, heard: str, asked: FollowUp | None) -> Match | None:

@@ -278,7 +278,7 @@ class Robot:
         took is reported failed at once (``not carried out: why``): an operator is never
         left waiting for a command that will not be carried out."""
         for tree in trees:
-            for command in tree.take_unread(IOT_INBOX):
+            for command in tree.events.take_unread(IOT_INBOX):
                 if isinstance(command, Mapping) and "id" in command:
                     tree.context.actions.report_result(
                         str(command["id"]), "failed", {"error": f"not carried out: {why}"}

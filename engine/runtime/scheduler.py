@@ -25,7 +25,6 @@ import logging
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
-from typing import Any
 
 import py_trees
 
@@ -34,8 +33,8 @@ from engine.clock import Clock, stopwatch
 from engine.errors import ConfigError
 from engine.loader.tree_definition import TreeDefinition
 from engine.nodes.context import TreeContext
-from engine.nodes.event_reader import where_they_stand
 from engine.runtime.stats import TickStats
+from engine.runtime.tree_events import TreeEvents
 from engine.values.params import RATE_HZ
 
 _log = logging.getLogger("vest.scheduler")
@@ -63,9 +62,7 @@ class RunningTree:
     """One of its keys changed since its round began: it ticks (a new round) as soon as
     its rate allows."""
     last_tick_s: float = -math.inf
-    _round_start: list[tuple[Any, tuple[int, frozenset[int]]]] = field(default_factory=list)
-    _readers: list[Any] = field(default_factory=list)
-    _readers_of: Any = None
+    _events: TreeEvents | None = None
 
     @property
     def name(self) -> str:
@@ -93,61 +90,18 @@ class RunningTree:
         try_again``) rather than let go."""
         return self.definition.when_interrupted == "try_again"
 
-    def round_starts(self) -> None:
-        """A new round begins at this tick: remember which events the tree had handled,
-        so that a round cut short can be tried again with the same events (only for a tree
-        that tries again: the others pay nothing)."""
-        if not self.tries_again:
-            return
-        self._round_start = [(node, node.events.place()) for node in self._event_readers()]
-
-    def _event_readers(self) -> list[Any]:
-        """The nodes that read events (found once a version)."""
-        if self._readers_of is not self.tree.root:
-            self._readers = [n for n in self.tree.root.iterate() if hasattr(n, "events")]
-            self._readers_of = self.tree.root
-        return self._readers
-
-    def round_ends(self) -> None:
-        """The round is over (done, given up, or halted and let go): an event one of its
-        nodes took is the tree's, and no other of its nodes reacts to it later."""
-        readers = self._event_readers()
-        taken: dict[str, list[int]] = {}
-        for node in readers:
-            if node.events.taken:
-                taken.setdefault(node.events.key, []).extend(node.events.taken)
-                node.events.taken = []
-        for node in readers if taken else ():
-            node.events.passes_over(taken.get(node.events.key, ()))
-
-    def take_unread(self, key: str) -> list[Any]:
-        """The values of ``key``'s events that no node of the tree has handled yet, oldest
-        first; from now on its nodes take them as handled (they are the caller's)."""
-        readers = [node for node in self._event_readers() if node.events.key == key]
-        if not any(node.events.unread() for node in readers):  # the usual tick: nothing
-            return []
-        log = self.context.blackboard.event_log(key)
-        took = {seq for node in readers for seq in node.events.taken}  # this round's
-        unread = [
-            event
-            for event in log.after(min(node.events.handled_seq for node in readers))
-            if event.seq not in took and not all(n.events.done_with(event.seq) for n in readers)
-        ]
-        for node in readers:
-            node.events.handled_seq = max(node.events.handled_seq, log.last_seq)
-        return [event.value for event in unread]
-
-    def has_unread_events(self) -> bool:
-        """Whether an event came that a node of the tree has not handled yet (a second
-        pat in one round, a command that came while another was carried out)."""
-        return any(node.events.unread() for node in self._event_readers())
+    @property
+    def events(self) -> TreeEvents:
+        """Its event readers, read as one (found again for a new version)."""
+        if self._events is None or self._events.root is not self.tree.root:
+            self._events = TreeEvents(self.tree.root, self.context.blackboard)
+        return self._events
 
     def try_again(self) -> None:
         """Hand the events of the round that was cut short back to its nodes: at its next
         tick the tree starts the round again as if they had just come (``retrying`` until
         a round ends)."""
-        for node, place in self._round_start:
-            node.events.go_back(place)
+        self.events.back_to_round_start()
         self.retrying = True
 
     def replace(self, definition: TreeDefinition) -> None:
@@ -170,7 +124,7 @@ class RunningTree:
         that came while it was built, one handed back to try again, is not lost)."""
         old_root = self.tree.root
         self.halt("its tree was replaced")
-        stood = where_they_stand([n.events for n in self._event_readers()] if keep_events else [])
+        stood = self.events.places() if keep_events else {}
         for node in old_root.iterate():  # the old nodes' blackboard clients go with them
             for client in node.blackboards:
                 client.unregister(clear=False)
@@ -179,9 +133,7 @@ class RunningTree:
         self.resting = self.woken = False  # the new version's first round starts now
         self.definition = definition
         self.tree = new_tree
-        for node in self._event_readers() if stood else ():
-            if node.events.key in stood:
-                node.events.take_up(stood[node.events.key])
+        self.events.take_up(stood)
         actions = self.context.actions
         if actions.taking is not None:  # the new version's priority and patience
             actions.taking = replace(
@@ -215,7 +167,7 @@ class RunningTree:
                 actions.last_sentence_heard = False
             actions.settle()
             if not tried_again:
-                self.round_ends()
+                self.events.round_ends()
 
 
 class Scheduler:
@@ -375,8 +327,8 @@ class Scheduler:
         now = self.clock.now()  # hooks and earlier trees of this step count as lateness
         lateness = now - tree.next_deadline_s
         fresh = tree.status != py_trees.common.Status.RUNNING  # a round starts: sees it all
-        if fresh:
-            tree.round_starts()
+        if fresh and tree.tries_again:  # only a tree that tries again remembers where it began
+            tree.events.round_starts()
         started = self._measure()
         try:
             tree.tree.tick()
@@ -388,11 +340,11 @@ class Scheduler:
         if status == py_trees.common.Status.FAILURE:  # gave up half-way: nothing left raised
             tree.context.actions.settle(lights=False)  # a timed light goes out by itself
             tree.retrying = False
-            tree.round_ends()
+            tree.events.round_ends()
         elif status == py_trees.common.Status.SUCCESS:  # done as the tree meant
             tree.context.actions.forget()
             tree.retrying = False
-            tree.round_ends()
+            tree.events.round_ends()
         for observer in self.after_tick:
             try:
                 observer(tree)
@@ -406,7 +358,7 @@ class Scheduler:
         # round that acted (SUCCESS) it ticks once more, so its nodes say they wait again
         waits = status == py_trees.common.Status.FAILURE and not tree.retrying
         if tree.definition.wake_on and waits and not tree.woken:
-            tree.woken = tree.has_unread_events()  # one event a round: the next one, next
+            tree.woken = tree.events.unread()  # one event a round: the next one, next
         tree.resting = bool(tree.definition.wake_on) and waits and not tree.woken
         if tree.next_deadline_s <= now:
             behind = math.floor((now - tree.origin_s) / tree.period_s) + 1

@@ -15,13 +15,17 @@ from engine.testing import TreeHarness
 DIALOG = Path(__file__).resolve().parents[2] / "trees" / "dialog.yaml"
 
 
-def heard_in_two_parts(first: str, second: str, pause_s: float) -> list[str]:
+def heard_in_turn(*utterances: tuple[str, float]) -> list[str]:
+    """What the robot said to each utterance, each followed by that many seconds."""
     robot = TreeHarness.from_file(DIALOG)
-    robot.set("/speech/heard", first)
-    robot.advance(pause_s)
-    robot.set("/speech/heard", second)
-    robot.advance(6.0)
+    for words, then_s in utterances:
+        robot.set("/speech/heard", words)
+        robot.advance(then_s)
     return robot.said
+
+
+def heard_in_two_parts(first: str, second: str, pause_s: float) -> list[str]:
+    return heard_in_turn((first, pause_s), (second, 6.0))
 
 
 def test_the_rest_of_a_sentence_is_answered_with_its_start() -> None:
@@ -56,30 +60,18 @@ def test_an_unrelated_start_does_not_turn_a_question_into_another_answer() -> No
 
 
 def test_only_the_part_just_before_is_joined() -> None:
-    robot = TreeHarness.from_file(DIALOG)
-    for part in ("tell me", "and", "so", "well"):  # four sorries: no sentence goes on
-        robot.set("/speech/heard", part)
-        robot.advance(4.5)
-    robot.set("/speech/heard", "your name")
-    robot.advance(6.0)
-    assert robot.said[-1] == "Did you ask my name?"  # not "tell me ... your name"
+    parts = [(part, 4.5) for part in ("tell me", "and", "so", "well")]  # four sorries
+    said = heard_in_turn(*parts, ("your name", 6.0))
+    assert said[-1] == "Did you ask my name?"  # not "tell me ... your name"
 
 
 def test_an_answer_to_the_robot_s_question_said_in_parts_is_answered() -> None:
-    robot = TreeHarness.from_file(DIALOG)
-    robot.set("/speech/heard", "do you like dogs")
-    robot.advance(4.0)  # "I love animals. Do you have a pet?"
-    robot.set("/speech/heard", "i have")
-    robot.advance(2.0)
-    robot.set("/speech/heard", "a dog")
-    robot.advance(6.0)
-    assert robot.said[-1] == "How lovely! Pets are good friends."
+    # "I love animals. Do you have a pet?" ... "i have" ... "a dog"
+    said = heard_in_turn(("do you like dogs", 4.0), ("i have", 2.0), ("a dog", 6.0))
+    assert said[-1] == "How lovely! Pets are good friends."
 
 
 def test_a_yes_after_a_hesitation_and_a_sorry_answers_no_old_question() -> None:
     # "Did you ask my name?" ... "um" gets a sorry: the question has passed
-    robot = TreeHarness.from_file(DIALOG)
-    for words in ("what is your aim", "um", "yes"):
-        robot.set("/speech/heard", words)
-        robot.advance(2.0)
-    assert "My name is H B S 2" not in robot.said
+    said = heard_in_turn(("what is your aim", 2.0), ("um", 2.0), ("yes", 2.0))
+    assert "My name is H B S 2" not in said

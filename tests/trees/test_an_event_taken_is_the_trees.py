@@ -129,7 +129,7 @@ def test_what_a_tree_took_is_neither_unread_nor_missed(tmp_path: Path) -> None:
     robot.set("/speech/heard", "three")
     robot.blackboard.commit()
     # what a pause or the session's end reports as not carried out
-    assert robot.running.take_unread("/speech/heard") == ["three"]
+    assert robot.running.events.take_unread("/speech/heard") == ["three"]
 
     for n in range(32):  # a burst: "two" leaves the key's last 32, and was the tree's
         robot.set("/speech/heard", f"burst {n}")
