@@ -7,8 +7,9 @@ speaker was given, placed on the clock, :class:`~engine.speech.speaker.SelfHeari
 with WebRTC's acoustic echo canceller (AEC3, in its audio processing module, from the
 ``livekit`` wheel: Apache-2.0). It learns the room's echo path (delay, loudness,
 reverberation) as the robot speaks and keeps learning; a little of the echo remains (its
-residual, about 30 dB below the echo), which the listener's stricter threshold while the
-robot speaks keeps from being taken for a person (:mod:`engine.speech.vad`).
+residual, about 30 dB below the echo), which :mod:`engine.speech.residual_echo` keeps from
+being taken for a person: it is the robot's voice still, and a voice detector finds speech
+in it.
 
 Measured on the same recordings against SpeexDSP's canceller (``pyaec``): 32 dB of echo
 removed against 16, 4 % of the residual's frames over the VAD's threshold against 26 %
@@ -21,6 +22,8 @@ untouched and costs nothing: an idle robot listens as cheaply as it did without 
 """
 
 from __future__ import annotations
+
+from typing import NamedTuple
 
 import numpy as np
 
@@ -40,6 +43,14 @@ LEARNING_S = 0.5
 LEARNS_AT_LEAST_S = 1.5
 """It is not judged learned before it has heard this much of the robot's voice."""
 SCALE = 32767.0
+
+
+class Cancelled(NamedTuple):
+    """A piece of the microphone's audio with the robot's voice taken out, and what the
+    speaker played over the same samples (16 kHz, as long as ``heard``)."""
+
+    heard: Samples
+    played: Samples
 
 
 class NoEchoCancellerError(RuntimeError):
@@ -85,10 +96,11 @@ class EchoCanceller:
         """Whether the robot has been silent long enough that the audio passes untouched."""
         return self._silent_frames >= RESTS_AFTER_S * 100
 
-    def cancel(self, microphone: Samples, reference: Samples) -> Samples:
+    def cancel(self, microphone: Samples, reference: Samples) -> Cancelled:
         """The microphone's audio with the reference's echo taken out: the same number of
-        samples as given, less :attr:`lag_samples` waiting, plus those that waited.
-        ``reference``: what the speaker played over the same samples (same length)."""
+        samples as given, less :attr:`lag_samples` waiting, plus those that waited; with
+        the reference over those very samples. ``reference``: what the speaker played
+        over the same samples as ``microphone`` (same length)."""
         if len(reference) != len(microphone):
             raise ValueError("the reference must be as long as the microphone's piece")
         self._microphone = np.concatenate([self._microphone, microphone.astype(np.float32)])
@@ -109,7 +121,7 @@ class EchoCanceller:
             left = out[start : start + FRAME] = self._frame(heard, far_frame)
             if speaking and not self._learned:
                 self._learn(heard, left)
-        return out
+        return Cancelled(out, far)
 
     def _learn(self, heard: Samples, left: Samples) -> None:
         """Average how much of the robot's voice is taken out; learned past LEARNED_DB."""

@@ -16,11 +16,12 @@ shortens the wait for silence (:meth:`~engine.speech.vad.SpeechDetector.whole_tu
 While the robot speaks it keeps listening, and never answers its own voice: an echo
 canceller (:mod:`engine.speech.echo_canceller`) takes what the speaker plays (known from
 :class:`~engine.speech.speaker.SelfHearing`) out of the microphone's audio, and the
-detector is stricter while the robot speaks and just after
-(:attr:`~engine.speech.vad.SpeechDetector.strict`). A person who speaks over the robot is
-heard like anyone else, and told at once to ``on_barge_in(onset_s)`` (when their voice
-began, clock seconds), so the robot can stop talking. A voice that begins while the robot
-is silent is told to ``on_voice(at_s)``, so the robot starts no sentence over it.
+detector, while the robot speaks and just after, starts speech only on sound the robot's
+voice cannot explain (:attr:`~engine.speech.vad.SpeechDetector.strict`). A person who
+speaks over the robot is heard like anyone else, and told at once to
+``on_barge_in(onset_s)`` (when their voice began, clock seconds), so the robot can stop
+talking. A voice that begins while the robot is silent is told to ``on_voice(at_s)``, so
+the robot starts no sentence over it.
 
 Without a canceller the microphone is ignored while the robot speaks. Someone who speaks
 over it is then not heard; what can be known of it is told to
@@ -161,14 +162,17 @@ class Listener:
         robot's is told to ``on_barge_in``."""
         assert self.canceller is not None
         reference = self.self_hearing.reference(starts_at_s, len(audio.samples))
-        samples = self.canceller.cancel(audio.samples, reference)
+        samples, played = self.canceller.cancel(audio.samples, reference)
         ends_at_s -= self.canceller.lag_samples / audio.rate_hz  # still in the canceller
         self.detector.strict = speaking
-        self.detector.held = speaking and not self.canceller.learned
+        self.detector.echo_learned = self.canceller.learned
+        self.detector.held = speaking and not (
+            self.canceller.learned and self.detector.residual_echo.learned
+        )
         if self.detector.held:  # nobody can be told from the robot yet: not listening
             self._not_listening(starts_at_s, ends_at_s)
         was_speech = self.detector.in_speech
-        utterances = self.detector.feed(samples)
+        utterances = self.detector.feed(samples, played)
         if not speaking:
             self._voice_began(was_speech, utterances, ends_at_s)
         onset = self.detector.take_onset()

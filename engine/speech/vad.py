@@ -35,6 +35,7 @@ from typing import Protocol
 import numpy as np
 
 from engine.media.audio import SPEECH_RATE_HZ, Audio, Samples
+from engine.speech.residual_echo import ResidualEcho
 
 FRAME_SAMPLES = 512
 FRAME_S = FRAME_SAMPLES / SPEECH_RATE_HZ
@@ -64,15 +65,33 @@ class SileroVad:
         self._detector.reset()
 
 
-BARGE_IN_THRESHOLD = 0.5
-"""While the robot speaks, a frame is a person's voice from this probability up, as at any
-time: the echo canceller leaves too little of the robot's own voice to reach it once it
-has learned the room (until then nobody may start, :attr:`SpeechDetector.held`)."""
+BARGE_IN_THRESHOLD = 0.1
+"""While the robot speaks, a run of frames the robot's voice cannot explain
+(:class:`~engine.speech.residual_echo.ResidualEcho`) starts speech only if the VAD gives
+one of the frames of :data:`VOICED_WITHIN_S` at least this: a knock or a hum it finds no
+speech in at all does not stop the robot. (The VAD alone cannot tell: what the canceller
+leaves of the robot's voice is speech too, and a child's first words, partly taken out
+with the echo, score low.)"""
+BARGE_IN_PAUSE_THRESHOLD = 0.5
+"""... and in a pause of the robot's voice
+(:attr:`~engine.speech.residual_echo.ResidualEcho.pausing`), where the canceller lets the
+room's tail through as it lets go of the voice, at least this (as when the robot is
+silent): in a loud room that rings for 0.8 s, its tail stopped the robot at 0.1."""
+VOICED_WITHIN_S = 0.192
+"""The VAD's sign of a voice counts from this long (six frames) before the run's end: a
+child's first sounds under the robot's voice are quiet."""
 BARGE_IN_S = 0.064
-"""While the robot speaks, speech starts only after this long (two frames) in a row at
-:data:`BARGE_IN_THRESHOLD`: a click of the robot's echo is shorter. Chosen on the tuning
-children of bench/children_speech.py (bench/bench_barge_in.py): longer runs or a higher
-threshold stopped the robot later and never less often for its own voice."""
+"""While the robot speaks, speech starts only after this long (two frames) in a row that
+the robot's voice cannot explain: a click of its echo is shorter. Chosen, with
+:data:`BARGE_IN_THRESHOLD`, :data:`VOICED_WITHIN_S` and the thresholds of
+:mod:`~engine.speech.residual_echo`, on the tuning children of bench/children_speech.py
+(``bench/bench_barge_in.py --tuning``); the bench measures on the others."""
+
+PRE_ROLL_OVER_ROBOT_S = 0.192
+"""Speech that starts over the robot's voice keeps only this much from before the frame
+that started it (``pre_roll_s`` otherwise): further back, what the canceller let through
+is the robot's words, which the recognizer would take for the person's ("puppies" over
+"...animals?" was heard as "apis")."""
 
 REOPEN_FRESH_S = 1.0
 """The VAD's network starts afresh when the room rises above its floor after this long
@@ -141,14 +160,22 @@ class SpeechDetector:
     """Between utterances, frames no louder than the room's noise are not asked about
     (None: every frame is)."""
     strict: bool = False
-    """The robot is speaking: speech starts only at :data:`BARGE_IN_THRESHOLD`, held
-    :data:`BARGE_IN_S` (set by the listener for each piece it feeds)."""
+    """The robot is speaking: speech starts only after :data:`BARGE_IN_S` of frames the
+    robot's voice cannot explain (:attr:`residual_echo`), in which the VAD reaches
+    :data:`BARGE_IN_THRESHOLD` (set by the listener for each piece it feeds)."""
+    residual_echo: ResidualEcho = field(default_factory=ResidualEcho)
+    """Tells, while :attr:`strict`, the frames that hold more than the robot's voice (fed
+    the reference with each piece: :meth:`feed`)."""
+    echo_learned: bool = True
+    """The echo canceller has learned the room: :attr:`residual_echo` learns the residue
+    from what it leaves (set by the listener)."""
     held: bool = False
     """No speech may start now (the robot speaks, and its echo cannot yet be told from a
     person); speech already started goes on."""
 
     def __post_init__(self) -> None:
         self._pending = np.zeros(0, dtype=np.float32)
+        self._pending_played = np.zeros(0, dtype=np.float32)
         self._history: deque[Samples] = deque(maxlen=max(1, round(self.pre_roll_s / FRAME_S)))
         self._speech: list[Samples] = []
         self._voiced_frames = 0
@@ -159,7 +186,9 @@ class SpeechDetector:
         self._overtaken: deque[Utterance] = deque(maxlen=4)  # drafts speech went on after
         self._lock = threading.Lock()  # whole_turn comes from the listener's worker
         self._below_floor = 0  # frames in a row the noise floor kept from the VAD
-        self._strict_run = 0  # frames in a row at the barge-in threshold
+        self._strict_run = 0  # frames in a row the robot's voice cannot explain
+        # whether the VAD found some voice, in each of the last frames over the robot's voice
+        self._strict_voiced: deque[bool] = deque(maxlen=round(VOICED_WITHIN_S / FRAME_S))
         self._onset: int | None = None
         self.position = 0
         """Samples taken so far."""
@@ -175,6 +204,7 @@ class SpeechDetector:
         self._history.clear()
         self._speech = []
         self._voiced_frames = self._quiet_frames = self._strict_run = 0
+        self._strict_voiced.clear()
         self._forget_draft(overtaken=True)
 
     def take_onset(self) -> int | None:
@@ -203,14 +233,20 @@ class SpeechDetector:
                 self._overtaken.append(self._draft)
             self._drafted, self._whole, self._draft = False, False, None
 
-    def feed(self, samples: Samples) -> list[Utterance]:
-        """Take more of the stream; every utterance that ended in it."""
+    def feed(self, samples: Samples, played: Samples | None = None) -> list[Utterance]:
+        """Take more of the stream; every utterance that ended in it. ``played``: what the
+        robot's speaker played over the same samples (None: silence)."""
+        if played is None:
+            played = np.zeros(len(samples), dtype=np.float32)
         self._pending = np.concatenate([self._pending, samples.astype(np.float32)])
+        self._pending_played = np.concatenate([self._pending_played, played.astype(np.float32)])
         ended: list[Utterance] = []
         while len(self._pending) >= FRAME_SAMPLES:
             frame, self._pending = self._pending[:FRAME_SAMPLES], self._pending[FRAME_SAMPLES:]
+            played_frame = self._pending_played[:FRAME_SAMPLES]
+            self._pending_played = self._pending_played[FRAME_SAMPLES:]
             self.position += FRAME_SAMPLES
-            utterance = self._frame(frame)
+            utterance = self._frame(frame, played_frame)
             if utterance is not None:
                 ended.append(utterance)
         return ended
@@ -219,14 +255,21 @@ class SpeechDetector:
         """The end of the stream ends an utterance still being spoken."""
         return self._end() if self._speech else None
 
-    def _frame(self, frame: Samples) -> Utterance | None:
+    def _frame(self, frame: Samples, played: Samples) -> Utterance | None:
         probability = self._probability(frame)
+        unexplained = self.strict and self.residual_echo.unexplained(
+            frame, played, settled=self.echo_learned
+        )
         if not self._speech:
-            if self._starts(probability):
+            if self._starts(probability, unexplained):
                 if self.strict:  # over the robot's voice: from the run's first frame
                     self._onset = self.position - self._strict_run * FRAME_SAMPLES
-                self._speech = [*self._history, frame]
+                kept = list(self._history)
+                if self.strict:  # before the run: the robot's words, not the person's
+                    kept = kept[len(kept) - round(PRE_ROLL_OVER_ROBOT_S / FRAME_S) :]
+                self._speech = [*kept, frame]
                 self._voiced_frames, self._quiet_frames, self._strict_run = 1, 0, 0
+                self._strict_voiced.clear()
             else:
                 self._history.append(frame)
             return None
@@ -247,17 +290,22 @@ class SpeechDetector:
             return self._end()
         return None
 
-    def _starts(self, probability: float) -> bool:
+    def _starts(self, probability: float, unexplained: bool) -> bool:
         """Whether a frame of this probability starts speech (over the robot's voice, the
-        last of a run of them)."""
-        if self.held:
-            self._strict_run = 0
-            return False
+        last of a run of :data:`BARGE_IN_S` the robot's voice cannot explain, with some
+        voice found within :data:`VOICED_WITHIN_S`)."""
         if not self.strict:
             self._strict_run = 0
-            return probability >= self.start_threshold
-        self._strict_run = self._strict_run + 1 if probability >= BARGE_IN_THRESHOLD else 0
-        return self._strict_run >= round(BARGE_IN_S / FRAME_S)
+            self._strict_voiced.clear()
+            return not self.held and probability >= self.start_threshold
+        pausing = self.residual_echo.pausing  # the room's tail: the VAD judges as ever
+        threshold = BARGE_IN_PAUSE_THRESHOLD if pausing else BARGE_IN_THRESHOLD
+        self._strict_voiced.append(probability >= threshold)
+        if self.held or not unexplained:
+            self._strict_run = 0
+            return False
+        self._strict_run += 1
+        return self._strict_run >= round(BARGE_IN_S / FRAME_S) and any(self._strict_voiced)
 
     def _probability(self, frame: Samples) -> float:
         """The VAD's probability; 0 for the room's noise between utterances."""

@@ -244,7 +244,8 @@ def test_a_yes_said_before_the_question_began_answers_no_question(
     [stop] = [e for e in lines if e["event"] == "spoken_over"]
     assert stop["saying"] == "I love animals. Do you have a pet?"
     assert "How lovely! Pets are good friends." not in said(lines)
-    assert [e["text"] for e in lines if e["event"] == "not_understood"] == ["Yes,"]
+    not_understood = [e["text"] for e in lines if e["event"] == "not_understood"]
+    assert [text.strip(".,!?").lower() for text in not_understood] == ["yes"]
 
 
 def test_the_robot_starts_no_sentence_while_a_child_is_talking(
