@@ -3,8 +3,9 @@
 Record the robot's microphone while its speaker plays a sentence (the hardware guide says
 how). This measures the path from speaker to microphone (delay, loudness, the room's
 reverberation), prints it as a scenario's ``echo:`` event, so the simulated vest meets the
-same room, and runs the robot's listening (the echo canceller, the stricter start while it
-speaks) over the recording: a robot that would stop for its own voice here is told so.
+same room, and runs the robot's listening (the echo canceller, the residual-echo check
+while it speaks) over the recording: a robot that would stop for its own voice here is
+told so.
 """
 
 from __future__ import annotations

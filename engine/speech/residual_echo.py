@@ -18,11 +18,15 @@ heard) and above the room's noise. A frame holds a voice that is not the robot's
 :data:`UNEXPLAINED_SHARE` of its energy is in unexplained bins
 (:meth:`ResidualEcho.unexplained`).
 
-Measured on bench/bench_barge_in.py's tuning children (the thresholds were chosen there):
-none of the robot's 368 sentences, at every volume and echo path of the bench, was taken
-for another voice, where the detector alone stopped the robot 4 times; a child starting
-under the robot is found sooner than the voice detector alone finds them, at any level.
-Its cost: two 512-point FFTs a frame while the robot speaks (about 0.3 % of a core).
+In a pause of the robot's voice, where the canceller lets the room's tail through as it
+lets go of the voice, the level is not learned, and the voice detector is asked as when
+the robot is silent (:attr:`ResidualEcho.pausing`).
+
+The thresholds were chosen with ``bench/bench_barge_in.py --tuning``; its figures on the
+held-back children are in docs/speech.md (none of the robot's 368 sentences stopped it,
+where the voice detector alone stopped it 3 times; a child 12 dB under the robot's echo
+stops it within 0.23 s, p90). Its cost: two 512-point FFTs a frame, only while the robot
+speaks.
 """
 
 from __future__ import annotations
@@ -70,15 +74,20 @@ UNEXPLAINED_SHARE = 0.2
 RESIDUE_QUANTILE = 0.99
 """The residue's level is this quantile of the output's ratio to the reference."""
 FIRST_FRAMES = 8
-"""The residue's level is set once this many frames of the robot's voice (0.26 s) were
-learned: first from what the canceller leaves while it still learns the room (high: few
-sounds are unexplained), then again from what it leaves once settled (nobody may start
-over the robot before then)."""
+"""The residue's level is first set once this many frames of the robot's voice (0.26 s)
+were learned, from what the canceller leaves while it still learns the room (high: few
+sounds are unexplained; nobody may start over the robot before it has settled)."""
+SETTLED_FRAMES = 32
+"""Once the canceller has settled, the level is set again from what it leaves then, as
+soon as this many frames (1 s) of it were learned: fewer let a quiet stretch of the
+robot's voice set it too low."""
 RECENT_VOICE_FRAMES = 64
 """Then it is the quantile over the last 2 s of the robot's voice: it follows the
 canceller as it settles further, or as the room changes."""
 NOISE_RISES_PER_FRAME = 10 ** (2.0 * FRAME_SAMPLES / SPEECH_RATE_HZ / 10)
 """The room's noise estimate rises 2 dB a second when the room grows louder for good."""
+NOISE_FLOOR = 1e-12
+"""The least the room's noise in a bin is taken to be (power: a silent microphone)."""
 LEARNS_OVER_NOISE = 30.0
 """The level is learned in the bins where the reference stands this far (15 dB) above
 the room's noise in the output: where the residue can be heard."""
@@ -129,6 +138,8 @@ class ResidualEcho:
         if settled and not self._settled:
             self._level.forget_frames()
         self._settled = settled
+        if not (np.all(np.isfinite(heard)) and np.all(np.isfinite(played))):
+            return False  # a broken frame teaches nothing and tells nothing
         output = self._spectrum(heard)
         playing = self._spectrum(played)
         reference = self._spread(playing)
@@ -167,6 +178,7 @@ class ResidualEcho:
         """The room's noise in each bin: the band's mean power (steadier than one bin's)
         falls at once to a quieter frame's and rises slowly."""
         mean = np.bincount(self._band, weights=output, minlength=BANDS) / self._band_bins
+        mean = np.maximum(mean, NOISE_FLOOR)  # a silent frame must not hold it at 0
         if self._noise is None:
             self._noise = mean
         else:
@@ -184,12 +196,15 @@ class _Level:
         self._band = band
         self.log_level = np.full(BANDS, math.log(STARTING_LEVEL))
         self.learned = False
+        self._needed = FIRST_FRAMES  # frames learned before the level is set
         # the recent frames: the band of each bin heard, and its ratio (nepers)
         self._frames: deque[tuple[npt.NDArray[np.intp], Power]] = deque(maxlen=RECENT_VOICE_FRAMES)
 
     def forget_frames(self) -> None:
-        """Forget the frames learned so far (their level stays until new frames set it)."""
+        """Forget the frames learned so far: their level stays until
+        :data:`SETTLED_FRAMES` new ones set it."""
         self._frames.clear()
+        self._needed = SETTLED_FRAMES
 
     def level(self) -> Power:
         """The level of each bin (power ratio)."""
@@ -199,7 +214,7 @@ class _Level:
     def learn(self, output: Power, reference: Power, bins: npt.NDArray[np.bool_]) -> None:
         """One more frame: the output and reference in the ``bins`` heard."""
         self._frames.append((self._band[bins], np.log(output + 1e-20) - np.log(reference)))
-        if len(self._frames) < FIRST_FRAMES:
+        if len(self._frames) < self._needed:
             return
         bands = np.concatenate([bands for bands, _ in self._frames])
         ratios = np.concatenate([ratios for _, ratios in self._frames])

@@ -65,7 +65,7 @@ class SileroVad:
         self._detector.reset()
 
 
-BARGE_IN_THRESHOLD = 0.1
+BARGE_IN_THRESHOLD = 0.2
 """While the robot speaks, a run of frames the robot's voice cannot explain
 (:class:`~engine.speech.residual_echo.ResidualEcho`) starts speech only if the VAD gives
 one of the frames of :data:`VOICED_WITHIN_S` at least this: a knock or a hum it finds no
@@ -75,8 +75,9 @@ with the echo, score low.)"""
 BARGE_IN_PAUSE_THRESHOLD = 0.5
 """... and in a pause of the robot's voice
 (:attr:`~engine.speech.residual_echo.ResidualEcho.pausing`), where the canceller lets the
-room's tail through as it lets go of the voice, at least this (as when the robot is
-silent): in a loud room that rings for 0.8 s, its tail stopped the robot at 0.1."""
+room's tail through as it lets go of the voice, at least this in every frame of the run
+(as when the robot is silent): in rooms that ring for 0.8 s, the tail of a long sentence's
+first pause stopped the robot at less."""
 VOICED_WITHIN_S = 0.192
 """The VAD's sign of a voice counts from this long (six frames) before the run's end: a
 child's first sounds under the robot's voice are quiet."""
@@ -86,12 +87,6 @@ the robot's voice cannot explain: a click of its echo is shorter. Chosen, with
 :data:`BARGE_IN_THRESHOLD`, :data:`VOICED_WITHIN_S` and the thresholds of
 :mod:`~engine.speech.residual_echo`, on the tuning children of bench/children_speech.py
 (``bench/bench_barge_in.py --tuning``); the bench measures on the others."""
-
-PRE_ROLL_OVER_ROBOT_S = 0.192
-"""Speech that starts over the robot's voice keeps only this much from before the frame
-that started it (``pre_roll_s`` otherwise): further back, what the canceller let through
-is the robot's words, which the recognizer would take for the person's ("puppies" over
-"...animals?" was heard as "apis")."""
 
 REOPEN_FRESH_S = 1.0
 """The VAD's network starts afresh when the room rises above its floor after this long
@@ -189,6 +184,9 @@ class SpeechDetector:
         self._strict_run = 0  # frames in a row the robot's voice cannot explain
         # whether the VAD found some voice, in each of the last frames over the robot's voice
         self._strict_voiced: deque[bool] = deque(maxlen=round(VOICED_WITHIN_S / FRAME_S))
+        self._run_in_pause = False  # a frame of the run was in a pause of the robot's voice
+        # whether the VAD heard a voice as at any time, in each frame of the run's length
+        self._pause_voiced: deque[bool] = deque(maxlen=round(BARGE_IN_S / FRAME_S))
         self._onset: int | None = None
         self.position = 0
         """Samples taken so far."""
@@ -204,7 +202,9 @@ class SpeechDetector:
         self._history.clear()
         self._speech = []
         self._voiced_frames = self._quiet_frames = self._strict_run = 0
+        self._run_in_pause = False
         self._strict_voiced.clear()
+        self._pause_voiced.clear()
         self._forget_draft(overtaken=True)
 
     def take_onset(self) -> int | None:
@@ -264,12 +264,11 @@ class SpeechDetector:
             if self._starts(probability, unexplained):
                 if self.strict:  # over the robot's voice: from the run's first frame
                     self._onset = self.position - self._strict_run * FRAME_SAMPLES
-                kept = list(self._history)
-                if self.strict:  # before the run: the robot's words, not the person's
-                    kept = kept[len(kept) - round(PRE_ROLL_OVER_ROBOT_S / FRAME_S) :]
-                self._speech = [*kept, frame]
+                self._speech = [*self._history, frame]
                 self._voiced_frames, self._quiet_frames, self._strict_run = 1, 0, 0
+                self._run_in_pause = False
                 self._strict_voiced.clear()
+                self._pause_voiced.clear()
             else:
                 self._history.append(frame)
             return None
@@ -293,19 +292,25 @@ class SpeechDetector:
     def _starts(self, probability: float, unexplained: bool) -> bool:
         """Whether a frame of this probability starts speech (over the robot's voice, the
         last of a run of :data:`BARGE_IN_S` the robot's voice cannot explain, with some
-        voice found within :data:`VOICED_WITHIN_S`)."""
+        voice found within :data:`VOICED_WITHIN_S`; a run that began or passed through a
+        pause of the robot's voice, with a voice in every frame of it)."""
         if not self.strict:
-            self._strict_run = 0
+            self._strict_run, self._run_in_pause = 0, False
             self._strict_voiced.clear()
+            self._pause_voiced.clear()
             return not self.held and probability >= self.start_threshold
-        pausing = self.residual_echo.pausing  # the room's tail: the VAD judges as ever
-        threshold = BARGE_IN_PAUSE_THRESHOLD if pausing else BARGE_IN_THRESHOLD
-        self._strict_voiced.append(probability >= threshold)
+        self._strict_voiced.append(probability >= BARGE_IN_THRESHOLD)
+        self._pause_voiced.append(probability >= BARGE_IN_PAUSE_THRESHOLD)
         if self.held or not unexplained:
-            self._strict_run = 0
+            self._strict_run, self._run_in_pause = 0, False
             return False
         self._strict_run += 1
-        return self._strict_run >= round(BARGE_IN_S / FRAME_S) and any(self._strict_voiced)
+        self._run_in_pause = self._run_in_pause or self.residual_echo.pausing
+        if self._strict_run < round(BARGE_IN_S / FRAME_S):
+            return False
+        if self._run_in_pause:  # the room's tail: the VAD judges as ever
+            return all(self._pause_voiced)
+        return any(self._strict_voiced)
 
     def _probability(self, frame: Samples) -> float:
         """The VAD's probability; 0 for the room's noise between utterances."""

@@ -9,7 +9,7 @@ import numpy as np
 
 from engine.media.audio import SPEECH_RATE_HZ, Samples
 from engine.speech.residual_echo import FIRST_FRAMES, FRAME_SAMPLES, ResidualEcho
-from engine.speech.vad import BARGE_IN_THRESHOLD, SpeechDetector
+from engine.speech.vad import BARGE_IN_PAUSE_THRESHOLD, BARGE_IN_THRESHOLD, SpeechDetector
 
 RATE = SPEECH_RATE_HZ
 
@@ -110,13 +110,16 @@ def test_the_room_s_noise_alone_is_not_another_voice() -> None:
 
 
 class Told(ResidualEcho):
-    """A residual-echo check that says, frame after frame, what it is told to."""
+    """A residual-echo check that says, frame after frame, what it is told to (and
+    whether the robot's voice pauses there)."""
 
-    def __init__(self, verdicts: list[bool]) -> None:
+    def __init__(self, verdicts: list[bool], pauses: list[bool] | None = None) -> None:
         super().__init__()
         self.verdicts = iter(verdicts)
+        self.pauses = iter(pauses or [False] * len(verdicts))
 
     def unexplained(self, heard: Samples, played: Samples, *, settled: bool = True) -> bool:
+        self.pausing = next(self.pauses)
         return next(self.verdicts)
 
 
@@ -133,10 +136,13 @@ class SteadyVad:
         pass
 
 
-def over_the_robot(verdicts: list[bool], probability: float = 0.9) -> int | None:
+def over_the_robot(
+    verdicts: list[bool], probability: float = 0.9, pauses: list[bool] | None = None
+) -> int | None:
     """Where speech began over the robot's voice, fed a frame per verdict (None: it did not)."""
+    told = Told(verdicts, pauses)
     detector = SpeechDetector(
-        SteadyVad(probability), noise_floor=None, residual_echo=Told(verdicts), strict=True
+        SteadyVad(probability), noise_floor=None, residual_echo=told, strict=True
     )
     frames = np.full(len(verdicts) * FRAME_SAMPLES, 0.01, np.float32)
     detector.feed(frames, played=frames)
@@ -157,3 +163,12 @@ def test_while_the_robot_is_not_speaking_speech_starts_as_ever() -> None:
     detector = SpeechDetector(SteadyVad(0.9), noise_floor=None, residual_echo=Told([]))
     assert detector.feed(np.full(20 * FRAME_SAMPLES, 0.01, np.float32)) == []
     assert detector.in_speech and detector.take_onset() is None
+
+
+def test_in_the_robot_s_pauses_its_room_s_tail_needs_a_voice_as_clear_as_in_silence() -> None:
+    # where the robot pauses, the canceller lets the room's ringing through: what it
+    # cannot explain there must sound like a voice in every frame, as to a silent robot
+    unexplained, paused = [False, True, True, False], [False, True, False, False]
+    assert over_the_robot(unexplained, probability=0.4, pauses=paused) is None
+    assert over_the_robot(unexplained, probability=BARGE_IN_PAUSE_THRESHOLD, pauses=paused) == 512
+    assert over_the_robot(unexplained, probability=0.4) == 512  # the robot did not pause
