@@ -288,7 +288,9 @@ def test_a_therapist_s_phrase_spoken_over_is_not_said_again_over_the_child(
     assert [e["args"].get("text") for e in hello if e["action"] == "say"] == [
         "Hello! I am happy to see you."
     ]  # once: cut short, never again from the top
-    assert said(lines)[-1] == "My name is H B S 2"
+    # the child's question is answered, or, its start heard through the robot's voice
+    # ("what is her name"), the robot asks whether it was the one about its name
+    assert said(lines)[-1] in ("My name is H B S 2", "Did you ask my name?")
 
 
 @pytest.mark.parametrize("says_at", [0.5, 1.0])  # 1.0: a new user's trial, told nothing
