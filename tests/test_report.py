@@ -12,7 +12,8 @@ from engine.cli import main
 from engine.privacy.site_data import SiteKey
 from engine.recording.moments import outages
 from engine.recording.replay import Recording
-from engine.recording.report import person_moments, printable
+from engine.recording.report import person_moments
+from engine.recording.report_page import printable
 
 ROOT = Path(__file__).resolve().parents[1]
 

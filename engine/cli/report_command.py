@@ -20,7 +20,8 @@ from engine.errors import ConfigError, UsageError
 from engine.privacy.site import Site
 from engine.recording.progress import SessionSummary, progress_html, summarize
 from engine.recording.replay import Recording
-from engine.recording.report import REPORT_HEAD, report_html
+from engine.recording.report import report_html
+from engine.recording.report_page import REPORT_HEAD
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

@@ -18,7 +18,8 @@ from pathlib import Path
 
 from engine.recording.moments import not_understood, person_moments
 from engine.recording.replay import Recording
-from engine.recording.report import REPORT_HEAD, STYLE, printable, simulated
+from engine.recording.report import simulated
+from engine.recording.report_page import REPORT_HEAD, STYLE, printable
 from engine.recording.report_plots import per_session_plot
 
 THE_PERSON = "the person"

@@ -17,7 +17,6 @@ import datetime
 import html
 import json
 from collections import Counter
-from pathlib import Path
 
 import yaml
 
@@ -35,6 +34,7 @@ from engine.recording.moments import (
     person_moments,
 )
 from engine.recording.replay import RecordedAction, Recording
+from engine.recording.report_page import REPORT_HEAD, STYLE, note_section, printable, table
 from engine.recording.report_plots import numbers, plot
 from engine.recording.told import told_events
 from engine.session.events import NotUnderstood, SafetyAction
@@ -185,12 +185,6 @@ def simulated(meta: dict[str, str]) -> bool:
     return meta.get("scenario", "") not in SCENARIO_OF_NONE
 
 
-REPORT_HEAD = '<!doctype html>\n<html lang="en"><head><meta charset="utf-8">'
-"""How every report vest writes begins (a file that does may be written over)."""
-STYLE = (Path(__file__).resolve().parent / "report.css").read_text
-"""The report's style sheet, read when a report is written (it goes inside the page)."""
-
-
 def report_html(recording: Recording, note: str = "") -> str:
     """The report as one HTML document (no outside files), with the therapist's ``note``
     (plain text; a blank line between paragraphs) when there is one."""
@@ -319,20 +313,20 @@ def report_html(recording: Recording, note: str = "") -> str:
                 f'<p class="meta">{when} &middot; {person} &middot; {end:.1f} s &middot; '
                 f"{html.escape(profile)} &middot; robot {robot} &middot; {recorded}</p>",
                 f"<p>{html.escape(summary)}</p>",
-                _note(note),
+                note_section(note),
                 _left_out(meta),
                 f'<p class="warning">{html.escape(cut)}: this report is of what it holds.</p>'
                 if cut
                 else "",
                 "<h2>What the person did, and how the robot answered</h2>",
-                _table(
+                table(
                     ["when", "who", "did", "the robot", "answer after"],
                     rows_html,
                     "nothing",
                     numeric={0, 4},
                 ),
                 "<h2>What was done, by whom and kind</h2>",
-                _table(
+                table(
                     ["who", "kind", "times", "per minute"],
                     by_kind,
                     "nothing was done",
@@ -341,14 +335,14 @@ def report_html(recording: Recording, note: str = "") -> str:
                 "<h2>How often each behaviour answered</h2>",
                 "<p>Times it answered something done (a row above), and its actions: each light, "
                 "word or move it could make (not those refused or failed).</p>",
-                _table(
+                table(
                     ["behaviour", "what it does", "times it answered", "actions"],
                     behaviours,
                     "none acted",
                     numeric={2, 3},
                 ),
                 "<h2>What the robot did not understand</h2>",
-                _table(
+                table(
                     ["when", "heard", "the robot"],
                     missed,
                     "everything it heard matched a rule"
@@ -357,14 +351,14 @@ def report_html(recording: Recording, note: str = "") -> str:
                     numeric={0},
                 ),
                 "<h2>What the safety envelope did</h2>",
-                _table(
+                table(
                     ["when", "did", "joint", "rule", "sensors", "why"],
                     _safety_rows(recording),
                     "nothing: no move was refused, slowed or stopped",
                     numeric={0},
                 ),
                 "<h2>Devices that dropped out</h2>",
-                _table(
+                table(
                     ["device", "offline at", "back at", "for"], dropped, "none", numeric={1, 2, 3}
                 ),
                 "<h2>The sensors over the session</h2>",
@@ -388,32 +382,3 @@ def descriptions(recording: Recording) -> dict[str, str]:
         described = document.get("description") if isinstance(document, dict) else None
         found[row["tree"]] = " ".join(str(described).split()) if described else ""
     return found
-
-
-_UNPRINTABLE = dict.fromkeys(
-    [*range(0x09), 0x0B, 0x0C, *range(0x0E, 0x20), *range(0x7F, 0xA0)], "\ufffd"
-)
-
-
-def printable(page: str) -> str:
-    """``page`` with each control character (NUL, ESC, C1...) shown as \ufffd, so a damaged
-    or hand-made recording's text cannot put one in a page a supervisor opens."""
-    return page.translate(_UNPRINTABLE)
-
-
-def _note(note: str) -> str:
-    """The therapist's note as paragraphs ('' when there is none)."""
-    paragraphs = [part.strip() for part in note.split("\n\n") if part.strip()]
-    if not paragraphs:
-        return ""
-    body = "".join(f"<p>{html.escape(part)}</p>" for part in paragraphs)
-    return f'<section class="note"><h2>The therapist\'s note</h2>{body}</section>'
-
-
-def _table(heads: list[str], rows: str, empty: str, *, numeric: set[int]) -> str:
-    cells = "".join(
-        f'<th class="num">{h}</th>' if i in numeric else f"<th>{h}</th>"
-        for i, h in enumerate(heads)
-    )
-    body = rows or f"<tr><td colspan={len(heads)}>{html.escape(empty)}</td></tr>"
-    return f"<table><thead><tr>{cells}</tr></thead><tbody>{body}</tbody></table>"

@@ -171,7 +171,7 @@ class ResidualEcho:
         spread = self._ringing.copy()
         for recent in self._recent:
             spread = np.maximum(spread, recent)
-        self._recent = [*self._recent[-(RECENT_FRAMES - 1) :], wide] if RECENT_FRAMES else []
+        self._recent = [*self._recent[-(RECENT_FRAMES - 1) :], wide]
         return spread
 
     def _follow_noise(self, output: Power) -> Power:
